@@ -1,0 +1,326 @@
+/*
+ * terratin.h -- the public C API of the terratin engine.
+ *
+ * The engine turns a height grid into a TIN whose vertices are grid samples,
+ * by greedy insertion under a triangulation criterion, and measures how well
+ * the TIN approximates the grid. It knows nothing of GDAL: a program fills a
+ * tt_grid from memory, runs tt_refine_run() and reads the tt_tin it returns.
+ * terratin_gdal.h adds reading rasters and writing vector layers.
+ *
+ * Conventions used throughout:
+ *  - Every object is opaque and made by a _create (or _run) function that
+ *    returns a status and hands the object back through its last argument;
+ *    its _destroy function accepts NULL.
+ *  - Ownership is stated in one fixed sentence: "The caller owns *out_X and
+ *    frees it with tt_X_destroy()."
+ *  - Fallible functions return tt_status; the context keeps the last code and
+ *    a formatted one-line message (tt_context_errmsg()).
+ *  - Samples stand at pixel centres. Column c, row r of the grid is the point
+ *    (c, r) in pixel space and (gt0 + (c+0.5)gt1 + (r+0.5)gt2,
+ *    gt3 + (c+0.5)gt4 + (r+0.5)gt5) in map space (GDAL geotransform).
+ *  - Heights are floats; NaN marks nodata. Counts are size_t; mesh indices
+ *    are int32_t, so a TIN holds at most TT_MAX_VERTICES vertices.
+ *  - No global mutable state: everything lives in the context.
+ *
+ * The header compiles alone, in C11 and in C++.
+ */
+#ifndef TERRATIN_H
+#define TERRATIN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TT_VERSION_MAJOR 0
+#define TT_VERSION_MINOR 1
+#define TT_VERSION_PATCH 0
+#define TT_VERSION_STRING "0.1.0"
+
+/* The largest vertex count of a TIN (triangles: about twice that). */
+#define TT_MAX_VERTICES ((size_t)0x3fffffff)
+/* The largest grid side accepted (columns or rows). */
+#define TT_MAX_GRID_SIDE ((size_t)0x0fffffff)
+
+/* ---------------------------------------------------------------------------
+ * Status codes: one table makes the enum, the names and the messages.
+ * ------------------------------------------------------------------------- */
+#define TT_STATUS_MAP(X)                                                      \
+  X(OK, "success")                                                            \
+  X(ERR_ARG, "invalid argument")                                              \
+  X(ERR_NOMEM, "out of memory")                                               \
+  X(ERR_IO, "input/output error")                                             \
+  X(ERR_FORMAT, "unsupported or malformed data")                              \
+  X(ERR_DATA, "invalid data")                                                 \
+  X(ERR_LIMIT, "size limit exceeded")                                         \
+  X(ERR_EXISTS, "output exists")                                              \
+  X(ERR_INTERRUPTED, "interrupted by the progress callback")                  \
+  X(ERR_INTERNAL, "internal error")
+
+typedef enum tt_status {
+#define TT_STATUS_ENUM_(name, msg) TT_##name,
+  TT_STATUS_MAP(TT_STATUS_ENUM_)
+#undef TT_STATUS_ENUM_
+  TT_STATUS_COUNT_
+} tt_status;
+
+/* "OK", "ERR_ARG", ...; "UNKNOWN" for a value outside the table. */
+const char *tt_status_name(tt_status status);
+/* The generic message of a status ("invalid argument"). */
+const char *tt_status_message(tt_status status);
+/* "0.1.0" */
+const char *tt_version(void);
+
+/* ---------------------------------------------------------------------------
+ * Context: last error, warnings sink. One per thread of use.
+ * ------------------------------------------------------------------------- */
+typedef struct tt_context tt_context;
+
+/* Called for each warning (a complete sentence, no trailing newline). */
+typedef void (*tt_log_fn)(void *user, const char *message);
+
+/* Progress callback, GDAL's GDALProgressFunc shape: complete in [0,1];
+ * returning 0 stops the run with TT_ERR_INTERRUPTED. */
+typedef int (*tt_progress_fn)(double complete, const char *message,
+                              void *user);
+
+/* Returns NULL when out of memory. The caller owns the context and frees it
+ * with tt_context_destroy(). */
+tt_context *tt_context_create(void);
+void tt_context_destroy(tt_context *ctx);
+tt_status tt_context_errno(const tt_context *ctx);
+/* The last error's one-line message, "" when none. Valid until the next call
+ * that fails on this context. */
+const char *tt_context_errmsg(const tt_context *ctx);
+void tt_context_clear_error(tt_context *ctx);
+/* Warnings go to fn (default: none are shown, but they are counted). */
+void tt_context_set_log(tt_context *ctx, tt_log_fn fn, void *user);
+size_t tt_context_warning_count(const tt_context *ctx);
+
+/* ---------------------------------------------------------------------------
+ * Height grid.
+ * ------------------------------------------------------------------------- */
+typedef struct tt_grid tt_grid;
+
+/* Makes an nx x ny grid, every sample NaN (nodata), geotransform
+ * (0,1,0,0,0,1). nx and ny must be >= 2 and <= TT_MAX_GRID_SIDE.
+ * The caller owns *out_grid and frees it with tt_grid_destroy(). */
+tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
+                         tt_grid **out_grid);
+/* Same, filled from a row-major array of nx*ny heights (NaN = nodata). */
+tt_status tt_grid_create_from_floats(tt_context *ctx, size_t nx, size_t ny,
+                                     const float *z, tt_grid **out_grid);
+void tt_grid_destroy(tt_grid *grid);
+
+size_t tt_grid_width(const tt_grid *grid);
+size_t tt_grid_height(const tt_grid *grid);
+/* Row-major heights, nx*ny floats; write them before the first run.
+ * NaN marks nodata; infinities are refused by tt_grid_check(). */
+float *tt_grid_heights(tt_grid *grid);
+const float *tt_grid_heights_const(const tt_grid *grid);
+
+/* GDAL geotransform: map x = gt[0] + px*gt[1] + py*gt[2],
+ * y = gt[3] + px*gt[4] + py*gt[5], px/py in pixel-edge units. Sets the ground
+ * frame to the geotransform's linear part too. The determinant must not be
+ * zero. */
+tt_status tt_grid_set_geotransform(tt_context *ctx, tt_grid *grid,
+                                   const double gt[6]);
+void tt_grid_get_geotransform(const tt_grid *grid, double out_gt[6]);
+
+/* The ground frame: the linear map from a pixel step to metres (or the CRS's
+ * linear unit) on the ground, x = a[0]*dc + a[1]*dr, y = a[2]*dc + a[3]*dr.
+ * Angles, areas and the Delaunay test are measured in this frame. The glue
+ * sets it for geographic grids; by default it is the geotransform's linear
+ * part. Its orientation must match the geotransform's (same determinant
+ * sign). */
+tt_status tt_grid_set_ground_frame(tt_context *ctx, tt_grid *grid,
+                                   const double a[4]);
+void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4]);
+
+/* Checks the heights: refuses infinities (naming the first row/column) and
+ * counts the valid (non-NaN) samples. out_valid may be NULL. */
+tt_status tt_grid_check(tt_context *ctx, const tt_grid *grid,
+                        size_t *out_valid);
+
+/* ---------------------------------------------------------------------------
+ * Criteria and refinement options.
+ * ------------------------------------------------------------------------- */
+typedef enum tt_criterion {
+  TT_CRITERION_DELAUNAY = 0
+} tt_criterion;
+
+/* "delaunay", ...; NULL for an unknown value. */
+const char *tt_criterion_name(tt_criterion criterion);
+/* Parses a name; TT_ERR_ARG for an unknown one. */
+tt_status tt_criterion_parse(tt_context *ctx, const char *name,
+                             tt_criterion *out_criterion);
+
+typedef struct tt_refine_options {
+  /* Stop when the worst remaining sample error is <= max_error (z units).
+   * Negative: no error limit. */
+  double max_error;
+  /* Stop before the TIN would have more than max_points vertices; 0: none. */
+  size_t max_points;
+  /* Stop before the TIN would have more than max_triangles; 0: none. */
+  size_t max_triangles;
+  /* Stop at floor(percent/100 * valid samples) vertices; 0: none. */
+  double percent;
+  tt_criterion criterion;
+  /* Called now and then with the fraction done; may be NULL. */
+  tt_progress_fn progress;
+  void *progress_arg;
+} tt_refine_options;
+
+/* Default: max_error 1 z unit, no other limit, Delaunay, no progress. */
+void tt_refine_options_init(tt_refine_options *opt);
+
+/* ---------------------------------------------------------------------------
+ * The TIN: the result of a run, with its bookkeeping.
+ * ------------------------------------------------------------------------- */
+typedef struct tt_tin tt_tin;
+
+/* Greedy insertion (Garland-Heckbert) of the grid's samples under the
+ * criterion, until the first stop condition is met. At least one stop
+ * condition must be set. The caller owns *out_tin and frees it with
+ * tt_tin_destroy(). */
+tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
+                        const tt_refine_options *opt, tt_tin **out_tin);
+void tt_tin_destroy(tt_tin *tin);
+
+typedef enum tt_stop_reason {
+  TT_STOP_NONE = 0,        /* not stopped */
+  TT_STOP_MAX_ERROR,       /* every sample within max_error */
+  TT_STOP_MAX_POINTS,      /* max_points (or percent) reached */
+  TT_STOP_MAX_TRIANGLES,   /* the next insertion would pass max_triangles */
+  TT_STOP_EXHAUSTED        /* every sample is a vertex or exact */
+} tt_stop_reason;
+
+const char *tt_stop_reason_name(tt_stop_reason reason);
+
+/* Error measures over the valid samples (SPEC section 6), z units. */
+typedef struct tt_error_stats {
+  size_t samples;       /* valid samples measured */
+  size_t covered;       /* of those, lying in or on some triangle */
+  double max_error;     /* L-infinity */
+  double rmse;          /* L2 / sqrt(samples) */
+  double mean_abs;      /* sum |H - H'| / samples */
+  double total_abs;     /* sum |H - H'| */
+  double l2;            /* sqrt(sum (H - H')^2) */
+  int64_t max_col;      /* where max_error was found (-1 if none) */
+  int64_t max_row;
+} tt_error_stats;
+
+typedef struct tt_tin_summary {
+  size_t vertices;
+  size_t triangles;
+  size_t valid_samples;
+  size_t grid_width, grid_height;
+  tt_criterion criterion;
+  tt_stop_reason stop_reason;
+  tt_error_stats errors;
+} tt_tin_summary;
+
+void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary);
+size_t tt_tin_vertex_count(const tt_tin *tin);
+size_t tt_tin_triangle_count(const tt_tin *tin);
+
+typedef struct tt_vertex_info {
+  int32_t col, row;       /* source sample */
+  double x, y;            /* map coordinates (geotransform of the grid) */
+  double z;               /* height */
+  /* |H - H'| at this sample just before it was inserted; NaN for the
+   * vertices of the starting triangulation. */
+  double insert_error;
+  size_t rank;            /* insertion order, 0-based; equals the index */
+  double star_max_error;  /* max |H - H'| over the samples of its star */
+  double star_rmse;       /* RMS of the same samples */
+  size_t star_samples;
+} tt_vertex_info;
+
+typedef struct tt_triangle_info {
+  int32_t v[3];           /* vertex indices, counter-clockwise in map space */
+  double max_error;       /* over the samples the triangle owns */
+  double rmse;
+  size_t samples;         /* samples owned: every valid sample is owned by
+                             exactly one triangle */
+  double area_2d;         /* ground units squared (ground frame) */
+  double area_3d;
+  double slope_deg;       /* 0 = flat */
+  double aspect_deg;      /* downslope azimuth clockwise from map north
+                             (+y), [0,360); NaN when flat */
+  double min_angle_deg;   /* in the ground frame */
+  double max_angle_deg;
+} tt_triangle_info;
+
+/* index < count, else TT_ERR_ARG (the context may be NULL here). */
+tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
+                        tt_vertex_info *out_vertex);
+tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
+                          tt_triangle_info *out_triangle);
+
+/* ---------------------------------------------------------------------------
+ * Evaluation of any triangle soup (ours or another tool's) against a grid.
+ * ------------------------------------------------------------------------- */
+typedef struct tt_eval_result {
+  tt_error_stats errors;   /* over covered samples; samples = valid */
+  size_t triangles;        /* triangles given */
+  size_t degenerate;       /* zero-area triangles skipped */
+  size_t uncovered;        /* valid samples in no triangle */
+  size_t overlapped;       /* valid samples in more than one triangle */
+} tt_eval_result;
+
+/* Triangles as 9 doubles each: (col,row,z) of 3 corners in pixel-centre
+ * space (sample (c,r) at (c,r)). A sample within 1e-9 pixel of a triangle
+ * counts as inside. */
+tt_status tt_eval_triangles(tt_context *ctx, const tt_grid *grid,
+                            size_t ntriangles, const double *pix_xyz,
+                            tt_eval_result *out_result);
+
+/* ---------------------------------------------------------------------------
+ * Synthetic terrains (SPEC section 4). All are seeded and bit-reproducible.
+ * ------------------------------------------------------------------------- */
+typedef enum tt_synth_kind {
+  TT_SYNTH_FAULT = 0,     /* fault lines, step (rough) or cosine (smooth) */
+  TT_SYNTH_DIAMOND_SQUARE,
+  TT_SYNTH_SPHERE,
+  TT_SYNTH_CYLINDER,
+  TT_SYNTH_BUMP
+} tt_synth_kind;
+
+typedef enum tt_synth_seeding {
+  TT_SEED_NONE = 0, TT_SEED_PEAK, TT_SEED_VALLEY, TT_SEED_HYBRID
+} tt_synth_seeding;
+
+typedef struct tt_synth_options {
+  tt_synth_kind kind;
+  size_t nx, ny;            /* grid size; diamond-square needs 2^n+1 square */
+  uint64_t seed;
+  /* fault */
+  size_t iterations;        /* number of fault lines */
+  double displacement;
+  double wave_size;         /* > 0: smooth (cosine ramp half-width, cells) */
+  /* diamond-square */
+  double roughness;         /* amplitude factor per level, 0.7 in the study */
+  double amplitude;         /* first-level random amplitude */
+  tt_synth_seeding seeding;
+} tt_synth_options;
+
+/* Defaults per kind: the study's sizes (fault rough 100x100 displacement 100,
+ * diamond-square 257x257 roughness 0.7, sphere/cylinder 41x41 on [0,40]^2,
+ * bump 20x30). */
+void tt_synth_options_init(tt_synth_options *opt, tt_synth_kind kind);
+/* "fault", "diamond_square", "sphere", "cylinder", "bump" */
+const char *tt_synth_kind_name(tt_synth_kind kind);
+tt_status tt_synth_kind_parse(tt_context *ctx, const char *name,
+                              tt_synth_kind *out_kind);
+/* The caller owns *out_grid and frees it with tt_grid_destroy(). The grid's
+ * geotransform gives the function's own x,y units (e.g. [0,40]^2). */
+tt_status tt_synth_generate(tt_context *ctx, const tt_synth_options *opt,
+                            tt_grid **out_grid);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* TERRATIN_H */

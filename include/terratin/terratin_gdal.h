@@ -1,0 +1,124 @@
+/*
+ * terratin_gdal.h -- the GDAL/OGR/PROJ glue of terratin.
+ *
+ * Functions take GDAL types in GDAL's argument order (band or layer, then
+ * NAME=VALUE options, then a GDALProgressFunc-shaped callback and its
+ * argument), like GDALContourGenerateEx. The engine header terratin.h stays
+ * free of GDAL; only this header includes it.
+ *
+ * Ownership sentences are fixed: "The caller owns *out_X and frees it with
+ * tt_X_destroy()."
+ */
+#ifndef TERRATIN_GDAL_H
+#define TERRATIN_GDAL_H
+
+#include "terratin/terratin.h"
+
+#include <gdal.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What a read learned about the raster, for summaries and run_parameters. */
+typedef struct tt_raster_info {
+  char *path;             /* as given */
+  char *driver;           /* GDAL short name, e.g. "GTiff" */
+  int band;               /* 1-based */
+  size_t width, height;
+  size_t valid_samples;   /* samples with data */
+  size_t nodata_samples;
+  double gt[6];
+  int has_geotransform;   /* 0: the default (0,1,0,0,0,1) was used */
+  char *crs_wkt;          /* "" when the raster has no CRS */
+  char *crs_name;         /* short human name, "" when none */
+  int crs_is_geographic;
+  char *z_unit;           /* band unit type ("m", "ft", ...) or "" */
+  double scale, offset;   /* applied to the raw values */
+  double z_factor;        /* applied after scale/offset */
+  char *area_or_point;    /* "Area", "Point" or "" as declared */
+  char *datatype;         /* GDAL data type name of the band */
+  double frame[4];        /* ground frame set on the grid */
+  char *frame_name;       /* "geotransform", "local equirectangular ..." */
+} tt_raster_info;
+
+void tt_raster_info_destroy(tt_raster_info *info);
+
+/* Reads a band into a new grid, block by block, scale/offset and Z_FACTOR
+ * applied, masked samples (GDAL mask band: nodata value, NaN, alpha, .msk)
+ * stored as NaN. Valid samples that are NaN or infinite are refused.
+ * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> (overrides the mask),
+ * MAX_MEMORY=<bytes> (refuse grids whose samples need more).
+ * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
+ * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
+tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
+                            char **options, tt_progress_fn progress,
+                            void *progress_arg, tt_grid **out_grid,
+                            tt_raster_info **out_info);
+
+/* One column of the run_parameters table. */
+typedef enum tt_field_type {
+  TT_FIELD_STRING = 0, TT_FIELD_INTEGER, TT_FIELD_REAL
+} tt_field_type;
+
+typedef struct tt_run_field {
+  const char *name;       /* <= 10 characters when Shapefile may be used */
+  tt_field_type type;
+  const char *s;
+  int64_t i;
+  double r;
+} tt_run_field;
+
+/* Writes the TIN into an open vector dataset: layers <prefix>triangles
+ * (POLYGON Z) and <prefix>vertices (POINT Z), and a one-row table
+ * <prefix>run_parameters from fields, in one transaction when the driver has
+ * them. srs may be NULL. Options: NLN_PREFIX=<p>, LCO=<NAME=VALUE> (repeat
+ * for each layer creation option). */
+tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
+                           const tt_tin *tin, OGRSpatialReferenceH srs,
+                           const tt_run_field *fields, size_t nfields,
+                           char **options, tt_progress_fn progress,
+                           void *progress_arg);
+
+/* Reads the triangles of a POLYGON Z (or MULTIPOLYGON Z / TIN) layer into
+ * pixel-space (col,row,z) triples for tt_eval_triangles(): 9 doubles per
+ * triangle, map coordinates put through the inverse of gt. Polygons that are
+ * not triangles (4 ring points) are counted in *out_rejected.
+ * The caller owns *out_xyz and frees it with free(). */
+tt_status tt_ogr_read_triangles(tt_context *ctx, OGRLayerH layer,
+                                const double gt[6], double **out_xyz,
+                                size_t *out_ntriangles, size_t *out_rejected);
+
+/* Writes a grid as a single-band Float32 GeoTIFF (nodata NaN when the grid
+ * has any), with srs_wkt ("" for none). Written to a temporary name and
+ * renamed on success. */
+tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
+                             const char *path, const char *srs_wkt,
+                             int overwrite);
+
+/* ---------------------------------------------------------------------------
+ * Safe output: never overwrite without permission, never leave a half-written
+ * file. A tt_output names the final files and the temporary ones beside them.
+ * ------------------------------------------------------------------------- */
+typedef struct tt_output tt_output;
+
+/* Plans output to `path` in `format` ("GPKG", "ESRI Shapefile", ...).
+ * Refuses (TT_ERR_EXISTS) when a final file exists and overwrite is 0, and
+ * (TT_ERR_IO) when the folder is not writable. The caller owns *out_output
+ * and frees it with tt_output_destroy(), which removes the temporary files
+ * unless tt_output_commit() succeeded. */
+tt_status tt_output_begin(tt_context *ctx, const char *path,
+                          const char *format, int overwrite,
+                          tt_output **out_output);
+/* The name to create the dataset under (temporary). */
+const char *tt_output_temp_path(const tt_output *out);
+/* Renames the temporary files to their final names. */
+tt_status tt_output_commit(tt_context *ctx, tt_output *out);
+void tt_output_destroy(tt_output *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* TERRATIN_GDAL_H */

@@ -1,0 +1,2 @@
+/* placeholder: being written this session */
+typedef int tt_placeholder_georef_proj;

@@ -1,0 +1,67 @@
+/*
+ * internal.h -- what the engine's files share and the public API hides: the
+ * context and grid structures, the error helpers, hidden-visibility
+ * declarations. Internal cross-file symbols are named tt__<module>_<verb>.
+ */
+#ifndef TT_INTERNAL_H
+#define TT_INTERNAL_H
+
+#include "terratin/terratin.h"
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(__GNUC__)
+#define TT_HIDDEN __attribute__((visibility("hidden")))
+#define TT_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define TT_HIDDEN
+#define TT_PRINTF(a, b)
+#endif
+
+#define TT_ERRMSG_MAX 1024
+
+struct tt_context {
+  tt_status last_status;
+  char errmsg[TT_ERRMSG_MAX];
+  tt_log_fn log_fn;
+  void *log_user;
+  size_t warnings;
+};
+
+struct tt_grid {
+  size_t nx, ny;
+  float *z;          /* nx*ny, row-major, NaN = nodata */
+  double gt[6];      /* GDAL geotransform */
+  double frame[4];   /* ground frame: pixel step -> ground units */
+};
+
+/* Sets the context's status and message and returns the status, so a
+ * failure reads `return tt__error(ctx, TT_ERR_ARG, "...", ...);`. A NULL
+ * context is allowed (nothing is recorded). */
+TT_HIDDEN tt_status tt__error(tt_context *ctx, tt_status status,
+                              const char *fmt, ...) TT_PRINTF(3, 4);
+/* Sends a warning to the context's log function and counts it. */
+TT_HIDDEN void tt__warn(tt_context *ctx, const char *fmt, ...)
+    TT_PRINTF(2, 3);
+
+/* Growable arrays: grows *ptr (element size elem) to hold at least need
+ * elements, by 1.5x steps; returns false when out of memory (the old array is
+ * kept). */
+TT_HIDDEN bool tt__grow(void **ptr, size_t *cap, size_t need, size_t elem);
+
+/* Metric tensor of a ground frame a[4]: |A v|^2 = m11 dc^2 + 2 m12 dc dr +
+ * m22 dr^2, and the sign of det(A). */
+typedef struct tt__metric {
+  double m11, m12, m22;
+  int det_sign;      /* +1 or -1 */
+} tt__metric;
+
+TT_HIDDEN void tt__metric_from_frame(const double a[4], tt__metric *out);
+
+/* Seconds of a monotonic clock. */
+TT_HIDDEN double tt__now(void);
+
+#endif /* TT_INTERNAL_H */
