@@ -114,7 +114,16 @@ tt_status tt_output_begin(tt_context *ctx, const char *path,
                           tt_output **out_output);
 /* The name to create the dataset under (temporary). */
 const char *tt_output_temp_path(const tt_output *out);
-/* Renames the temporary files to their final names. */
+/* The path as given to tt_output_begin(), for messages. */
+const char *tt_output_final_path(const tt_output *out);
+/* The layer-name prefix to give tt_ogr_write_tin() as NLN_PREFIX: "<name>_"
+ * for a shapefile output (OUTPUT `name` or `name.shp` makes the files
+ * `name_triangles.shp`, `name_vertices.shp`, `name_run_parameters.dbf`),
+ * "" for any other format. */
+const char *tt_output_layer_prefix(const tt_output *out);
+/* Renames the temporary files to their final names (for a shapefile, moves
+ * each file of the temporary folder into place; the old files of those
+ * names are put back if a move fails). */
 tt_status tt_output_commit(tt_context *ctx, tt_output *out);
 void tt_output_destroy(tt_output *out);
 
