@@ -1,2 +1,523 @@
-/* placeholder: being written this session */
-typedef int tt_placeholder_mesh;
+/*
+ * mesh.c -- the only writer of the half-edge arrays of mesh.h.
+ *
+ * Operations: add vertices and triangles, split a triangle or an edge at a
+ * new vertex, flip an edge, validate. Each keeps the invariants listed in
+ * mesh.h and logs the triangle slots it wrote. Workload: greedy refinement
+ * does one split and a few flips per inserted vertex, so operations are
+ * O(1) with amortised array growth; validate() is O(V + T) and meant for
+ * tests.
+ */
+#include "mesh.h"
+
+#include "predicates.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void tt__mesh_init(tt__mesh *m, const tt__metric *metric)
+{
+  memset(m, 0, sizeof *m);
+  m->metric = *metric;
+}
+
+void tt__mesh_free(tt__mesh *m)
+{
+  free(m->vc);
+  free(m->vr);
+  free(m->vedge);
+  free(m->hv);
+  free(m->twin);
+  free(m->eflag);
+  free(m->freelist);
+  free(m->touched);
+  memset(m, 0, sizeof *m);
+}
+
+static bool grow_vertices(tt__mesh *m, size_t need)
+{
+  if (need <= m->vcap)
+    return true;
+  size_t c1 = m->vcap, c2 = m->vcap, c3 = m->vcap;
+  if (!tt__grow((void **)&m->vc, &c1, need, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->vr, &c2, need, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->vedge, &c3, need, sizeof(int32_t)))
+    return false;
+  /* all three grew by the same rule from the same capacity */
+  m->vcap = c1;
+  return true;
+}
+
+static bool grow_triangles(tt__mesh *m, size_t need)
+{
+  if (need <= m->tcap)
+    return true;
+  if (need > (size_t)INT32_MAX / 3)
+    return false;
+  size_t ncap = m->tcap < 16 ? 16 : m->tcap + m->tcap / 2;
+  if (ncap < need)
+    ncap = need;
+  if (ncap > (size_t)INT32_MAX / 3)
+    ncap = (size_t)INT32_MAX / 3;
+  size_t c1 = 3 * m->tcap, c2 = 3 * m->tcap, c3 = 3 * m->tcap;
+  if (!tt__grow((void **)&m->hv, &c1, 3 * ncap, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->twin, &c2, 3 * ncap, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->eflag, &c3, 3 * ncap, sizeof(uint8_t)))
+    return false;
+  m->tcap = ncap;
+  return true;
+}
+
+bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt)
+{
+  return grow_vertices(m, nv) && grow_triangles(m, nt);
+}
+
+int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row)
+{
+  if (m->nv >= TT_MAX_VERTICES || !grow_vertices(m, m->nv + 1))
+    return -1;
+  int32_t v = (int32_t)m->nv++;
+  m->vc[v] = col;
+  m->vr[v] = row;
+  m->vedge[v] = -1;
+  return v;
+}
+
+/* Takes a slot (recycled or new) and reserves room in the touched log, so
+ * that the operations below cannot fail half-way: callers take all their
+ * slots first. */
+static int32_t take_slot(tt__mesh *m)
+{
+  if (!tt__grow((void **)&m->touched, &m->touchedcap, m->ntouched + 4,
+                sizeof(int32_t)))
+    return -1;
+  if (m->nfree > 0)
+    return m->freelist[--m->nfree];
+  if (!grow_triangles(m, m->nslots + 1))
+    return -1;
+  int32_t t = (int32_t)m->nslots++;
+  m->hv[3 * t] = -1;
+  return t;
+}
+
+/* Returns an unused slot to the free list (used when an operation has to
+ * give back slots it took before failing). */
+static void give_back(tt__mesh *m, int32_t t)
+{
+  /* the free list has room: it held this slot before, or the slot is new
+   * and the list's capacity grows with the slots in release_slot */
+  if (!tt__grow((void **)&m->freelist, &m->freecap, m->nfree + 1,
+                sizeof(int32_t))) {
+    /* cannot happen for slots taken from the free list; for a new slot at
+     * the end, shrink the slot count instead */
+    if ((size_t)t + 1 == m->nslots)
+      m->nslots--;
+    return;
+  }
+  m->hv[3 * t] = -1;
+  m->freelist[m->nfree++] = t;
+}
+
+/* Writes triangle (a, b, c) into slot t with the given twins (-1 allowed)
+ * and constraint flags, and fixes the twins' back links. */
+static void set_triangle(tt__mesh *m, int32_t t, int32_t a, int32_t b,
+                         int32_t c)
+{
+  int32_t e = 3 * t;
+  if (m->hv[e] < 0)
+    m->nlive++;
+  m->hv[e] = a;
+  m->hv[e + 1] = b;
+  m->hv[e + 2] = c;
+  m->twin[e] = m->twin[e + 1] = m->twin[e + 2] = -1;
+  m->eflag[e] = m->eflag[e + 1] = m->eflag[e + 2] = 0;
+  m->vedge[a] = e;
+  m->vedge[b] = e + 1;
+  m->vedge[c] = e + 2;
+  m->touched[m->ntouched++] = t;
+}
+
+/* Links half-edges e and f (f may be -1: e becomes a boundary edge). The
+ * constraint flag is taken from `flag`. */
+static void link(tt__mesh *m, int32_t e, int32_t f, uint8_t flag)
+{
+  m->twin[e] = f;
+  m->eflag[e] = flag;
+  if (f >= 0) {
+    m->twin[f] = e;
+    m->eflag[f] = flag;
+  }
+}
+
+int32_t tt__mesh_add_triangle(tt__mesh *m, int32_t a, int32_t b, int32_t c)
+{
+  int32_t t = take_slot(m);
+  if (t < 0)
+    return -1;
+  set_triangle(m, t, a, b, c);
+  return t;
+}
+
+bool tt__mesh_link_all(tt__mesh *m)
+{
+  /* Sort boundary half-edges by (start, end) and pair each with its
+   * reverse. O(E log E); used once per starting triangulation. */
+  size_t n = 0;
+  for (size_t e = 0; e < 3 * m->nslots; e++)
+    if (m->hv[e - e % 3] >= 0 && m->twin[e] < 0)
+      n++;
+  int64_t *keys = malloc((n ? n : 1) * sizeof *keys);
+  int32_t *edges = malloc((n ? n : 1) * sizeof *edges);
+  if (!keys || !edges) {
+    free(keys);
+    free(edges);
+    return false;
+  }
+  /* Simple approach: for each boundary half-edge store key (a<<32 | b) and
+   * search the reverse with bsearch over the sorted keys. */
+  size_t k = 0;
+  for (size_t e = 0; e < 3 * m->nslots; e++) {
+    if (m->hv[e - e % 3] < 0 || m->twin[e] >= 0)
+      continue;
+    int64_t a = m->hv[e], b = m->hv[tt__next((int32_t)e)];
+    keys[k] = (a << 32) | b;
+    edges[k] = (int32_t)e;
+    k++;
+  }
+  /* insertion into a sorted order via qsort on an index array */
+  size_t *idx = malloc((n ? n : 1) * sizeof *idx);
+  if (!idx) {
+    free(keys);
+    free(edges);
+    return false;
+  }
+  for (size_t i = 0; i < n; i++)
+    idx[i] = i;
+  /* shell sort on keys (no qsort context pointer in C11) */
+  for (size_t gap = n / 2; gap > 0; gap /= 2)
+    for (size_t i = gap; i < n; i++)
+      for (size_t j = i; j >= gap && keys[idx[j - gap]] > keys[idx[j]];
+           j -= gap) {
+        size_t tmp = idx[j];
+        idx[j] = idx[j - gap];
+        idx[j - gap] = tmp;
+      }
+  for (size_t i = 0; i < n; i++) {
+    int32_t e = edges[idx[i]];
+    if (m->twin[e] >= 0)
+      continue;
+    int64_t a = m->hv[e], b = m->hv[tt__next(e)];
+    int64_t want = (b << 32) | a;
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+      size_t mid = lo + (hi - lo) / 2;
+      if (keys[idx[mid]] < want)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    if (lo < n && keys[idx[lo]] == want) {
+      int32_t f = edges[idx[lo]];
+      if (m->twin[f] < 0)
+        link(m, e, f, 0);
+    }
+  }
+  free(idx);
+  free(keys);
+  free(edges);
+  return true;
+}
+
+int tt__mesh_orient(const tt__mesh *m, int32_t a, int32_t b, int32_t c)
+{
+  return m->metric.det_sign *
+         tt__orient_i(m->vc[a], m->vr[a], m->vc[b], m->vr[b], m->vc[c],
+                      m->vr[c]);
+}
+
+int tt__mesh_incircle(const tt__mesh *m, int32_t a, int32_t b, int32_t c,
+                      int32_t d)
+{
+  return tt__incircle_metric(&m->metric, m->vc[a], m->vr[a], m->vc[b],
+                             m->vr[b], m->vc[c], m->vr[c], m->vc[d],
+                             m->vr[d]);
+}
+
+bool tt__mesh_split_triangle(tt__mesh *m, int32_t t, int32_t p,
+                             int32_t out_opposite[3])
+{
+  int32_t t1 = take_slot(m);
+  if (t1 < 0)
+    return false;
+  int32_t t2 = take_slot(m);
+  if (t2 < 0) {
+    give_back(m, t1);
+    return false;
+  }
+  int32_t e0 = 3 * t;
+  int32_t a = m->hv[e0], b = m->hv[e0 + 1], c = m->hv[e0 + 2];
+  int32_t o_ab = m->twin[e0], o_bc = m->twin[e0 + 1], o_ca = m->twin[e0 + 2];
+  uint8_t f_ab = m->eflag[e0], f_bc = m->eflag[e0 + 1],
+          f_ca = m->eflag[e0 + 2];
+  /*
+   *            c                      c
+   *           / \                    /|\
+   *          /   \                  / | \      t  = (a, b, p)
+   *         /  t  \       ==>      /t2p t1\    t1 = (b, c, p)
+   *        a-------b               a-------b   t2 = (c, a, p)
+   */
+  set_triangle(m, t, a, b, p);
+  set_triangle(m, t1, b, c, p);
+  set_triangle(m, t2, c, a, p);
+  link(m, 3 * t, o_ab, f_ab);
+  link(m, 3 * t1, o_bc, f_bc);
+  link(m, 3 * t2, o_ca, f_ca);
+  link(m, 3 * t + 1, 3 * t1 + 2, 0);  /* b->p with p->b */
+  link(m, 3 * t1 + 1, 3 * t2 + 2, 0); /* c->p with p->c */
+  link(m, 3 * t2 + 1, 3 * t + 2, 0);  /* a->p with p->a */
+  out_opposite[0] = 3 * t;
+  out_opposite[1] = 3 * t1;
+  out_opposite[2] = 3 * t2;
+  return true;
+}
+
+bool tt__mesh_split_edge(tt__mesh *m, int32_t e, int32_t p,
+                         int32_t out_opposite[4])
+{
+  int32_t f = m->twin[e];
+  int32_t t = e / 3, u = f >= 0 ? f / 3 : -1;
+  int32_t t1 = take_slot(m);
+  if (t1 < 0)
+    return false;
+  int32_t u1 = -1;
+  if (f >= 0) {
+    u1 = take_slot(m);
+    if (u1 < 0) {
+      give_back(m, t1);
+      return false;
+    }
+  }
+  int32_t a = m->hv[e], b = m->hv[tt__next(e)], c = m->hv[tt__prev(e)];
+  int32_t o_bc = m->twin[tt__next(e)], o_ca = m->twin[tt__prev(e)];
+  uint8_t f_bc = m->eflag[tt__next(e)], f_ca = m->eflag[tt__prev(e)];
+  uint8_t f_ab = m->eflag[e];
+  int32_t d = -1, o_ad = -1, o_db = -1;
+  uint8_t f_ad = 0, f_db = 0;
+  if (f >= 0) {
+    d = m->hv[tt__prev(f)];
+    o_ad = m->twin[tt__next(f)];
+    o_db = m->twin[tt__prev(f)];
+    f_ad = m->eflag[tt__next(f)];
+    f_db = m->eflag[tt__prev(f)];
+  }
+  /*
+   *          c                        c
+   *         / \                      /|\
+   *        / t \                    / | \      t  = (c, a, p)
+   *       a-----b       ==>        a--p--b     t1 = (c, p, b)
+   *        \ u /                    \ | /      u  = (d, b, p)
+   *         \ /                      \|/       u1 = (d, p, a)
+   *          d                        d
+   */
+  set_triangle(m, t, c, a, p);
+  set_triangle(m, t1, c, p, b);
+  link(m, 3 * t, o_ca, f_ca);
+  link(m, 3 * t1 + 2, o_bc, f_bc);
+  link(m, 3 * t + 2, 3 * t1, 0); /* p->c with c->p */
+  out_opposite[0] = 3 * t;
+  out_opposite[1] = 3 * t1 + 2;
+  if (f >= 0) {
+    set_triangle(m, u, d, b, p);
+    set_triangle(m, u1, d, p, a);
+    link(m, 3 * u, o_db, f_db);
+    link(m, 3 * u1 + 2, o_ad, f_ad);
+    link(m, 3 * u + 2, 3 * u1, 0);     /* p->d with d->p */
+    link(m, 3 * t + 1, 3 * u1 + 1, f_ab); /* a->p with p->a */
+    link(m, 3 * t1 + 1, 3 * u + 1, f_ab); /* p->b with b->p */
+    out_opposite[2] = 3 * u;
+    out_opposite[3] = 3 * u1 + 2;
+  } else {
+    link(m, 3 * t + 1, -1, 0);
+    link(m, 3 * t1 + 1, -1, 0);
+    out_opposite[2] = out_opposite[3] = -1;
+  }
+  return true;
+}
+
+bool tt__mesh_flippable(const tt__mesh *m, int32_t e)
+{
+  int32_t f = m->twin[e];
+  if (f < 0 || (m->eflag[e] & TT__EDGE_CONSTRAINED))
+    return false;
+  int32_t a = m->hv[e], b = m->hv[f];
+  int32_t c = m->hv[tt__prev(e)], d = m->hv[tt__prev(f)];
+  /* Strictly convex iff the segment c-d separates a and b strictly (a, b, c
+   * and b, a, d are already strictly counter-clockwise). */
+  return tt__mesh_orient(m, c, d, b) > 0 && tt__mesh_orient(m, d, c, a) > 0;
+}
+
+int32_t tt__mesh_flip(tt__mesh *m, int32_t e)
+{
+  int32_t f = m->twin[e];
+  int32_t t = e / 3, u = f / 3;
+  int32_t a = m->hv[e], b = m->hv[f];
+  int32_t c = m->hv[tt__prev(e)], d = m->hv[tt__prev(f)];
+  int32_t o_bc = m->twin[tt__next(e)], o_ca = m->twin[tt__prev(e)];
+  int32_t o_ad = m->twin[tt__next(f)], o_db = m->twin[tt__prev(f)];
+  uint8_t f_bc = m->eflag[tt__next(e)], f_ca = m->eflag[tt__prev(e)];
+  uint8_t f_ad = m->eflag[tt__next(f)], f_db = m->eflag[tt__prev(f)];
+  if (!tt__grow((void **)&m->touched, &m->touchedcap, m->ntouched + 2,
+                sizeof(int32_t)))
+    return -1; /* out of memory: nothing changed */
+  m->nlive -= 2; /* set_triangle counts them live again */
+  m->hv[3 * t] = -1;
+  m->hv[3 * u] = -1;
+  set_triangle(m, t, c, a, d);
+  set_triangle(m, u, d, b, c);
+  link(m, 3 * t, o_ca, f_ca);
+  link(m, 3 * t + 1, o_ad, f_ad);
+  link(m, 3 * u, o_db, f_db);
+  link(m, 3 * u + 1, o_bc, f_bc);
+  link(m, 3 * t + 2, 3 * u + 2, 0); /* d->c with c->d */
+  return 3 * t + 2;
+}
+
+/* --- validation --------------------------------------------------------- */
+
+static int32_t uf_find(int32_t *parent, int32_t x)
+{
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+bool tt__mesh_validate(const tt__mesh *m, char *why, size_t whylen)
+{
+#define FAIL(...)                                                            \
+  do {                                                                       \
+    snprintf(why, whylen, __VA_ARGS__);                                      \
+    ok = false;                                                              \
+    goto done;                                                               \
+  } while (0)
+  bool ok = true;
+  int32_t *parent = NULL;
+  uint8_t *used = NULL;
+  uint8_t *seen = NULL;
+  size_t live = 0, half_interior = 0, boundary = 0;
+
+  parent = malloc((m->nslots ? m->nslots : 1) * sizeof *parent);
+  used = calloc(m->nv ? m->nv : 1, 1);
+  seen = calloc(3 * m->nslots + 1, 1);
+  if (!parent || !used || !seen)
+    FAIL("out of memory while validating");
+
+  for (size_t t = 0; t < m->nslots; t++) {
+    parent[t] = (int32_t)t;
+    if (m->hv[3 * t] < 0)
+      continue;
+    live++;
+    for (int k = 0; k < 3; k++) {
+      int32_t e = (int32_t)(3 * t) + k;
+      int32_t v = m->hv[e];
+      if (v < 0 || (size_t)v >= m->nv)
+        FAIL("triangle %zu: vertex %d out of range", t, v);
+      used[v] = 1;
+    }
+    int32_t a = m->hv[3 * t], b = m->hv[3 * t + 1], c = m->hv[3 * t + 2];
+    if (a == b || b == c || c == a)
+      FAIL("triangle %zu repeats a vertex (%d %d %d)", t, a, b, c);
+    if (tt__mesh_orient(m, a, b, c) <= 0)
+      FAIL("triangle %zu (%d %d %d) is not counter-clockwise in the ground "
+           "frame", t, a, b, c);
+  }
+  if (live != m->nlive)
+    FAIL("live triangle count %zu, recorded %zu", live, m->nlive);
+  for (size_t i = 0; i < m->nfree; i++) {
+    int32_t t = m->freelist[i];
+    if (t < 0 || (size_t)t >= m->nslots || m->hv[3 * t] >= 0)
+      FAIL("free list entry %zu (slot %d) is not a free slot", i, t);
+  }
+  if (live + m->nfree != m->nslots)
+    FAIL("%zu live + %zu free != %zu slots", live, m->nfree, m->nslots);
+
+  for (size_t e = 0; e < 3 * m->nslots; e++) {
+    if (m->hv[e - e % 3] < 0)
+      continue;
+    int32_t f = m->twin[e];
+    int32_t a = m->hv[e], b = m->hv[tt__next((int32_t)e)];
+    if (f < 0) {
+      boundary++;
+      continue;
+    }
+    half_interior++;
+    if ((size_t)f >= 3 * m->nslots || m->hv[f - f % 3] < 0)
+      FAIL("half-edge %zu: twin %d is not live", e, f);
+    if (m->twin[f] != (int32_t)e)
+      FAIL("half-edge %zu: twin %d does not point back (%d)", e, f,
+           m->twin[f]);
+    if (m->hv[f] != b || m->hv[tt__next(f)] != a)
+      FAIL("half-edge %zu (%d->%d): twin %d is not its reverse", e, a, b, f);
+    if (m->eflag[e] != m->eflag[f])
+      FAIL("half-edge %zu: constraint flag differs from its twin", e);
+    int32_t r1 = uf_find(parent, (int32_t)(e / 3)), r2 = uf_find(parent, f / 3);
+    if (r1 != r2)
+      parent[r1] = r2;
+  }
+  size_t nvused = 0;
+  for (size_t v = 0; v < m->nv; v++) {
+    if (!used[v]) {
+      if (m->vedge[v] >= 0)
+        FAIL("vertex %zu is in no triangle but has an edge", v);
+      continue;
+    }
+    nvused++;
+    int32_t e = m->vedge[v];
+    if (e < 0 || (size_t)e >= 3 * m->nslots || m->hv[e - e % 3] < 0 ||
+        m->hv[e] != (int32_t)v)
+      FAIL("vertex %zu: its edge %d does not leave it", v, e);
+  }
+  /* Euler: V - E + F = 2C - L, with E = interior/2 + boundary. */
+  {
+    size_t comps = 0;
+    for (size_t t = 0; t < m->nslots; t++)
+      if (m->hv[3 * t] >= 0 && uf_find(parent, (int32_t)t) == (int32_t)t)
+        comps++;
+    size_t loops = 0;
+    for (size_t e = 0; e < 3 * m->nslots; e++) {
+      if (m->hv[e - e % 3] < 0 || m->twin[e] >= 0 || seen[e])
+        continue;
+      loops++;
+      /* walk the boundary loop: from half-edge e (a->b), the next boundary
+       * half-edge leaves b: rotate around b through interior edges */
+      int32_t cur = (int32_t)e;
+      size_t guard = 0;
+      while (!seen[cur]) {
+        seen[cur] = 1;
+        int32_t g = tt__next(cur); /* leaves b */
+        while (m->twin[g] >= 0) {
+          g = tt__next(m->twin[g]);
+          if (++guard > 6 * m->nslots + 6)
+            FAIL("boundary walk does not close near half-edge %d", cur);
+        }
+        cur = g;
+      }
+    }
+    long long chi = (long long)nvused - (long long)(half_interior / 2) -
+                    (long long)boundary + (long long)live;
+    long long want = 2 * (long long)comps - (long long)loops;
+    if (chi != want)
+      FAIL("Euler: V - E + F = %lld, expected 2C - L = %lld (V %zu, "
+           "interior half-edges %zu, boundary %zu, F %zu, C %zu, L %zu)",
+           chi, want, nvused, half_interior, boundary, live, comps, loops);
+  }
+done:
+  free(parent);
+  free(used);
+  free(seen);
+  return ok;
+#undef FAIL
+}

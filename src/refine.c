@@ -1,2 +1,460 @@
-/* placeholder: being written this session */
-typedef int tt_placeholder_refine;
+/*
+ * refine.c -- greedy insertion (Garland & Heckbert 1995; SPEC section 3.1).
+ *
+ * Start from the grid's four corners (or, when the valid samples do not
+ * fill the rectangle, from the convex hull of the valid samples), made to
+ * satisfy the criterion. Each live triangle keeps its candidate: the sample
+ * it owns with the largest |H - H'| (raster_scan.c); candidates sit in an
+ * indexed max-heap keyed by that error. Repeat: take the worst candidate,
+ * check the stop conditions, insert it (split its triangle, or the edge it
+ * lies on), restore the criterion around it by flips (swap.c), and rescan
+ * only the triangles the mesh logged as written.
+ *
+ * Stop conditions (the first reached wins, and each is exact): the worst
+ * error is <= max_error; one more vertex would pass max_points (or the
+ * percentage); the next insertion would pass max_triangles; no sample has
+ * a non-zero error left.
+ *
+ * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 20.
+ * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
+ */
+#include "criteria/criterion.h"
+#include "heap.h"
+#include "mesh.h"
+#include "predicates.h"
+#include "raster_scan.h"
+#include "swap.h"
+#include "tin.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void tt_refine_options_init(tt_refine_options *opt)
+{
+  memset(opt, 0, sizeof *opt);
+  opt->max_error = 1.0;
+  opt->criterion = TT_CRITERION_DELAUNAY;
+}
+
+typedef struct refine {
+  tt_context *ctx;
+  const tt_grid *g;
+  const tt_refine_options *opt;
+  const tt__criterion_vt *crit;
+  tt__crit_env env;
+  tt__mesh m;
+  tt__heap heap;
+  int64_t *cand;       /* per triangle slot: candidate sample or -1 */
+  double *cerr;        /* per triangle slot: its error */
+  size_t ccap;
+  double *ins_err;     /* per vertex */
+  size_t inscap;
+  tt__edge_stack stack;
+  size_t max_points, max_tris;
+  double max_error;    /* < 0: none */
+  /* progress */
+  double e0, frac;
+} refine;
+
+static tt_status oom(refine *r)
+{
+  return tt__error(r->ctx, TT_ERR_NOMEM,
+                   "out of memory after %zu vertices and %zu triangles",
+                   r->m.nv, r->m.nlive);
+}
+
+/* Per-slot arrays follow the mesh's slot count. */
+static bool fit_slots(refine *r)
+{
+  size_t need = r->m.nslots;
+  if (need <= r->ccap)
+    return true;
+  size_t c1 = r->ccap, c2 = r->ccap;
+  if (!tt__grow((void **)&r->cand, &c1, need, sizeof(int64_t)) ||
+      !tt__grow((void **)&r->cerr, &c2, need, sizeof(double)))
+    return false;
+  r->ccap = c1 < c2 ? c1 : c2;
+  return tt__heap_reserve_items(&r->heap, r->ccap);
+}
+
+static bool add_vertex(refine *r, int32_t col, int32_t row, double err,
+                       int32_t *out_v)
+{
+  int32_t v = tt__mesh_add_vertex(&r->m, col, row);
+  if (v < 0 || !tt__grow((void **)&r->ins_err, &r->inscap, (size_t)v + 1,
+                         sizeof(double)))
+    return false;
+  r->ins_err[v] = err;
+  *out_v = v;
+  return true;
+}
+
+static bool rescan(refine *r, int32_t t)
+{
+  if (!tt__mesh_live(&r->m, t)) {
+    tt__heap_remove(&r->heap, t);
+    return true;
+  }
+  tt__scan_tri st;
+  double err;
+  int64_t idx;
+  tt__scan_tri_from_mesh(&r->m, r->g, t, &st);
+  tt__scan_candidate(r->g, &st, &err, &idx);
+  r->cand[t] = idx;
+  r->cerr[t] = err;
+  if (idx < 0) {
+    tt__heap_remove(&r->heap, t);
+    return true;
+  }
+  return tt__heap_set(&r->heap, t, err);
+}
+
+static int cmp_i32(const void *a, const void *b)
+{
+  int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* Rescans each triangle slot the mesh logged, once. */
+static bool drain(refine *r)
+{
+  tt__mesh *m = &r->m;
+  if (!fit_slots(r))
+    return false;
+  qsort(m->touched, m->ntouched, sizeof(int32_t), cmp_i32);
+  for (size_t i = 0; i < m->ntouched; i++) {
+    if (i > 0 && m->touched[i] == m->touched[i - 1])
+      continue;
+    if (!rescan(r, m->touched[i]))
+      return false;
+  }
+  tt__mesh_clear_touched(m);
+  return true;
+}
+
+/* --- starting triangulation -------------------------------------------- */
+
+/* Adds triangle (a, b, c) with its ground-frame orientation fixed. */
+static bool add_ccw(refine *r, int32_t a, int32_t b, int32_t c)
+{
+  int o = tt__mesh_orient(&r->m, a, b, c);
+  if (o == 0)
+    return true; /* degenerate: skipped (hull fans never make one) */
+  return (o > 0 ? tt__mesh_add_triangle(&r->m, a, b, c)
+                : tt__mesh_add_triangle(&r->m, a, c, b)) >= 0;
+}
+
+static tt_status start_rectangle(refine *r)
+{
+  const tt_grid *g = r->g;
+  int32_t w = (int32_t)g->nx - 1, h = (int32_t)g->ny - 1;
+  int32_t v[4];
+  if (!add_vertex(r, 0, 0, NAN, &v[0]) || !add_vertex(r, w, 0, NAN, &v[1]) ||
+      !add_vertex(r, w, h, NAN, &v[2]) || !add_vertex(r, 0, h, NAN, &v[3]))
+    return oom(r);
+  if (!add_ccw(r, v[0], v[1], v[2]) || !add_ccw(r, v[0], v[2], v[3]))
+    return oom(r);
+  return TT_OK;
+}
+
+/* Andrew's monotone chain over the leftmost and rightmost valid sample of
+ * every row, exact in integers; the hull has no collinear vertices. */
+static tt_status start_hull(refine *r, size_t valid)
+{
+  const tt_grid *g = r->g;
+  tt_status status = TT_OK;
+  int64_t *px = NULL, *py = NULL;
+  size_t *hull = NULL;
+  size_t n = 0;
+  px = malloc(2 * g->ny * sizeof *px);
+  py = malloc(2 * g->ny * sizeof *py);
+  hull = malloc((2 * g->ny + 2) * 2 * sizeof *hull);
+  if (!px || !py || !hull) {
+    status = oom(r);
+    goto done;
+  }
+  /* points sorted by (y, x): row by row, left end then right end */
+  for (size_t row = 0; row < g->ny; row++) {
+    size_t lo = SIZE_MAX, hi = 0;
+    for (size_t c = 0; c < g->nx; c++)
+      if (!isnan(g->z[row * g->nx + c])) {
+        if (lo == SIZE_MAX)
+          lo = c;
+        hi = c;
+      }
+    if (lo == SIZE_MAX)
+      continue;
+    px[n] = (int64_t)lo;
+    py[n++] = (int64_t)row;
+    if (hi != lo) {
+      px[n] = (int64_t)hi;
+      py[n++] = (int64_t)row;
+    }
+  }
+  /* lower and upper chains (counter-clockwise in pixel space) */
+  size_t k = 0;
+  for (size_t i = 0; i < n; i++) {
+    while (k >= 2 && tt__orient_i(px[hull[k - 2]], py[hull[k - 2]],
+                                  px[hull[k - 1]], py[hull[k - 1]], px[i],
+                                  py[i]) <= 0)
+      k--;
+    hull[k++] = i;
+  }
+  for (size_t i = n - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && tt__orient_i(px[hull[k - 2]], py[hull[k - 2]],
+                                      px[hull[k - 1]], py[hull[k - 1]], px[i],
+                                      py[i]) <= 0)
+      k--;
+    hull[k++] = i;
+  }
+  if (k > 1)
+    k--; /* the last point repeats the first */
+  if (k < 3) {
+    status = tt__error(r->ctx, TT_ERR_DATA,
+                       "the %zu valid sample%s lie on one line: no triangle "
+                       "can be made", valid, valid == 1 ? "" : "s");
+    goto done;
+  }
+  tt__warn(r->ctx, "%zu of %zu samples are nodata: the TIN covers the "
+           "convex hull of the valid samples, so triangles may span nodata "
+           "areas (nodata never counts as error)",
+           g->nx * g->ny - valid, g->nx * g->ny);
+  int32_t first = (int32_t)r->m.nv;
+  for (size_t i = 0; i < k; i++) {
+    int32_t v;
+    if (!add_vertex(r, (int32_t)px[hull[i]], (int32_t)py[hull[i]], NAN, &v)) {
+      status = oom(r);
+      goto done;
+    }
+  }
+  for (size_t i = 1; i + 1 < k; i++)
+    if (!add_ccw(r, first, first + (int32_t)i, first + (int32_t)i + 1)) {
+      status = oom(r);
+      goto done;
+    }
+done:
+  free(px);
+  free(py);
+  free(hull);
+  return status;
+}
+
+static tt_status start(refine *r, size_t valid)
+{
+  const tt_grid *g = r->g;
+  tt_status s = valid == g->nx * g->ny ? start_rectangle(r)
+                                       : start_hull(r, valid);
+  if (s != TT_OK)
+    return s;
+  if (!tt__mesh_link_all(&r->m) ||
+      tt__swap_all(&r->m, r->crit, &r->env, &r->stack) < 0)
+    return oom(r);
+  tt__mesh_clear_touched(&r->m);
+  if (!fit_slots(r))
+    return oom(r);
+  for (size_t t = 0; t < r->m.nslots; t++)
+    if (!rescan(r, (int32_t)t))
+      return oom(r);
+  return TT_OK;
+}
+
+/* --- the loop ----------------------------------------------------------- */
+
+static double progress_fraction(refine *r, double err)
+{
+  double f = 0;
+  if (r->max_points)
+    f = fmax(f, (double)r->m.nv / (double)r->max_points);
+  if (r->max_tris)
+    f = fmax(f, (double)r->m.nlive / (double)r->max_tris);
+  if (r->max_error >= 0 && r->e0 > 0 && err > 0) {
+    double target = r->max_error > 0 ? r->max_error : r->e0 * 1e-6;
+    if (target < r->e0)
+      f = fmax(f, log(r->e0 / err) / log(r->e0 / target));
+  }
+  f = fmin(fmax(f, 0), 1);
+  if (f > r->frac)
+    r->frac = f;
+  return r->frac;
+}
+
+/* Where sample (col,row) sits in triangle t: -1 strictly inside, else the
+ * half-edge it lies on. */
+static int32_t locate_in(const refine *r, int32_t t, int64_t col, int64_t row)
+{
+  const tt__mesh *m = &r->m;
+  int s = m->metric.det_sign; /* pixel-space orientation of live triangles */
+  for (int k = 0; k < 3; k++) {
+    int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
+    if (s * tt__orient_i(m->vc[a], m->vr[a], m->vc[b], m->vr[b], col, row) ==
+        0)
+      return 3 * t + k;
+  }
+  return -1;
+}
+
+static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
+{
+  if (isnan(o->max_error) || isinf(o->max_error))
+    return tt__error(ctx, TT_ERR_ARG, "max error must be a finite number, "
+                     "got %g", o->max_error);
+  if (isnan(o->percent) || o->percent < 0 || o->percent > 100)
+    return tt__error(ctx, TT_ERR_ARG, "percent must be in (0, 100], got %g",
+                     o->percent);
+  if (o->max_error < 0 && !o->max_points && !o->max_triangles &&
+      o->percent == 0)
+    return tt__error(ctx, TT_ERR_ARG, "no stop condition: set a max error, "
+                     "a point or triangle budget, or a percentage");
+  if (o->max_points > TT_MAX_VERTICES)
+    return tt__error(ctx, TT_ERR_LIMIT, "max points %zu is above the limit "
+                     "of %zu vertices", o->max_points,
+                     (size_t)TT_MAX_VERTICES);
+  if (!tt__criterion_get(o->criterion))
+    return tt__error(ctx, TT_ERR_ARG, "unknown criterion %d",
+                     (int)o->criterion);
+  return TT_OK;
+}
+
+tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
+                        const tt_refine_options *opt, tt_tin **out_tin)
+{
+  if (!grid || !opt || !out_tin)
+    return tt__error(ctx, TT_ERR_ARG, "grid, options and out_tin must not be "
+                     "NULL");
+  *out_tin = NULL;
+  tt_status status = check_options(ctx, opt);
+  if (status != TT_OK)
+    return status;
+  size_t valid = 0;
+  status = tt_grid_check(ctx, grid, &valid);
+  if (status != TT_OK)
+    return status;
+  if (valid < 3)
+    return tt__error(ctx, TT_ERR_DATA, "the grid has %zu valid sample%s: a "
+                     "triangle needs 3", valid, valid == 1 ? "" : "s");
+
+  refine r;
+  memset(&r, 0, sizeof r);
+  r.ctx = ctx;
+  r.g = grid;
+  r.opt = opt;
+  r.crit = tt__criterion_get(opt->criterion);
+  tt__metric metric;
+  tt__metric_from_frame(grid->frame, &metric);
+  tt__mesh_init(&r.m, &metric);
+  tt__heap_init(&r.heap);
+  r.env.mesh = &r.m;
+  r.env.grid = grid;
+  r.max_error = opt->max_error;
+  r.max_points = opt->max_points;
+  r.max_tris = opt->max_triangles;
+  if (opt->percent > 0) {
+    size_t p = (size_t)floor(opt->percent / 100.0 * (double)valid);
+    if (!r.max_points || p < r.max_points)
+      r.max_points = p;
+  }
+  if (r.max_points == 0 && (opt->percent > 0))
+    r.max_points = 1; /* below the start: stop at once (warned below) */
+
+  tt_stop_reason reason = TT_STOP_NONE;
+  status = start(&r, valid);
+  if (status != TT_OK)
+    goto done;
+  if (r.max_points && r.m.nv > r.max_points)
+    tt__warn(ctx, "the point limit %zu is below the %zu vertices of the "
+             "starting triangulation, which is returned as it is",
+             r.max_points, r.m.nv);
+  if (r.max_tris && r.m.nlive > r.max_tris)
+    tt__warn(ctx, "the triangle limit %zu is below the %zu triangles of the "
+             "starting triangulation, which is returned as it is",
+             r.max_tris, r.m.nlive);
+  r.e0 = tt__heap_size(&r.heap) ? tt__heap_top(&r.heap).key : 0;
+  if (opt->progress && !opt->progress(0.0, "inserting", opt->progress_arg)) {
+    status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
+    goto done;
+  }
+
+  for (size_t iter = 1;; iter++) {
+    if (tt__heap_size(&r.heap) == 0) {
+      /* every sample is exact: an error limit, if any, is met */
+      reason = r.max_error >= 0 ? TT_STOP_MAX_ERROR : TT_STOP_EXHAUSTED;
+      break;
+    }
+    tt__heap_entry top = tt__heap_top(&r.heap);
+    int32_t t = top.item;
+    double err = top.key;
+    if (r.max_error >= 0 && err <= r.max_error) {
+      reason = TT_STOP_MAX_ERROR;
+      break;
+    }
+    if (r.max_points && r.m.nv + 1 > r.max_points) {
+      reason = TT_STOP_MAX_POINTS;
+      break;
+    }
+    int64_t s = r.cand[t];
+    int64_t col = s % (int64_t)grid->nx, row = s / (int64_t)grid->nx;
+    int32_t on = locate_in(&r, t, col, row);
+    size_t more = (on >= 0 && r.m.twin[on] < 0) ? 1 : 2;
+    if (r.max_tris && r.m.nlive + more > r.max_tris) {
+      reason = TT_STOP_MAX_TRIANGLES;
+      break;
+    }
+    int32_t v;
+    if (!add_vertex(&r, (int32_t)col, (int32_t)row, err, &v)) {
+      status = oom(&r);
+      goto done;
+    }
+    int32_t opposite[4];
+    int nopp;
+    bool ok;
+    if (on < 0) {
+      ok = tt__mesh_split_triangle(&r.m, t, v, opposite);
+      nopp = 3;
+    } else {
+      ok = tt__mesh_split_edge(&r.m, on, v, opposite);
+      nopp = 4;
+    }
+    if (!ok || tt__swap_repair(&r.m, r.crit, &r.env, opposite, nopp,
+                               &r.stack) < 0 ||
+        !drain(&r)) {
+      status = oom(&r);
+      goto done;
+    }
+    if (opt->progress && (iter & 255) == 0 &&
+        !opt->progress(progress_fraction(&r, err), "inserting",
+                       opt->progress_arg)) {
+      status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted after %zu "
+                         "vertices", r.m.nv);
+      goto done;
+    }
+  }
+  /* The insertion state is no longer needed: free it before the TIN's
+   * arrays are made, to keep the peak low. */
+  tt__heap_free(&r.heap);
+  free(r.cand);
+  free(r.cerr);
+  r.cand = NULL;
+  r.cerr = NULL;
+  tt__edge_stack_free(&r.stack);
+  status = tt__tin_build(ctx, &r.m, grid, r.ins_err, out_tin);
+  r.ins_err = NULL; /* taken over by the tin, or freed on failure */
+  if (status != TT_OK)
+    goto done;
+  (*out_tin)->summary.criterion = opt->criterion;
+  (*out_tin)->summary.stop_reason = reason;
+  (*out_tin)->summary.valid_samples = valid;
+  if (opt->progress && !opt->progress(1.0, "done", opt->progress_arg)) {
+    tt_tin_destroy(*out_tin);
+    *out_tin = NULL;
+    status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
+  }
+done:
+  tt__heap_free(&r.heap);
+  free(r.cand);
+  free(r.cerr);
+  free(r.ins_err);
+  tt__edge_stack_free(&r.stack);
+  tt__mesh_free(&r.m);
+  return status;
+}

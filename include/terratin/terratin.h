@@ -194,7 +194,8 @@ typedef enum tt_stop_reason {
   TT_STOP_MAX_ERROR,       /* every sample within max_error */
   TT_STOP_MAX_POINTS,      /* max_points (or percent) reached */
   TT_STOP_MAX_TRIANGLES,   /* the next insertion would pass max_triangles */
-  TT_STOP_EXHAUSTED        /* every sample is a vertex or exact */
+  TT_STOP_EXHAUSTED        /* every sample is exact and no error limit
+                              was set */
 } tt_stop_reason;
 
 const char *tt_stop_reason_name(tt_stop_reason reason);

@@ -1,0 +1,36 @@
+/*
+ * criterion.h -- the small interface every triangulation criterion
+ * implements (SPEC section 2), one file per criterion in src/criteria/.
+ *
+ * A criterion scores a triangulation; what the optimisers need is local:
+ * swap_value(e) = Quality(after swapping e) - Quality(before), positive when
+ * the swap improves the triangulation, computed from e's neighbourhood only.
+ * The caller guarantees e has a twin; the criterion may assume nothing about
+ * convexity (flippability is checked by the mesh). Delaunay answers with the
+ * exact incircle sign (+1, 0, -1), so ties never flip and flipping
+ * terminates.
+ */
+#ifndef TT_CRITERION_H
+#define TT_CRITERION_H
+
+#include "../internal.h"
+#include "../mesh.h"
+
+typedef struct tt__crit_env {
+  const tt__mesh *mesh;
+  const tt_grid *grid;   /* heights, for data-dependent criteria */
+} tt__crit_env;
+
+typedef struct tt__criterion_vt {
+  tt_criterion id;
+  const char *name;
+  bool data_dependent;   /* uses heights, not only x,y */
+  double (*swap_value)(const tt__crit_env *env, int32_t e);
+} tt__criterion_vt;
+
+/* The criterion of an id, or NULL for an unknown id. */
+TT_HIDDEN const tt__criterion_vt *tt__criterion_get(tt_criterion id);
+
+TT_HIDDEN extern const tt__criterion_vt tt__criterion_delaunay;
+
+#endif /* TT_CRITERION_H */

@@ -1,0 +1,132 @@
+/*
+ * mesh.h -- the triangle mesh: flat arrays of half-edges.
+ *
+ * Triangle t owns half-edges 3t, 3t+1, 3t+2. Half-edge e starts at vertex
+ * hv[e] and ends at hv[tt__next(e)]; twin[e] is the opposite half-edge in
+ * the neighbouring triangle, or -1 on the boundary. Every live triangle is
+ * counter-clockwise in the ground frame (see predicates.h for the sign
+ * convention and mesh->metric.det_sign for how pixel space maps to it).
+ * A free triangle slot has hv[3t] == -1 and sits on the free list, so flips,
+ * splits and (later) vertex removals make no garbage.
+ *
+ * Vertices are grid samples: integer pixel coordinates (col, row). vedge[v]
+ * is one half-edge leaving v (hv[vedge[v]] == v), or -1 for a vertex in no
+ * triangle. eflag[e] holds TT__EDGE_CONSTRAINED for edges that flips must
+ * keep (domain boundaries; both half-edges carry it).
+ *
+ * Only mesh.c writes these arrays. Each operation appends the slots of the
+ * triangles it wrote to the touched log, which the caller drains (to rescan
+ * candidates); a logged slot may have been freed since, or logged twice.
+ *
+ * Limits: at most TT_MAX_VERTICES vertices and INT32_MAX/3 triangle slots.
+ */
+#ifndef TT_MESH_H
+#define TT_MESH_H
+
+#include "internal.h"
+
+#define TT__EDGE_CONSTRAINED 1u
+
+typedef struct tt__mesh {
+  /* vertices */
+  int32_t *vc, *vr;      /* pixel column, row */
+  int32_t *vedge;        /* a half-edge leaving the vertex, or -1 */
+  size_t nv, vcap;
+  /* triangles (3 half-edges each) */
+  int32_t *hv;           /* start vertex; hv[3t] == -1: free slot */
+  int32_t *twin;         /* opposite half-edge or -1 */
+  uint8_t *eflag;
+  size_t nslots;         /* triangle slots in use or free */
+  size_t tcap;           /* triangle slots allocated */
+  size_t nlive;          /* live triangles */
+  int32_t *freelist;
+  size_t nfree, freecap;
+  /* the ground frame */
+  tt__metric metric;
+  /* slots written since the caller last drained the log */
+  int32_t *touched;
+  size_t ntouched, touchedcap;
+} tt__mesh;
+
+static inline int32_t tt__next(int32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+static inline int32_t tt__prev(int32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
+static inline bool tt__mesh_live(const tt__mesh *m, int32_t t)
+{
+  return m->hv[3 * (size_t)t] >= 0;
+}
+
+TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
+TT_HIDDEN void tt__mesh_free(tt__mesh *m);
+/* Reserves room for about nv vertices and nt triangles (a hint). */
+TT_HIDDEN bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt);
+
+/* Adds an unconnected vertex; returns its index, or -1 when out of memory
+ * or past TT_MAX_VERTICES. */
+TT_HIDDEN int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row);
+
+/* Adds triangle (a, b, c), which must be counter-clockwise in the ground
+ * frame, with no twins; returns its slot or -1 when out of memory. */
+TT_HIDDEN int32_t tt__mesh_add_triangle(tt__mesh *m, int32_t a, int32_t b,
+                                        int32_t c);
+/* Links every boundary half-edge with its reverse, if present, among the
+ * live triangles (used once after building a starting triangulation). */
+TT_HIDDEN bool tt__mesh_link_all(tt__mesh *m);
+
+/* Ground-frame orientation of three vertices / incircle of four (d inside
+ * the circle through a, b, c given counter-clockwise: > 0). Exact. */
+TT_HIDDEN int tt__mesh_orient(const tt__mesh *m, int32_t a, int32_t b,
+                              int32_t c);
+TT_HIDDEN int tt__mesh_incircle(const tt__mesh *m, int32_t a, int32_t b,
+                                int32_t c, int32_t d);
+
+/* Inserts vertex p strictly inside live triangle t: t becomes three
+ * triangles around p. out_opposite receives the three half-edges opposite
+ * p (for the criterion's repair). False when out of memory (mesh unchanged). */
+TT_HIDDEN bool tt__mesh_split_triangle(tt__mesh *m, int32_t t, int32_t p,
+                                       int32_t out_opposite[3]);
+/* Inserts vertex p strictly inside the edge of half-edge e: its two
+ * triangles (one on the boundary) become four (two). out_opposite receives
+ * the half-edges opposite p (4, or 2 on the boundary; unused slots -1).
+ * A constrained edge stays constrained in both halves. False when out of
+ * memory (mesh unchanged). */
+TT_HIDDEN bool tt__mesh_split_edge(tt__mesh *m, int32_t e, int32_t p,
+                                   int32_t out_opposite[4]);
+
+/* True when the edge of e has two triangles, is not constrained, and its
+ * quadrilateral is strictly convex. */
+TT_HIDDEN bool tt__mesh_flippable(const tt__mesh *m, int32_t e);
+/* Flips the edge of e (which must be flippable). With e = a->b in
+ * (a, b, c) and its twin b->a in (b, a, d), the two triangles become
+ * (c, a, d) in e's slot and (d, b, c) in the twin's; the returned half-edge
+ * is the new diagonal d->c, in e's slot:
+ *
+ *          c                       c
+ *         / \                     /|\
+ *        /   \                   / | \
+ *       a-----b        ==>      a  |  b
+ *        \   /                   \ | /
+ *         \ /                     \|/
+ *          d                       d
+ *
+ * Afterwards tt__prev(h) is a->d and tt__next(twin[h]) is d->b: the two
+ * edges opposite c, for the next round of a repair that started at c.
+ * Returns -1 (mesh unchanged) when out of memory. */
+TT_HIDDEN int32_t tt__mesh_flip(tt__mesh *m, int32_t e);
+
+/* Vertex opposite half-edge e in its triangle. */
+static inline int32_t tt__mesh_apex(const tt__mesh *m, int32_t e)
+{
+  return m->hv[tt__prev(e)];
+}
+
+/* Checks every invariant: live triangles counter-clockwise and
+ * non-degenerate, twins symmetric and reversed, constraint flags symmetric,
+ * vertex edges leaving their vertex, free list consistent, Euler's formula
+ * V - E + F = 2C - L (C components, L boundary loops). On failure writes a
+ * reason into why and returns false. */
+TT_HIDDEN bool tt__mesh_validate(const tt__mesh *m, char *why, size_t whylen);
+
+/* Empties the touched log. */
+static inline void tt__mesh_clear_touched(tt__mesh *m) { m->ntouched = 0; }
+
+#endif /* TT_MESH_H */

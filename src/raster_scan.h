@@ -1,0 +1,51 @@
+/*
+ * raster_scan.h -- walking the grid samples a triangle owns.
+ *
+ * Ownership partitions the samples: every valid sample in the TIN's domain
+ * belongs to exactly one triangle, or is a vertex. A sample strictly inside
+ * a triangle is its own; a sample on an edge belongs to the triangle whose
+ * half-edge passes the "top-left" rule below (or to the only triangle, on
+ * the boundary); a vertex sample belongs to no triangle here (its error is
+ * zero by construction; metrics.c counts it once). Row spans are computed
+ * exactly in integers, so no sample is missed or seen twice.
+ *
+ * The plane through the three corners is evaluated as
+ * z0 + gx (x - x0) + gy (y - y0) in pixel space; every caller (candidate
+ * search, statistics) uses the same expression, so they agree bit for bit.
+ * This is the hot loop of refinement: keep it branch-free per sample.
+ */
+#ifndef TT_RASTER_SCAN_H
+#define TT_RASTER_SCAN_H
+
+#include "internal.h"
+#include "mesh.h"
+
+typedef struct tt__scan_tri {
+  int64_t x[3], y[3];   /* pixel coordinates of the corners */
+  double z[3];          /* heights at the corners */
+  bool own[3];          /* samples on edge i (corner i -> i+1) are ours */
+} tt__scan_tri;
+
+/* Fills st for live triangle t of the mesh over grid g. */
+TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, const tt_grid *g,
+                                      int32_t t, tt__scan_tri *st);
+
+/* The owned sample with the largest |H - H'| > 0; *out_index = -1 (and
+ * *out_err = 0) when every owned sample is exact or nodata. Ties go to the
+ * first sample in row-major order. */
+TT_HIDDEN void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
+                                  double *out_err, int64_t *out_index);
+
+typedef struct tt__scan_stats {
+  size_t count;         /* valid owned samples */
+  double max_err;
+  int64_t max_index;    /* -1 when count == 0 */
+  double sum_abs;
+  double sum_sq;
+} tt__scan_stats;
+
+/* Statistics of the valid owned samples (reset, then filled). */
+TT_HIDDEN void tt__scan_stats_run(const tt_grid *g, const tt__scan_tri *st,
+                                  tt__scan_stats *out);
+
+#endif /* TT_RASTER_SCAN_H */
