@@ -1,0 +1,157 @@
+/*
+ * terratin_lib.h -- the terratin command as a library, in the shape of GDAL's
+ * apps/gdal_utils.h: tt_app_options_new() parses the words of a command line
+ * into an options object, tt_app_run() runs it, and apps/terratin.c is a thin
+ * main() around the two. Tests and other programs can drive every subcommand
+ * (simplify, generate, eval) without a shell.
+ *
+ * Parsing has no side effects: it only reads the words and checks their
+ * values (numbers, ranges, names known to the engine). Everything that needs
+ * GDAL -- `--config` options, the output driver, the CRS given to -a_srs --
+ * is applied or checked by tt_app_run(), in that order, before any file is
+ * opened.
+ *
+ * Exit codes (documented in `terratin --help` and docs/cli.md):
+ *   0 success, 1 processing failure, 2 usage error, 3 eval threshold exceeded.
+ *
+ * Messages: a failure is reported as one line in tt_app_result.message,
+ * "<file>: <problem>" or "<problem>" for usage errors, without the leading
+ * "terratin: " which main() adds. Warnings are written by tt_app_run() to the
+ * error stream as "terratin: warning: <text>".
+ */
+#ifndef TERRATIN_LIB_H
+#define TERRATIN_LIB_H
+
+#include "terratin/terratin.h"
+
+#include <signal.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Exit codes of the command. */
+typedef enum tt_app_exit {
+  TT_APP_EXIT_OK = 0,
+  TT_APP_EXIT_FAILURE = 1,   /* bad input, I/O error, refused output */
+  TT_APP_EXIT_USAGE = 2,     /* unknown option, bad value, missing argument */
+  TT_APP_EXIT_THRESHOLD = 3  /* eval: measured max error > -max_error */
+} tt_app_exit;
+
+typedef enum tt_app_command {
+  TT_APP_NONE = 0,           /* no command (help topic: the top level) */
+  TT_APP_HELP,               /* print the help of help_topic */
+  TT_APP_VERSION,            /* print terratin, GDAL and PROJ versions */
+  TT_APP_SIMPLIFY,
+  TT_APP_GENERATE,
+  TT_APP_EVAL
+} tt_app_command;
+
+#define TT_APP_MESSAGE_MAX 1024
+
+/* The outcome of parsing or running: the exit code and, on failure, one line
+ * without a trailing newline ("" on success). */
+typedef struct tt_app_result {
+  int exit_code;             /* a tt_app_exit value */
+  tt_status status;          /* TT_OK, or what failed (TT_ERR_ARG: usage) */
+  char message[TT_APP_MESSAGE_MAX];
+} tt_app_result;
+
+/* What the command line said, read-only for callers. Strings and lists are
+ * owned by the options object; lists are NULL-terminated. A field that does
+ * not apply to the command keeps its default. */
+typedef struct tt_app_settings {
+  tt_app_command command;
+  tt_app_command help_topic; /* TT_APP_HELP: TT_APP_NONE = top level */
+
+  /* all commands */
+  const char *const *config; /* --config pairs: KEY, VALUE, KEY, VALUE, NULL */
+  int quiet;                 /* -q */
+  int json;                  /* -json (simplify, eval) */
+  int overwrite;             /* -overwrite (simplify, generate) */
+
+  /* simplify INPUT OUTPUT; eval INPUT TIN; generate TYPE OUTPUT */
+  const char *input;         /* the DEM (simplify, eval) */
+  const char *output;        /* the dataset written (simplify, generate) */
+  const char *tin;           /* the triangle dataset read (eval) */
+  int band;                  /* -b, 1-based; default 1 */
+  const char *srcnodata;     /* -srcnodata: a number or "nan"; NULL: the
+                                band's own mask (simplify, eval) */
+  double z_factor;           /* -z_factor; default 1 (simplify, eval) */
+
+  /* simplify; eval uses max_error as its threshold */
+  double max_error;          /* -max_error; negative: not given */
+  size_t max_points;         /* -max_points; 0: not given */
+  size_t max_triangles;      /* -max_triangles; 0: not given */
+  double percent;            /* -percent; 0: not given */
+  tt_criterion criterion;    /* -criterion; default delaunay */
+  const char *format;        /* -of; NULL: guessed from the output's
+                                extension, else GPKG */
+  const char *const *lco;    /* -lco NAME=VALUE, in order */
+  const char *const *dsco;   /* -dsco NAME=VALUE, in order */
+  const char *nln;           /* -nln layer name prefix; "" by default */
+
+  /* eval */
+  const char *layer;         /* -layer; NULL: the triangles layer */
+
+  /* generate */
+  tt_synth_options synth;    /* tt_synth_options_init(kind) + the flags */
+  const char *srs;           /* -a_srs; NULL: none */
+} tt_app_settings;
+
+typedef struct tt_app_options tt_app_options;
+
+/* Parses the words that follow the program name (argv: NULL-terminated, as
+ * GDAL's XxxOptionsNew takes them). On success returns TT_OK and the options
+ * with out_result->exit_code 0; on a usage error returns TT_ERR_ARG, sets
+ * *out_options to NULL and fills out_result (exit code 2, one-line message);
+ * TT_ERR_NOMEM when out of memory (exit code 1). out_result may be NULL.
+ * The caller owns *out_options and frees it with tt_app_options_destroy(). */
+tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
+                             tt_app_result *out_result);
+void tt_app_options_destroy(tt_app_options *options);
+
+/* The parsed values. Valid while the options live. */
+const tt_app_settings *tt_app_options_settings(const tt_app_options *options);
+
+/* The progress callback, called with the overall fraction done, scaled over
+ * the phases (read 0-0.10, simplify 0.10-0.85, write 0.85-1). Returning 0
+ * stops the run (TT_ERR_INTERRUPTED, nothing left behind). NULL: none. */
+void tt_app_options_set_progress(tt_app_options *options, tt_progress_fn fn,
+                                 void *arg);
+/* Where results (summary, JSON, help) and warnings go; default stdout and
+ * stderr. */
+void tt_app_options_set_streams(tt_app_options *options, FILE *out,
+                                FILE *err);
+/* Whether a progress bar belongs on the output stream (simplify without -q
+ * and without -json). */
+int tt_app_options_wants_progress_bar(const tt_app_options *options);
+
+/* Runs the command. Returns TT_OK and out_result->exit_code 0 (or 3 when an
+ * eval threshold was exceeded), else the failure's status with the exit code
+ * and one-line message in out_result. */
+tt_status tt_app_run(const tt_app_options *options, tt_app_result *out_result);
+
+/* The help text of a command (TT_APP_NONE: the top level). */
+const char *tt_app_help(tt_app_command topic);
+
+/* A GDAL-style text progress bar, "0...10...20...30...40...50...60...70...
+ * 80...90...100 - done.", whose state lives in this struct (GDALTermProgress
+ * keeps it in statics: one bar per process). It also stops the run when
+ * *stop becomes non-zero (a signal handler's flag), drawing or not. */
+typedef struct tt_app_term_progress {
+  FILE *fp;                        /* NULL: draw nothing */
+  int ticks;                       /* ticks drawn, 0..41 (-1: none yet) */
+  volatile sig_atomic_t *stop;     /* may be NULL */
+} tt_app_term_progress;
+
+void tt_app_term_progress_init(tt_app_term_progress *bar, FILE *fp,
+                               volatile sig_atomic_t *stop);
+/* A tt_progress_fn; arg is a tt_app_term_progress. */
+int tt_app_term_progress_fn(double complete, const char *message, void *arg);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* TERRATIN_LIB_H */

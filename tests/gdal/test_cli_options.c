@@ -1,0 +1,449 @@
+/*
+ * test_cli_options.c -- unit tests of the terratin command's option parser
+ * (apps/terratin_lib.c): defaults, every option of every command, every
+ * usage error (exit code 2, one line, no object), --help/--version winning
+ * over the rest of the line, the help texts documenting defaults and exit
+ * codes, and the text progress bar. Nothing here opens a file.
+ */
+#include "terratin_lib.h"
+#include "tt_test.h"
+
+#include <stdarg.h>
+
+#define MAXW 64
+
+/* Parses a NULL-terminated list of words. */
+static tt_status parse(tt_app_options **out, tt_app_result *res, ...)
+{
+  char *words[MAXW + 1];
+  size_t n = 0;
+  va_list ap;
+  va_start(ap, res);
+  const char *w;
+  while ((w = va_arg(ap, const char *)) != NULL && n < MAXW)
+    words[n++] = (char *)w;
+  va_end(ap);
+  words[n] = NULL;
+  return tt_app_options_new(words, out, res);
+}
+
+/* A usage error: TT_ERR_ARG, exit code 2, no object, one non-empty line
+ * that contains `needle`. */
+#define CHECK_USAGE(needle, ...)                                             \
+  do {                                                                       \
+    tt_app_options *o_ = (tt_app_options *)1;                                \
+    tt_app_result r_;                                                        \
+    tt_status s_ = parse(&o_, &r_, __VA_ARGS__, (const char *)NULL);         \
+    CHECK_INT_EQ(s_, TT_ERR_ARG);                                            \
+    CHECK(o_ == NULL);                                                       \
+    CHECK_INT_EQ(r_.exit_code, TT_APP_EXIT_USAGE);                           \
+    CHECK(r_.message[0] != '\0');                                            \
+    CHECK(strchr(r_.message, '\n') == NULL);                                 \
+    if (!strstr(r_.message, (needle)))                                       \
+      TT_FAIL_("message \"%s\" lacks \"%s\"", r_.message, (needle));         \
+  } while (0)
+
+/* A successful parse into `o`. */
+#define PARSE_OK(o, ...)                                                     \
+  do {                                                                       \
+    tt_app_result r_;                                                        \
+    tt_status s_ = parse(&(o), &r_, __VA_ARGS__, (const char *)NULL);        \
+    if (s_ != TT_OK)                                                         \
+      TT_FAIL_("parse failed: %s", r_.message);                              \
+    CHECK_INT_EQ(r_.exit_code, 0);                                           \
+    CHECK_STR_EQ(r_.message, "");                                            \
+  } while (0)
+
+static void test_simplify_defaults(void)
+{
+  tt_app_options *o = NULL;
+  PARSE_OK(o, "simplify", "in.tif", "out.gpkg");
+  const tt_app_settings *s = tt_app_options_settings(o);
+  CHECK(s != NULL);
+  if (!s)
+    return;
+  CHECK_INT_EQ(s->command, TT_APP_SIMPLIFY);
+  CHECK_STR_EQ(s->input, "in.tif");
+  CHECK_STR_EQ(s->output, "out.gpkg");
+  CHECK_INT_EQ(s->band, 1);
+  CHECK(s->max_error < 0);
+  CHECK_INT_EQ(s->max_points, 0);
+  CHECK_INT_EQ(s->max_triangles, 0);
+  CHECK(s->percent == 0);
+  CHECK_INT_EQ(s->criterion, TT_CRITERION_DELAUNAY);
+  CHECK(s->format == NULL);
+  CHECK(s->lco && s->lco[0] == NULL);
+  CHECK(s->dsco && s->dsco[0] == NULL);
+  CHECK(s->config && s->config[0] == NULL);
+  CHECK_STR_EQ(s->nln, "");
+  CHECK_INT_EQ(s->overwrite, 0);
+  CHECK_INT_EQ(s->quiet, 0);
+  CHECK_INT_EQ(s->json, 0);
+  CHECK(s->srcnodata == NULL);
+  CHECK(s->z_factor == 1.0);
+  CHECK_INT_EQ(tt_app_options_wants_progress_bar(o), 1);
+  tt_app_options_destroy(o);
+}
+
+static void test_simplify_all_options(void)
+{
+  tt_app_options *o = NULL;
+  /* options before, between and after the positional words, mixed case */
+  PARSE_OK(o, "--config", "GDAL_CACHEMAX", "64", "simplify", "-b", "2",
+           "-max_error", "0.25", "in.tif", "-max_points", "1000",
+           "-MAX_TRIANGLES", "2000", "-percent", "12.5", "-of",
+           "ESRI Shapefile", "-lco", "SPATIAL_INDEX=YES", "-lco",
+           "ENCODING=UTF-8", "-dsco", "A=B", "-nln", "dem_", "-overwrite",
+           "-q", "-criterion", "delaunay", "-json", "out.shp", "--config",
+           "CPL_TMPDIR=/tmp", "--debug", "on", "-srcnodata", "nan",
+           "-z_factor", "0.3048");
+  const tt_app_settings *s = tt_app_options_settings(o);
+  if (!s)
+    return;
+  CHECK_INT_EQ(s->command, TT_APP_SIMPLIFY);
+  CHECK_STR_EQ(s->input, "in.tif");
+  CHECK_STR_EQ(s->output, "out.shp");
+  CHECK_INT_EQ(s->band, 2);
+  CHECK_DBL_NEAR(s->max_error, 0.25, 0);
+  CHECK_INT_EQ(s->max_points, 1000);
+  CHECK_INT_EQ(s->max_triangles, 2000);
+  CHECK_DBL_NEAR(s->percent, 12.5, 0);
+  CHECK_STR_EQ(s->format, "ESRI Shapefile");
+  CHECK_STR_EQ(s->lco[0], "SPATIAL_INDEX=YES");
+  CHECK_STR_EQ(s->lco[1], "ENCODING=UTF-8");
+  CHECK(s->lco[2] == NULL);
+  CHECK_STR_EQ(s->dsco[0], "A=B");
+  CHECK(s->dsco[1] == NULL);
+  CHECK_STR_EQ(s->nln, "dem_");
+  CHECK_INT_EQ(s->overwrite, 1);
+  CHECK_INT_EQ(s->quiet, 1);
+  CHECK_INT_EQ(s->json, 1);
+  CHECK_STR_EQ(s->config[0], "GDAL_CACHEMAX");
+  CHECK_STR_EQ(s->config[1], "64");
+  CHECK_STR_EQ(s->config[2], "CPL_TMPDIR");
+  CHECK_STR_EQ(s->config[3], "/tmp");
+  CHECK_STR_EQ(s->config[4], "CPL_DEBUG");
+  CHECK_STR_EQ(s->config[5], "on");
+  CHECK(s->config[6] == NULL);
+  CHECK_INT_EQ(tt_app_options_wants_progress_bar(o), 0);
+  CHECK_STR_EQ(s->srcnodata, "nan");
+  CHECK_DBL_NEAR(s->z_factor, 0.3048, 0);
+  tt_app_options_destroy(o);
+
+  /* -max_error 0 is meaningful (an exact TIN); -f is ogr2ogr's -of */
+  PARSE_OK(o, "simplify", "-max_error", "0", "-f", "GPKG", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->max_error == 0);
+  CHECK(s && s->format && strcmp(s->format, "GPKG") == 0);
+  tt_app_options_destroy(o);
+
+  /* -json alone: no progress bar either */
+  PARSE_OK(o, "simplify", "-json", "a", "b");
+  CHECK_INT_EQ(tt_app_options_wants_progress_bar(o), 0);
+  tt_app_options_destroy(o);
+
+  /* "-" is a positional word (stdin-like names are the driver's affair) */
+  PARSE_OK(o, "simplify", "-", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && strcmp(s->input, "-") == 0);
+  tt_app_options_destroy(o);
+}
+
+static void test_simplify_usage_errors(void)
+{
+  CHECK_USAGE("missing command", "--debug", "on");
+  CHECK_USAGE("before the command", "-q", "simplify", "a", "b");
+  CHECK_USAGE("unknown command 'simplfy'", "simplfy", "a", "b");
+  CHECK_USAGE("missing INPUT and OUTPUT", "simplify");
+  CHECK_USAGE("missing OUTPUT", "simplify", "in.tif");
+  CHECK_USAGE("unexpected argument 'c'", "simplify", "a", "b", "c");
+  CHECK_USAGE("unknown option '-foo'", "simplify", "-foo", "a", "b");
+  CHECK_USAGE("needs a value", "simplify", "a", "b", "-max_error");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "-1", "a", "b");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "nan", "a", "b");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "inf", "a", "b");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "1e999", "a", "b");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "0.5m", "a", "b");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "", "a", "b");
+  CHECK_USAGE("-max_points", "simplify", "-max_points", "-5", "a", "b");
+  CHECK_USAGE("-max_points", "simplify", "-max_points", "0", "a", "b");
+  CHECK_USAGE("-max_points", "simplify", "-max_points", "1.5", "a", "b");
+  CHECK_USAGE("-max_points", "simplify", "-max_points",
+              "99999999999999999999999", "a", "b");
+  CHECK_USAGE("-max_points", "simplify", "-max_points", "4000000000", "a",
+              "b");
+  CHECK_USAGE("-max_triangles", "simplify", "-max_triangles", "0", "a", "b");
+  CHECK_USAGE("-percent", "simplify", "-percent", "0", "a", "b");
+  CHECK_USAGE("-percent", "simplify", "-percent", "150", "a", "b");
+  CHECK_USAGE("-percent", "simplify", "-percent", "-3", "a", "b");
+  CHECK_USAGE("-b", "simplify", "-b", "0", "a", "b");
+  CHECK_USAGE("-b", "simplify", "-b", "x", "a", "b");
+  CHECK_USAGE("-criterion 'foo'", "simplify", "-criterion", "foo", "a", "b");
+  CHECK_USAGE("NAME=VALUE", "simplify", "-lco", "SPATIAL_INDEX", "a", "b");
+  CHECK_USAGE("NAME=VALUE", "simplify", "-dsco", "=x", "a", "b");
+  CHECK_USAGE("-of", "simplify", "-of", "", "a", "b");
+  CHECK_USAGE("-srcnodata", "simplify", "-srcnodata", "none", "a", "b");
+  CHECK_USAGE("-z_factor", "simplify", "-z_factor", "0", "a", "b");
+  CHECK_USAGE("-z_factor", "simplify", "-z_factor", "inf", "a", "b");
+  CHECK_USAGE("does not apply", "simplify", "-seed", "1", "a", "b");
+  CHECK_USAGE("does not apply", "simplify", "-layer", "t", "a", "b");
+  CHECK_USAGE("--config", "simplify", "a", "b", "--config");
+  CHECK_USAGE("--config K needs a VALUE", "simplify", "a", "b", "--config",
+              "K");
+  CHECK_USAGE("--debug", "simplify", "a", "b", "--debug");
+  CHECK_USAGE("before the command", "-max_error", "1", "simplify", "a", "b");
+}
+
+static void test_help_and_version(void)
+{
+  tt_app_options *o = NULL;
+  const tt_app_settings *s;
+
+  PARSE_OK(o, "--help");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_HELP && s->help_topic == TT_APP_NONE);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "simplify", "--help");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_HELP && s->help_topic == TT_APP_SIMPLIFY);
+  tt_app_options_destroy(o);
+
+  /* help wins over errors elsewhere on the line */
+  PARSE_OK(o, "simplify", "-max_error", "-1", "-nonsense", "-h");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_HELP && s->help_topic == TT_APP_SIMPLIFY);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "help", "eval");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_HELP && s->help_topic == TT_APP_EVAL);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "generate", "--help");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_HELP && s->help_topic == TT_APP_GENERATE);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "--version");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_VERSION);
+  tt_app_options_destroy(o);
+
+  /* a --config value that reads "--help" is a value, not a request */
+  CHECK_USAGE("missing command", "--config", "X", "--help");
+
+  /* The texts document what the issue asks them to. */
+  const char *top = tt_app_help(TT_APP_NONE);
+  const char *sim = tt_app_help(TT_APP_SIMPLIFY);
+  const char *gen = tt_app_help(TT_APP_GENERATE);
+  const char *ev = tt_app_help(TT_APP_EVAL);
+  CHECK(strstr(top, "Exit codes") && strstr(top, "  3  eval"));
+  CHECK(strstr(top, "--config KEY VALUE") && strstr(top, "--version"));
+  CHECK(strstr(sim, "0.5% of the DEM's valid") != NULL);
+  static const char *const simplify_opts[] = {
+      "-b ", "-max_error", "-max_points", "-max_triangles", "-percent",
+      "-of ", "-lco", "-dsco", "-nln", "-overwrite", "-q ", "-criterion",
+      "-json", "Exit codes"};
+  for (size_t i = 0; i < sizeof simplify_opts / sizeof *simplify_opts; i++)
+    if (!strstr(sim, simplify_opts[i]))
+      TT_FAIL_("simplify help lacks %s", simplify_opts[i]);
+  static const char *const generate_opts[] = {
+      "fault", "diamond_square", "sphere", "cylinder", "bump", "-size",
+      "-seed", "-iterations", "-displacement", "-wave_size", "-roughness",
+      "-amplitude", "-seeding", "-a_srs", "-overwrite", "-q"};
+  for (size_t i = 0; i < sizeof generate_opts / sizeof *generate_opts; i++)
+    if (!strstr(gen, generate_opts[i]))
+      TT_FAIL_("generate help lacks %s", generate_opts[i]);
+  static const char *const eval_opts[] = {"-b ", "-layer", "-json",
+                                          "-max_error", "code 3"};
+  for (size_t i = 0; i < sizeof eval_opts / sizeof *eval_opts; i++)
+    if (!strstr(ev, eval_opts[i]))
+      TT_FAIL_("eval help lacks %s", eval_opts[i]);
+
+  /* Running help writes the text to the output stream, exit 0. */
+  FILE *out = tmpfile();
+  CHECK(out != NULL);
+  if (!out)
+    return;
+  PARSE_OK(o, "eval", "--help");
+  tt_app_options_set_streams(o, out, out);
+  tt_app_result res;
+  CHECK_INT_EQ(tt_app_run(o, &res), TT_OK);
+  CHECK_INT_EQ(res.exit_code, 0);
+  tt_app_options_destroy(o);
+  CHECK_INT_EQ(ftell(out), (long)strlen(ev));
+  fclose(out);
+}
+
+static void test_generate(void)
+{
+  tt_app_options *o = NULL;
+  const tt_app_settings *s;
+  tt_synth_options d;
+
+  PARSE_OK(o, "generate", "fault", "f.tif");
+  s = tt_app_options_settings(o);
+  tt_synth_options_init(&d, TT_SYNTH_FAULT);
+  CHECK(s && s->command == TT_APP_GENERATE);
+  CHECK(s && s->synth.kind == TT_SYNTH_FAULT);
+  CHECK(s && s->synth.nx == d.nx && s->synth.ny == d.ny);
+  CHECK(s && s->synth.seed == d.seed);
+  CHECK(s && s->synth.iterations == d.iterations);
+  CHECK(s && s->output && strcmp(s->output, "f.tif") == 0);
+  CHECK(s && s->srs == NULL);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "generate", "-size", "120x80", "fault", "-seed",
+           "18446744073709551615", "-iterations", "50", "-displacement", "20",
+           "-wave_size", "5", "f.tif", "-a_srs", "EPSG:32633", "-overwrite",
+           "-q");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->synth.nx == 120 && s->synth.ny == 80);
+  CHECK(s && s->synth.seed == UINT64_MAX);
+  CHECK(s && s->synth.iterations == 50);
+  CHECK(s && s->synth.displacement == 20 && s->synth.wave_size == 5);
+  CHECK(s && s->srs && strcmp(s->srs, "EPSG:32633") == 0);
+  CHECK(s && s->overwrite && s->quiet);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "generate", "diamond_square", "d.tif", "-size", "129",
+           "-roughness", "0.5", "-amplitude", "10", "-seeding", "hybrid");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->synth.kind == TT_SYNTH_DIAMOND_SQUARE);
+  CHECK(s && s->synth.nx == 129 && s->synth.ny == 129);
+  CHECK(s && s->synth.roughness == 0.5 && s->synth.amplitude == 10);
+  CHECK(s && s->synth.seeding == TT_SEED_HYBRID);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "generate", "bump", "b.tif");
+  s = tt_app_options_settings(o);
+  tt_synth_options_init(&d, TT_SYNTH_BUMP);
+  CHECK(s && s->synth.kind == TT_SYNTH_BUMP && s->synth.nx == d.nx &&
+        s->synth.ny == d.ny);
+  tt_app_options_destroy(o);
+
+  CHECK_USAGE("missing TYPE", "generate");
+  CHECK_USAGE("unknown TYPE 'hill'", "generate", "hill", "x.tif");
+  CHECK_USAGE("missing OUTPUT", "generate", "sphere");
+  CHECK_USAGE("-size", "generate", "fault", "x.tif", "-size", "1");
+  CHECK_USAGE("-size", "generate", "fault", "x.tif", "-size", "100x");
+  CHECK_USAGE("-size", "generate", "fault", "x.tif", "-size", "x100");
+  CHECK_USAGE("-size", "generate", "fault", "x.tif", "-size", "-5");
+  CHECK_USAGE("too large", "generate", "fault", "x.tif", "-size",
+              "100000x100000");
+  CHECK_USAGE("2^n+1", "generate", "diamond_square", "x.tif", "-size",
+              "100");
+  CHECK_USAGE("2^n+1", "generate", "diamond_square", "x.tif", "-size",
+              "129x65");
+  CHECK_USAGE("-seed", "generate", "fault", "x.tif", "-seed", "-1");
+  CHECK_USAGE("-seed", "generate", "fault", "x.tif", "-seed",
+              "18446744073709551616");
+  CHECK_USAGE("-iterations", "generate", "fault", "x.tif", "-iterations",
+              "0");
+  CHECK_USAGE("-roughness", "generate", "diamond_square", "x.tif",
+              "-roughness", "0");
+  CHECK_USAGE("-seeding", "generate", "diamond_square", "x.tif", "-seeding",
+              "mountain");
+  CHECK_USAGE("fault terrains only", "generate", "sphere", "x.tif",
+              "-wave_size", "3");
+  CHECK_USAGE("diamond_square terrains only", "generate", "fault", "x.tif",
+              "-roughness", "0.5");
+  CHECK_USAGE("does not apply", "generate", "fault", "x.tif", "-of", "GTiff");
+  CHECK_USAGE("does not apply", "generate", "fault", "x.tif", "-json");
+}
+
+static void test_eval(void)
+{
+  tt_app_options *o = NULL;
+  const tt_app_settings *s;
+  PARSE_OK(o, "eval", "dem.tif", "tin.gpkg");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_EVAL);
+  CHECK(s && strcmp(s->input, "dem.tif") == 0 && strcmp(s->tin, "tin.gpkg") == 0);
+  CHECK(s && s->layer == NULL && s->max_error < 0 && s->band == 1);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "eval", "-layer", "my_triangles", "dem.tif", "-b", "3",
+           "tin.gpkg", "-json", "-max_error", "0");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->layer && strcmp(s->layer, "my_triangles") == 0);
+  CHECK(s && s->band == 3 && s->json && s->max_error == 0);
+  tt_app_options_destroy(o);
+
+  CHECK_USAGE("missing DEM and TIN", "eval");
+  CHECK_USAGE("missing TIN", "eval", "dem.tif");
+  CHECK_USAGE("-max_error", "eval", "a", "b", "-max_error", "-0.1");
+  CHECK_USAGE("does not apply", "eval", "a", "b", "-overwrite");
+  CHECK_USAGE("does not apply", "eval", "a", "b", "-max_points", "5");
+}
+
+static char *slurp(FILE *f)
+{
+  long n = ftell(f);
+  char *buf = calloc((size_t)n + 1, 1);
+  rewind(f);
+  if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n)
+    buf[0] = '\0';
+  return buf;
+}
+
+static void test_progress_bar(void)
+{
+  FILE *f = tmpfile();
+  CHECK(f != NULL);
+  if (!f)
+    return;
+  tt_app_term_progress bar;
+  volatile sig_atomic_t stop = 0;
+  tt_app_term_progress_init(&bar, f, &stop);
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.0, NULL, &bar), 1);
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.12, "x", &bar), 1);
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.05, NULL, &bar), 1); /* back */
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.5, NULL, &bar), 1);
+  CHECK_INT_EQ(tt_app_term_progress_fn(NAN, NULL, &bar), 1); /* ignored */
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.75, NULL, &bar), 1);
+  CHECK_INT_EQ(tt_app_term_progress_fn(1.0, NULL, &bar), 1);
+  CHECK_INT_EQ(tt_app_term_progress_fn(1.0, NULL, &bar), 1); /* once */
+  char *text = slurp(f);
+  CHECK_STR_EQ(text,
+               "0...10...20...30...40...50...60...70...80...90...100 - "
+               "done.\n");
+  free(text);
+  fclose(f);
+
+  /* a second bar has its own state; the stop flag stops it */
+  tt_app_term_progress quiet;
+  tt_app_term_progress_init(&quiet, NULL, &stop);
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.3, NULL, &quiet), 1);
+  stop = 1;
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.4, NULL, &quiet), 0);
+  CHECK_INT_EQ(tt_app_term_progress_fn(0.4, NULL, &bar), 0);
+}
+
+static void test_no_argv(void)
+{
+  tt_app_result res;
+  tt_app_options *o = (tt_app_options *)1;
+  char *none[] = {NULL};
+  CHECK_INT_EQ(tt_app_options_new(none, &o, &res), TT_ERR_ARG);
+  CHECK(o == NULL);
+  CHECK_INT_EQ(res.exit_code, TT_APP_EXIT_USAGE);
+  /* A NULL result pointer is allowed. */
+  CHECK_INT_EQ(tt_app_options_new(none, &o, NULL), TT_ERR_ARG);
+  tt_app_options_destroy(NULL);
+  CHECK(tt_app_options_settings(NULL) == NULL);
+}
+
+int main(void)
+{
+  test_simplify_defaults();
+  test_simplify_all_options();
+  test_simplify_usage_errors();
+  test_help_and_version();
+  test_generate();
+  test_eval();
+  test_progress_bar();
+  test_no_argv();
+  TT_TEST_DONE();
+}
