@@ -72,10 +72,17 @@ typedef struct tt_run_field {
 } tt_run_field;
 
 /* Writes the TIN into an open vector dataset: layers <prefix>triangles
- * (POLYGON Z) and <prefix>vertices (POINT Z), and a one-row table
- * <prefix>run_parameters from fields, in one transaction when the driver has
- * them. srs may be NULL. Options: NLN_PREFIX=<p>, LCO=<NAME=VALUE> (repeat
- * for each layer creation option). */
+ * (POLYGON Z; fields v0 v1 v2 max_err rmse n_samples area_2d area_3d slope
+ * aspect min_angle max_angle; ring v0 v1 v2 v0, counter-clockwise in map
+ * space) and <prefix>vertices (POINT Z; fields vertex_id col row ins_err
+ * ins_rank star_max star_rmse star_n), and a one-row table
+ * <prefix>run_parameters from fields (names of at most 10 characters for a
+ * shapefile). NaN reals are written as NULL. The rows go in one transaction
+ * when the driver has them; on any failure or interruption nothing is
+ * committed and the layers made are deleted again. srs may be NULL.
+ * Options: NLN_PREFIX=<p>, LCO=<NAME=VALUE> (repeat for each layer creation
+ * option). GPKG gets its R-trees built once after the inserts
+ * (LCO=SPATIAL_INDEX=NO: none); shapefiles default to LCO ENCODING=UTF-8. */
 tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            const tt_tin *tin, OGRSpatialReferenceH srs,
                            const tt_run_field *fields, size_t nfields,
