@@ -457,10 +457,12 @@ static TT_NOINLINE int incircle_big(const double a[2], const double b[2],
 #define INCIRCLE_LO 0x1p-170
 #define INCIRCLE_HI 0x1p+230
 
-static inline int in_range(double x, double lo, double hi)
+/* Whether x is neither zero nor in [lo, hi], or NaN; without branches (a
+ * short-circuit chain costs as much as the filter itself). */
+static inline int out_of_range(double x, double lo, double hi)
 {
   double ax = fabs(x);
-  return x == 0.0 || (ax >= lo && ax <= hi);
+  return (ax > hi) | (ax != ax) | ((ax < lo) & (ax != 0.0));
 }
 
 /* Exact orient2d from the raw coordinates: the sum of the six products
@@ -486,12 +488,12 @@ static int orient2d_far(const double a[2], const double b[2],
 
 int tt__orient2d(const double a[2], const double b[2], const double c[2])
 {
-  if (!(in_range(a[0], ORIENT_LO, ORIENT_HI) &&
-        in_range(a[1], ORIENT_LO, ORIENT_HI) &&
-        in_range(b[0], ORIENT_LO, ORIENT_HI) &&
-        in_range(b[1], ORIENT_LO, ORIENT_HI) &&
-        in_range(c[0], ORIENT_LO, ORIENT_HI) &&
-        in_range(c[1], ORIENT_LO, ORIENT_HI)))
+  if (out_of_range(a[0], ORIENT_LO, ORIENT_HI) |
+      out_of_range(a[1], ORIENT_LO, ORIENT_HI) |
+      out_of_range(b[0], ORIENT_LO, ORIENT_HI) |
+      out_of_range(b[1], ORIENT_LO, ORIENT_HI) |
+      out_of_range(c[0], ORIENT_LO, ORIENT_HI) |
+      out_of_range(c[1], ORIENT_LO, ORIENT_HI))
     return orient2d_far(a, b, c);
 
   double detleft = (a[0] - c[0]) * (b[1] - c[1]);
@@ -601,7 +603,7 @@ static int rescale(int n, const double *v, double *out, double lo, double hi)
   frexp(vmax, &ex);
   for (int i = 0; i < n; i++) {
     out[i] = ldexp(v[i], -ex);
-    if (!in_range(out[i], lo, hi) || (v[i] != 0.0 && out[i] == 0.0))
+    if (out_of_range(out[i], lo, hi) || (v[i] != 0.0 && out[i] == 0.0))
       return 0;
   }
   return 1;
@@ -633,14 +635,14 @@ static TT_NOINLINE int incircle_far(const double a[2], const double b[2],
 int tt__incircle(const double a[2], const double b[2], const double c[2],
                  const double d[2])
 {
-  if (!(in_range(a[0], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(a[1], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(b[0], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(b[1], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(c[0], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(c[1], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(d[0], INCIRCLE_LO, INCIRCLE_HI) &&
-        in_range(d[1], INCIRCLE_LO, INCIRCLE_HI)))
+  if (out_of_range(a[0], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(a[1], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(b[0], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(b[1], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(c[0], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(c[1], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(d[0], INCIRCLE_LO, INCIRCLE_HI) |
+      out_of_range(d[1], INCIRCLE_LO, INCIRCLE_HI))
     return incircle_far(a, b, c, d);
 
   double adx = a[0] - d[0], ady = a[1] - d[1];
@@ -726,6 +728,15 @@ static inline int sign_i128(tt__i128 v)
   return v > 0 ? 1 : (v < 0 ? -1 : 0);
 }
 
+#ifndef NDEBUG
+/* The documented input bound |coordinate| < 2^28 (int64 minors overflow
+ * somewhat above it). */
+static int coord_ok(int64_t v)
+{
+  return v > -((int64_t)1 << 28) && v < ((int64_t)1 << 28);
+}
+#endif
+
 /* Adds mk * dk exactly to the expansion h of length n; returns the length. */
 static int add_product(int n, double *h, double mk, tt__i128 dk)
 {
@@ -770,9 +781,9 @@ static TT_NOINLINE int metric_general(const tt__metric *m, tt__i128 d1,
 {
   double mk[3] = {m->m11, m->m12, m->m22};
   tt__i128 dk[3] = {d1, d2x2, d3};
-  if (!(in_range(mk[0], METRIC_LO, METRIC_HI) &&
-        in_range(mk[1], METRIC_LO, METRIC_HI) &&
-        in_range(mk[2], METRIC_LO, METRIC_HI)))
+  if (out_of_range(mk[0], METRIC_LO, METRIC_HI) |
+      out_of_range(mk[1], METRIC_LO, METRIC_HI) |
+      out_of_range(mk[2], METRIC_LO, METRIC_HI))
     return metric_big(mk, dk);
 
   double t1 = mk[0] * (double)d1;
@@ -796,6 +807,8 @@ int tt__incircle_metric(const tt__metric *m, int64_t ax, int64_t ay,
                         int64_t bx, int64_t by, int64_t cx, int64_t cy,
                         int64_t dx, int64_t dy)
 {
+  assert(coord_ok(ax) && coord_ok(ay) && coord_ok(bx) && coord_ok(by) &&
+         coord_ok(cx) && coord_ok(cy) && coord_ok(dx) && coord_ok(dy));
   int64_t adx = ax - dx, ady = ay - dy;
   int64_t bdx = bx - dx, bdy = by - dy;
   int64_t cdx = cx - dx, cdy = cy - dy;
