@@ -89,18 +89,26 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            char **options, tt_progress_fn progress,
                            void *progress_arg);
 
-/* Reads the triangles of a POLYGON Z (or MULTIPOLYGON Z / TIN) layer into
- * pixel-space (col,row,z) triples for tt_eval_triangles(): 9 doubles per
- * triangle, map coordinates put through the inverse of gt. Polygons that are
- * not triangles (4 ring points) are counted in *out_rejected.
- * The caller owns *out_xyz and frees it with free(). */
+/* Reads the triangles of a POLYGON Z (or TRIANGLE Z, MULTIPOLYGON Z, TIN Z,
+ * POLYHEDRALSURFACE Z, GEOMETRYCOLLECTION Z) layer into pixel-centre
+ * (col,row,z) triples for tt_eval_triangles(): 9 doubles per triangle, map
+ * x,y put through the inverse of gt and shifted by -0.5 (sample (c,r) at
+ * (c,r)), z from the geometry. Counted in *out_rejected (may be NULL), one
+ * per polygon or per feature: polygons that are not triangles (a closed
+ * ring of 4 points, no holes), polygons without Z, other geometry types and
+ * features without geometry. The layer's filters apply. *out_xyz is NULL
+ * when no triangle was found. The caller owns *out_xyz and frees it with
+ * free(). */
 tt_status tt_ogr_read_triangles(tt_context *ctx, OGRLayerH layer,
                                 const double gt[6], double **out_xyz,
                                 size_t *out_ntriangles, size_t *out_rejected);
 
-/* Writes a grid as a single-band Float32 GeoTIFF (nodata NaN when the grid
- * has any), with srs_wkt ("" for none). Written to a temporary name and
- * renamed on success. */
+/* Writes a grid as a single-band Float32 GeoTIFF (TILED=YES,
+ * COMPRESS=DEFLATE; nodata NaN only when the grid has NaN), with the grid's
+ * geotransform and srs_wkt ("" or NULL for none). Written to a temporary
+ * name beside path and renamed on success (see tt_output); an existing
+ * path is refused with TT_ERR_EXISTS unless overwrite. Needs the GTiff
+ * driver registered. */
 tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
                              const char *path, const char *srs_wkt,
                              int overwrite);

@@ -5,7 +5,8 @@
  * the values written, the refusals (NaN not marked nodata, all nodata, 1 x N,
  * MAX_MEMORY, GCP-only), the geographic ground frame against an independent
  * series, GDAL's block cache held small during the read, and the shared real
- * DEMs when TT_SHARED_TESTDATA is present (skipped otherwise).
+ * DEMs when TT_SHARED_TESTDATA is present (skipped otherwise). Also
+ * tt_gdal_write_grid(): written, refused, overwritten and read back.
  */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
@@ -544,6 +545,101 @@ static void test_cache_and_progress(tt_context *ctx)
   GDALClose(ds);
 }
 
+/* tt_gdal_write_grid: Float32, tiled, DEFLATE, NaN nodata only when
+ * needed, CRS, temporary name, refusal without overwrite; read back. */
+static void test_write_grid(tt_context *ctx)
+{
+  const size_t nx = 300, ny = 270; /* more than one 256 x 256 tile */
+  float *z = malloc(nx * ny * sizeof *z);
+  for (size_t i = 0; i < nx * ny; i++)
+    z[i] = (float)(0.125 * (double)(i % 977)) - 40.0f;
+  z[17] = z[nx * ny - 1] = NAN;
+  tt_grid *g = NULL;
+  CHECK_OK(ctx, tt_grid_create_from_floats(ctx, nx, ny, z, &g));
+  const double gt[6] = {600000, 25, 0, 5100000, 0, -25};
+  CHECK_OK(ctx, tt_grid_set_geotransform(ctx, g, gt));
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
+  OSRImportFromEPSG(srs, 32633);
+  char *wkt = NULL;
+  OSRExportToWkt(srs, &wkt);
+  OSRDestroySpatialReference(srs);
+
+  char dir[300], path[400];
+  snprintf(dir, sizeof dir, "%s/wg", tmpdir);
+  mkdir(dir, 0777);
+  snprintf(path, sizeof path, "%s/grid.tif", dir);
+  CHECK_OK(ctx, tt_gdal_write_grid(ctx, g, path, wkt, 0));
+  CHECK_INT_EQ(tt_gdal_write_grid(ctx, g, path, wkt, 0), TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), path) != NULL);
+
+  GDALDatasetH ds = GDALOpen(path, GA_ReadOnly);
+  CHECK(ds != NULL);
+  if (ds) {
+    GDALRasterBandH b = GDALGetRasterBand(ds, 1);
+    CHECK_INT_EQ(GDALGetRasterDataType(b), GDT_Float32);
+    int bw = 0, bh = 0, has_nd = 0;
+    GDALGetBlockSize(b, &bw, &bh);
+    CHECK_INT_EQ(bw, 256);
+    CHECK_INT_EQ(bh, 256);
+    CHECK_STR_EQ(GDALGetMetadataItem(ds, "COMPRESSION", "IMAGE_STRUCTURE"),
+                 "DEFLATE");
+    CHECK(isnan(GDALGetRasterNoDataValue(b, &has_nd)));
+    CHECK(has_nd);
+    tt_grid *back = NULL;
+    tt_raster_info *info = NULL;
+    CHECK_OK(ctx, tt_gdal_read_grid(ctx, b, NULL, NULL, NULL, &back,
+                                    &info));
+    if (back) {
+      double want_gt[6];
+      tt_grid_get_geotransform(back, want_gt);
+      for (int i = 0; i < 6; i++)
+        CHECK_DBL_NEAR(want_gt[i], gt[i], 0);
+      const float *zb = tt_grid_heights_const(back);
+      size_t bad = 0;
+      for (size_t i = 0; i < nx * ny; i++)
+        bad += !(zb[i] == z[i] || (isnan(zb[i]) && isnan(z[i])));
+      CHECK_INT_EQ(bad, 0);
+      CHECK_INT_EQ(info->valid_samples, nx * ny - 2);
+      CHECK(strstr(info->crs_name, "32633") != NULL);
+    }
+    tt_grid_destroy(back);
+    tt_raster_info_destroy(info);
+    GDALClose(ds);
+  }
+
+  /* Overwrite with a grid without NaN: no nodata declared; no CRS. */
+  for (size_t i = 0; i < nx * ny; i++)
+    if (isnan(tt_grid_heights(g)[i]))
+      tt_grid_heights(g)[i] = 1;
+  CHECK_OK(ctx, tt_gdal_write_grid(ctx, g, path, "", 1));
+  ds = GDALOpen(path, GA_ReadOnly);
+  if (ds) {
+    int has_nd = 1;
+    GDALGetRasterNoDataValue(GDALGetRasterBand(ds, 1), &has_nd);
+    CHECK(!has_nd);
+    CHECK(GDALGetSpatialRef(ds) == NULL);
+    GDALClose(ds);
+  }
+  /* Nothing but the final file in the folder; a bad CRS leaves nothing. */
+  snprintf(path, sizeof path, "%s/bad.tif", dir);
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  CHECK_INT_EQ(tt_gdal_write_grid(ctx, g, path, "not a crs", 0), TT_ERR_ARG);
+  CPLPopErrorHandler();
+  char **files = VSIReadDir(dir);
+  int nfiles = 0;
+  for (int i = 0; files && files[i]; i++) {
+    if (strcmp(files[i], ".") == 0 || strcmp(files[i], "..") == 0)
+      continue;
+    nfiles++;
+    CHECK_STR_EQ(files[i], "grid.tif");
+  }
+  CHECK_INT_EQ(nfiles, 1);
+  CSLDestroy(files);
+  CPLFree(wkt);
+  free(z);
+  tt_grid_destroy(g);
+}
+
 static int test_shared_data(tt_context *ctx)
 {
   const char *root = getenv("TT_SHARED_TESTDATA");
@@ -628,6 +724,7 @@ int main(void)
   test_geographic_frame(ctx);
   test_refusals(ctx);
   test_cache_and_progress(ctx);
+  test_write_grid(ctx);
   int shared = test_shared_data(ctx);
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);
