@@ -4,11 +4,39 @@
  * written once by its producer (reader, generator, caller) and then only
  * read: the engine never modifies heights. Memory: 4 bytes per sample.
  */
+/* madvise() and MADV_HUGEPAGE are outside ISO C and POSIX. */
+#define _DEFAULT_SOURCE 1
+
 #include "internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+/* Heights of large grids sit on 2 MiB boundaries with transparent huge
+ * pages requested: the raster scans walk short rows 4 * nx bytes apart, and
+ * with 4 KiB pages nearly every row of a small triangle misses the TLB
+ * (measured: 30% of refinement time on a 4097^2 grid). Only advice: where
+ * the kernel does not give huge pages, nothing changes. */
+#define HUGE_ALIGN ((size_t)2 << 20)
+
+static float *alloc_heights(size_t n)
+{
+  size_t bytes = n * sizeof(float);
+  if (bytes < 4 * HUGE_ALIGN)
+    return malloc(bytes);
+  void *p = NULL;
+  size_t rounded = (bytes + HUGE_ALIGN - 1) / HUGE_ALIGN * HUGE_ALIGN;
+  if (posix_memalign(&p, HUGE_ALIGN, rounded) != 0)
+    return NULL;
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+  return p;
+}
 
 tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
                          tt_grid **out_grid)
@@ -30,7 +58,7 @@ tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
   tt_grid *g = calloc(1, sizeof *g);
   if (!g)
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory for a grid");
-  g->z = malloc(nx * ny * sizeof(float));
+  g->z = alloc_heights(nx * ny);
   if (!g->z) {
     free(g);
     return tt__error(ctx, TT_ERR_NOMEM,

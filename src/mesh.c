@@ -26,6 +26,7 @@ void tt__mesh_free(tt__mesh *m)
 {
   free(m->vc);
   free(m->vr);
+  free(m->vz);
   free(m->vedge);
   free(m->hv);
   free(m->twin);
@@ -39,12 +40,13 @@ static bool grow_vertices(tt__mesh *m, size_t need)
 {
   if (need <= m->vcap)
     return true;
-  size_t c1 = m->vcap, c2 = m->vcap, c3 = m->vcap;
+  size_t c1 = m->vcap, c2 = m->vcap, c3 = m->vcap, c4 = m->vcap;
   if (!tt__grow((void **)&m->vc, &c1, need, sizeof(int32_t)) ||
       !tt__grow((void **)&m->vr, &c2, need, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->vz, &c4, need, sizeof(float)) ||
       !tt__grow((void **)&m->vedge, &c3, need, sizeof(int32_t)))
     return false;
-  /* all three grew by the same rule from the same capacity */
+  /* all four grew by the same rule from the same capacity */
   m->vcap = c1;
   return true;
 }
@@ -74,13 +76,14 @@ bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt)
   return grow_vertices(m, nv) && grow_triangles(m, nt);
 }
 
-int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row)
+int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row, float z)
 {
   if (m->nv >= TT_MAX_VERTICES || !grow_vertices(m, m->nv + 1))
     return -1;
   int32_t v = (int32_t)m->nv++;
   m->vc[v] = col;
   m->vr[v] = row;
+  m->vz[v] = z;
   m->vedge[v] = -1;
   return v;
 }

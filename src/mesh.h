@@ -30,6 +30,8 @@
 typedef struct tt__mesh {
   /* vertices */
   int32_t *vc, *vr;      /* pixel column, row */
+  float *vz;             /* height (kept here so scans need not fetch it
+                            from the grid at a random place) */
   int32_t *vedge;        /* a half-edge leaving the vertex, or -1 */
   size_t nv, vcap;
   /* triangles (3 half-edges each) */
@@ -62,7 +64,8 @@ TT_HIDDEN bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt);
 
 /* Adds an unconnected vertex; returns its index, or -1 when out of memory
  * or past TT_MAX_VERTICES. */
-TT_HIDDEN int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row);
+TT_HIDDEN int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row,
+                                      float z);
 
 /* Adds triangle (a, b, c), which must be counter-clockwise in the ground
  * frame, with no twins; returns its slot or -1 when out of memory. */

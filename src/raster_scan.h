@@ -26,9 +26,9 @@ typedef struct tt__scan_tri {
   bool own[3];          /* samples on edge i (corner i -> i+1) are ours */
 } tt__scan_tri;
 
-/* Fills st for live triangle t of the mesh over grid g. */
-TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, const tt_grid *g,
-                                      int32_t t, tt__scan_tri *st);
+/* Fills st for live triangle t of the mesh. */
+TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t,
+                                      tt__scan_tri *st);
 
 /* The owned sample with the largest |H - H'| > 0; *out_index = -1 (and
  * *out_err = 0) when every owned sample is exact or nodata. Ties go to the

@@ -21,6 +21,7 @@
 #include "criteria/criterion.h"
 #include "heap.h"
 #include "mesh.h"
+#include "parallel.h"
 #include "predicates.h"
 #include "raster_scan.h"
 #include "swap.h"
@@ -51,6 +52,9 @@ typedef struct refine {
   double *ins_err;     /* per vertex */
   size_t inscap;
   tt__edge_stack stack;
+  tt__pool *pool;      /* NULL: single-threaded */
+  int32_t *jobs;       /* live triangles to rescan in this round */
+  size_t jobcap;
   size_t max_points, max_tris;
   double max_error;    /* < 0: none */
   /* progress */
@@ -81,7 +85,8 @@ static bool fit_slots(refine *r)
 static bool add_vertex(refine *r, int32_t col, int32_t row, double err,
                        int32_t *out_v)
 {
-  int32_t v = tt__mesh_add_vertex(&r->m, col, row);
+  int32_t v = tt__mesh_add_vertex(
+      &r->m, col, row, r->g->z[(size_t)row * r->g->nx + (size_t)col]);
   if (v < 0 || !tt__grow((void **)&r->ins_err, &r->inscap, (size_t)v + 1,
                          sizeof(double)))
     return false;
@@ -90,24 +95,15 @@ static bool add_vertex(refine *r, int32_t col, int32_t row, double err,
   return true;
 }
 
-static bool rescan(refine *r, int32_t t)
+/* A job of the scan pool: the candidate of one live triangle, written into
+ * its own slot of cand/cerr (jobs share nothing else). */
+static void scan_job(void *arg, size_t i)
 {
-  if (!tt__mesh_live(&r->m, t)) {
-    tt__heap_remove(&r->heap, t);
-    return true;
-  }
+  refine *r = arg;
+  int32_t t = r->jobs[i];
   tt__scan_tri st;
-  double err;
-  int64_t idx;
-  tt__scan_tri_from_mesh(&r->m, r->g, t, &st);
-  tt__scan_candidate(r->g, &st, &err, &idx);
-  r->cand[t] = idx;
-  r->cerr[t] = err;
-  if (idx < 0) {
-    tt__heap_remove(&r->heap, t);
-    return true;
-  }
-  return tt__heap_set(&r->heap, t, err);
+  tt__scan_tri_from_mesh(&r->m, t, &st);
+  tt__scan_candidate(r->g, &st, &r->cerr[t], &r->cand[t]);
 }
 
 static int cmp_i32(const void *a, const void *b)
@@ -116,21 +112,43 @@ static int cmp_i32(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
+/* Rescans the given triangle slots, each once: dead slots leave the heap,
+ * live ones are scanned (in parallel when there is a pool) and then, in
+ * slot order, enter the heap or leave it. */
+static bool rescan(refine *r, int32_t *slots, size_t n)
+{
+  if (!fit_slots(r) ||
+      !tt__grow((void **)&r->jobs, &r->jobcap, n ? n : 1, sizeof(int32_t)))
+    return false;
+  qsort(slots, n, sizeof(int32_t), cmp_i32);
+  size_t njobs = 0;
+  for (size_t i = 0; i < n; i++) {
+    int32_t t = slots[i];
+    if (i > 0 && t == slots[i - 1])
+      continue;
+    if (tt__mesh_live(&r->m, t))
+      r->jobs[njobs++] = t;
+    else
+      tt__heap_remove(&r->heap, t);
+  }
+  tt__pool_run(r->pool, njobs, scan_job, r);
+  for (size_t i = 0; i < njobs; i++) {
+    int32_t t = r->jobs[i];
+    if (r->cand[t] < 0)
+      tt__heap_remove(&r->heap, t);
+    else if (!tt__heap_set(&r->heap, t, r->cerr[t]))
+      return false;
+  }
+  return true;
+}
+
 /* Rescans each triangle slot the mesh logged, once. */
 static bool drain(refine *r)
 {
   tt__mesh *m = &r->m;
-  if (!fit_slots(r))
-    return false;
-  qsort(m->touched, m->ntouched, sizeof(int32_t), cmp_i32);
-  for (size_t i = 0; i < m->ntouched; i++) {
-    if (i > 0 && m->touched[i] == m->touched[i - 1])
-      continue;
-    if (!rescan(r, m->touched[i]))
-      return false;
-  }
+  bool ok = rescan(r, m->touched, m->ntouched);
   tt__mesh_clear_touched(m);
-  return true;
+  return ok;
 }
 
 /* --- starting triangulation -------------------------------------------- */
@@ -250,12 +268,9 @@ static tt_status start(refine *r, size_t valid)
   if (!tt__mesh_link_all(&r->m) ||
       tt__swap_all(&r->m, r->crit, &r->env, &r->stack) < 0)
     return oom(r);
-  tt__mesh_clear_touched(&r->m);
-  if (!fit_slots(r))
+  /* every slot written so far is logged: scan them all */
+  if (!drain(r))
     return oom(r);
-  for (size_t t = 0; t < r->m.nslots; t++)
-    if (!rescan(r, (int32_t)t))
-      return oom(r);
   return TT_OK;
 }
 
@@ -346,6 +361,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   tt__heap_init(&r.heap);
   r.env.mesh = &r.m;
   r.env.grid = grid;
+  int nthreads = opt->threads;
+  if (nthreads == 0 && grid->nx * grid->ny < ((size_t)1 << 20))
+    nthreads = 1; /* small grids: handing jobs over costs more than it saves */
+  r.pool = tt__pool_create(tt__pool_threads(nthreads));
   r.max_error = opt->max_error;
   r.max_points = opt->max_points;
   r.max_tris = opt->max_triangles;
@@ -437,7 +456,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.cand = NULL;
   r.cerr = NULL;
   tt__edge_stack_free(&r.stack);
-  status = tt__tin_build(ctx, &r.m, grid, r.ins_err, out_tin);
+  status = tt__tin_build(ctx, &r.m, grid, r.ins_err, r.pool, out_tin);
   r.ins_err = NULL; /* taken over by the tin, or freed on failure */
   if (status != TT_OK)
     goto done;
@@ -450,6 +469,8 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
 done:
+  tt__pool_destroy(r.pool);
+  free(r.jobs);
   tt__heap_free(&r.heap);
   free(r.cand);
   free(r.cerr);

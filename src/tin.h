@@ -10,6 +10,7 @@
 
 #include "internal.h"
 #include "mesh.h"
+#include "parallel.h"
 
 struct tt_tin {
   size_t nv, nt;
@@ -30,11 +31,12 @@ struct tt_tin {
   tt_tin_summary summary;
 };
 
-/* Builds a tin from the mesh's live triangles (in slot order) with the
+/* Builds a tin from the mesh's live triangles (in spatial order) with the
  * error statistics of every sample (metrics.c). ins_err: per mesh vertex
- * (taken over, freed by the tin). Frees nothing of the mesh. */
+ * (taken over, freed by the tin). Frees nothing of the mesh. The scans
+ * run on pool (may be NULL); the result does not depend on it. */
 TT_HIDDEN tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m,
                                   const tt_grid *g, double *ins_err,
-                                  tt_tin **out_tin);
+                                  tt__pool *pool, tt_tin **out_tin);
 
 #endif /* TT_TIN_H */

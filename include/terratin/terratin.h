@@ -168,6 +168,10 @@ typedef struct tt_refine_options {
   /* Stop at floor(percent/100 * valid samples) vertices; 0: none. */
   double percent;
   tt_criterion criterion;
+  /* Threads for the raster scans: 0 = automatic (all online CPUs for grids
+   * of a million samples or more, else 1), 1 = the caller's only, N = N.
+   * The result does not depend on it. */
+  int threads;
   /* Called now and then with the fraction done; may be NULL. */
   tt_progress_fn progress;
   void *progress_arg;

@@ -49,10 +49,10 @@ static void run(const double frame[4], uint64_t seed)
   tt__mesh m;
   tt__mesh_init(&m, &metric);
   const int W = 40, H = 30;
-  int32_t v0 = tt__mesh_add_vertex(&m, 0, 0);
-  int32_t v1 = tt__mesh_add_vertex(&m, W, 0);
-  int32_t v2 = tt__mesh_add_vertex(&m, W, H);
-  int32_t v3 = tt__mesh_add_vertex(&m, 0, H);
+  int32_t v0 = tt__mesh_add_vertex(&m, 0, 0, 0.0f);
+  int32_t v1 = tt__mesh_add_vertex(&m, W, 0, 0.0f);
+  int32_t v2 = tt__mesh_add_vertex(&m, W, H, 0.0f);
+  int32_t v3 = tt__mesh_add_vertex(&m, 0, H, 0.0f);
   if (tt__mesh_orient(&m, v0, v1, v2) > 0) {
     tt__mesh_add_triangle(&m, v0, v1, v2);
     tt__mesh_add_triangle(&m, v0, v2, v3);
@@ -80,7 +80,7 @@ static void run(const double frame[4], uint64_t seed)
       if (t < 0 || on == -2)
         goto out;
       used[c][r] = 1;
-      int32_t v = tt__mesh_add_vertex(&m, c, r);
+      int32_t v = tt__mesh_add_vertex(&m, c, r, 0.0f);
       int32_t opp[4];
       int nopp = 3;
       if (on < 0)

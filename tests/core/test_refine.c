@@ -381,9 +381,38 @@ static void test_errors(void)
   tt_grid_destroy(g);
 }
 
+/* The worker pool changes nothing: 1 and 3 threads give the same TIN and
+ * the same statistics. */
+static void test_threads(void)
+{
+  tt_grid *g = terrain(301, 257, 11, 25.0);
+  tt_refine_options opt;
+  tt_refine_options_init(&opt);
+  opt.max_error = 3;
+  tt_tin *one = NULL, *three = NULL;
+  opt.threads = 1;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &one));
+  opt.threads = 3;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &three));
+  if (one && three) {
+    CHECK(same_tin(one, three));
+    tt_tin_summary a, b;
+    tt_tin_get_summary(one, &a);
+    tt_tin_get_summary(three, &b);
+    CHECK(a.errors.max_error == b.errors.max_error);
+    CHECK(a.errors.rmse == b.errors.rmse);
+    CHECK(a.errors.total_abs == b.errors.total_abs);
+    CHECK_INT_EQ(a.errors.samples, b.errors.samples);
+  }
+  tt_tin_destroy(one);
+  tt_tin_destroy(three);
+  tt_grid_destroy(g);
+}
+
 int main(void)
 {
   ctx = tt_context_create();
+  test_threads();
   test_bounds_and_frames();
   test_stop_conditions();
   test_flat_and_plane();
