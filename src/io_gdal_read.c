@@ -161,7 +161,23 @@ static tt_status parse_options(tt_context *ctx, char **options,
   return TT_OK;
 }
 
-static double mib(size_t bytes) { return (double)bytes / 1048576.0; }
+/* "31.2 KiB", "1.5 GiB": sizes for messages. */
+static const char *fmt_bytes(char *buf, size_t size, size_t bytes)
+{
+  static const char *const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB",
+                                      "PiB", "EiB"};
+  double v = (double)bytes;
+  int u = 0;
+  while (v >= 1024.0 && u < 6) {
+    v /= 1024.0;
+    u++;
+  }
+  if (u == 0)
+    snprintf(buf, size, "%zu bytes", bytes);
+  else
+    snprintf(buf, size, "%.1f %s", v, units[u]);
+  return buf;
+}
 
 /* Prefixes the context's current message with "path: ". */
 static tt_status with_path(tt_context *ctx, tt_status s, const char *path)
@@ -189,11 +205,24 @@ static tt_status describe_crs(tt_context *ctx, OGRSpatialReferenceH srs,
     const char *crs = OSRGetName(srs);
     const char *auth = OSRGetAuthorityName(srs, NULL);
     const char *code = OSRGetAuthorityCode(srs, NULL);
-    if (auth && code)
+    if (auth && code) {
       snprintf(name, sizeof name, "%s (%s:%s)", crs ? crs : "unnamed", auth,
                code);
-    else
-      snprintf(name, sizeof name, "%s", crs ? crs : "unnamed");
+    } else {
+      /* No code of its own (USGS DEM, .prj files): say what it looks like,
+       * which helps more than "unnamed". Only the name is affected. */
+      OGRSpatialReferenceH guess = OSRClone(srs);
+      CPLPushErrorHandler(CPLQuietErrorHandler);
+      int found = guess && OSRAutoIdentifyEPSG(guess) == OGRERR_NONE;
+      CPLPopErrorHandler();
+      const char *gcode = found ? OSRGetAuthorityCode(guess, NULL) : NULL;
+      if (gcode)
+        snprintf(name, sizeof name, "%s (like EPSG:%s)",
+                 crs ? crs : "unnamed", gcode);
+      else
+        snprintf(name, sizeof name, "%s", crs ? crs : "unnamed");
+      OSRDestroySpatialReference(guess);
+    }
     info->crs_is_geographic = OSRIsGeographic(srs) ? 1 : 0;
   }
   info->crs_wkt = dup_str(wkt);
@@ -210,10 +239,10 @@ static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
                               size_t nx, size_t r0, size_t nrows,
                               const unsigned char *mask,
                               const read_options *opt, double scale,
-                              double offset, size_t *valid)
+                              double offset, size_t *valid_count)
 {
-  const double zs = scale * opt->z_factor, zo = offset * opt->z_factor;
-  const int identity = zs == 1.0 && zo == 0.0;
+  const double zf = opt->z_factor;
+  const int identity = scale == 1.0 && offset == 0.0 && zf == 1.0;
   for (size_t r = 0; r < nrows; r++) {
     float *row = z + (r0 + r) * nx;
     const unsigned char *mrow = mask ? mask + r * nx : NULL;
@@ -228,8 +257,15 @@ static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
         row[c] = NAN;
         continue;
       }
-      float h = identity ? raw : (float)((double)raw * zs + zo);
+      /* Scale and offset first, then Z_FACTOR, as documented. */
+      double hd = ((double)raw * scale + offset) * zf;
+      float h = identity ? raw : (float)hd;
       if (!isfinite(h)) {
+        if (isnan(raw) && opt->has_srcnodata)
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is NaN, which SRCNODATA %g does not cover "
+                           "(use -srcnodata nan)", path, r0 + r, c,
+                           (double)opt->srcnodata);
         if (isnan(raw))
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                            "%zu is NaN but not marked nodata (use "
@@ -241,11 +277,10 @@ static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
         return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                          "%zu is %g after scale %g, offset %g and Z_FACTOR "
                          "%g: too large for a 32-bit float", path, r0 + r, c,
-                         (double)raw * zs + zo, scale, offset,
-                         opt->z_factor);
+                         hd, scale, offset, zf);
       }
       row[c] = h;
-      (*valid)++;
+      (*valid_count)++;
     }
   }
   return TT_OK;
@@ -305,9 +340,11 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   }
   const size_t need = nx * ny * sizeof(float);
   if (need > opt.max_memory) {
-    s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %.1f "
-                  "MiB, more than MAX_MEMORY (%.1f MiB)", path, nx, ny,
-                  mib(need), mib(opt.max_memory));
+    char need_s[32], max_s[32];
+    s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %s, "
+                  "more than MAX_MEMORY (%s)", path, nx, ny,
+                  fmt_bytes(need_s, sizeof need_s, need),
+                  fmt_bytes(max_s, sizeof max_s, opt.max_memory));
     goto done;
   }
 
