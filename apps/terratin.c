@@ -35,8 +35,14 @@ static void install_handlers(void)
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
-  for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++)
+  for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+    /* A signal ignored by the parent stays ignored (nohup, the SIGINT of a
+     * shell's background job). */
+    struct sigaction old;
+    if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+      continue;
     sigaction(sigs[i], &sa, NULL);
+  }
   signal(SIGPIPE, SIG_IGN);
 }
 

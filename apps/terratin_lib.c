@@ -46,21 +46,6 @@
 #define TT_APP_PRINTF_(a, b)
 #endif
 
-/* TEMPORARY: the glue's grid writer and triangle reader are being written
- * (src/io_gdal_write.c, src/io_ogr_read.c); until they land, generate and
- * eval report it instead of breaking the link for everyone. */
-#ifndef TT_APP_GLUE_PENDING
-#define TT_APP_GLUE_PENDING 1
-#endif
-#if TT_APP_GLUE_PENDING
-static tt_status tt_glue_pending(tt_context *ctx, const char *what)
-{
-  (void)ctx;
-  (void)what;
-  return TT_ERR_INTERNAL;
-}
-#endif
-
 /* ===========================================================================
  * Small helpers
  * ========================================================================= */
@@ -1484,6 +1469,29 @@ static int ext_in_list(const char *list, const char *ext)
   return 0;
 }
 
+/* Drivers whose datasets tt_output cannot keep safe: they write no file
+ * (Memory, database connections), or they put each further layer in a file
+ * of its own beside OUTPUT (CSV), outside the temporary name, where it could
+ * replace a file without -overwrite and survive a failure. */
+static int refuse_driver(app_run *r, GDALDriverH drv)
+{
+  const char *name = GDALGetDriverShortName(drv);
+  if (!GDALGetMetadataItem(drv, GDAL_DMD_EXTENSIONS, NULL) &&
+      !GDALGetMetadataItem(drv, GDAL_DMD_EXTENSION, NULL)) {
+    run_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: -of '%s': the driver does not write files", name);
+    return 1;
+  }
+  if (str_ieq(name, "CSV")) {
+    run_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: -of CSV writes each layer to a file of its own "
+             "beside OUTPUT, which cannot be written safely; use GPKG, "
+             "SQLite or \"ESRI Shapefile\"");
+    return 1;
+  }
+  return 0;
+}
+
 /* The output driver: -of, else the first vector driver that can create and
  * claims OUTPUT's extension (GPKG and ESRI Shapefile first), else GPKG. */
 static GDALDriverH output_driver(app_run *r)
@@ -1503,7 +1511,7 @@ static GDALDriverH output_driver(app_run *r)
                "datasets", of);
       return NULL;
     }
-    return drv;
+    return refuse_driver(r, drv) ? NULL : drv;
   }
   char ext[32] = "";
   const char *base = strrchr(r->s->output, '/');
@@ -1528,7 +1536,7 @@ static GDALDriverH output_driver(app_run *r)
       if (!exts)
         exts = GDALGetMetadataItem(drv, GDAL_DMD_EXTENSION, NULL);
       if (exts && ext_in_list(exts, ext))
-        return drv;
+        return refuse_driver(r, drv) ? NULL : drv;
     }
   }
   GDALDriverH drv = GDALGetDriverByName("GPKG");
@@ -1635,7 +1643,7 @@ static void print_simplify_summary(app_run *r, const simplify_report *p)
   char lim[256] = "", num[40];
   size_t n = 0;
   if (ro->max_error >= 0) {
-    format_double(num, sizeof num, ro->max_error);
+    snprintf(num, sizeof num, "%.6g", ro->max_error);
     n += (size_t)snprintf(lim + n, sizeof lim - n, "%smax_error %s %s%s",
                           n ? ", " : "", num, unit,
                           p->default_error ? " (default: 0.5% of the height "
@@ -1649,7 +1657,7 @@ static void print_simplify_summary(app_run *r, const simplify_report *p)
     n += (size_t)snprintf(lim + n, sizeof lim - n, "%smax_triangles %zu",
                           n ? ", " : "", ro->max_triangles);
   if (ro->percent > 0 && n < sizeof lim) {
-    format_double(num, sizeof num, ro->percent);
+    snprintf(num, sizeof num, "%.6g", ro->percent);
     snprintf(lim + n, sizeof lim - n, "%spercent %s", n ? ", " : "", num);
   }
   fprintf(r->out,
@@ -1741,7 +1749,7 @@ static tt_status run_simplify(app_run *r)
   double t = app_now();
   st = tt_refine_run(r->ctx, grid, &ro, &tin);
   if (st != TT_OK) {
-    run_fail_tt(r, st, s->input);
+    run_fail_tt(r, st, st == TT_ERR_INTERRUPTED ? s->output : s->input);
     goto done;
   }
   rep.t_simplify = app_now() - t;
@@ -1907,12 +1915,8 @@ static tt_status run_generate(app_run *r)
     goto done;
   }
   r->msg.last[0] = '\0';
-#if TT_APP_GLUE_PENDING
-  st = tt_glue_pending(r->ctx, "tt_gdal_write_grid");
-#else
   st = tt_gdal_write_grid(r->ctx, grid, s->output, wkt ? wkt : "",
                           s->overwrite);
-#endif
   if (st == TT_ERR_EXISTS) {
     run_fail(r, TT_APP_EXIT_FAILURE, st, s->output,
              "exists; use -overwrite to replace it");
@@ -2072,11 +2076,8 @@ static tt_status run_eval(app_run *r)
   }
 
   r->msg.last[0] = '\0';
-#if TT_APP_GLUE_PENDING
-  st = tt_glue_pending(r->ctx, "tt_ogr_read_triangles");
-#else
-  st = tt_ogr_read_triangles(r->ctx, layer, info->gt, &xyz, &ntri, &rejected);
-#endif
+  st = tt_ogr_read_triangles(r->ctx, layer, info->gt, &xyz, &ntri,
+                             &rejected);
   if (st != TT_OK) {
     run_fail_tt(r, st, s->tin);
     goto done;
@@ -2189,8 +2190,8 @@ static tt_status run_eval(app_run *r)
   fflush(r->out);
   if (!pass) {
     char a[40], b[40];
-    format_double(a, sizeof a, e->max_error);
-    format_double(b, sizeof b, s->max_error);
+    snprintf(a, sizeof a, "%.9g", e->max_error);
+    snprintf(b, sizeof b, "%.9g", s->max_error);
     result_set(r->res, TT_APP_EXIT_THRESHOLD, TT_OK,
                "%s: max error %s %s exceeds -max_error %s", s->tin, a, unit,
                b);
