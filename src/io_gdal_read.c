@@ -40,9 +40,9 @@ TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
 
 /* Largest mask buffer used at once; taller blocks are read in bands of rows
  * (the block itself then stays in GDAL's cache between the bands). */
-#define TT_READ_MASK_BYTES ((size_t)4 << 20)
+#define TT_READ_MASK_BYTES ((size_t)1 << 20)
 /* Block-cache limit during the read when the user has not chosen one. */
-#define TT_READ_CACHE_BYTES ((GIntBig)8 << 20)
+#define TT_READ_CACHE_BYTES ((GIntBig)2 << 20)
 
 typedef struct read_options {
   double z_factor;
