@@ -407,8 +407,19 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     double frame[4];
     s = tt__georef_geographic_frame(ctx, srs, gt, nx, ny, frame, frame_name,
                                     sizeof frame_name);
-    if (s == TT_OK)
+    if (s == TT_ERR_DATA) {
+      /* A CRS that says geographic over coordinates that cannot be (a
+       * mislabelled projected grid) or a grid centred on a pole: measure
+       * in the geotransform's units rather than refuse the DEM. */
+      tt__warn(ctx, "%s: %s; angles and areas are measured in the "
+               "geotransform's units instead", path, ctx ? ctx->errmsg : "");
+      tt_context_clear_error(ctx);
+      snprintf(frame_name, sizeof frame_name, "geotransform (the CRS is "
+               "geographic but no local frame fits)");
+      s = TT_OK;
+    } else if (s == TT_OK) {
       s = tt_grid_set_ground_frame(ctx, grid, frame);
+    }
     if (s != TT_OK) {
       s = with_path(ctx, s, path);
       goto done;

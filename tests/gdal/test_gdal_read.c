@@ -428,6 +428,29 @@ static void test_geographic_frame(tt_context *ctx)
       tt_raster_info_destroy(info);
     }
   }
+
+  /* A projected grid mislabelled as WGS 84: a warning, and the
+   * geotransform as ground frame. */
+  const double utm[6] = {500000, 30, 0, 4100000, 0, -30};
+  raster_spec sp = {GDT_Int16, nx, ny, NULL, 0, 0, 0, 1, 0, 4326, utm, v,
+                    NULL, NULL};
+  make_raster(tmp_path("mislabelled.tif"), &sp);
+  size_t warnings = tt_context_warning_count(ctx);
+  tt_grid *g = NULL;
+  tt_raster_info *info = NULL;
+  CHECK_OK(ctx, read_path(ctx, tmp_path("mislabelled.tif"), NULL, &g,
+                          &info));
+  CHECK_INT_EQ(tt_context_warning_count(ctx), warnings + 1);
+  CHECK_INT_EQ(tt_context_errno(ctx), TT_OK);
+  if (g) {
+    double a[4];
+    tt_grid_get_ground_frame(g, a);
+    CHECK_DBL_NEAR(a[0], 30, 0);
+    CHECK_DBL_NEAR(a[3], -30, 0);
+    CHECK(strncmp(info->frame_name, "geotransform", 12) == 0);
+  }
+  tt_grid_destroy(g);
+  tt_raster_info_destroy(info);
   free(v);
 }
 
