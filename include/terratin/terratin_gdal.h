@@ -48,9 +48,17 @@ void tt_raster_info_destroy(tt_raster_info *info);
 
 /* Reads a band into a new grid, block by block, scale/offset and Z_FACTOR
  * applied, masked samples (GDAL mask band: nodata value, NaN, alpha, .msk)
- * stored as NaN. Valid samples that are NaN or infinite are refused.
- * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> (overrides the mask),
- * MAX_MEMORY=<bytes> (refuse grids whose samples need more).
+ * stored as NaN. Valid samples that are NaN or infinite are refused (naming
+ * row and column), so are rasters under 2 x 2, rasters with no valid
+ * sample, and rasters georeferenced by GCPs only; a raster without a
+ * geotransform gets (0,1,0,0,0,1) and has_geotransform 0. A geographic CRS
+ * gives the grid a local equirectangular ground frame in metres at the
+ * centre latitude (info->frame_name says which frame). Unless the user set
+ * GDAL_CACHEMAX, GDAL's block cache limit (process-wide) is lowered to a
+ * few MiB during the read and restored after.
+ * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> or SRCNODATA=nan
+ * (replaces the mask; compared with the raw values), MAX_MEMORY=<bytes>
+ * (refuse grids whose samples need more; default 3/4 of physical memory).
  * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
  * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
 tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
