@@ -728,8 +728,19 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     case O_JSON: o->s.json = 1; break;
     case O_CRITERION: {
       tt_criterion c;
-      if (tt_criterion_parse(ctx, v, &c) != TT_OK)
-        USAGE("%s: unknown -criterion '%s'; known: delaunay", cmdname, v);
+      if (tt_criterion_parse(ctx, v, &c) != TT_OK) {
+        /* The engine's list, so new criteria show up here by themselves. */
+        char known[256] = "";
+        size_t n = 0;
+        for (int k = 0; k < 64 && n < sizeof known; k++) {
+          const char *name = tt_criterion_name((tt_criterion)k);
+          if (!name)
+            break;
+          n += (size_t)snprintf(known + n, sizeof known - n, "%s%s",
+                                k ? ", " : "", name);
+        }
+        USAGE("%s: unknown -criterion '%s'; known: %s", cmdname, v, known);
+      }
       o->s.criterion = c;
       break;
     }
@@ -2067,12 +2078,15 @@ static tt_status run_eval(app_run *r)
   const char *lname = OGR_L_GetName(layer);
 
   /* Triangles in another CRS would be measured in the wrong place. */
+  int other_crs = 0;
   OGRSpatialReferenceH lsrs = OGR_L_GetSpatialRef(layer);
   if (lsrs && info->crs_wkt && *info->crs_wkt) {
+    static const char *const same_opts[] = {
+        "IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
+        "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", NULL};
     rsrs = OSRNewSpatialReference(info->crs_wkt);
-    if (rsrs && !OSRIsSame(rsrs, lsrs))
-      warn(&r->msg, "%s: layer '%s' is not in the CRS of %s; the error is "
-                    "measured as if it were", s->tin, lname, s->input);
+    other_crs =
+        rsrs && !OSRIsSameEx(rsrs, lsrs, (const char *const *)same_opts);
   }
 
   r->msg.last[0] = '\0';
@@ -2098,9 +2112,14 @@ static tt_status run_eval(app_run *r)
   if (ev.errors.covered == 0) {
     st = run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, s->tin,
                   "no valid sample of %s lies in a triangle of layer '%s' "
-                  "(another CRS or extent?)", s->input, lname);
+                  "(%s)", s->input, lname,
+                  other_crs ? "the layer is in another CRS"
+                            : "another extent?");
     goto done;
   }
+  if (other_crs)
+    warn(&r->msg, "%s: layer '%s' is not in the CRS of %s; the error is "
+                  "measured as if it were", s->tin, lname, s->input);
   if (ev.uncovered)
     warn(&r->msg, "%s: %zu of %zu valid samples lie in no triangle; their "
                   "error is not measured", s->tin, ev.uncovered,
