@@ -1708,6 +1708,28 @@ static tt_status run_simplify(app_run *r)
   /* Plan the output first: a refusal costs nothing yet. */
   r->msg.last[0] = '\0';
   st = tt_output_begin(r->ctx, s->output, drvname, s->overwrite, &outp);
+  if (st == TT_OK && !s->overwrite && s->nln[0] &&
+      str_ieq(drvname, "ESRI Shapefile")) {
+    /* tt_output checked the files of the plain layer names; with -nln the
+     * files are named otherwise: check those too, before the work. */
+    static const char *const names[] = {"triangles.shp", "triangles.dbf",
+                                        "vertices.shp", "vertices.dbf",
+                                        "run_parameters.dbf"};
+    const char *slash = strrchr(s->output, '/');
+    int dirlen = slash ? (int)(slash - s->output) : 1;
+    const char *dir = slash ? s->output : ".";
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+      VSIStatBufL sb;
+      const char *p = CPLSPrintf("%.*s/%s%s%s", dirlen, dir,
+                                 tt_output_layer_prefix(outp), s->nln,
+                                 names[i]);
+      if (VSIStatL(p, &sb) == 0) {
+        st = run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, p,
+                      "exists; use -overwrite to replace it");
+        goto done;
+      }
+    }
+  }
   if (st == TT_ERR_EXISTS) {
     run_fail(r, TT_APP_EXIT_FAILURE, st, s->output,
              "exists; use -overwrite to replace it");
@@ -2054,7 +2076,9 @@ static tt_status run_eval(app_run *r)
   src = open_raster(r, s->input, s->band, &band);
   if (!src)
     return r->res->status;
-  st = read_dem(r, band, s->input, NULL, NULL, &grid, &info, &valid);
+  /* No bar for eval, but the reading still polls for an interruption. */
+  phase_set(&r->prog, 0.0, 0.3);
+  st = read_dem(r, band, s->input, phase_fn, &r->prog, &grid, &info, &valid);
   if (st != TT_OK)
     goto done;
   GDALClose(src);

@@ -9,7 +9,8 @@
  * values (numbers, ranges, names known to the engine). Everything that needs
  * GDAL -- `--config` options, the output driver, the CRS given to -a_srs --
  * is applied or checked by tt_app_run(), in that order, before any file is
- * opened.
+ * opened. `--config` options are set process-wide (CPLSetConfigOption), as
+ * GDAL's utilities do, and stay set after the run.
  *
  * Exit codes (documented in `terratin --help` and docs/cli.md):
  *   0 success, 1 processing failure, 2 usage error, 3 eval threshold exceeded.

@@ -364,6 +364,42 @@ for delay in 0.05 0.3 1 2; do
   fi
 done
 
+# SIGINT (Ctrl-C) too: job control gives the background job the default
+# SIGINT disposition a terminal's foreground job has
+rm -rf sig && mkdir sig
+set -m
+"$T" simplify -max_error 0 in/big.tif sig/o.gpkg >/dev/null 2>sig.err &
+pid=$!
+set +m
+sleep 1
+kill -INT "$pid" 2>/dev/null
+wait "$pid"
+code=$?
+check "SIGINT: killed by SIGINT or finished (exit $code)" \
+  [ "$code" -eq 130 -o "$code" -eq 0 ]
+if [ "$code" -eq 130 ]; then
+  check "SIGINT: nothing left ($(ls -A sig))" [ -z "$(ls -A sig)" ]
+  check "SIGINT: says so in one line" grep -q "interrupted" sig.err
+fi
+
+# -nln: layer names; eval finds "<prefix>triangles" by itself
+run simplify -q -nln dem_ -max_error 2 in/fault.tif out/nln.gpkg
+check "-nln: exit 0" [ "$rc" -eq 0 ]
+check "-nln: prefixed layers" bash -c 'ogrinfo -so out/nln.gpkg >l.txt 2>&1 &&
+  grep -q ": dem_triangles" l.txt && grep -q ": dem_vertices" l.txt &&
+  grep -q ": dem_run_parameters" l.txt'
+run eval -json in/fault.tif out/nln.gpkg
+check "eval picks dem_triangles" \
+  [ "$rc:$(json_get out.txt layer 2>/dev/null)" = "0:dem_triangles" ]
+mkdir shp3
+run simplify -q -f "ESRI Shapefile" -nln a_ -max_error 5 in/fault.tif shp3/x
+check "shapefile -nln: exit 0 (-f spelling)" [ "$rc" -eq 0 ]
+check "shapefile -nln: files named name_prefix_layer" [ -f shp3/x_a_triangles.shp ]
+cp -r shp3 shp3.before
+run simplify -q -f "ESRI Shapefile" -nln a_ -max_error 9 in/fault.tif shp3/x
+check "shapefile -nln: refuses to overwrite" [ "$rc" -eq 1 ]
+check "shapefile -nln: old files intact" diff -r shp3 shp3.before
+
 # help and version
 run --help
 check "--help: exit 0" [ "$rc" -eq 0 ]
