@@ -98,7 +98,9 @@ static inline void divmod_floor(int64_t n, int64_t d, int64_t *q, int64_t *r)
   *r = rr;
 }
 
-static void rows_init(const tt__scan_tri *st, int64_t nx, rows *r)
+/* Prepares the walk from row `from` (clamped to the triangle's rows). */
+static void rows_init(const tt__scan_tri *st, int64_t nx, int64_t from,
+                      rows *r)
 {
   int64_t dx1 = st->x[1] - st->x[0], dy1 = st->y[1] - st->y[0];
   int64_t dx2 = st->x[2] - st->x[0], dy2 = st->y[2] - st->y[0];
@@ -111,12 +113,14 @@ static void rows_init(const tt__scan_tri *st, int64_t nx, rows *r)
       r->ymax = st->y[k];
   }
   r->xmax = nx - 1;
+  if (from > r->ymin)
+    r->ymin = from;
   r->nlo = r->nhi = r->nflat = 0;
   for (int k = 0; k < 3; k++) {
     int k1 = (k + 1) % 3;
     int64_t a = -s * (st->y[k1] - st->y[k]);
     int64_t ey = s * (st->x[k1] - st->x[k]);
-    int64_t b = ey * (r->ymin - st->y[k]) - a * st->x[k]; /* at ymin */
+    int64_t b = ey * (r->ymin - st->y[k]) - a * st->x[k]; /* at first row */
     if (a == 0) {
       edge_flat *f = &r->flat[r->nflat++];
       f->own = st->own[k];
@@ -140,14 +144,15 @@ static void rows_init(const tt__scan_tri *st, int64_t nx, rows *r)
   }
 }
 
+/* Branch-free: whether the remainder wraps is data-dependent and would be
+ * mispredicted on about every other row (measured: a third of all
+ * refinement time on a 4097^2 grid). */
 static inline void dda_step(edge_dda *d)
 {
-  d->q += d->dq;
-  d->rem += d->dr;
-  if (d->rem >= d->A) {
-    d->rem -= d->A;
-    d->q++;
-  }
+  int64_t rem = d->rem + d->dr;
+  int64_t wrap = (int64_t)(rem >= d->A); /* 0 or 1 */
+  d->rem = rem - (d->A & -wrap);
+  d->q += d->dq + wrap;
 }
 
 /* The owned span of the current row, then moves every edge to the next
@@ -183,7 +188,7 @@ static inline bool row_span_step(rows *r, int64_t *out_xl, int64_t *out_xr)
 /* Rows are 4 nx bytes apart, too far for the hardware prefetcher: ask for
  * the ends of the span PREFETCH_AHEAD rows below (spans drift slowly, so
  * the current one is a good guess; within a row the hardware follows). */
-#define PREFETCH_AHEAD 3
+#define PREFETCH_AHEAD 6
 
 static inline void prefetch_row(const float *zr, size_t nx, int64_t y,
                                 int64_t ymax, int64_t xl, int64_t xr)
@@ -196,6 +201,31 @@ static inline void prefetch_row(const float *zr, size_t nx, int64_t y,
   }
 #else
   (void)zr, (void)nx, (void)y, (void)ymax, (void)xl, (void)xr;
+#endif
+}
+
+void tt__scan_prefetch(const tt_grid *g, const tt__scan_tri *st, int64_t ylo,
+                       int64_t yhi)
+{
+#if defined(__GNUC__)
+  int64_t xmin = st->x[0], xmax = st->x[0], ymin = st->y[0], ymax = st->y[0];
+  for (int k = 1; k < 3; k++) {
+    xmin = st->x[k] < xmin ? st->x[k] : xmin;
+    xmax = st->x[k] > xmax ? st->x[k] : xmax;
+    ymin = st->y[k] < ymin ? st->y[k] : ymin;
+    ymax = st->y[k] > ymax ? st->y[k] : ymax;
+  }
+  if (ylo > ymin)
+    ymin = ylo;
+  if (yhi < ymax)
+    ymax = yhi;
+  for (int64_t y = ymin; y <= ymax; y++) {
+    const float *row = g->z + (size_t)y * g->nx;
+    for (int64_t x = xmin; x <= xmax + 15; x += 16)
+      __builtin_prefetch(row + (x < xmax ? x : xmax));
+  }
+#else
+  (void)g, (void)st, (void)ylo, (void)yhi;
 #endif
 }
 
@@ -410,12 +440,22 @@ static int64_t find_in_row(const tt_grid *g, const tt__scan_tri *st,
 void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
                         double *out_err, int64_t *out_index)
 {
+  tt__scan_candidate_rows(g, st, INT64_MIN, INT64_MAX, out_err, out_index);
+}
+
+void tt__scan_candidate_rows(const tt_grid *g, const tt__scan_tri *st,
+                             int64_t ylo, int64_t yhi, double *out_err,
+                             int64_t *out_index)
+{
   plane p;
   rows r;
   kern kn;
   plane_of(st, &p);
-  rows_init(st, (int64_t)g->nx, &r);
+  rows_init(st, (int64_t)g->nx, ylo, &r);
+  if (yhi < r.ymax)
+    r.ymax = yhi;
   kern_init(&kn, p.gx);
+  tt__scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
   double best = 0;
   int64_t best_y = -1, best_xl = 0, best_xr = -1;
   for (int64_t y = r.ymin; y <= r.ymax; y++) {
@@ -463,7 +503,7 @@ void tt__scan_stats_run(const tt_grid *g, const tt__scan_tri *st,
   rows r;
   kern kn;
   plane_of(st, &p);
-  rows_init(st, (int64_t)g->nx, &r);
+  rows_init(st, (int64_t)g->nx, INT64_MIN, &r);
   kern_init(&kn, p.gx);
   row_acc acc = {0, 0, 0, 0};
   int64_t max_y = -1, max_xl = 0, max_xr = -1;

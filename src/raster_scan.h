@@ -36,6 +36,20 @@ TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t,
 TT_HIDDEN void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
                                   double *out_err, int64_t *out_index);
 
+/* The same, restricted to rows [ylo, yhi] of the triangle (for splitting a
+ * large triangle into jobs: the candidate of the whole is the largest of
+ * the parts, the earliest part winning ties). */
+TT_HIDDEN void tt__scan_candidate_rows(const tt_grid *g,
+                                       const tt__scan_tri *st, int64_t ylo,
+                                       int64_t yhi, double *out_err,
+                                       int64_t *out_index);
+
+/* Asks the memory system for the bounding-box rows [ylo, yhi] of the
+ * triangle (all of them: ylo = INT64_MIN, yhi = INT64_MAX), so that the
+ * misses of several small triangles overlap. Only a hint. */
+TT_HIDDEN void tt__scan_prefetch(const tt_grid *g, const tt__scan_tri *st,
+                                 int64_t ylo, int64_t yhi);
+
 typedef struct tt__scan_stats {
   size_t count;         /* valid owned samples */
   double max_err;

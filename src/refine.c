@@ -53,7 +53,7 @@ typedef struct refine {
   size_t inscap;
   tt__edge_stack stack;
   tt__pool *pool;      /* NULL: single-threaded */
-  int32_t *jobs;       /* live triangles to rescan in this round */
+  struct scan_job_t *jobs; /* scans of this round */
   size_t jobcap;
   size_t max_points, max_tris;
   double max_error;    /* < 0: none */
@@ -95,15 +95,73 @@ static bool add_vertex(refine *r, int32_t col, int32_t row, double err,
   return true;
 }
 
-/* A job of the scan pool: the candidate of one live triangle, written into
- * its own slot of cand/cerr (jobs share nothing else). */
+/* A job of the scan pool: the candidate of a band of rows of one live
+ * triangle (a whole small triangle is one band), written into the job's own
+ * result; jobs share nothing else. */
+typedef struct scan_job_t {
+  int32_t t;
+  int64_t ylo, yhi;
+  double err;
+  int64_t index;
+} scan_job_t;
+
+/* Triangles with more rows than this and a large area are cut into bands
+ * of this many rows, so that all threads share the early, huge triangles. */
+#define BAND_ROWS 256
+#define BAND_MIN_AREA ((int64_t)1 << 16)
+/* Batches smaller than this (in samples, estimated from areas) run in the
+ * calling thread: a hand-over costs about a microsecond, and a worker that
+ * the system has descheduled would hold the batch for a whole timeslice. */
+#define PARALLEL_MIN_SAMPLES ((int64_t)1 << 15)
+
 static void scan_job(void *arg, size_t i)
 {
   refine *r = arg;
-  int32_t t = r->jobs[i];
+  scan_job_t *j = &r->jobs[i];
   tt__scan_tri st;
-  tt__scan_tri_from_mesh(&r->m, t, &st);
-  tt__scan_candidate(r->g, &st, &r->cerr[t], &r->cand[t]);
+  tt__scan_tri_from_mesh(&r->m, j->t, &st);
+  tt__scan_candidate_rows(r->g, &st, j->ylo, j->yhi, &j->err, &j->index);
+}
+
+/* Appends the jobs of live triangle t. */
+static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
+{
+  const tt__mesh *m = &r->m;
+  int64_t x[3], y[3];
+  for (int k = 0; k < 3; k++) {
+    x[k] = m->vc[m->hv[3 * t + k]];
+    y[k] = m->vr[m->hv[3 * t + k]];
+  }
+  int64_t ylo = y[0] < y[1] ? (y[0] < y[2] ? y[0] : y[2]) : (y[1] < y[2] ? y[1] : y[2]);
+  int64_t yhi = y[0] > y[1] ? (y[0] > y[2] ? y[0] : y[2]) : (y[1] > y[2] ? y[1] : y[2]);
+  int64_t area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+  if (area2 < 0)
+    area2 = -area2;
+  *samples += area2 / 2;
+  int64_t band = (r->pool && area2 / 2 >= BAND_MIN_AREA) ? BAND_ROWS
+                                                         : yhi - ylo + 1;
+  for (int64_t y0 = ylo; y0 <= yhi; y0 += band) {
+    if (!tt__grow((void **)&r->jobs, &r->jobcap, *njobs + 1,
+                  sizeof(scan_job_t)))
+      return false;
+    scan_job_t *j = &r->jobs[(*njobs)++];
+    j->t = t;
+    j->ylo = y0;
+    j->yhi = y0 + band - 1 < yhi ? y0 + band - 1 : yhi;
+  }
+  return true;
+}
+
+/* Sorts a short list of slots (the handful an insertion touches). */
+static void sort_slots(int32_t *a, size_t n)
+{
+  for (size_t i = 1; i < n; i++) {
+    int32_t v = a[i];
+    size_t j = i;
+    for (; j > 0 && a[j - 1] > v; j--)
+      a[j] = a[j - 1];
+    a[j] = v;
+  }
 }
 
 static int cmp_i32(const void *a, const void *b)
@@ -117,26 +175,50 @@ static int cmp_i32(const void *a, const void *b)
  * slot order, enter the heap or leave it. */
 static bool rescan(refine *r, int32_t *slots, size_t n)
 {
-  if (!fit_slots(r) ||
-      !tt__grow((void **)&r->jobs, &r->jobcap, n ? n : 1, sizeof(int32_t)))
+  if (!fit_slots(r))
     return false;
-  qsort(slots, n, sizeof(int32_t), cmp_i32);
+  if (n <= 32)
+    sort_slots(slots, n);
+  else
+    qsort(slots, n, sizeof(int32_t), cmp_i32);
   size_t njobs = 0;
+  int64_t samples = 0;
   for (size_t i = 0; i < n; i++) {
     int32_t t = slots[i];
     if (i > 0 && t == slots[i - 1])
       continue;
-    if (tt__mesh_live(&r->m, t))
-      r->jobs[njobs++] = t;
-    else
+    if (!tt__mesh_live(&r->m, t))
       tt__heap_remove(&r->heap, t);
+    else if (!add_jobs(r, t, &njobs, &samples))
+      return false;
   }
-  tt__pool_run(r->pool, njobs, scan_job, r);
-  for (size_t i = 0; i < njobs; i++) {
-    int32_t t = r->jobs[i];
-    if (r->cand[t] < 0)
+  if (samples < PARALLEL_MIN_SAMPLES) {
+    /* small triangles, cold in cache: ask for all their rows first, so
+     * the misses overlap instead of queueing one row at a time */
+    for (size_t i = 0; i < njobs; i++) {
+      tt__scan_tri st;
+      tt__scan_tri_from_mesh(&r->m, r->jobs[i].t, &st);
+      tt__scan_prefetch(r->g, &st, INT64_MIN, INT64_MAX);
+    }
+  }
+  tt__pool_run(samples >= PARALLEL_MIN_SAMPLES ? r->pool : NULL, njobs,
+               scan_job, r);
+  /* jobs of one triangle are adjacent and in row order: the first largest
+   * error wins, as in a single scan */
+  for (size_t i = 0; i < njobs;) {
+    int32_t t = r->jobs[i].t;
+    double err = r->jobs[i].err;
+    int64_t index = r->jobs[i].index;
+    for (i++; i < njobs && r->jobs[i].t == t; i++)
+      if (r->jobs[i].err > err) {
+        err = r->jobs[i].err;
+        index = r->jobs[i].index;
+      }
+    r->cand[t] = index;
+    r->cerr[t] = err;
+    if (index < 0)
       tt__heap_remove(&r->heap, t);
-    else if (!tt__heap_set(&r->heap, t, r->cerr[t]))
+    else if (!tt__heap_set(&r->heap, t, err))
       return false;
   }
   return true;
