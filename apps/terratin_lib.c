@@ -2120,6 +2120,18 @@ static tt_status run_eval(app_run *r)
     run_fail_tt(r, st, s->tin);
     goto done;
   }
+  /* Map coordinates stored in a file carry round-off: a TIN vertex on a
+   * grid sample comes back a few 1e-9 pixel away when pixels are tiny
+   * next to the coordinates (lidar in degrees), and the boundary samples
+   * would then fall outside every triangle. Put corners within 1e-6 pixel
+   * of a sample centre back on it; no other corner moves. */
+  for (size_t i = 0; i < ntri * 9; i++) {
+    if (i % 3 == 2)
+      continue; /* z */
+    double rounded = floor(xyz[i] + 0.5);
+    if (fabs(xyz[i] - rounded) <= 1e-6)
+      xyz[i] = rounded;
+  }
   if (ntri == 0) {
     st = run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, s->tin,
                   "layer '%s' holds no triangles (%zu polygon%s rejected)",
@@ -2155,7 +2167,10 @@ static tt_status run_eval(app_run *r)
   double mx = gt[0] + mc * gt[1] + mr * gt[2];
   double my = gt[3] + mc * gt[4] + mr * gt[5];
   int checked = s->max_error >= 0;
-  int pass = !checked || e->max_error <= s->max_error;
+  /* The same round-off moves the interpolated heights by ~1e-10 relative:
+   * a bound met by construction must not fail the check because of it. */
+  int pass = !checked ||
+             e->max_error <= s->max_error + 1e-6 * fmax(s->max_error, 1.0);
   const char *unit = unit_or(info, "z units");
 
   if (s->json) {

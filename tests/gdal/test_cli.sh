@@ -400,6 +400,33 @@ run simplify -q -f "ESRI Shapefile" -nln a_ -max_error 9 in/fault.tif shp3/x
 check "shapefile -nln: refuses to overwrite" [ "$rc" -eq 1 ]
 check "shapefile -nln: old files intact" diff -r shp3 shp3.before
 
+# real DEMs, when ../shared/testdata is there: the bound and the coverage
+# hold on geographic lidar with tiny pixels, a feet DEM with a nodata
+# collar, and a 54%-valid country outline
+S=${TT_SHARED_TESTDATA:-}
+for spec in "spatial.tools_tahoe_lidar/tahoe_lidar_bareearth.tif:0.1" \
+            "usgs_dem_san_francisco/sanfranciscos.dem:5" \
+            "rspatial_terra/elev.tif:3"; do
+  f=${spec%%:*}
+  e=${spec##*:}
+  [ -n "$S" ] && [ -f "$S/$f" ] || continue
+  rm -f real.gpkg
+  run simplify -q -max_error "$e" "$S/$f" real.gpkg
+  check "$f: simplify exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  run eval -json -max_error "$e" "$S/$f" real.gpkg
+  check "$f: eval -max_error $e passes" [ "$rc" -eq 0 ]
+  check "$f: every valid sample covered, none twice" python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert d["uncovered"] == 0 and d["overlapped"] == 0, d
+assert d["covered"] == d["valid_samples"] > 0, d' <out.txt
+done
+if [ -n "$S" ] && [ -f "$S/usgs_dem_san_francisco/sanfranciscos.dem" ]; then
+  run simplify -max_points 500 "$S/usgs_dem_san_francisco/sanfranciscos.dem" \
+    real_ft.gpkg
+  check "the summary carries the z unit (ft)" grep -q "max error .* ft, RMS .* ft" out.txt
+fi
+
 # help and version
 run --help
 check "--help: exit 0" [ "$rc" -eq 0 ]
