@@ -193,7 +193,7 @@ static const char help_top[] =
     "are grid samples, and measures triangle layers against DEMs.\n"
     "\n"
     "Commands:\n"
-    "  simplify   DEM -> TIN layers (GeoPackage, Shapefile, other OGR formats)\n"
+    "  simplify   DEM -> TIN layers (GeoPackage, Shapefile, other formats)\n"
     "  generate   write a synthetic test terrain as a GeoTIFF\n"
     "  eval       measure the error of a triangle layer against a DEM\n"
     "\n"
@@ -596,14 +596,17 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (!k)
         USAGE("--config needs KEY VALUE");
       const char *eq = strchr(k, '=');
-      if (eq && eq != k) {
+      if (eq == k)
+        USAGE("--config: empty KEY in '%s'", k);
+      if (eq) {
         /* --config KEY=VALUE (GDAL >= 3.9 accepts it too) */
         char *key = malloc((size_t)(eq - k) + 1);
         if (!key)
           NOMEM();
         memcpy(key, k, (size_t)(eq - k));
         key[eq - k] = '\0';
-        int ok = strlist_add(&o->config, key) && strlist_add(&o->config, eq + 1);
+        int ok = strlist_add(&o->config, key) &&
+                 strlist_add(&o->config, eq + 1);
         free(key);
         if (!ok)
           NOMEM();
@@ -681,7 +684,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (!parse_double(v, &x) || x < 0)
         USAGE("%s: -max_error must be a finite number >= 0 (z units), got "
               "'%s'", cmdname, v);
-      o->s.max_error = x;
+      o->s.max_error = x + 0.0; /* -0 reads as "no limit" to the engine */
       break;
     case O_MAX_POINTS:
       if (!parse_size(v, &z) || z < 1)
