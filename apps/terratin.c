@@ -6,8 +6,10 @@
  * Signals: SIGINT, SIGTERM and SIGHUP set a flag that the progress callback
  * turns into a stop; the run then removes its temporary files, and main
  * re-raises the signal with its default action so the shell sees the
- * process killed by it (a second signal kills at once). SIGPIPE is ignored:
- * a closed stdout must not kill a run halfway through writing a file.
+ * process killed by it (a second signal kills at once). A run that
+ * completed before it saw the flag exits 0 with its output in place.
+ * SIGPIPE is ignored: a closed stdout must not kill a run halfway through
+ * writing a file.
  */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* sigaction; the build sets it elsewhere */
@@ -67,7 +69,10 @@ int main(int argc, char **argv)
   if (res.message[0])
     fprintf(stderr, "terratin: %s\n", res.message);
   tt_app_options_destroy(opts);
-  if (caught_signal) {
+  /* Stopped by a signal: end by it, as the shell expects. A run that had
+   * already finished (the signal came during its last steps) keeps its
+   * success: its output is complete. */
+  if (caught_signal && res.exit_code != TT_APP_EXIT_OK) {
     signal((int)caught_signal, SIG_DFL);
     raise((int)caught_signal);
   }
