@@ -3,7 +3,9 @@
  * (apps/terratin_lib.c): defaults, every option of every command, every
  * usage error (exit code 2, one line, no object), --help/--version winning
  * over the rest of the line, the help texts documenting defaults and exit
- * codes, and the text progress bar. Nothing here opens a file.
+ * codes, and the text progress bar; then the library shape: commands run
+ * without a shell, with a progress callback that sees the phases climb and
+ * that can stop a run at any point without leaving a file.
  */
 #include "terratin_lib.h"
 #include "tt_test.h"
@@ -443,6 +445,153 @@ static void test_no_argv(void)
   CHECK(tt_app_options_settings(NULL) == NULL);
 }
 
+/* ---------------------------------------------------------------------------
+ * The library shape: a program runs the commands without a shell, with its
+ * own progress callback, and can stop a run at any point.
+ * ------------------------------------------------------------------------- */
+
+typedef struct progress_log {
+  double last;
+  int calls, decreasing, in_read, in_simplify, in_write;
+  double stop_at;          /* return 0 once complete >= stop_at */
+} progress_log;
+
+static int record_progress(double complete, const char *message, void *arg)
+{
+  progress_log *p = arg;
+  (void)message;
+  if (complete < p->last)
+    p->decreasing++;
+  p->last = complete;
+  p->calls++;
+  /* read 0 - 0.10, simplify 0.10 - 0.85, write 0.85 - 1 */
+  if (complete > 0.0 && complete <= 0.10) p->in_read++;
+  if (complete > 0.10 && complete <= 0.85) p->in_simplify++;
+  if (complete > 0.85 && complete < 1.0) p->in_write++;
+  return complete < p->stop_at;
+}
+
+/* Runs a command line (words separated by '|'), streams to out/err. */
+static tt_status run_line(const char *line, FILE *out, tt_progress_fn fn,
+                          void *arg, tt_app_result *res)
+{
+  char buf[1024];
+  char *words[MAXW + 1];
+  size_t n = 0;
+  snprintf(buf, sizeof buf, "%s", line);
+  for (char *p = strtok(buf, "|"); p && n < MAXW; p = strtok(NULL, "|"))
+    words[n++] = p;
+  words[n] = NULL;
+  tt_app_options *o = NULL;
+  tt_status st = tt_app_options_new(words, &o, res);
+  if (st != TT_OK)
+    return st;
+  tt_app_options_set_streams(o, out, out);
+  tt_app_options_set_progress(o, fn, arg);
+  st = tt_app_run(o, res);
+  tt_app_options_destroy(o);
+  return st;
+}
+
+static size_t count_files(const char *dir)
+{
+  char cmd[600];
+  snprintf(cmd, sizeof cmd, "ls -A '%s' | wc -l", dir);
+  FILE *p = popen(cmd, "r");
+  size_t n = 0;
+  if (p) {
+    if (fscanf(p, "%zu", &n) != 1)
+      n = (size_t)-1;
+    pclose(p);
+  }
+  return n;
+}
+
+static void test_library_runs(void)
+{
+  char dir[] = "/tmp/tt_cli_lib.XXXXXX";
+  char line[1024];
+  tt_app_result res;
+  if (!mkdtemp(dir)) {
+    TT_FAIL_("mkdtemp failed");
+    return;
+  }
+  FILE *out = tmpfile();
+  if (!out) {
+    TT_FAIL_("tmpfile failed");
+    return;
+  }
+
+  snprintf(line, sizeof line,
+           "generate|fault|%s/f.tif|-size|60x50|-seed|3|-displacement|20|"
+           "-wave_size|4|-q", dir);
+  CHECK_INT_EQ(run_line(line, out, NULL, NULL, &res), TT_OK);
+  CHECK_INT_EQ(res.exit_code, 0);
+  CHECK_INT_EQ(count_files(dir), 1);
+
+  /* Stopped while simplifying, then while writing: an interrupted run,
+   * exit code 1, one line, nothing left but the input. */
+  static const double stops[] = {0.0, 0.5, 0.9, 0.99};
+  for (size_t i = 0; i < sizeof stops / sizeof *stops; i++) {
+    progress_log log = {0, 0, 0, 0, 0, 0, stops[i]};
+    snprintf(line, sizeof line, "simplify|-max_error|0|%s/f.tif|%s/o.gpkg",
+             dir, dir);
+    CHECK_INT_EQ(run_line(line, out, record_progress, &log, &res),
+                 TT_ERR_INTERRUPTED);
+    CHECK_INT_EQ(res.exit_code, TT_APP_EXIT_FAILURE);
+    CHECK(strstr(res.message, "interrupted") != NULL);
+    CHECK(strstr(res.message, "o.gpkg") != NULL);
+    if (count_files(dir) != 1)
+      TT_FAIL_("stop at %g left files behind", stops[i]);
+  }
+
+  /* A full run: the fractions climb through the three phases to 1. */
+  progress_log log = {0, 0, 0, 0, 0, 0, 2.0};
+  long before = ftell(out);
+  snprintf(line, sizeof line,
+           "simplify|-json|-max_error|0.5|%s/f.tif|%s/o.gpkg", dir, dir);
+  CHECK_INT_EQ(run_line(line, out, record_progress, &log, &res), TT_OK);
+  CHECK_INT_EQ(res.exit_code, 0);
+  CHECK_INT_EQ(log.decreasing, 0);
+  CHECK(log.last == 1.0);
+  CHECK(log.in_read > 0);
+  CHECK(log.in_simplify > 0);
+  CHECK(log.in_write > 0);
+  CHECK_INT_EQ(count_files(dir), 2);
+  /* the JSON object went to the stream given */
+  long after = ftell(out);
+  CHECK(after > before);
+  if (after > before) {
+    char *text = calloc((size_t)(after - before) + 1, 1);
+    fseek(out, before, SEEK_SET);
+    if (text && fread(text, 1, (size_t)(after - before), out) ==
+                    (size_t)(after - before)) {
+      CHECK(text[0] == '{');
+      CHECK(strstr(text, "\"vertices\": ") != NULL);
+      CHECK(strstr(text, "\"max_error_default\": false") != NULL);
+    }
+    free(text);
+    fseek(out, 0, SEEK_END);
+  }
+
+  /* eval through the library: within the bound, exit 0; a tighter bound,
+   * exit 3 with the status still TT_OK (the run itself worked). */
+  snprintf(line, sizeof line, "eval|-q|-max_error|0.5|%s/f.tif|%s/o.gpkg",
+           dir, dir);
+  CHECK_INT_EQ(run_line(line, out, NULL, NULL, &res), TT_OK);
+  CHECK_INT_EQ(res.exit_code, 0);
+  snprintf(line, sizeof line, "eval|-q|-max_error|0|%s/f.tif|%s/o.gpkg",
+           dir, dir);
+  CHECK_INT_EQ(run_line(line, out, NULL, NULL, &res), TT_OK);
+  CHECK_INT_EQ(res.exit_code, TT_APP_EXIT_THRESHOLD);
+  CHECK(strstr(res.message, "exceeds -max_error") != NULL);
+
+  fclose(out);
+  snprintf(line, sizeof line, "rm -rf '%s'", dir);
+  if (system(line) != 0)
+    TT_FAIL_("cannot remove %s", dir);
+}
+
 int main(void)
 {
   test_simplify_defaults();
@@ -453,5 +602,6 @@ int main(void)
   test_eval();
   test_progress_bar();
   test_no_argv();
+  test_library_runs();
   TT_TEST_DONE();
 }
