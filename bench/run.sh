@@ -164,4 +164,6 @@ if [ "$quick" = 0 ]; then
 fi
 
 say "results ($(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores, $("$TT" --version 2>&1 | head -n 1))"
+echo "terratin scans with all online CPUs on grids of a million samples or more;"
+echo "delatin runs on one thread. Load average now: $(cut -d' ' -f1-3 /proc/loadavg)"
 node bench/report.mjs "$OUT" "${cases[@]}" | tee "$OUT/report.txt"
