@@ -382,6 +382,17 @@ if [ "$code" -eq 130 ]; then
   check "SIGINT: says so in one line" grep -q "interrupted" sig.err
 fi
 
+# -dsco and -lco reach the driver
+run simplify -q -dsco VERSION=1.2 -lco GEOMETRY_NAME=shape -max_error 5 \
+  in/fault.tif out/co.gpkg
+check "-dsco/-lco: exit 0" [ "$rc" -eq 0 ]
+check "-dsco VERSION=1.2 applied" \
+  grep -q "user_version (Integer) = 10200" \
+  <(ogrinfo -q out/co.gpkg -sql "PRAGMA user_version" 2>&1)
+check "-lco GEOMETRY_NAME=shape applied to every layer" bash -c '
+  ogrinfo -so out/co.gpkg triangles | grep -q "Geometry Column = shape" &&
+  ogrinfo -so out/co.gpkg vertices | grep -q "Geometry Column = shape"'
+
 # -nln: layer names; eval finds "<prefix>triangles" by itself
 run simplify -q -nln dem_ -max_error 2 in/fault.tif out/nln.gpkg
 check "-nln: exit 0" [ "$rc" -eq 0 ]

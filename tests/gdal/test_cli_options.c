@@ -145,6 +145,13 @@ static void test_simplify_all_options(void)
   CHECK(s && s->format && strcmp(s->format, "GPKG") == 0);
   tt_app_options_destroy(o);
 
+  /* --opt is accepted for -opt, as GDAL's utilities do */
+  PARSE_OK(o, "simplify", "--max_error", "1.5", "--of", "GPKG", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->max_error == 1.5 && s->format &&
+        strcmp(s->format, "GPKG") == 0);
+  tt_app_options_destroy(o);
+
   /* -json alone: no progress bar either */
   PARSE_OK(o, "simplify", "-json", "a", "b");
   CHECK_INT_EQ(tt_app_options_wants_progress_bar(o), 0);
