@@ -23,8 +23,12 @@
  * the kernel does not give huge pages, nothing changes. */
 #define HUGE_ALIGN ((size_t)2 << 20)
 
+/* Every grid has TT__GRID_PAD floats after its last sample, so that the
+ * vector kernels may read a whole group past a row's end (the extra lanes
+ * are masked out) even on the last row. */
 static float *alloc_heights(size_t n)
 {
+  n += TT__GRID_PAD;
   size_t bytes = n * sizeof(float);
   if (bytes < 4 * HUGE_ALIGN)
     return malloc(bytes);
@@ -52,7 +56,7 @@ tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
     return tt__error(ctx, TT_ERR_LIMIT,
                      "grid is %zu x %zu samples: a side may have at most %zu",
                      nx, ny, (size_t)TT_MAX_GRID_SIDE);
-  if (nx > SIZE_MAX / sizeof(float) / ny)
+  if (nx > (SIZE_MAX / sizeof(float) - TT__GRID_PAD) / ny)
     return tt__error(ctx, TT_ERR_LIMIT, "grid of %zu x %zu samples is too "
                      "large for this machine's address space", nx, ny);
   tt_grid *g = calloc(1, sizeof *g);
@@ -65,7 +69,7 @@ tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
                      "out of memory: a %zu x %zu grid needs %.1f MiB", nx, ny,
                      (double)(nx * ny * sizeof(float)) / 1048576.0);
   }
-  for (size_t i = 0; i < nx * ny; i++)
+  for (size_t i = 0; i < nx * ny + TT__GRID_PAD; i++)
     g->z[i] = NAN;
   g->nx = nx;
   g->ny = ny;

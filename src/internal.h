@@ -31,6 +31,9 @@ struct tt_context {
   size_t warnings;
 };
 
+/* Floats of padding after a grid's last sample (see grid.c). */
+#define TT__GRID_PAD 16
+
 struct tt_grid {
   size_t nx, ny;
   float *z;          /* nx*ny, row-major, NaN = nodata */

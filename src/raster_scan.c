@@ -86,13 +86,21 @@ typedef struct rows {
   int nlo, nhi, nflat;
 } rows;
 
-/* floor division with remainder in [0, d), d > 0 */
+/* Floor division with remainder in [0, d), d > 0. A double division
+ * (|n| < 2^57, d < 2^29 here) is within one of the floor, and the integer
+ * remainder corrects it exactly; a 64-bit integer division costs several
+ * times more, six times per scanned triangle. */
 static inline void divmod_floor(int64_t n, int64_t d, int64_t *q, int64_t *r)
 {
-  int64_t qq = n / d, rr = n % d;
-  if (rr < 0) {
+  int64_t qq = (int64_t)floor((double)n / (double)d);
+  int64_t rr = n - qq * d;
+  while (rr < 0) {
     rr += d;
     qq--;
+  }
+  while (rr >= d) {
+    rr -= d;
+    qq++;
   }
   *q = qq;
   *r = rr;
@@ -303,9 +311,13 @@ static inline __m128d load2(const float *p)
   return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)p)));
 }
 
+/* Max of |z - plane| over columns [xl, xr]. Works in groups of 4; the last
+ * group may run past xr (the grid is padded, grid.c) and its extra lanes
+ * are masked to 0, which never wins a maximum of errors >= 0. */
 static inline double row_max(const kern *kn, const float *zr, int64_t xl,
                              int64_t xr, double rowbase, double gx, int64_t x0)
 {
+  (void)gx;
   const __m128d vbase = _mm_set1_pd(rowbase);
   __m128d m0 = _mm_setzero_pd(), m1 = _mm_setzero_pd();
   __m128d k0 = _mm_set_pd((double)(xl - x0 + 1), (double)(xl - x0));
@@ -321,15 +333,21 @@ static inline double row_max(const kern *kn, const float *zr, int64_t xl,
     k0 = _mm_add_pd(k0, kn->four);
     k1 = _mm_add_pd(k1, kn->four);
   }
+  if (x <= xr) {
+    /* 1 to 3 columns left: lanes with k <= xr - x0 count */
+    __m128d last = _mm_set1_pd((double)(xr - x0));
+    __m128d v0 = _mm_add_pd(vbase, _mm_mul_pd(kn->gx, k0));
+    __m128d v1 = _mm_add_pd(vbase, _mm_mul_pd(kn->gx, k1));
+    __m128d e0 = _mm_and_pd(_mm_sub_pd(load2(zr + x), v0), kn->absmask);
+    __m128d e1 = _mm_and_pd(_mm_sub_pd(load2(zr + x + 2), v1), kn->absmask);
+    e0 = _mm_and_pd(e0, _mm_cmple_pd(k0, last));
+    e1 = _mm_and_pd(e1, _mm_cmple_pd(k1, last));
+    m0 = _mm_max_pd(e0, m0);
+    m1 = _mm_max_pd(e1, m1);
+  }
   m0 = _mm_max_pd(m0, m1);
   m0 = _mm_max_pd(m0, _mm_unpackhi_pd(m0, m0));
-  double m = _mm_cvtsd_f64(m0);
-  for (; x <= xr; x++) {
-    double v = rowbase + gx * (double)(x - x0);
-    double e = fabs((double)zr[x] - v);
-    m = e > m ? e : m;
-  }
-  return m;
+  return _mm_cvtsd_f64(m0);
 }
 
 static inline void row_stats(const kern *kn, const float *zr, int64_t xl,
