@@ -1261,7 +1261,9 @@ static tt_status run_fail(app_run *r, int exit_code, tt_status st,
 
 /* The best one-line explanation of a failed engine or glue call: the
  * context's message, else GDAL's last failure, else the status's generic
- * message. A leading "<file>: " is dropped, the caller adds it. */
+ * message. A leading "<file>: " or "<file> " is dropped, the caller puts
+ * the file first ("out.gpkg exists and is a folder" reads
+ * "out.gpkg: exists and is a folder"). */
 static const char *why(app_run *r, tt_status st, const char *file)
 {
   const char *m = tt_context_errmsg(r->ctx);
@@ -1272,6 +1274,8 @@ static const char *why(app_run *r, tt_status st, const char *file)
   size_t n = file ? strlen(file) : 0;
   if (n && strncmp(m, file, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
     m += n + 2;
+  else if (n && strncmp(m, file, n) == 0 && m[n] == ' ' && m[n + 1])
+    m += n + 1;
   return m;
 }
 
@@ -1284,6 +1288,24 @@ static tt_status run_fail_tt(app_run *r, tt_status st, const char *file)
   if (st == TT_ERR_NOMEM)
     return run_fail(r, TT_APP_EXIT_FAILURE, st, file, "out of memory");
   return run_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s", why(r, st, file));
+}
+
+/* An output refused because something exists: name the file that is in
+ * the way (for a shapefile, one of the layer files), and the way out. */
+static tt_status run_fail_exists(app_run *r, const char *output)
+{
+  static const char tail[] = " exists; not overwriting it without permission";
+  const char *m = tt_context_errmsg(r->ctx);
+  size_t n = m ? strlen(m) : 0, t = sizeof tail - 1;
+  if (n > t && strcmp(m + n - t, tail) == 0)
+    return run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, NULL,
+                    "%.*s: exists; use -overwrite to replace it",
+                    (int)(n - t), m);
+  if (m && *m)
+    return run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, output, "%s",
+                    why(r, TT_ERR_EXISTS, output));
+  return run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, output,
+                  "exists; use -overwrite to replace it");
 }
 
 /* Polls the progress callback outside the phases that report progress, so
@@ -1734,8 +1756,7 @@ static tt_status run_simplify(app_run *r)
     }
   }
   if (st == TT_ERR_EXISTS) {
-    run_fail(r, TT_APP_EXIT_FAILURE, st, s->output,
-             "exists; use -overwrite to replace it");
+    run_fail_exists(r, s->output);
     goto done;
   }
   if (st != TT_OK) {
@@ -1879,6 +1900,10 @@ static tt_status run_simplify(app_run *r)
     goto done;
   }
   st = tt_output_commit(r->ctx, outp);
+  if (st == TT_ERR_EXISTS) {
+    run_fail_exists(r, s->output); /* it appeared while we worked */
+    goto done;
+  }
   if (st != TT_OK) {
     run_fail_tt(r, st, s->output);
     goto done;
@@ -1954,8 +1979,7 @@ static tt_status run_generate(app_run *r)
   st = tt_gdal_write_grid(r->ctx, grid, s->output, wkt ? wkt : "",
                           s->overwrite);
   if (st == TT_ERR_EXISTS) {
-    run_fail(r, TT_APP_EXIT_FAILURE, st, s->output,
-             "exists; use -overwrite to replace it");
+    run_fail_exists(r, s->output);
     goto done;
   }
   if (st != TT_OK) {
