@@ -1,7 +1,7 @@
 /*
  * context.c -- the context (last error, warning sink), status names, version,
  * and the small helpers every module uses: error formatting, array growth,
- * the clock, the ground-frame metric. The context holds all mutable state a
+ * the clock. The context holds all mutable state a
  * run needs besides its own objects: there is no global mutable state.
  */
 #include "internal.h"
@@ -120,15 +120,6 @@ bool tt__grow(void **ptr, size_t *cap, size_t need, size_t elem)
   *ptr = p;
   *cap = ncap;
   return true;
-}
-
-void tt__metric_from_frame(const double a[4], tt__metric *out)
-{
-  /* Columns of A are the ground images of a column step and a row step. */
-  out->m11 = a[0] * a[0] + a[2] * a[2];
-  out->m12 = a[0] * a[1] + a[2] * a[3];
-  out->m22 = a[1] * a[1] + a[3] * a[3];
-  out->det_sign = (a[0] * a[3] - a[1] * a[2]) < 0 ? -1 : 1;
 }
 
 double tt__now(void)

@@ -56,7 +56,8 @@ TT_HIDDEN void tt__warn(tt_context *ctx, const char *fmt, ...)
 TT_HIDDEN bool tt__grow(void **ptr, size_t *cap, size_t need, size_t elem);
 
 /* Metric tensor of a ground frame a[4]: |A v|^2 = m11 dc^2 + 2 m12 dc dr +
- * m22 dr^2, and the sign of det(A). */
+ * m22 dr^2, and the exact sign of det(A) (predicates.c). The m's are
+ * rounded to doubles: the Delaunay test is exact for that metric. */
 typedef struct tt__metric {
   double m11, m12, m22;
   int det_sign;      /* +1 or -1 */

@@ -835,3 +835,15 @@ int tt__incircle_metric(const tt__metric *m, int64_t ax, int64_t ay,
                 (tt__i128)(cdx * cdy) * mc);
   return det_sign * metric_general(m, d1, d2x2, d3);
 }
+
+void tt__metric_from_frame(const double a[4], tt__metric *out)
+{
+  /* Columns of A are the ground images of a column step and a row step.
+   * The orientation is the exact sign of det(A) = orient2d(0, A e1, A e2),
+   * so a nearly singular frame cannot get the wrong one. */
+  const double o[2] = {0, 0}, c1[2] = {a[0], a[2]}, c2[2] = {a[1], a[3]};
+  out->m11 = a[0] * a[0] + a[2] * a[2];
+  out->m12 = a[0] * a[1] + a[2] * a[3];
+  out->m22 = a[1] * a[1] + a[3] * a[3];
+  out->det_sign = tt__orient2d(o, c1, c2) < 0 ? -1 : 1;
+}
