@@ -255,6 +255,10 @@ static const char help_simplify[] =
     "  -json             print one JSON object with the results instead of\n"
     "                    the progress bar and the summary line\n"
     "\n"
+    "A shapefile OUTPUT dir/name (or dir/name.shp) makes the files\n"
+    "dir/name_triangles.shp, dir/name_vertices.shp and\n"
+    "dir/name_run_parameters.dbf (with their .shx, .dbf, .prj, .cpg).\n"
+    "\n"
     "OUTPUT is written under a temporary name and renamed when complete: a\n"
     "failure or an interruption leaves nothing behind. Progress goes to\n"
     "stdout, warnings and errors to stderr.\n"
@@ -1029,7 +1033,7 @@ static void warn(app_messages *m, const char *fmt, ...)
   if (m->warnings > MAX_WARNINGS + 1)
     return;
   if (m->warnings == MAX_WARNINGS + 1) {
-    fprintf(m->err, "terratin: warning: more warnings follow; not shown\n");
+    fprintf(m->err, "terratin: warning: further warnings are not shown\n");
     return;
   }
   va_start(ap, fmt);
