@@ -24,10 +24,7 @@ void tt__mesh_init(tt__mesh *m, const tt__metric *metric)
 
 void tt__mesh_free(tt__mesh *m)
 {
-  free(m->vc);
-  free(m->vr);
-  free(m->vz);
-  free(m->vedge);
+  free(m->v);
   free(m->hv);
   free(m->twin);
   free(m->eflag);
@@ -38,17 +35,7 @@ void tt__mesh_free(tt__mesh *m)
 
 static bool grow_vertices(tt__mesh *m, size_t need)
 {
-  if (need <= m->vcap)
-    return true;
-  size_t c1 = m->vcap, c2 = m->vcap, c3 = m->vcap, c4 = m->vcap;
-  if (!tt__grow((void **)&m->vc, &c1, need, sizeof(int32_t)) ||
-      !tt__grow((void **)&m->vr, &c2, need, sizeof(int32_t)) ||
-      !tt__grow((void **)&m->vz, &c4, need, sizeof(float)) ||
-      !tt__grow((void **)&m->vedge, &c3, need, sizeof(int32_t)))
-    return false;
-  /* all four grew by the same rule from the same capacity */
-  m->vcap = c1;
-  return true;
+  return tt__grow((void **)&m->v, &m->vcap, need, sizeof(tt__mesh_vertex));
 }
 
 static bool grow_triangles(tt__mesh *m, size_t need)
@@ -81,10 +68,10 @@ int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row, float z)
   if (m->nv >= TT_MAX_VERTICES || !grow_vertices(m, m->nv + 1))
     return -1;
   int32_t v = (int32_t)m->nv++;
-  m->vc[v] = col;
-  m->vr[v] = row;
-  m->vz[v] = z;
-  m->vedge[v] = -1;
+  m->v[v].c = col;
+  m->v[v].r = row;
+  m->v[v].z = z;
+  m->v[v].edge = -1;
   return v;
 }
 
@@ -136,9 +123,9 @@ static void set_triangle(tt__mesh *m, int32_t t, int32_t a, int32_t b,
   m->hv[e + 2] = c;
   m->twin[e] = m->twin[e + 1] = m->twin[e + 2] = -1;
   m->eflag[e] = m->eflag[e + 1] = m->eflag[e + 2] = 0;
-  m->vedge[a] = e;
-  m->vedge[b] = e + 1;
-  m->vedge[c] = e + 2;
+  m->v[a].edge = e;
+  m->v[b].edge = e + 1;
+  m->v[c].edge = e + 2;
   m->touched[m->ntouched++] = t;
 }
 
@@ -236,16 +223,16 @@ bool tt__mesh_link_all(tt__mesh *m)
 int tt__mesh_orient(const tt__mesh *m, int32_t a, int32_t b, int32_t c)
 {
   return m->metric.det_sign *
-         tt__orient_i(m->vc[a], m->vr[a], m->vc[b], m->vr[b], m->vc[c],
-                      m->vr[c]);
+         tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, m->v[c].c,
+                      m->v[c].r);
 }
 
 int tt__mesh_incircle(const tt__mesh *m, int32_t a, int32_t b, int32_t c,
                       int32_t d)
 {
-  return tt__incircle_metric(&m->metric, m->vc[a], m->vr[a], m->vc[b],
-                             m->vr[b], m->vc[c], m->vr[c], m->vc[d],
-                             m->vr[d]);
+  return tt__incircle_metric(&m->metric, m->v[a].c, m->v[a].r, m->v[b].c,
+                             m->v[b].r, m->v[c].c, m->v[c].r, m->v[d].c,
+                             m->v[d].r);
 }
 
 bool tt__mesh_split_triangle(tt__mesh *m, int32_t t, int32_t p,
@@ -473,12 +460,12 @@ bool tt__mesh_validate(const tt__mesh *m, char *why, size_t whylen)
   size_t nvused = 0;
   for (size_t v = 0; v < m->nv; v++) {
     if (!used[v]) {
-      if (m->vedge[v] >= 0)
+      if (m->v[v].edge >= 0)
         FAIL("vertex %zu is in no triangle but has an edge", v);
       continue;
     }
     nvused++;
-    int32_t e = m->vedge[v];
+    int32_t e = m->v[v].edge;
     if (e < 0 || (size_t)e >= 3 * m->nslots || m->hv[e - e % 3] < 0 ||
         m->hv[e] != (int32_t)v)
       FAIL("vertex %zu: its edge %d does not leave it", v, e);

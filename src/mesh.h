@@ -9,9 +9,9 @@
  * A free triangle slot has hv[3t] == -1 and sits on the free list, so flips,
  * splits and (later) vertex removals make no garbage.
  *
- * Vertices are grid samples: integer pixel coordinates (col, row). vedge[v]
- * is one half-edge leaving v (hv[vedge[v]] == v), or -1 for a vertex in no
- * triangle. eflag[e] holds TT__EDGE_CONSTRAINED for edges that flips must
+ * Vertices are grid samples: integer pixel coordinates (col, row). v[i].edge
+ * is one half-edge leaving vertex i (hv[v[i].edge] == i), or -1 for a
+ * vertex in no triangle. eflag[e] holds TT__EDGE_CONSTRAINED for edges that flips must
  * keep (domain boundaries; both half-edges carry it).
  *
  * Only mesh.c writes these arrays. Each operation appends the slots of the
@@ -27,12 +27,18 @@
 
 #define TT__EDGE_CONSTRAINED 1u
 
+/* A vertex: one 16-byte record, so a triangle's corners cost three cache
+ * lines, not twelve. */
+typedef struct tt__mesh_vertex {
+  int32_t c, r;          /* pixel column, row */
+  float z;               /* height (kept here so scans need not fetch it
+                            from the grid at a random place) */
+  int32_t edge;          /* a half-edge leaving the vertex, or -1 */
+} tt__mesh_vertex;
+
 typedef struct tt__mesh {
   /* vertices */
-  int32_t *vc, *vr;      /* pixel column, row */
-  float *vz;             /* height (kept here so scans need not fetch it
-                            from the grid at a random place) */
-  int32_t *vedge;        /* a half-edge leaving the vertex, or -1 */
+  tt__mesh_vertex *v;
   size_t nv, vcap;
   /* triangles (3 half-edges each) */
   int32_t *hv;           /* start vertex; hv[3t] == -1: free slot */

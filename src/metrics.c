@@ -94,8 +94,8 @@ static void stats_job(void *arg, size_t c)
 
 static size_t top_row(const tt__mesh *m, int32_t t)
 {
-  int32_t r0 = m->vr[m->hv[3 * t]], r1 = m->vr[m->hv[3 * t + 1]],
-          r2 = m->vr[m->hv[3 * t + 2]];
+  int32_t r0 = m->v[m->hv[3 * t]].r, r1 = m->v[m->hv[3 * t + 1]].r,
+          r2 = m->v[m->hv[3 * t + 2]].r;
   int32_t r = r0 < r1 ? r0 : r1;
   return (size_t)(r < r2 ? r : r2);
 }
@@ -126,9 +126,9 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   memcpy(tin->gt, g->gt, sizeof tin->gt);
   memcpy(tin->frame, g->frame, sizeof tin->frame);
   for (size_t v = 0; v < m->nv; v++) {
-    tin->vc[v] = m->vc[v];
-    tin->vr[v] = m->vr[v];
-    tin->vz[v] = m->vz[v];
+    tin->vc[v] = m->v[v].c;
+    tin->vr[v] = m->v[v].r;
+    tin->vz[v] = m->v[v].z;
   }
 
   tt_error_stats *es = &tin->summary.errors;
@@ -189,14 +189,14 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   }
   /* vertex samples: error zero, owned by the triangle of the vertex edge */
   for (size_t v = 0; v < m->nv; v++) {
-    int32_t e = m->vedge[v];
+    int32_t e = m->v[v].edge;
     if (e < 0)
       continue;
     int32_t t = slot_to_tri[e / 3];
     tin->t_n[t]++;
     count++;
     if (max_index < 0) {
-      max_index = (int64_t)m->vr[v] * (int64_t)g->nx + m->vc[v];
+      max_index = (int64_t)m->v[v].r * (int64_t)g->nx + m->v[v].c;
       es->max_error = 0;
     }
   }

@@ -20,9 +20,9 @@ void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t, tt__scan_tri *st)
   for (int k = 0; k < 3; k++) {
     int32_t e = 3 * t + k;
     int32_t v = m->hv[e];
-    st->x[k] = m->vc[v];
-    st->y[k] = m->vr[v];
-    st->z[k] = (double)m->vz[v];
+    st->x[k] = m->v[v].c;
+    st->y[k] = m->v[v].r;
+    st->z[k] = (double)m->v[v].z;
   }
   /* Interior on the positive side of every normalised edge function; the
    * half-edge with direction (dx, dy) owns its samples iff dy > 0 or

@@ -129,8 +129,8 @@ static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
   const tt__mesh *m = &r->m;
   int64_t x[3], y[3];
   for (int k = 0; k < 3; k++) {
-    x[k] = m->vc[m->hv[3 * t + k]];
-    y[k] = m->vr[m->hv[3 * t + k]];
+    x[k] = m->v[m->hv[3 * t + k]].c;
+    y[k] = m->v[m->hv[3 * t + k]].r;
   }
   int64_t ylo = y[0] < y[1] ? (y[0] < y[2] ? y[0] : y[2]) : (y[1] < y[2] ? y[1] : y[2]);
   int64_t yhi = y[0] > y[1] ? (y[0] > y[2] ? y[0] : y[2]) : (y[1] > y[2] ? y[1] : y[2]);
@@ -384,7 +384,7 @@ static int32_t locate_in(const refine *r, int32_t t, int64_t col, int64_t row)
   int s = m->metric.det_sign; /* pixel-space orientation of live triangles */
   for (int k = 0; k < 3; k++) {
     int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
-    if (s * tt__orient_i(m->vc[a], m->vr[a], m->vc[b], m->vr[b], col, row) ==
+    if (s * tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, col, row) ==
         0)
       return 3 * t + k;
   }

@@ -28,7 +28,7 @@ static int32_t locate(const tt__mesh *m, int64_t c, int64_t r, int32_t *on)
     for (int k = 0; k < 3; k++) {
       int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
       int o = m->metric.det_sign *
-              tt__orient_i(m->vc[a], m->vr[a], m->vc[b], m->vr[b], c, r);
+              tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, c, r);
       if (o < 0)
         neg = 1;
       else if (o == 0)
