@@ -17,7 +17,9 @@
  *        /tmp/build-fuzz/libterratin_app.a /tmp/build-fuzz/libterratin_gdal.a \
  *        /tmp/build-fuzz/libterratin.a -lgdal -lproj -lm -o fuzz_options
  *      ./fuzz_options tests/corpus/options
- *    New crashes go into tests/corpus/options/ named after their issue.
+ *    New crashes go into tests/corpus/options/ named after their issue;
+ *    the cov-* files there are a coverage corpus merged from such runs
+ *    (./fuzz_options -merge=1 NEW_DIR tests/corpus/options RUN_DIR).
  */
 #include "terratin_lib.h"
 
