@@ -20,8 +20,10 @@
  * top key, FORCED_KEY, with its worst valid sample as candidate, so the
  * outline of the data is followed before any error is reduced; such
  * insertions ignore the point and triangle limits (a warning says so).
- * Splits keep a triangle inside the domain, and a flip only re-divides a
- * quadrilateral that is, so triangles once inside stay inside. At the end
+ * Splitting a triangle inside the domain, or flipping the edge between two
+ * such triangles, only re-divides a region inside it; the triangles that
+ * other flips make are rescanned like any other, and every forced
+ * insertion adds a vertex, so the process ends. At the end
  * the triangles still outside hold no valid sample but corners and are
  * deleted (carve_holes): lakes become holes, islands separate components,
  * and valid samples that can carry no triangle remain lone vertices.
