@@ -1646,6 +1646,10 @@ static void print_simplify_json(app_run *r, const simplify_report *p)
   json_str(&j, "stop_reason", tt_stop_reason_name(p->sum.stop_reason));
   json_size(&j, "vertices", p->sum.vertices);
   json_size(&j, "triangles", p->sum.triangles);
+  json_size(&j, "covered_samples", e->covered);
+  json_size(&j, "lone_samples", e->samples - e->covered);
+  json_size(&j, "components", p->sum.components);
+  json_size(&j, "forced_vertices", p->sum.forced_vertices);
   json_num(&j, "max_error", e->max_error);
   json_num(&j, "rmse", e->rmse);
   json_num(&j, "mean_abs_error", e->mean_abs);
@@ -1707,6 +1711,15 @@ static void print_simplify_summary(app_run *r, const simplify_report *p)
           p->sum.triangles, p->sum.errors.max_error, unit,
           p->sum.errors.rmse, unit, lim,
           tt_stop_reason_name(p->sum.stop_reason), p->t_total);
+  /* nodata outlines: what the TIN could not carry is said, not dropped */
+  size_t lone = p->sum.errors.samples - p->sum.errors.covered;
+  if (lone || p->sum.components > 1)
+    fprintf(r->out,
+            "%s: %zu separate piece%s; %zu valid sample%s amid nodata "
+            "cannot carry a triangle and %s kept as lone vertices\n",
+            r->s->output, p->sum.components,
+            p->sum.components == 1 ? "" : "s", lone, lone == 1 ? "" : "s",
+            lone == 1 ? "is" : "are");
 }
 
 static tt_status run_simplify(app_run *r)
@@ -1862,6 +1875,9 @@ static tt_status run_simplify(app_run *r)
       {"triangles", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.triangles, 0},
       {"cells", TT_FIELD_INTEGER, NULL, (int64_t)rep.cells, 0},
       {"valid", TT_FIELD_INTEGER, NULL, (int64_t)rep.valid, 0},
+      {"lone", TT_FIELD_INTEGER, NULL,
+       (int64_t)(e->samples - e->covered), 0},
+      {"pieces", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.components, 0},
       {"ach_max", TT_FIELD_REAL, NULL, 0, e->max_error},
       {"ach_rmse", TT_FIELD_REAL, NULL, 0, e->rmse},
       {"ach_mean", TT_FIELD_REAL, NULL, 0, e->mean_abs},
