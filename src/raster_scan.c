@@ -216,13 +216,8 @@ void tt__scan_prefetch(const tt_grid *g, const tt__scan_tri *st, int64_t ylo,
                        int64_t yhi)
 {
 #if defined(__GNUC__)
-  int64_t xmin = st->x[0], xmax = st->x[0], ymin = st->y[0], ymax = st->y[0];
-  for (int k = 1; k < 3; k++) {
-    xmin = st->x[k] < xmin ? st->x[k] : xmin;
-    xmax = st->x[k] > xmax ? st->x[k] : xmax;
-    ymin = st->y[k] < ymin ? st->y[k] : ymin;
-    ymax = st->y[k] > ymax ? st->y[k] : ymax;
-  }
+  int64_t xmin, xmax, ymin, ymax;
+  tt__scan_tri_bbox(st, &xmin, &xmax, &ymin, &ymax);
   if (ylo > ymin)
     ymin = ylo;
   if (yhi < ymax)
@@ -687,13 +682,8 @@ bool tt__tri_in_domain(const tt_grid *g, const tt__scan_tri *st)
     tri[k][0] = st->x[src];
     tri[k][1] = st->y[src];
   }
-  int64_t x0 = tri[0][0], x1 = tri[0][0], y0 = tri[0][1], y1 = tri[0][1];
-  for (int k = 1; k < 3; k++) {
-    x0 = tri[k][0] < x0 ? tri[k][0] : x0;
-    x1 = tri[k][0] > x1 ? tri[k][0] : x1;
-    y0 = tri[k][1] < y0 ? tri[k][1] : y0;
-    y1 = tri[k][1] > y1 ? tri[k][1] : y1;
-  }
+  int64_t x0, x1, y0, y1;
+  tt__scan_tri_bbox(st, &x0, &x1, &y0, &y1);
   /* every bad cell meeting the box has a nodata corner in the box */
   for (int64_t y = y0; y <= y1; y++) {
     const float *row = g->z + (size_t)y * g->nx;

@@ -26,6 +26,20 @@ typedef struct tt__scan_tri {
   bool own[3];          /* samples on edge i (corner i -> i+1) are ours */
 } tt__scan_tri;
 
+/* The bounding box of the corners. */
+static inline void tt__scan_tri_bbox(const tt__scan_tri *st, int64_t *x0,
+                                     int64_t *x1, int64_t *y0, int64_t *y1)
+{
+  *x0 = *x1 = st->x[0];
+  *y0 = *y1 = st->y[0];
+  for (int k = 1; k < 3; k++) {
+    *x0 = st->x[k] < *x0 ? st->x[k] : *x0;
+    *x1 = st->x[k] > *x1 ? st->x[k] : *x1;
+    *y0 = st->y[k] < *y0 ? st->y[k] : *y0;
+    *y1 = st->y[k] > *y1 ? st->y[k] : *y1;
+  }
+}
+
 /* Fills st for live triangle t of the mesh. */
 TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t,
                                       tt__scan_tri *st);

@@ -159,13 +159,8 @@ static bool near_nodata(const refine *r, const tt__scan_tri *st)
 {
   if (!r->nodata)
     return false;
-  int64_t x0 = st->x[0], x1 = st->x[0], y0 = st->y[0], y1 = st->y[0];
-  for (int k = 1; k < 3; k++) {
-    x0 = st->x[k] < x0 ? st->x[k] : x0;
-    x1 = st->x[k] > x1 ? st->x[k] : x1;
-    y0 = st->y[k] < y0 ? st->y[k] : y0;
-    y1 = st->y[k] > y1 ? st->y[k] : y1;
-  }
+  int64_t x0, x1, y0, y1;
+  tt__scan_tri_bbox(st, &x0, &x1, &y0, &y1);
   size_t w = r->bnx + 1;
   size_t bx0 = (size_t)x0 / ND_BLOCK, bx1 = (size_t)x1 / ND_BLOCK + 1;
   size_t by0 = (size_t)y0 / ND_BLOCK, by1 = (size_t)y1 / ND_BLOCK + 1;
@@ -207,15 +202,12 @@ static void scan_job(void *arg, size_t i)
 /* Appends the jobs of live triangle t. */
 static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
 {
-  const tt__mesh *m = &r->m;
-  int64_t x[3], y[3];
-  for (int k = 0; k < 3; k++) {
-    x[k] = m->v[m->hv[3 * t + k]].c;
-    y[k] = m->v[m->hv[3 * t + k]].r;
-  }
-  int64_t ylo = y[0] < y[1] ? (y[0] < y[2] ? y[0] : y[2]) : (y[1] < y[2] ? y[1] : y[2]);
-  int64_t yhi = y[0] > y[1] ? (y[0] > y[2] ? y[0] : y[2]) : (y[1] > y[2] ? y[1] : y[2]);
-  int64_t area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+  tt__scan_tri st;
+  tt__scan_tri_from_mesh(&r->m, t, &st);
+  int64_t xlo, xhi, ylo, yhi;
+  tt__scan_tri_bbox(&st, &xlo, &xhi, &ylo, &yhi);
+  int64_t area2 = (st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) -
+                  (st.x[2] - st.x[0]) * (st.y[1] - st.y[0]);
   if (area2 < 0)
     area2 = -area2;
   *samples += area2 / 2;

@@ -9,46 +9,9 @@
  * generator, so ctest runs them all without clang. */
 #include "terratin/terratin.h"
 #include "tt_test.h"
+#include "tt_tin_oracle.h"
 
 #include <stdbool.h>
-
-/* Exact: does any triangle hold a nodata sample strictly inside? */
-static bool nodata_inside(const tt_grid *g, const tt_tin *tin)
-{
-  const float *z = tt_grid_heights_const(g);
-  size_t nx = tt_grid_width(g);
-  for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {
-    tt_triangle_info ti;
-    tt_tin_triangle(tin, t, &ti);
-    long long x[3], y[3];
-    for (int k = 0; k < 3; k++) {
-      tt_vertex_info vi;
-      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
-      x[k] = vi.col;
-      y[k] = vi.row;
-    }
-    long long x0 = x[0], x1 = x[0], y0 = y[0], y1 = y[0];
-    for (int k = 1; k < 3; k++) {
-      x0 = x[k] < x0 ? x[k] : x0;
-      x1 = x[k] > x1 ? x[k] : x1;
-      y0 = y[k] < y0 ? y[k] : y0;
-      y1 = y[k] > y1 ? y[k] : y1;
-    }
-    for (long long r = y0; r <= y1; r++)
-      for (long long c = x0; c <= x1; c++) {
-        int pos = 0, neg = 0;
-        for (int k = 0; k < 3; k++) {
-          int k1 = (k + 1) % 3;
-          long long o = (x[k1] - x[k]) * (r - y[k]) - (y[k1] - y[k]) * (c - x[k]);
-          pos += o > 0;
-          neg += o < 0;
-        }
-        if ((pos == 3 || neg == 3) && isnan(z[(size_t)r * nx + (size_t)c]))
-          return true;
-      }
-  }
-  return false;
-}
 
 static int check_input(const uint8_t *data, size_t size)
 {
@@ -96,18 +59,7 @@ static int check_input(const uint8_t *data, size_t size)
     goto out;
   }
   size_t nt = tt_tin_triangle_count(tin);
-  double *xyz = malloc((nt ? nt : 1) * 9 * sizeof *xyz);
-  for (size_t t = 0; t < nt; t++) {
-    tt_triangle_info ti;
-    tt_tin_triangle(tin, t, &ti);
-    for (int k = 0; k < 3; k++) {
-      tt_vertex_info vi;
-      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
-      xyz[9 * t + 3 * k] = vi.col;
-      xyz[9 * t + 3 * k + 1] = vi.row;
-      xyz[9 * t + 3 * k + 2] = vi.z;
-    }
-  }
+  double *xyz = tt_oracle_pixel_triangles(tin);
   tt_eval_result ev;
   if (tt_eval_triangles(ctx, g, nt, xyz, &ev) != TT_OK)
     TT_FAIL_("eval failed: %s", tt_context_errmsg(ctx));
@@ -120,7 +72,7 @@ static int check_input(const uint8_t *data, size_t size)
   if (ev.uncovered != sum.errors.samples - sum.errors.covered)
     TT_FAIL_("%zux%zu mode %u: %zu uncovered, summary says %zu", nx, ny,
              mode, ev.uncovered, sum.errors.samples - sum.errors.covered);
-  if (nodata_inside(g, tin))
+  if (tt_oracle_nodata_inside(g, tin))
     TT_FAIL_("%zux%zu mode %u: a triangle has nodata strictly inside", nx,
              ny, mode);
   if (sum.stop_reason == TT_STOP_MAX_ERROR &&

@@ -9,6 +9,7 @@
 #include "predicates.h"
 #include "terratin/terratin.h"
 #include "tt_test.h"
+#include "tt_tin_oracle.h"
 
 #include <stdbool.h>
 
@@ -43,18 +44,7 @@ static void brute_force(const tt_grid *g, const tt_tin *tin, oracle *o)
   size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
   const float *z = tt_grid_heights_const(g);
   size_t nt = tt_tin_triangle_count(tin);
-  double *tri = malloc(nt * 9 * sizeof *tri);
-  for (size_t t = 0; t < nt; t++) {
-    tt_triangle_info ti;
-    tt_tin_triangle(tin, t, &ti);
-    for (int k = 0; k < 3; k++) {
-      tt_vertex_info vi;
-      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
-      tri[9 * t + 3 * k] = vi.col;
-      tri[9 * t + 3 * k + 1] = vi.row;
-      tri[9 * t + 3 * k + 2] = vi.z;
-    }
-  }
+  double *tri = tt_oracle_pixel_triangles(tin);
   memset(o, 0, sizeof *o);
   for (size_t r = 0; r < ny; r++)
     for (size_t c = 0; c < nx; c++) {
@@ -296,38 +286,6 @@ static void test_flat_and_plane(void)
   tt_grid_destroy(g);
 }
 
-/* Exact: the number of nodata samples strictly inside some triangle. */
-static size_t nodata_inside(const tt_grid *g, const tt_tin *tin)
-{
-  const float *z = tt_grid_heights_const(g);
-  size_t nx = tt_grid_width(g), bad = 0;
-  for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {
-    tt_triangle_info ti;
-    tt_tin_triangle(tin, t, &ti);
-    long long x[3], y[3];
-    for (int k = 0; k < 3; k++) {
-      tt_vertex_info vi;
-      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
-      x[k] = vi.col;
-      y[k] = vi.row;
-    }
-    for (long long r = 0; r < (long long)tt_grid_height(g); r++)
-      for (long long c = 0; c < (long long)nx; c++) {
-        int pos = 0, neg = 0;
-        for (int k = 0; k < 3; k++) {
-          int k1 = (k + 1) % 3;
-          long long o =
-              (x[k1] - x[k]) * (r - y[k]) - (y[k1] - y[k]) * (c - x[k]);
-          pos += o > 0;
-          neg += o < 0;
-        }
-        if ((pos == 3 || neg == 3) && isnan(z[(size_t)r * nx + (size_t)c]))
-          bad++;
-      }
-  }
-  return bad;
-}
-
 /* Nodata domains (issue 3): the TIN covers the valid samples and nothing
  * else. Masks: a disc with a one-sample hole, a ring (a hole of a lake),
  * two islands, a checkerboard corner, a diagonal staircase, a one-pixel
@@ -388,36 +346,20 @@ static void test_nodata(void)
       CHECK_INT_EQ(s.valid_samples, valid);
       /* every valid sample is covered but the lone ones */
       CHECK_INT_EQ(o.uncovered, s.errors.samples - s.errors.covered);
-      size_t lone = 0;
-      for (size_t v = 0; v < tt_tin_vertex_count(tin); v++) {
-        tt_vertex_info vi;
-        tt_tin_vertex(tin, v, &vi);
-        if (vi.star_samples != 0)
-          continue;
-        lone++;
-        /* a lone sample is never one that a wholly valid cell around it
-         * could carry. (Known gap, issue 3: a sample whose only valid
-         * cells have three valid corners may be left out when the mesh
-         * does not follow the cell's diagonal; recovering the domain's
-         * outline as constrained edges will close it.) */
-        for (int cy = vi.row - 1; cy <= vi.row; cy++)
-          for (int cx = vi.col - 1; cx <= vi.col; cx++) {
-            int nv = 0;
-            for (int k = 0; k < 4; k++) {
-              int x = cx + (k & 1), y = cy + (k >> 1);
-              nv += x >= 0 && y >= 0 && x < (int)n && y < (int)n &&
-                    !isnan(z[(size_t)y * n + (size_t)x]);
-            }
-            if (nv == 4)
-              TT_FAIL_("mask %d: sample (%d, %d) left out, but cell (%d, "
-                       "%d) could carry a triangle", mask, vi.col, vi.row,
-                       cx, cy);
-          }
-      }
+      /* a lone sample is never one that a wholly valid cell around it
+       * could carry. (Known gap, issue 3: a sample whose only valid cells
+       * have three valid corners may be left out when the mesh does not
+       * follow the cell's diagonal; recovering the domain's outline as
+       * constrained edges will close it.) */
+      size_t lone, misplaced;
+      tt_oracle_lone(g, tin, &lone, &misplaced);
+      if (misplaced)
+        TT_FAIL_("mask %d: %zu samples left out beside a valid cell", mask,
+                 misplaced);
       CHECK_INT_EQ(o.uncovered, lone);
-      if (nodata_inside(g, tin))
+      if (tt_oracle_nodata_inside(g, tin))
         TT_FAIL_("mask %d: %zu nodata samples strictly inside triangles",
-                 mask, nodata_inside(g, tin));
+                 mask, tt_oracle_nodata_inside(g, tin));
       CHECK_DBL_LE(o.max_err, bound + 1e-9);
       if (mask == 1 || mask == 2)
         CHECK(s.components >= (mask == 2 ? 2u : 1u));

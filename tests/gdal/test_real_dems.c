@@ -10,6 +10,7 @@
  *    and a handful of DEMs with nodata, feet, NaN and odd CRSs. */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
+#include "tt_tin_oracle.h"
 
 #include <cpl_conv.h>
 
@@ -40,18 +41,7 @@ static void check_against_eval(const tt_grid *g, const tt_tin *tin,
                                double bound, const char *what)
 {
   size_t nt = tt_tin_triangle_count(tin);
-  double *xyz = malloc(nt * 9 * sizeof *xyz);
-  for (size_t t = 0; t < nt; t++) {
-    tt_triangle_info ti;
-    tt_tin_triangle(tin, t, &ti);
-    for (int k = 0; k < 3; k++) {
-      tt_vertex_info vi;
-      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
-      xyz[9 * t + 3 * k] = vi.col;
-      xyz[9 * t + 3 * k + 1] = vi.row;
-      xyz[9 * t + 3 * k + 2] = vi.z;
-    }
-  }
+  double *xyz = tt_oracle_pixel_triangles(tin);
   tt_eval_result ev;
   CHECK_OK(ctx, tt_eval_triangles(ctx, g, nt, xyz, &ev));
   free(xyz);
@@ -62,31 +52,14 @@ static void check_against_eval(const tt_grid *g, const tt_tin *tin,
   if (ev.uncovered != s.errors.samples - s.errors.covered)
     TT_FAIL_("%s: %zu valid samples outside the TIN, the summary says %zu",
              what, ev.uncovered, s.errors.samples - s.errors.covered);
-  {
-    const float *z = tt_grid_heights_const(g);
-    long long nx = (long long)tt_grid_width(g), ny = (long long)tt_grid_height(g);
-    size_t lone = 0;
-    for (size_t v = 0; v < tt_tin_vertex_count(tin); v++) {
-      tt_vertex_info vi;
-      tt_tin_vertex(tin, v, &vi);
-      if (vi.star_samples)
-        continue;
-      lone++;
-      for (long long cy = vi.row - 1; cy <= vi.row; cy++)
-        for (long long cx = vi.col - 1; cx <= vi.col; cx++) {
-          int nv = 0;
-          for (int k = 0; k < 4; k++) {
-            long long x = cx + (k & 1), y = cy + (k >> 1);
-            nv += x >= 0 && y >= 0 && x < nx && y < ny &&
-                  !isnan(z[y * nx + x]);
-          }
-          if (nv == 4)
-            TT_FAIL_("%s: sample (%d, %d) left out beside a valid cell",
-                     what, vi.col, vi.row);
-        }
-    }
-    CHECK_INT_EQ(lone, ev.uncovered);
-  }
+  size_t lone, misplaced;
+  tt_oracle_lone(g, tin, &lone, &misplaced);
+  CHECK_INT_EQ(lone, ev.uncovered);
+  if (misplaced)
+    TT_FAIL_("%s: %zu samples left out beside a wholly valid cell", what,
+             misplaced);
+  if (tt_oracle_nodata_inside(g, tin))
+    TT_FAIL_("%s: nodata samples strictly inside triangles", what);
   if (ev.overlapped != 0)
     TT_FAIL_("%s: %zu samples inside two triangles", what, ev.overlapped);
   if (bound >= 0 && !(ev.errors.max_error <= bound + 1e-9 * (1 + bound)))
