@@ -1899,6 +1899,14 @@ static tt_status run_simplify(app_run *r)
   CPLFree(prefix);
   for (size_t i = 0; s->lco[i]; i++)
     wopts = CSLAddNameValue(wopts, "LCO", s->lco[i]);
+  /* GPKG R-trees: bulk-loaded on the closed file by tt_gpkg_build_rtree()
+   * (GDAL 3.6 inserts them one by one); -lco SPATIAL_INDEX=NO: none. */
+  const char *si = CSLFetchNameValue((CSLConstList)s->lco, "SPATIAL_INDEX");
+  int rtree = str_ieq(drvname, "GPKG") && (!si || CPLTestBool(si));
+  if (rtree) {
+    wopts = CSLSetNameValue(wopts, "RTREE", "DEFERRED");
+    phase_set(&r->prog, 0.85, 0.95);
+  }
   r->msg.last[0] = '\0';
   st = tt_ogr_write_tin(r->ctx, dst, tin, srs, fields,
                         sizeof fields / sizeof fields[0], wopts, phase_fn,
@@ -1914,6 +1922,25 @@ static tt_status run_simplify(app_run *r)
     st = run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
                   "error while closing: %s", r->msg.last);
     goto done;
+  }
+  for (int k = 0; rtree && k < 2; k++) {
+    const char *geom = CSLFetchNameValueDef((CSLConstList)s->lco,
+                                            "GEOMETRY_NAME", "geom");
+    char *layer = CPLStrdup(CPLSPrintf("%s%s", s->nln,
+                                       k ? "vertices" : "triangles"));
+    phase_set(&r->prog, k ? 0.98 : 0.95, k ? 0.99 : 0.98);
+    st = tt_gpkg_build_rtree(r->ctx, tt_output_temp_path(outp), layer, geom,
+                             phase_fn, &r->prog);
+    CPLFree(layer);
+    if (st == TT_ERR_INTERRUPTED || st == TT_ERR_NOMEM) {
+      run_fail_tt(r, st, s->output);
+      goto done;
+    }
+    if (st != TT_OK) {
+      run_fail(r, TT_APP_EXIT_FAILURE, st, s->output, "%s",
+               why(r, st, tt_output_temp_path(outp)));
+      goto done;
+    }
   }
   if (!run_continue(r, 0.99)) {
     st = run_fail_tt(r, TT_ERR_INTERRUPTED, s->output);

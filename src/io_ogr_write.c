@@ -26,7 +26,9 @@
  * Spatial index: GPKG layers are created with SPATIAL_INDEX=NO (its R-tree
  * triggers would update the index per insert) and the R-tree is built once,
  * in bulk, by the driver's CreateSpatialIndex() SQL function after the
- * inserts and inside the transaction; LCO=SPATIAL_INDEX=NO skips it. Other
+ * inserts and inside the transaction; LCO=SPATIAL_INDEX=NO skips it, and
+ * RTREE=DEFERRED leaves it to the caller (tt_gpkg_build_rtree() on the
+ * closed file, several times faster than GDAL 3.6's one-by-one inserts). Other
  * drivers index as their own options say (Shapefile: .qix at close with
  * LCO=SPATIAL_INDEX=YES). Shapefile layers default to ENCODING=UTF-8 (.cpg).
  *
@@ -89,6 +91,7 @@ typedef struct write_state {
   int ncreated;
   int gpkg;
   int build_rtree;         /* GPKG: bulk-build the R-trees before commit */
+  int rtree_deferred;      /* RTREE=DEFERRED: the caller builds them */
   OGRLayerH tri_layer, vtx_layer, run_layer;
   int tri_idx[TF_COUNT], vtx_idx[VF_COUNT];
   int *run_idx;
@@ -128,9 +131,17 @@ static tt_status parse_options(write_state *w, char **options)
       else
         w->lco = CSLSetNameValue(w->lco, lkey, lvalue);
       CPLFree(lkey);
+    } else if (strcasecmp(key, "RTREE") == 0) {
+      if (strcasecmp(value, "DEFERRED") == 0)
+        w->rtree_deferred = 1;
+      else if (strcasecmp(value, "NOW") == 0)
+        w->rtree_deferred = 0;
+      else
+        s = tt__error(w->ctx, TT_ERR_ARG, "RTREE=%s: expected NOW or "
+                      "DEFERRED", value);
     } else {
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
-                    "(known: NLN_PREFIX, LCO)", key);
+                    "(known: NLN_PREFIX, LCO, RTREE)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -143,7 +154,8 @@ static tt_status parse_options(write_state *w, char **options)
    * the user asked for none. */
   if (w->gpkg) {
     const char *si = CSLFetchNameValue(w->lco, "SPATIAL_INDEX");
-    w->build_rtree = !si || CPLTestBool(si);
+    /* RTREE=DEFERRED: tt_gpkg_build_rtree() on the closed file instead. */
+    w->build_rtree = (!si || CPLTestBool(si)) && !w->rtree_deferred;
     w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "NO");
   }
   /* DBF strings are Latin-1 unless told otherwise; CRS names and paths may
