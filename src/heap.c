@@ -1,5 +1,5 @@
 /*
- * heap.c -- the indexed binary max-heap of heap.h. Workload: in greedy
+ * heap.c -- the indexed 4-ary max-heap of heap.h. Workload: in greedy
  * refinement one pop and a handful of updates per inserted vertex, so every
  * operation is O(log n) with no allocation but amortised growth.
  */
@@ -19,11 +19,17 @@ static void place(tt__heap *h, size_t i, tt__heap_entry x)
   h->pos[x.item] = (int32_t)i;
 }
 
+/* A 4-ary heap: children of i are 4i+1 .. 4i+4, parent (i-1)/4. Half the
+ * depth of a binary heap, and the four children of a node (16 bytes each)
+ * share one 64-byte cache line: sift-downs touch half as many lines, which
+ * matters once the heap (16 bytes a triangle) outgrows the caches. */
+#define ARITY 4
+
 static void sift_up(tt__heap *h, size_t i)
 {
   tt__heap_entry x = h->e[i];
   while (i > 0) {
-    size_t parent = (i - 1) / 2;
+    size_t parent = (i - 1) / ARITY;
     if (!above(&x, &h->e[parent]))
       break;
     place(h, i, h->e[parent]);
@@ -36,15 +42,18 @@ static void sift_down(tt__heap *h, size_t i)
 {
   tt__heap_entry x = h->e[i];
   for (;;) {
-    size_t child = 2 * i + 1;
-    if (child >= h->n)
+    size_t first = ARITY * i + 1;
+    if (first >= h->n)
       break;
-    if (child + 1 < h->n && above(&h->e[child + 1], &h->e[child]))
-      child++;
-    if (!above(&h->e[child], &x))
+    size_t last = first + ARITY < h->n ? first + ARITY : h->n;
+    size_t best = first;
+    for (size_t c = first + 1; c < last; c++)
+      if (above(&h->e[c], &h->e[best]))
+        best = c;
+    if (!above(&h->e[best], &x))
       break;
-    place(h, i, h->e[child]);
-    i = child;
+    place(h, i, h->e[best]);
+    i = best;
   }
   place(h, i, x);
 }
@@ -115,7 +124,7 @@ void tt__heap_remove(tt__heap *h, int32_t item)
   tt__heap_entry last = h->e[h->n];
   h->e[i] = last;
   h->pos[last.item] = (int32_t)i;
-  if (i > 0 && above(&last, &h->e[(i - 1) / 2]))
+  if (i > 0 && above(&last, &h->e[(i - 1) / ARITY]))
     sift_up(h, i);
   else
     sift_down(h, i);

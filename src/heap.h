@@ -1,5 +1,5 @@
 /*
- * heap.h -- an indexed binary max-heap of (key, item) pairs.
+ * heap.h -- an indexed 4-ary max-heap of (key, item) pairs.
  *
  * Items are small non-negative integers (triangle or edge slots); the heap
  * keeps each item's position so an item's key can be changed or the item
