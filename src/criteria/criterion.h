@@ -18,14 +18,26 @@
 
 typedef struct tt__crit_env {
   const tt__mesh *mesh;
-  const tt_grid *grid;   /* heights, for data-dependent criteria */
+  const tt_grid *grid;   /* heights, for data-dependent criteria; the
+                            ground frame is grid->frame: a pixel step
+                            (dc, dr) is (a0 dc + a1 dr, a2 dc + a3 dr) on
+                            the ground, and heights are in ground units */
 } tt__crit_env;
 
 typedef struct tt__criterion_vt {
   tt_criterion id;
   const char *name;
   bool data_dependent;   /* uses heights, not only x,y */
+  /* Quality(after swapping e) - Quality(before), > 0 when the swap
+   * improves; e has a twin (convexity is the caller's business). */
   double (*swap_value)(const tt__crit_env *env, int32_t e);
+  /* After a swap made half-edge h (the new diagonal, mesh.h), writes the
+   * half-edges whose swap values may have changed into out (at most max)
+   * and returns their count. NULL: the four outer edges of the quad (enough
+   * for every criterion whose swap value depends on the two triangles of
+   * an edge only; Gaussian curvature needs the edges around the quad's
+   * vertices). */
+  int (*affected)(const tt__crit_env *env, int32_t h, int32_t *out, int max);
 } tt__criterion_vt;
 
 /* The criterion of an id, or NULL for an unknown id. */
