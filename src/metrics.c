@@ -179,16 +179,20 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
     goto done;
   }
-  for (size_t s = 0; s < m->nslots; s++)
-    if (tt__mesh_live(m, (int32_t)s))
-      first[top_row(m, (int32_t)s) + 1]++;
+  /* slot_to_tri holds each live slot's top row for the two passes of the
+   * sort, then the slot's triangle index */
+  for (size_t s = 0; s < m->nslots; s++) {
+    slot_to_tri[s] = -1;
+    if (tt__mesh_live(m, (int32_t)s)) {
+      slot_to_tri[s] = (int32_t)top_row(m, (int32_t)s);
+      first[slot_to_tri[s] + 1]++;
+    }
+  }
   for (size_t y = 0; y < g->ny; y++)
     first[y + 1] += first[y];
   for (size_t s = 0; s < m->nslots; s++)
-    if (tt__mesh_live(m, (int32_t)s))
-      order[first[top_row(m, (int32_t)s)]++] = (int32_t)s;
-  for (size_t s = 0; s < m->nslots; s++)
-    slot_to_tri[s] = -1;
+    if (slot_to_tri[s] >= 0)
+      order[first[slot_to_tri[s]]++] = (int32_t)s;
   size_t nt = m->nlive;
   for (size_t i = 0; i < nt; i++) {
     int32_t s = order[i];

@@ -122,6 +122,7 @@ static bool add_vertex(refine *r, int32_t col, int32_t row, double err,
 typedef struct scan_job_t {
   int32_t t;
   int64_t ylo, yhi;
+  tt__scan_tri st;      /* the triangle, read once from the mesh */
   double err;
   int64_t index;
 } scan_job_t;
@@ -182,8 +183,7 @@ static void scan_job(void *arg, size_t i)
 {
   refine *r = arg;
   scan_job_t *j = &r->jobs[i];
-  tt__scan_tri st;
-  tt__scan_tri_from_mesh(&r->m, j->t, &st);
+  const tt__scan_tri st = j->st;
   if (near_nodata(r, &st)) {
     /* near nodata a triangle is never cut into bands (add_jobs) */
     bool inside;
@@ -220,6 +220,7 @@ static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
       return false;
     scan_job_t *j = &r->jobs[(*njobs)++];
     j->t = t;
+    j->st = st;
     j->ylo = y0;
     j->yhi = y0 + band - 1 < yhi ? y0 + band - 1 : yhi;
   }
@@ -269,11 +270,8 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
   if (samples < PARALLEL_MIN_SAMPLES) {
     /* small triangles, cold in cache: ask for all their rows first, so
      * the misses overlap instead of queueing one row at a time */
-    for (size_t i = 0; i < njobs; i++) {
-      tt__scan_tri st;
-      tt__scan_tri_from_mesh(&r->m, r->jobs[i].t, &st);
-      tt__scan_prefetch(r->g, &st, INT64_MIN, INT64_MAX);
-    }
+    for (size_t i = 0; i < njobs; i++)
+      tt__scan_prefetch(r->g, &r->jobs[i].st, INT64_MIN, INT64_MAX);
   }
   tt__pool_run(samples >= PARALLEL_MIN_SAMPLES ? r->pool : NULL, njobs,
                scan_job, r);
