@@ -1,17 +1,40 @@
 /*
  * georef_proj.c -- where a grid's pixels stand on the ground.
  *
- * This file will hold the PROJ side of the glue: transforming a geographic
- * or otherwise non-metric grid into a proper local projected frame, vertical
- * unit conversion, and datum checks (a later issue). For now it holds one
- * function, the ground frame of a geographic grid: a local equirectangular
- * approximation at the grid's centre latitude, in metres, computed from the
- * CRS's own ellipsoid (meridional and prime-vertical radii of curvature).
- * It is exact at the centre latitude for distances along a parallel or a
- * meridian and drifts by about (1 - cos(dlat)) away from it, which is ample
- * for the angle and area measures of a TIN over a single DEM tile.
+ * The engine measures angles, areas and the Delaunay test in a *ground
+ * frame*: an affine map from a pixel step to metres (tt_grid_set_ground_
+ * frame). It must stay affine, because the incircle test is exact only for
+ * a constant metric tensor. This file chooses that frame.
  *
- * Workload: a handful of floating-point operations per grid read.
+ *  - A projected CRS in metres whose scale is within TT_METRIC_TOLERANCE of
+ *    the local UTM zone's (UTM itself, national grids, conformal conics):
+ *    the geotransform's linear part, unchanged.
+ *  - A geographic CRS, or a projected CRS whose map units are not ground
+ *    metres (Web Mercator, feet, a sheared sinusoidal), or any CRS when the
+ *    caller names a working CRS (-work_srs): the Jacobian of
+ *    pixel -> working-CRS coordinates at the grid's centre, by central
+ *    differences over TT_JACOBIAN_STEP pixels through PROJ (OGR coordinate
+ *    transformations, traditional GIS axis order on both sides). That is
+ *    the Jacobian of map -> working frame times the geotransform's linear
+ *    part. The working CRS is the UTM zone of the centre on the CRS's own
+ *    datum (WGS 84: EPSG:326zz / 327zz; other datums: the same projection
+ *    built on their geographic CRS, named by EPSG when GDAL can identify
+ *    it), or UPS beyond 84 N / 80 S on WGS 84.
+ *  - When PROJ cannot transform (no datum, no grid, a CRS it rejects): for
+ *    a geographic CRS, the old local equirectangular frame from the CRS's
+ *    ellipsoid (meridional and prime-vertical radii at the centre latitude),
+ *    with a warning; for a projected CRS, the geotransform scaled by the
+ *    CRS's linear unit, with a warning.
+ *
+ * An affine frame is exact at the centre only. Over a DEM tile the relative
+ * distance error grows like (distance from the centre / Earth radius) times
+ * the change of UTM's scale and convergence; tests/gdal/test_georef.c
+ * measures it against PROJ's own coordinates.
+ *
+ * Heights are never touched here.
+ *
+ * Workload: five coordinate transformations and the creation of one PROJ
+ * pipeline per grid read.
  */
 #include "internal.h"
 
@@ -19,13 +42,22 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <cpl_conv.h>
+#include <cpl_error.h>
 #include <ogr_srs_api.h>
 
 /* M_PI is not in strict C11. */
 #define TT_PI 3.14159265358979323846
 
-/* Declared again in io_gdal_read.c, its only caller (the glue has no private
- * header of its own yet); keep the two in step. */
+/* Half-width, in pixels, of the central differences of the Jacobian. */
+#define TT_JACOBIAN_STEP 2.0
+/* A metric projected CRS keeps its geotransform frame when the lengths of
+ * a column step, a row step and the angle between them agree with UTM's to
+ * this relative tolerance (UTM's own scale varies by 0.1% across a zone). */
+#define TT_METRIC_TOLERANCE 0.01
+
+/* Declared again in io_gdal_read.c, the only caller (the glue has no
+ * private header of its own yet); keep the declarations in step. */
 TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
                                                 OGRSpatialReferenceH srs,
                                                 const double gt[6],
@@ -33,6 +65,13 @@ TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
                                                 double out_frame[4],
                                                 char *out_name,
                                                 size_t name_size);
+TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
+                                            OGRSpatialReferenceH srs,
+                                            const char *work_srs,
+                                            const double gt[6], size_t nx,
+                                            size_t ny, double out_frame[4],
+                                            char *out_name,
+                                            size_t name_size);
 
 /* Sets out_frame to the geotransform's linear part scaled to metres at the
  * centre latitude of an nx x ny grid: column and row steps in the CRS's
@@ -94,4 +133,300 @@ tt_status tt__georef_geographic_frame(tt_context *ctx,
              lat / TT_PI * 180.0, kx, unit_name ? unit_name : "unit", ky,
              unit_name ? unit_name : "unit");
   return TT_OK;
+}
+
+/* A copy of srs that takes and gives (x = easting or longitude, y =
+ * northing or latitude), whatever the CRS's own axis order. */
+static OGRSpatialReferenceH gis_order_clone(OGRSpatialReferenceH srs)
+{
+  OGRSpatialReferenceH c = OSRClone(srs);
+  if (c)
+    OSRSetAxisMappingStrategy(c, OAMS_TRADITIONAL_GIS_ORDER);
+  return c;
+}
+
+/* Map coordinates of pixel-edge position (px, py). */
+static void pixel_to_map(const double gt[6], double px, double py,
+                         double *x, double *y)
+{
+  *x = gt[0] + px * gt[1] + py * gt[2];
+  *y = gt[3] + px * gt[4] + py * gt[5];
+}
+
+/* Longitude and latitude (degrees) of the grid's centre on srs's own
+ * geographic CRS. 0 when PROJ cannot say. */
+static int centre_lonlat(OGRSpatialReferenceH srs, const double gt[6],
+                         size_t nx, size_t ny, double *out_lon,
+                         double *out_lat)
+{
+  int ok = 0;
+  OGRSpatialReferenceH geog = OSRCloneGeogCS(srs);
+  OGRSpatialReferenceH src = gis_order_clone(srs);
+  OGRCoordinateTransformationH ct = NULL;
+  if (!geog || !src)
+    goto done;
+  OSRSetAxisMappingStrategy(geog, OAMS_TRADITIONAL_GIS_ORDER);
+  double x, y, z = 0;
+  pixel_to_map(gt, 0.5 * (double)nx, 0.5 * (double)ny, &x, &y);
+  if (OSRIsGeographic(srs)) {
+    ok = 1;
+  } else {
+    ct = OCTNewCoordinateTransformation(src, geog);
+    ok = ct && OCTTransform(ct, 1, &x, &y, &z);
+  }
+  if (ok) {
+    double deg = OSRGetAngularUnits(geog, NULL) * 180.0 / TT_PI;
+    *out_lon = x * deg;
+    *out_lat = y * deg;
+    ok = isfinite(*out_lon) && isfinite(*out_lat) && fabs(*out_lat) <= 90;
+  }
+done:
+  if (ct)
+    OCTDestroyCoordinateTransformation(ct);
+  OSRDestroySpatialReference(src);
+  OSRDestroySpatialReference(geog);
+  return ok;
+}
+
+/* "EPSG:32617" when srs carries or can be identified by an EPSG code,
+ * else "". */
+static void epsg_of(OGRSpatialReferenceH srs, char *buf, size_t size)
+{
+  buf[0] = '\0';
+  const char *auth = OSRGetAuthorityName(srs, NULL);
+  const char *code = OSRGetAuthorityCode(srs, NULL);
+  if (auth && code) {
+    snprintf(buf, size, "%s:%s", auth, code);
+    return;
+  }
+  OGRSpatialReferenceH guess = OSRClone(srs);
+  if (!guess)
+    return;
+  if (OSRAutoIdentifyEPSG(guess) == OGRERR_NONE) {
+    code = OSRGetAuthorityCode(guess, NULL);
+    if (code)
+      snprintf(buf, size, "like EPSG:%s", code);
+  }
+  OSRDestroySpatialReference(guess);
+}
+
+/* The UTM (or UPS) working CRS of a centre at (lon, lat) on srs's datum.
+ * out_name gets e.g. "UTM zone 17N (EPSG:32617)". NULL when none fits. */
+static OGRSpatialReferenceH utm_of(OGRSpatialReferenceH srs, double lon,
+                                   double lat, char *out_name,
+                                   size_t name_size)
+{
+  OGRSpatialReferenceH geog = OSRCloneGeogCS(srs);
+  OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(NULL);
+  OGRSpatialReferenceH work = OSRNewSpatialReference(NULL);
+  int is_wgs84 = 0, ok = 0;
+  if (!geog || !wgs84 || !work)
+    goto done;
+  is_wgs84 = OSRImportFromEPSG(wgs84, 4326) == OGRERR_NONE &&
+             OSRIsSameGeogCS(geog, wgs84);
+  lon = fmod(lon + 180.0, 360.0);
+  if (lon < 0)
+    lon += 360.0;
+  int zone = (int)floor(lon / 6.0) + 1;
+  if (zone > 60)
+    zone = 60;
+  int north = lat >= 0;
+  char code[64];
+  if (lat > 84.0 || lat < -80.0) {
+    /* Beyond UTM's range: Universal Polar Stereographic, WGS 84 only. */
+    if (!is_wgs84)
+      goto done;
+    int epsg = north ? 32661 : 32761;
+    ok = OSRImportFromEPSG(work, epsg) == OGRERR_NONE;
+    snprintf(out_name, name_size, "UPS %s (EPSG:%d)",
+             north ? "North" : "South", epsg);
+  } else if (is_wgs84) {
+    int epsg = (north ? 32600 : 32700) + zone;
+    ok = OSRImportFromEPSG(work, epsg) == OGRERR_NONE;
+    snprintf(out_name, name_size, "UTM zone %d%c (EPSG:%d)", zone,
+             north ? 'N' : 'S', epsg);
+  } else {
+    ok = OSRCopyGeogCSFrom(work, geog) == OGRERR_NONE &&
+         OSRSetProjCS(work, "UTM") == OGRERR_NONE &&
+         OSRSetUTM(work, zone, north) == OGRERR_NONE;
+    if (ok) {
+      const char *datum = OSRGetAttrValue(geog, "DATUM", 0);
+      epsg_of(work, code, sizeof code);
+      snprintf(out_name, name_size, "UTM zone %d%c on %s (%s)", zone,
+               north ? 'N' : 'S', datum ? datum : "its datum",
+               code[0] ? code : "no EPSG code");
+    }
+  }
+done:
+  OSRDestroySpatialReference(geog);
+  OSRDestroySpatialReference(wgs84);
+  if (!ok) {
+    OSRDestroySpatialReference(work);
+    return NULL;
+  }
+  return work;
+}
+
+/* The Jacobian of pixel -> work coordinates at the grid's centre, by
+ * central differences over TT_JACOBIAN_STEP pixels. 0 on failure. */
+static int jacobian(OGRSpatialReferenceH srs, OGRSpatialReferenceH work,
+                    const double gt[6], size_t nx, size_t ny,
+                    double out_frame[4])
+{
+  OGRSpatialReferenceH src = gis_order_clone(srs);
+  OGRSpatialReferenceH dst = gis_order_clone(work);
+  OGRCoordinateTransformationH ct =
+      src && dst ? OCTNewCoordinateTransformation(src, dst) : NULL;
+  int ok = 0;
+  if (ct) {
+    const double h = TT_JACOBIAN_STEP;
+    const double cx = 0.5 * (double)nx, cy = 0.5 * (double)ny;
+    /* +col, -col, +row, -row */
+    const double dpx[4] = {h, -h, 0, 0}, dpy[4] = {0, 0, h, -h};
+    double x[4], y[4], z[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 4; k++)
+      pixel_to_map(gt, cx + dpx[k], cy + dpy[k], &x[k], &y[k]);
+    int success[4] = {0, 0, 0, 0};
+    ok = OCTTransformEx(ct, 4, x, y, z, success) &&
+         success[0] && success[1] && success[2] && success[3];
+    if (ok) {
+      out_frame[0] = (x[0] - x[1]) / (2 * h);
+      out_frame[2] = (y[0] - y[1]) / (2 * h);
+      out_frame[1] = (x[2] - x[3]) / (2 * h);
+      out_frame[3] = (y[2] - y[3]) / (2 * h);
+      for (int k = 0; k < 4; k++)
+        ok = ok && isfinite(out_frame[k]);
+    }
+    OCTDestroyCoordinateTransformation(ct);
+  }
+  OSRDestroySpatialReference(src);
+  OSRDestroySpatialReference(dst);
+  return ok;
+}
+
+/* Whether frame a and the geotransform's linear part agree as metrics:
+ * column and row step lengths and the angle between them within tol. */
+static int same_metric(const double a[4], const double gt[6], double tol)
+{
+  double ac = hypot(a[0], a[2]), ar = hypot(a[1], a[3]);
+  double gc = hypot(gt[1], gt[4]), gr = hypot(gt[2], gt[5]);
+  double acos_ = (a[0] * a[1] + a[2] * a[3]) / (ac * ar);
+  double gcos = (gt[1] * gt[2] + gt[4] * gt[5]) / (gc * gr);
+  return fabs(ac / gc - 1) <= tol && fabs(ar / gr - 1) <= tol &&
+         fabs(acos_ - gcos) <= tol;
+}
+
+static int orientation_ok(const double a[4], const double gt[6])
+{
+  double det = a[0] * a[3] - a[1] * a[2];
+  double gdet = gt[1] * gt[5] - gt[2] * gt[4];
+  return det != 0 && (det < 0) == (gdet < 0);
+}
+
+/* Chooses the ground frame of an nx x ny grid with geotransform gt in CRS
+ * srs (may be NULL: the geotransform) as the file comment says. work_srs:
+ * NULL or a CRS in any form OSRSetFromUserInput() takes (it must be
+ * projected). out_name gets the frame's description; warnings go to the
+ * context. TT_ERR_ARG for an unusable work_srs. */
+tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
+                                  const char *work_srs, const double gt[6],
+                                  size_t nx, size_t ny, double out_frame[4],
+                                  char *out_name, size_t name_size)
+{
+  tt_status s = TT_OK;
+  OGRSpatialReferenceH work = NULL;
+  char work_name[256] = "";
+  out_frame[0] = gt[1];
+  out_frame[1] = gt[2];
+  out_frame[2] = gt[4];
+  out_frame[3] = gt[5];
+  snprintf(out_name, name_size, "geotransform");
+
+  if (work_srs && *work_srs) {
+    if (!srs)
+      return tt__error(ctx, TT_ERR_ARG, "-work_srs %s: the raster has no "
+                       "CRS to transform from", work_srs);
+    work = OSRNewSpatialReference(NULL);
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRErr e = work ? OSRSetFromUserInput(work, work_srs) : OGRERR_FAILURE;
+    CPLPopErrorHandler();
+    if (e != OGRERR_NONE) {
+      s = tt__error(ctx, TT_ERR_ARG, "-work_srs '%s' is not a CRS GDAL "
+                    "understands", work_srs);
+      goto done;
+    }
+    if (!OSRIsProjected(work)) {
+      s = tt__error(ctx, TT_ERR_ARG, "-work_srs '%s' is not a projected "
+                    "CRS: the working frame must be in linear units",
+                    work_srs);
+      goto done;
+    }
+    const char *nm = OSRGetName(work);
+    char code[64];
+    epsg_of(work, code, sizeof code);
+    snprintf(work_name, sizeof work_name, "%s (%s)", nm ? nm : "unnamed",
+             code[0] ? code : "no EPSG code");
+  }
+  if (!srs)
+    goto done;
+
+  const int geographic = OSRIsGeographic(srs);
+  const int projected = OSRIsProjected(srs);
+  if (!work && !geographic && !projected)
+    goto done; /* local or engineering CRS: its units are all we have */
+
+  double lon = 0, lat = 0;
+  int have_centre = centre_lonlat(srs, gt, nx, ny, &lon, &lat);
+  if (!work && have_centre)
+    work = utm_of(srs, lon, lat, work_name, sizeof work_name);
+
+  double frame[4];
+  int ok = work && jacobian(srs, work, gt, nx, ny, frame) &&
+           orientation_ok(frame, gt);
+  if (work && !ok && work_srs && *work_srs) {
+    s = tt__error(ctx, TT_ERR_ARG, "-work_srs '%s': PROJ cannot transform "
+                  "the raster's CRS to it", work_srs);
+    goto done;
+  }
+  if (ok) {
+    double m_per_unit = projected ? OSRGetLinearUnits(srs, NULL) : 0;
+    if (!(work_srs && *work_srs) && projected && m_per_unit == 1.0 &&
+        same_metric(frame, gt, TT_METRIC_TOLERANCE)) {
+      snprintf(out_name, name_size, "geotransform (map units are metres "
+               "within %g%% of %s)", 100 * TT_METRIC_TOLERANCE, work_name);
+      goto done;
+    }
+    memcpy(out_frame, frame, sizeof frame);
+    if (have_centre)
+      snprintf(out_name, name_size, "%s, affine at the centre (%.6f, "
+               "%.6f)", work_name, lon, lat);
+    else
+      snprintf(out_name, name_size, "%s, affine at the centre", work_name);
+    goto done;
+  }
+
+  /* PROJ failed: the fallbacks. */
+  if (geographic) {
+    s = tt__georef_geographic_frame(ctx, srs, gt, nx, ny, frame, out_name,
+                                    name_size);
+    if (s == TT_OK) {
+      memcpy(out_frame, frame, sizeof frame);
+      tt__warn(ctx, "PROJ found no local projected frame for this "
+               "geographic CRS; using the %s", out_name);
+    }
+    goto done;
+  }
+  double m_per_unit = OSRGetLinearUnits(srs, NULL);
+  if (m_per_unit > 0 && isfinite(m_per_unit) && m_per_unit != 1.0) {
+    for (int k = 0; k < 4; k++)
+      out_frame[k] = gt[k < 2 ? k + 1 : k + 2] * m_per_unit;
+    snprintf(out_name, name_size, "geotransform x %.10g m per map unit "
+             "(PROJ found no UTM frame)", m_per_unit);
+    tt__warn(ctx, "PROJ found no local projected frame for this CRS; "
+             "angles and areas use its map units converted to metres, "
+             "without correcting its scale");
+  }
+done:
+  OSRDestroySpatialReference(work);
+  return s;
 }

@@ -37,6 +37,13 @@ TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
                                                 double out_frame[4],
                                                 char *out_name,
                                                 size_t name_size);
+TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
+                                            OGRSpatialReferenceH srs,
+                                            const char *work_srs,
+                                            const double gt[6], size_t nx,
+                                            size_t ny, double out_frame[4],
+                                            char *out_name,
+                                            size_t name_size);
 
 /* Largest mask buffer used at once; taller blocks are read in bands of rows
  * (the block itself then stays in GDAL's cache between the bands). */
@@ -46,6 +53,10 @@ TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
 
 typedef struct read_options {
   double z_factor;
+  int has_z_factor;      /* Z_FACTOR was given */
+  int z_unit_m;          /* Z_UNIT=m: convert ft and us-ft to metres */
+  const char *work_srs;  /* WORK_SRS, NULL: chosen here (points into the
+                            options list) */
   int has_srcnodata;
   int srcnodata_is_nan;
   float srcnodata;       /* compared with the raw value read as Float32 */
@@ -72,6 +83,8 @@ void tt_raster_info_destroy(tt_raster_info *info)
   free(info->crs_wkt);
   free(info->crs_name);
   free(info->z_unit);
+  free(info->z_unit_declared);
+  free(info->z_unit_source);
   free(info->area_or_point);
   free(info->datatype);
   free(info->frame_name);
@@ -109,6 +122,9 @@ static tt_status parse_options(tt_context *ctx, char **options,
                                read_options *opt)
 {
   opt->z_factor = 1.0;
+  opt->has_z_factor = 0;
+  opt->z_unit_m = 0;
+  opt->work_srs = NULL;
   opt->has_srcnodata = 0;
   opt->srcnodata_is_nan = 0;
   opt->srcnodata = 0.0f;
@@ -128,8 +144,21 @@ static tt_status parse_options(tt_context *ctx, char **options,
       if (!parse_double(value, &v) || v == 0)
         s = tt__error(ctx, TT_ERR_ARG, "Z_FACTOR must be a non-zero number, "
                       "got \"%s\"", value);
-      else
+      else {
         opt->z_factor = v;
+        opt->has_z_factor = 1;
+      }
+    } else if (strcasecmp(key, "Z_UNIT") == 0) {
+      if (strcasecmp(value, "m") != 0)
+        s = tt__error(ctx, TT_ERR_ARG, "Z_UNIT must be m (heights in ft or "
+                      "us-ft converted to metres), got \"%s\"", value);
+      else
+        opt->z_unit_m = 1;
+    } else if (strcasecmp(key, "WORK_SRS") == 0) {
+      if (!*value)
+        s = tt__error(ctx, TT_ERR_ARG, "WORK_SRS needs a CRS");
+      else
+        opt->work_srs = value;
     } else if (strcasecmp(key, "SRCNODATA") == 0) {
       opt->has_srcnodata = 1;
       if (strcasecmp(value, "nan") == 0) {
@@ -150,7 +179,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
       }
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
-                    "Z_FACTOR, SRCNODATA, MAX_MEMORY)", key);
+                    "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS)",
+                    key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -231,6 +261,76 @@ static tt_status describe_crs(tt_context *ctx, OGRSpatialReferenceH srs,
   if (!info->crs_wkt || !info->crs_name)
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
   return TT_OK;
+}
+
+/* The short name of a height unit: "m", "ft" (international foot) or
+ * "us-ft" (US survey foot); NULL for anything else. */
+static const char *unit_short_name(const char *u)
+{
+  static const char *const m[] = {"m", "metre", "meter", "metres", "meters",
+                                  NULL};
+  static const char *const ft[] = {"ft", "foot", "feet", "international "
+                                   "foot", "foot (international)", "intl ft",
+                                   NULL};
+  static const char *const usft[] = {"us-ft", "us_ft", "ftus", "us-foot",
+                                     "us survey foot", "foot_us",
+                                     "us foot", "survey foot",
+                                     "foot (us survey)", NULL};
+  if (!u)
+    return NULL;
+  for (int i = 0; m[i]; i++)
+    if (strcasecmp(u, m[i]) == 0)
+      return "m";
+  for (int i = 0; ft[i]; i++)
+    if (strcasecmp(u, ft[i]) == 0)
+      return "ft";
+  for (int i = 0; usft[i]; i++)
+    if (strcasecmp(u, usft[i]) == 0)
+      return "us-ft";
+  return NULL;
+}
+
+/* Metres per unit of a short unit name (unit_short_name). */
+static double unit_metres(const char *short_name)
+{
+  if (strcmp(short_name, "ft") == 0)
+    return 0.3048;
+  if (strcmp(short_name, "us-ft") == 0)
+    return 1200.0 / 3937.0;
+  return 1.0;
+}
+
+/* The unit the heights are declared in: the band's unit type, else the
+ * linear unit of the vertical part of a compound CRS (or of a vertical
+ * CRS). Writes the name as declared to buf ("" when nothing says) and
+ * returns where it came from. */
+static const char *declared_z_unit(GDALRasterBandH band,
+                                   OGRSpatialReferenceH srs, char *buf,
+                                   size_t size)
+{
+  const char *u = GDALGetRasterUnitType(band);
+  buf[0] = '\0';
+  if (u && *u) {
+    snprintf(buf, size, "%s", u);
+    return "band unit";
+  }
+  if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
+    char *name = NULL;
+    double to_m = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
+    if (to_m > 0 && name && *name) {
+      const char *sn = unit_short_name(name);
+      /* A unit PROJ names oddly but whose size is known still counts. */
+      if (!sn && fabs(to_m - 1.0) < 1e-12)
+        sn = "m";
+      else if (!sn && fabs(to_m - 0.3048) < 1e-12)
+        sn = "ft";
+      else if (!sn && fabs(to_m - 1200.0 / 3937.0) < 1e-12)
+        sn = "us-ft";
+      snprintf(buf, size, "%s", sn ? sn : name);
+      return "vertical CRS";
+    }
+  }
+  return "";
 }
 
 /* Converts a band of rows [r0, r0+nrows) in place: mask, scale/offset,
@@ -392,6 +492,29 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     goto done;
   }
 
+  /* The height unit, and Z_UNIT=m's conversion (before Z_FACTOR). */
+  char unit_declared[128];
+  const char *unit_source = declared_z_unit(band, srs, unit_declared,
+                                            sizeof unit_declared);
+  const char *unit_short = unit_short_name(unit_declared);
+  double unit_factor = 1.0;
+  const char *unit_out = unit_short ? unit_short : unit_declared;
+  if (opt.z_unit_m) {
+    if (unit_short) {
+      unit_factor = unit_metres(unit_short);
+    } else if (!opt.has_z_factor) {
+      s = tt__error(ctx, TT_ERR_DATA, "%s: Z_UNIT=m: the height unit is %s%s%s"
+                    "; give Z_FACTOR (the factor to metres) to convert it",
+                    path, unit_declared[0] ? "\"" : "unknown (no band unit, no "
+                    "vertical CRS)", unit_declared,
+                    unit_declared[0] ? "\", which is not m, ft or us-ft" : "");
+      goto done;
+    }
+    unit_out = "m";
+  }
+  read_options conv = opt; /* what convert_rows() multiplies by */
+  conv.z_factor = opt.z_factor * unit_factor;
+
   s = tt_grid_create(ctx, nx, ny, &grid);
   if (s != TT_OK) {
     s = with_path(ctx, s, path);
@@ -402,11 +525,11 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     s = with_path(ctx, s, path);
     goto done;
   }
-  char frame_name[256] = "geotransform";
-  if (srs && info->crs_is_geographic) {
+  char frame_name[512] = "geotransform";
+  if (srs || opt.work_srs) {
     double frame[4];
-    s = tt__georef_geographic_frame(ctx, srs, gt, nx, ny, frame, frame_name,
-                                    sizeof frame_name);
+    s = tt__georef_ground_frame(ctx, srs, opt.work_srs, gt, nx, ny, frame,
+                                frame_name, sizeof frame_name);
     if (s == TT_ERR_DATA) {
       /* A CRS that says geographic over coordinates that cannot be (a
        * mislabelled projected grid) or a grid centred on a pole: measure
@@ -491,8 +614,8 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
         goto done;
       }
     }
-    s = convert_rows(ctx, path, z, nx, r0, nrows, mask, &opt, scale, offset,
-                     &valid);
+    s = convert_rows(ctx, path, z, nx, r0, nrows, mask, &conv, scale,
+                     offset, &valid);
     if (s != TT_OK)
       goto done;
     if (progress &&
@@ -519,7 +642,10 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   info->nodata_samples = nx * ny - valid;
   memcpy(info->gt, gt, sizeof gt);
   info->has_geotransform = has_gt;
-  info->z_unit = dup_str(GDALGetRasterUnitType(band));
+  info->z_unit = dup_str(unit_out);
+  info->z_unit_declared = dup_str(unit_declared);
+  info->z_unit_source = dup_str(unit_source);
+  info->z_unit_factor = unit_factor;
   info->scale = scale;
   info->offset = offset;
   info->z_factor = opt.z_factor;
@@ -529,6 +655,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   tt_grid_get_ground_frame(grid, info->frame);
   info->frame_name = dup_str(frame_name);
   if (!info->path || !info->driver || !info->z_unit ||
+      !info->z_unit_declared || !info->z_unit_source ||
       !info->area_or_point || !info->datatype || !info->frame_name) {
     s = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
     goto done;

@@ -35,13 +35,22 @@ typedef struct tt_raster_info {
   char *crs_wkt;          /* "" when the raster has no CRS */
   char *crs_name;         /* short human name, "" when none */
   int crs_is_geographic;
-  char *z_unit;           /* band unit type ("m", "ft", ...) or "" */
+  char *z_unit;           /* unit of the grid's heights: "m", "ft" or
+                             "us-ft" when known (after Z_UNIT=m: "m"),
+                             else the declared name, "" when unknown */
   double scale, offset;   /* applied to the raw values */
-  double z_factor;        /* applied after scale/offset */
+  double z_factor;        /* applied last, after scale/offset and
+                             z_unit_factor */
   char *area_or_point;    /* "Area", "Point" or "" as declared */
   char *datatype;         /* GDAL data type name of the band */
   double frame[4];        /* ground frame set on the grid */
-  char *frame_name;       /* "geotransform", "local equirectangular ..." */
+  char *frame_name;       /* "geotransform", "UTM zone 17N (EPSG:32617),
+                             affine at the centre (...)", ... */
+  char *z_unit_declared;  /* the height unit as the file declares it, ""
+                             when it does not */
+  char *z_unit_source;    /* "band unit", "vertical CRS" or "" */
+  double z_unit_factor;   /* Z_UNIT=m's factor (0.3048 for ft, 1200/3937
+                             for us-ft), else 1 */
 } tt_raster_info;
 
 void tt_raster_info_destroy(tt_raster_info *info);
@@ -51,14 +60,23 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * stored as NaN. Valid samples that are NaN or infinite are refused (naming
  * row and column), so are rasters under 2 x 2, rasters with no valid
  * sample, and rasters georeferenced by GCPs only; a raster without a
- * geotransform gets (0,1,0,0,0,1) and has_geotransform 0. A geographic CRS
- * gives the grid a local equirectangular ground frame in metres at the
- * centre latitude (info->frame_name says which frame). Unless the user set
+ * geotransform gets (0,1,0,0,0,1) and has_geotransform 0. A geographic CRS,
+ * or a projected one whose map units are not ground metres (Web Mercator,
+ * feet), gives the grid a local metric ground frame chosen with PROJ: the
+ * Jacobian at the grid's centre of pixel -> UTM zone of the centre (or
+ * WORK_SRS) coordinates; metric projected CRSs keep the geotransform's
+ * frame unless WORK_SRS is given (src/georef_proj.c; info->frame_name says
+ * which frame). Heights are never changed by the frame. Unless the user set
  * GDAL_CACHEMAX, GDAL's block cache limit (process-wide) is lowered to a
  * few MiB during the read and restored after.
  * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> or SRCNODATA=nan
  * (replaces the mask; compared with the raw values), MAX_MEMORY=<bytes>
- * (refuse grids whose samples need more; default 3/4 of physical memory).
+ * (refuse grids whose samples need more; default 3/4 of physical memory),
+ * Z_UNIT=m (heights declared in ft or us-ft -- band unit type, else the
+ * vertical CRS -- are converted to metres: height = ((raw * scale + offset)
+ * * unit factor) * Z_FACTOR; an unknown unit is refused unless Z_FACTOR is
+ * given, which then does the whole conversion), WORK_SRS=<CRS> (any
+ * OSRSetFromUserInput form, projected: the working frame).
  * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
  * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
 tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
