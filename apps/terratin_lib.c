@@ -1716,7 +1716,8 @@ static void print_simplify_summary(app_run *r, const simplify_report *p)
   if (lone || p->sum.components > 1)
     fprintf(r->out,
             "%s: %zu separate piece%s; %zu valid sample%s amid nodata "
-            "cannot carry a triangle and %s kept as lone vertices\n",
+            "(in no cell with 3 valid corners) cannot carry a triangle and "
+            "%s left out\n",
             r->s->output, p->sum.components,
             p->sum.components == 1 ? "" : "s", lone, lone == 1 ? "" : "s",
             lone == 1 ? "is" : "are");

@@ -402,6 +402,95 @@ void tt__mesh_fix_vertex_edges(tt__mesh *m)
       m->v[m->hv[e]].edge = (int32_t)e;
 }
 
+int32_t tt__mesh_find_edge(const tt__mesh *m, int32_t a, int32_t b)
+{
+  int32_t e0 = m->v[a].edge;
+  if (e0 < 0)
+    return -1;
+  /* around a one way (through twin(prev)), then the other way (through
+   * next(twin)) in case a boundary stopped the first turn */
+  int32_t e = e0;
+  do {
+    if (m->hv[tt__next(e)] == b)
+      return e;
+    int32_t f = m->twin[tt__prev(e)];
+    if (f < 0)
+      break;
+    e = f;
+  } while (e != e0);
+  e = e0;
+  for (;;) {
+    int32_t f = m->twin[e];
+    if (f < 0)
+      return -1;
+    e = tt__next(f);
+    if (e == e0)
+      return -1;
+    if (m->hv[tt__next(e)] == b)
+      return e;
+  }
+}
+
+/* Where (col, row) is in triangle t: 1 outside edge *out_k, 0 inside or on
+ * (sets *out_on as tt__mesh_locate does). */
+static int where_in(const tt__mesh *m, int32_t t, int64_t col, int64_t row,
+                    int *out_k, int32_t *out_on)
+{
+  int s = m->metric.det_sign, zero = -1, nzero = 0;
+  for (int k = 0; k < 3; k++) {
+    int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
+    int o = s * tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r,
+                             col, row);
+    if (o < 0) {
+      *out_k = k;
+      return 1;
+    }
+    if (o == 0) {
+      zero = k;
+      nzero++;
+    }
+  }
+  if (nzero == 0) {
+    *out_on = -1;
+  } else if (nzero == 1) {
+    *out_on = 3 * t + zero;
+  } else {
+    /* on two edges: a corner */
+    for (int k = 0; k < 3; k++) {
+      int32_t v = m->hv[3 * t + k];
+      if (m->v[v].c == col && m->v[v].r == row)
+        *out_on = -2 - v;
+    }
+  }
+  return 0;
+}
+
+int32_t tt__mesh_locate(const tt__mesh *m, int32_t start, int64_t col,
+                        int64_t row, int32_t *out_on)
+{
+  int32_t t = start;
+  if (t < 0 || !tt__mesh_live(m, t))
+    for (t = 0; (size_t)t < m->nslots && !tt__mesh_live(m, t); t++)
+      ;
+  if ((size_t)t >= m->nslots)
+    return -1;
+  size_t limit = 4 * m->nlive + 16;
+  int k = 0;
+  for (size_t step = 0; step < limit; step++) {
+    if (!where_in(m, t, col, row, &k, out_on))
+      return t;
+    int32_t f = m->twin[3 * t + k];
+    if (f < 0)
+      break; /* outside this way; a scan decides */
+    t = f / 3;
+  }
+  for (size_t u = 0; u < m->nslots; u++)
+    if (tt__mesh_live(m, (int32_t)u) &&
+        !where_in(m, (int32_t)u, col, row, &k, out_on))
+      return (int32_t)u;
+  return -1;
+}
+
 /* --- validation --------------------------------------------------------- */
 
 static int32_t uf_find(int32_t *parent, int32_t x)

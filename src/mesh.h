@@ -131,6 +131,20 @@ TT_HIDDEN bool tt__mesh_delete_triangle(tt__mesh *m, int32_t t);
  * no triangle any more. O(V + T). */
 TT_HIDDEN void tt__mesh_fix_vertex_edges(tt__mesh *m);
 
+/* The half-edge from vertex a to vertex b, or -1 when there is none.
+ * O(degree of a). */
+TT_HIDDEN int32_t tt__mesh_find_edge(const tt__mesh *m, int32_t a, int32_t b);
+
+/* Locates pixel point (col, row) by a walk from live triangle `start`
+ * (any live triangle when -1). Returns the triangle holding it (closed)
+ * and sets *out_on to -1 (strictly inside), to the half-edge it lies on,
+ * or to -2 - v when it is vertex v. Returns -1 when the point is outside
+ * the mesh. Meant for Delaunay-like meshes (walks terminate there); gives
+ * up after a linear number of steps and falls back to a scan. */
+TT_HIDDEN int32_t tt__mesh_locate(const tt__mesh *m, int32_t start,
+                                  int64_t col, int64_t row,
+                                  int32_t *out_on);
+
 /* Vertex opposite half-edge e in its triangle. */
 static inline int32_t tt__mesh_apex(const tt__mesh *m, int32_t e)
 {

@@ -15,25 +15,17 @@
  * percentage); the next insertion would pass max_triangles; no sample has
  * a non-zero error left.
  *
- * Nodata: a triangle that leaves the valid domain (raster_scan.h:
- * tt__tri_in_domain) and holds a valid sample besides its corners gets the
- * top key, FORCED_KEY, with its worst valid sample as candidate, so the
- * outline of the data is followed before any error is reduced; such
- * insertions ignore the point and triangle limits (a warning says so).
- * Splitting a triangle inside the domain, or flipping the edge between two
- * such triangles, only re-divides a region inside it; the triangles that
- * other flips make are rescanned like any other, and every forced
- * insertion adds a vertex, so the process ends. At the end
- * the triangles still outside hold no valid sample but corners and are
- * deleted (carve_holes): lakes become holes, islands separate components,
- * and valid samples that can carry no triangle remain lone vertices.
- * Known gap: a sample whose only valid cells have three valid corners may
- * be left lone when the mesh does not follow the cell's diagonal.
+ * Nodata (domain.c): the starting triangulation follows the outline of
+ * the valid domain with constrained edges and holds no triangle outside
+ * it; splits and flips of unconstrained inner edges never leave it, so the
+ * TIN covers exactly the valid samples that a valid cell part holds (the
+ * others, lone samples amid nodata, are counted as uncovered).
  *
  * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 20.
  * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
  */
 #include "criteria/criterion.h"
+#include "domain.h"
 #include "heap.h"
 #include "mesh.h"
 #include "parallel.h"
@@ -73,11 +65,7 @@ typedef struct refine {
   size_t jobcap;
   size_t max_points, max_tris;
   double max_error;    /* < 0: none */
-  /* nodata domains: per 16x16 block, prefix sums of nodata counts */
-  bool nodata;
-  uint32_t *nd_sum;    /* (bny + 1) x (bnx + 1) */
-  size_t bnx, bny;
-  size_t forced;       /* insertions the nodata outline required */
+  size_t forced;       /* vertices the nodata outline required */
   /* progress */
   double e0, frac;
 } refine;
@@ -127,49 +115,6 @@ typedef struct scan_job_t {
   int64_t index;
 } scan_job_t;
 
-/* Key of a triangle that has nodata strictly inside and a valid sample to
- * insert: above every error, so the outline is settled first. */
-#define FORCED_KEY DBL_MAX
-
-#define ND_BLOCK 16
-
-/* Builds the block table of nodata counts (prefix sums). */
-static bool nodata_table(refine *r)
-{
-  const tt_grid *g = r->g;
-  r->bnx = (g->nx + ND_BLOCK - 1) / ND_BLOCK;
-  r->bny = (g->ny + ND_BLOCK - 1) / ND_BLOCK;
-  r->nd_sum = calloc((r->bnx + 1) * (r->bny + 1), sizeof *r->nd_sum);
-  if (!r->nd_sum)
-    return false;
-  size_t w = r->bnx + 1;
-  for (size_t y = 0; y < g->ny; y++)
-    for (size_t x = 0; x < g->nx; x++)
-      if (isnan(g->z[y * g->nx + x]))
-        r->nd_sum[(y / ND_BLOCK + 1) * w + x / ND_BLOCK + 1]++;
-  for (size_t by = 1; by <= r->bny; by++)
-    for (size_t bx = 1; bx <= r->bnx; bx++)
-      r->nd_sum[by * w + bx] += r->nd_sum[(by - 1) * w + bx] +
-                                r->nd_sum[by * w + bx - 1] -
-                                r->nd_sum[(by - 1) * w + bx - 1];
-  return true;
-}
-
-/* Whether the triangle's bounding box meets a block holding nodata. */
-static bool near_nodata(const refine *r, const tt__scan_tri *st)
-{
-  if (!r->nodata)
-    return false;
-  int64_t x0, x1, y0, y1;
-  tt__scan_tri_bbox(st, &x0, &x1, &y0, &y1);
-  size_t w = r->bnx + 1;
-  size_t bx0 = (size_t)x0 / ND_BLOCK, bx1 = (size_t)x1 / ND_BLOCK + 1;
-  size_t by0 = (size_t)y0 / ND_BLOCK, by1 = (size_t)y1 / ND_BLOCK + 1;
-  uint32_t n = r->nd_sum[by1 * w + bx1] - r->nd_sum[by0 * w + bx1] -
-               r->nd_sum[by1 * w + bx0] + r->nd_sum[by0 * w + bx0];
-  return n > 0;
-}
-
 /* Triangles with more rows than this and a large area are cut into bands
  * of this many rows, so that all threads share the early, huge triangles. */
 #define BAND_ROWS 256
@@ -184,18 +129,6 @@ static void scan_job(void *arg, size_t i)
   refine *r = arg;
   scan_job_t *j = &r->jobs[i];
   const tt__scan_tri st = j->st;
-  if (near_nodata(r, &st)) {
-    /* near nodata a triangle is never cut into bands (add_jobs) */
-    bool inside;
-    double err;
-    int64_t index;
-    tt__scan_domain(r->g, &st, &inside, &err, &index);
-    if (index >= 0 && (inside || !tt__tri_in_domain(r->g, &st))) {
-      j->err = FORCED_KEY;
-      j->index = index;
-      return;
-    }
-  }
   tt__scan_candidate_rows(r->g, &st, j->ylo, j->yhi, &j->err, &j->index);
 }
 
@@ -211,9 +144,8 @@ static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
   if (area2 < 0)
     area2 = -area2;
   *samples += area2 / 2;
-  int64_t band = (r->pool && !r->nodata && area2 / 2 >= BAND_MIN_AREA)
-                     ? BAND_ROWS
-                     : yhi - ylo + 1;
+  int64_t band = (r->pool && area2 / 2 >= BAND_MIN_AREA) ? BAND_ROWS
+                                                         : yhi - ylo + 1;
   for (int64_t y0 = ylo; y0 <= yhi; y0 += band) {
     if (!tt__grow((void **)&r->jobs, &r->jobcap, *njobs + 1,
                   sizeof(scan_job_t)))
@@ -408,6 +340,12 @@ done:
   return status;
 }
 
+static bool domain_vertex(void *arg, int32_t col, int32_t row,
+                          int32_t *out_v)
+{
+  return add_vertex(arg, col, row, NAN, out_v);
+}
+
 static tt_status start(refine *r, size_t valid)
 {
   const tt_grid *g = r->g;
@@ -418,54 +356,22 @@ static tt_status start(refine *r, size_t valid)
   if (!tt__mesh_link_all(&r->m) ||
       tt__swap_all(&r->m, r->crit, &r->env, &r->stack) < 0)
     return oom(r);
+  if (valid < g->nx * g->ny) {
+    size_t before = r->m.nv;
+    s = tt__domain_build(r->ctx, &r->m, g, r->crit, &r->env, &r->stack,
+                         domain_vertex, r);
+    if (s != TT_OK)
+      return s;
+    r->forced = r->m.nv - before;
+    if (r->max_points && r->m.nv > r->max_points)
+      tt__warn(r->ctx, "the outline of the nodata areas needs %zu "
+               "vertices, more than the point limit %zu", r->m.nv,
+               r->max_points);
+  }
   /* every slot written so far is logged: scan them all */
   if (!drain(r))
     return oom(r);
   return TT_OK;
-}
-
-/* |H - H'| at sample (col, row) under triangle t's plane (for the record of
- * a forced insertion, whose heap key is not an error). */
-static double point_error(const refine *r, int32_t t, int64_t col,
-                          int64_t row)
-{
-  tt__scan_tri st;
-  tt__scan_tri_from_mesh(&r->m, t, &st);
-  double dx1 = (double)(st.x[1] - st.x[0]), dy1 = (double)(st.y[1] - st.y[0]);
-  double dx2 = (double)(st.x[2] - st.x[0]), dy2 = (double)(st.y[2] - st.y[0]);
-  double det = dx1 * dy2 - dx2 * dy1;
-  double dz1 = st.z[1] - st.z[0], dz2 = st.z[2] - st.z[0];
-  double gx = (dz1 * dy2 - dz2 * dy1) / det, gy = (dx1 * dz2 - dx2 * dz1) / det;
-  double h = st.z[0] + gx * (double)(col - st.x[0]) +
-             gy * (double)(row - st.y[0]);
-  return fabs((double)r->g->z[row * (int64_t)r->g->nx + col] - h);
-}
-
-/* Deletes the triangles that leave the valid domain (raster_scan.h) and
- * hold no valid sample but their corners: lakes, voids, the space between
- * islands. A triangle leaving the domain with another valid sample was
- * split before (forced insertion), so no valid sample is lost: it is a
- * vertex, or lies on a kept triangle, or can carry no triangle at all. */
-static bool carve_holes(refine *r)
-{
-  for (size_t t = 0; t < r->m.nslots; t++) {
-    if (!tt__mesh_live(&r->m, (int32_t)t))
-      continue;
-    tt__scan_tri st;
-    tt__scan_tri_from_mesh(&r->m, (int32_t)t, &st);
-    if (!near_nodata(r, &st))
-      continue;
-    bool inside;
-    double err;
-    int64_t index;
-    tt__scan_domain(r->g, &st, &inside, &err, &index);
-    if (index < 0 && (inside || !tt__tri_in_domain(r->g, &st)) &&
-        !tt__mesh_delete_triangle(&r->m, (int32_t)t))
-      return false;
-  }
-  tt__mesh_fix_vertex_edges(&r->m);
-  tt__mesh_clear_touched(&r->m);
-  return true;
 }
 
 /* --- the loop ----------------------------------------------------------- */
@@ -555,11 +461,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   tt__heap_init(&r.heap);
   r.env.mesh = &r.m;
   r.env.grid = grid;
-  r.nodata = valid < grid->nx * grid->ny;
-  if (r.nodata && !nodata_table(&r)) {
-    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-    goto done;
-  }
+
   int nthreads = opt->threads;
   if (nthreads == 0 && grid->nx * grid->ny < ((size_t)1 << 20))
     nthreads = 1; /* small grids: handing jobs over costs more than it saves */
@@ -602,13 +504,11 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     tt__heap_entry top = tt__heap_top(&r.heap);
     int32_t t = top.item;
     double err = top.key;
-    /* an insertion the nodata outline requires ignores the limits */
-    bool forced = err == FORCED_KEY;
-    if (!forced && r.max_error >= 0 && err <= r.max_error) {
+    if (r.max_error >= 0 && err <= r.max_error) {
       reason = TT_STOP_MAX_ERROR;
       break;
     }
-    if (!forced && r.max_points && r.m.nv + 1 > r.max_points) {
+    if (r.max_points && r.m.nv + 1 > r.max_points) {
       reason = TT_STOP_MAX_POINTS;
       break;
     }
@@ -616,13 +516,9 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     int64_t col = s % (int64_t)grid->nx, row = s / (int64_t)grid->nx;
     int32_t on = locate_in(&r, t, col, row);
     size_t more = (on >= 0 && r.m.twin[on] < 0) ? 1 : 2;
-    if (!forced && r.max_tris && r.m.nlive + more > r.max_tris) {
+    if (r.max_tris && r.m.nlive + more > r.max_tris) {
       reason = TT_STOP_MAX_TRIANGLES;
       break;
-    }
-    if (forced) {
-      r.forced++;
-      err = point_error(&r, t, col, row);
     }
     int32_t v;
     if (!add_vertex(&r, (int32_t)col, (int32_t)row, err, &v)) {
@@ -653,15 +549,6 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       goto done;
     }
   }
-  if (r.nodata && !carve_holes(&r)) {
-    status = oom(&r);
-    goto done;
-  }
-  if (r.forced && ((r.max_points && r.m.nv > r.max_points) ||
-                   (r.max_tris && r.m.nlive > r.max_tris)))
-    tt__warn(ctx, "the outline of the nodata areas needed %zu vertices, "
-             "more than the limits allow: the TIN has %zu vertices and %zu "
-             "triangles", r.forced, r.m.nv, r.m.nlive);
   /* The insertion state is no longer needed: free it before the TIN's
    * arrays are made, to keep the peak low. */
   tt__heap_free(&r.heap);
@@ -685,7 +572,6 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
 done:
-  free(r.nd_sum);
   tt__pool_destroy(r.pool);
   free(r.jobs);
   tt__heap_free(&r.heap);

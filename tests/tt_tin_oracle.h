@@ -76,36 +76,32 @@ static inline size_t tt_oracle_nodata_inside(const tt_grid *g,
   return bad;
 }
 
-/* The lone vertices (in no triangle) and, of those, how many sit beside a
- * wholly valid grid cell, which could have carried a triangle. */
-static inline void tt_oracle_lone(const tt_grid *g, const tt_tin *tin,
-                                  size_t *out_lone, size_t *out_misplaced)
+/* The valid samples that no valid cell part holds (no cell around them has
+ * three or more valid corners): exactly those a TIN confined to the valid
+ * domain cannot cover. */
+static inline size_t tt_oracle_uncarriable(const tt_grid *g)
 {
   const float *z = tt_grid_heights_const(g);
   long long nx = (long long)tt_grid_width(g);
   long long ny = (long long)tt_grid_height(g);
-  size_t lone = 0, misplaced = 0;
-  for (size_t v = 0; v < tt_tin_vertex_count(tin); v++) {
-    tt_vertex_info vi;
-    tt_tin_vertex(tin, v, &vi);
-    if (vi.star_samples != 0)
-      continue;
-    lone++;
-    bool beside_valid_cell = false;
-    for (long long cy = vi.row - 1; cy <= vi.row; cy++)
-      for (long long cx = vi.col - 1; cx <= vi.col; cx++) {
-        int nv = 0;
-        for (int k = 0; k < 4; k++) {
-          long long x = cx + (k & 1), y = cy + (k >> 1);
-          nv += x >= 0 && y >= 0 && x < nx && y < ny &&
-                !isnan(z[y * nx + x]);
+  size_t n = 0;
+  for (long long r = 0; r < ny; r++)
+    for (long long c = 0; c < nx; c++) {
+      if (isnan(z[r * nx + c]))
+        continue;
+      bool carried = false;
+      for (long long cy = r - 1; cy <= r && !carried; cy++)
+        for (long long cx = c - 1; cx <= c && !carried; cx++) {
+          if (cx < 0 || cy < 0 || cx + 1 >= nx || cy + 1 >= ny)
+            continue;
+          int nv = 0;
+          for (int k = 0; k < 4; k++)
+            nv += !isnan(z[(cy + (k >> 1)) * nx + cx + (k & 1)]);
+          carried = nv >= 3;
         }
-        beside_valid_cell |= nv == 4;
-      }
-    misplaced += beside_valid_cell;
-  }
-  *out_lone = lone;
-  *out_misplaced = misplaced;
+      n += !carried;
+    }
+  return n;
 }
 
 #endif /* TT_TIN_ORACLE_H */

@@ -68,7 +68,10 @@ static int check_input(const uint8_t *data, size_t size)
   tt_tin_get_summary(tin, &sum);
   if (ev.overlapped)
     TT_FAIL_("%zux%zu mode %u: %zu overlapped", nx, ny, mode, ev.overlapped);
-  /* only lone samples that cannot carry a triangle may stay uncovered */
+  /* only samples that no valid cell part holds stay uncovered */
+  if (ev.uncovered != tt_oracle_uncarriable(g))
+    TT_FAIL_("%zux%zu mode %u: %zu uncovered, %zu cannot be carried", nx,
+             ny, mode, ev.uncovered, tt_oracle_uncarriable(g));
   if (ev.uncovered != sum.errors.samples - sum.errors.covered)
     TT_FAIL_("%zux%zu mode %u: %zu uncovered, summary says %zu", nx, ny,
              mode, ev.uncovered, sum.errors.samples - sum.errors.covered);

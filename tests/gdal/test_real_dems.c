@@ -47,17 +47,13 @@ static void check_against_eval(const tt_grid *g, const tt_tin *tin,
   free(xyz);
   tt_tin_summary s;
   tt_tin_get_summary(tin, &s);
-  /* only lone samples (amid nodata) may stay outside the TIN: each is a
-   * vertex of no triangle, and no wholly valid cell touches it */
+  /* only samples that no valid cell part holds stay outside the TIN */
   if (ev.uncovered != s.errors.samples - s.errors.covered)
     TT_FAIL_("%s: %zu valid samples outside the TIN, the summary says %zu",
              what, ev.uncovered, s.errors.samples - s.errors.covered);
-  size_t lone, misplaced;
-  tt_oracle_lone(g, tin, &lone, &misplaced);
-  CHECK_INT_EQ(lone, ev.uncovered);
-  if (misplaced)
-    TT_FAIL_("%s: %zu samples left out beside a wholly valid cell", what,
-             misplaced);
+  if (ev.uncovered != tt_oracle_uncarriable(g))
+    TT_FAIL_("%s: %zu valid samples outside the TIN, %zu cannot be carried",
+             what, ev.uncovered, tt_oracle_uncarriable(g));
   if (tt_oracle_nodata_inside(g, tin))
     TT_FAIL_("%s: nodata samples strictly inside triangles", what);
   if (ev.overlapped != 0)
