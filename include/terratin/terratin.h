@@ -147,11 +147,26 @@ tt_status tt_grid_check(tt_context *ctx, const tt_grid *grid,
 /* ---------------------------------------------------------------------------
  * Criteria and refinement options.
  * ------------------------------------------------------------------------- */
+/* Triangulation criteria (SPEC section 2; docs/criteria.md explains each
+ * one and when to pick it). All measure in the ground frame. */
 typedef enum tt_criterion {
-  TT_CRITERION_DELAUNAY = 0
+  TT_CRITERION_DELAUNAY = 0,      /* max-min angle, exact incircle */
+  TT_CRITERION_MINMAX_ANGLE,      /* minimise the largest map angle */
+  TT_CRITERION_MINMAX_ANGLE_LEX,  /* the same, sorted angles compared
+                                     lexicographically */
+  TT_CRITERION_MIN_AREA,          /* minimise the 3-D surface area */
+  TT_CRITERION_MEAN_CURVATURE,    /* minimise sum |e| * normal angle */
+  TT_CRITERION_GAUSSIAN_CURVATURE,/* minimise sum |K| (tight) */
+  TT_CRITERION_ABN,               /* angles between normals, sorted,
+                                     lexicographic */
+  TT_CRITERION_ABN_SUM,           /* sum of the angles between normals */
+  TT_CRITERION_ABN_SUMSQ,         /* sum of their squares */
+  TT_CRITERION_L2                 /* least squares: sum (H - H')^2 */
 } tt_criterion;
 
-/* "delaunay", ...; NULL for an unknown value. */
+/* "delaunay", "minmax_angle", "minmax_angle_lex", "min_area",
+ * "mean_curvature", "gaussian_curvature", "abn", "abn_sum", "abn_sumsq",
+ * "l2"; NULL for an unknown value. */
 const char *tt_criterion_name(tt_criterion criterion);
 /* Parses a name; TT_ERR_ARG for an unknown one. */
 tt_status tt_criterion_parse(tt_context *ctx, const char *name,

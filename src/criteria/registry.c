@@ -2,12 +2,16 @@
  * registry.c -- the table of criteria: id <-> name <-> vtable. Adding a
  * criterion means one file in src/criteria/ and one row here.
  */
-#include "criterion.h"
+#include "geometry.h"
 
 #include <string.h>
 
 static const tt__criterion_vt *const table[] = {
-    &tt__criterion_delaunay,
+    &tt__criterion_delaunay,        &tt__criterion_minmax_angle,
+    &tt__criterion_minmax_angle_lex, &tt__criterion_min_area,
+    &tt__criterion_mean_curvature,  &tt__criterion_gaussian,
+    &tt__criterion_abn,             &tt__criterion_abn_sum,
+    &tt__criterion_abn_sumsq,       &tt__criterion_l2,
 };
 
 #define NCRIT (sizeof table / sizeof table[0])

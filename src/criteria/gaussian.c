@@ -1,0 +1,402 @@
+/*
+ * gaussian.c -- the Gaussian curvature criterion (tight triangulation),
+ * SPEC section 2.5.
+ *
+ * Definition: minimise the sum over vertices of |K(v)|, the absolute
+ * integral Gaussian curvature of the TIN as a surface in ground units.
+ * With theta_i the 3-D angles at v between consecutive edges of its star:
+ *  - a boundary vertex has |K| = |pi - sum theta_i|;
+ *  - an interior vertex is classified by supporting planes: consecutive
+ *    edges e_i, e_{i+1} span one when every other edge e_k lies on one
+ *    side of it, (e_i x e_{i+1}) . e_k >= 0 for all k or <= 0 for all k
+ *    (the SPEC writes the first, for a surface oriented outwards; a
+ *    terrain has no inside, so a peak and a pit are both convex), a tie
+ *    counting as supporting. Convex: every consecutive pair supports,
+ *    |K| = 2 pi - sum theta. Saddle: none does, |K| = sum theta - 2 pi.
+ *    Mixed: otherwise; |K| = 2 pi - 2 sum theta+_j + sum theta_i, theta+
+ *    the angles of the convex hull cone of the star's rays.
+ * Robustness: the signs of the triple products are exact. A triple product
+ * in the ground frame is det(frame) times the same product in pixel space
+ * (column, row, height), whose 2x2 minors are exact integers; it is
+ * evaluated in doubles with Shewchuk's orient3d error bound and, when the
+ * bound does not decide (slivers, coplanar rays), exactly, as a sum of
+ * twelve exactly representable products (float height x 21-bit slice of a
+ * minor) added by expansion arithmetic. The common factor det(frame) does
+ * not change which side the rays are on, so it is never needed.
+ * The hull cone: from a ray of a supporting pair (a hull ray), gift
+ * wrapping in the star's cyclic order (the hull rays keep that order)
+ * with the same exact signs; O(d h) for degree d and h hull rays.
+ *
+ * Swap value: sum |K| over the quad's four vertices before minus after
+ * (the stars of those four change: a and b lose the diagonal, c and d gain
+ * the new one); positive when the swap lowers the sum. Differences below
+ * 1e-12 of the total read 0. Needs: the stars of the quad's four vertices
+ * (heights included), so the affected hook returns every edge of every
+ * triangle incident to a quad vertex. Quads that are not strictly convex
+ * score 0 (geometry.h), so every star met is a proper fan. A vertex of
+ * degree above TT__STAR_MAX (before or after) counts 0 on both sides: no
+ * allocation ever happens here.
+ * Cost: per vertex d atan2 and d(d-2) filtered triple products, plus the
+ * hull for mixed vertices; eight vertices per swap value, about ten times
+ * the geometric criteria, not a hundred.
+ */
+#include "geometry.h"
+
+#define TT__STAR_MAX 256
+
+/* A star: the neighbours of v in counter-clockwise (ground) order. */
+typedef struct star {
+  int32_t nb[TT__STAR_MAX + 1];
+  int n;
+  bool boundary;
+} star;
+
+/* Gathers v's star from the mesh; false when the degree exceeds the cap or
+ * v is in no triangle. */
+static bool star_gather(const tt__mesh *m, int32_t v, star *s)
+{
+  int32_t h0 = m->v[v].edge;
+  s->n = 0;
+  s->boundary = false;
+  if (h0 < 0)
+    return false;
+  /* walk clockwise to the boundary, if any: cw(h) = next(twin[h]) */
+  int32_t h = h0;
+  for (;;) {
+    int32_t t = m->twin[h];
+    if (t < 0) {
+      s->boundary = true;
+      break;
+    }
+    h = tt__next(t);
+    if (h == h0)
+      break;
+  }
+  int32_t start = h;
+  for (;;) {
+    if (s->n >= TT__STAR_MAX)
+      return false;
+    s->nb[s->n++] = m->hv[tt__next(h)];
+    int32_t p = tt__prev(h);
+    int32_t t = m->twin[p];
+    if (t < 0) {
+      if (s->n >= TT__STAR_MAX)
+        return false;
+      s->nb[s->n++] = m->hv[p];
+      break;
+    }
+    h = t;
+    if (h == start)
+      break;
+  }
+  return true;
+}
+
+static void star_remove(star *s, int32_t x)
+{
+  for (int i = 0; i < s->n; i++)
+    if (s->nb[i] == x) {
+      for (int j = i + 1; j < s->n; j++)
+        s->nb[j - 1] = s->nb[j];
+      s->n--;
+      return;
+    }
+}
+
+static bool star_insert_after(star *s, int32_t x, int32_t y)
+{
+  if (s->n >= TT__STAR_MAX)
+    return false;
+  for (int i = 0; i < s->n; i++)
+    if (s->nb[i] == x) {
+      for (int j = s->n; j > i + 1; j--)
+        s->nb[j] = s->nb[j - 1];
+      s->nb[i + 1] = y;
+      s->n++;
+      return true;
+    }
+  return false;
+}
+
+/* --- exact sign of a triple product in pixel space -------------------- */
+
+/* The rays of a star in pixel space (exact column and row steps, the
+ * heights as floats) and on the ground. */
+typedef struct rays {
+  int64_t dc[TT__STAR_MAX + 1], dr[TT__STAR_MAX + 1];
+  double dz[TT__STAR_MAX + 1];          /* z_k - z_v, rounded */
+  float zk[TT__STAR_MAX + 1];
+  float zv;
+  tt__gvec g[TT__STAR_MAX + 1];         /* ground vectors */
+} rays;
+
+static inline void two_sum(double a, double b, double *x, double *y)
+{
+  double s = a + b;
+  double bv = s - a;
+  double av = s - bv;
+  *x = s;
+  *y = (a - av) + (b - bv);
+}
+
+/* Adds the exact products sign * z * |m| (|m| < 2^63) to expansion h. */
+static int add_products(double *h, int len, float z, int64_t m)
+{
+  double sz = m < 0 ? -(double)z : (double)z;
+  uint64_t u = m < 0 ? (uint64_t)0 - (uint64_t)m : (uint64_t)m;
+  const double scale[3] = {1.0, 2097152.0, 4398046511104.0}; /* 2^0,21,42 */
+  for (int k = 0; k < 3; k++) {
+    double b = sz * (double)((u >> (21 * k)) & 0x1fffffu) * scale[k];
+    for (int i = 0; i < len; i++)
+      two_sum(b, h[i], &b, &h[i]);
+    h[len++] = b;
+  }
+  return len;
+}
+
+static int exact_sign(const rays *r, int i, int j, int k)
+{
+  int64_t mi = r->dc[j] * r->dr[k] - r->dr[j] * r->dc[k];
+  int64_t mj = r->dc[k] * r->dr[i] - r->dr[k] * r->dc[i];
+  int64_t mk = r->dc[i] * r->dr[j] - r->dr[i] * r->dc[j];
+  double h[12];
+  int len = 0;
+  len = add_products(h, len, r->zk[i], mi);
+  len = add_products(h, len, r->zk[j], mj);
+  len = add_products(h, len, r->zk[k], mk);
+  len = add_products(h, len, -r->zv, mi + mj + mk);
+  for (int x = len - 1; x >= 0; x--)
+    if (h[x] != 0)
+      return h[x] > 0 ? 1 : -1;
+  return 0;
+}
+
+/* A pair's cross product and the absolute parts for the error bound. */
+typedef struct pair {
+  double nx, ny, nz, px, py, pz;
+} pair;
+
+static inline void pair_make(const rays *r, int i, int j, pair *p)
+{
+  double xi = (double)r->dc[i], yi = (double)r->dr[i], zi = r->dz[i];
+  double xj = (double)r->dc[j], yj = (double)r->dr[j], zj = r->dz[j];
+  p->nx = yi * zj - zi * yj;
+  p->ny = zi * xj - xi * zj;
+  p->nz = xi * yj - yi * xj;
+  p->px = fabs(yi * zj) + fabs(zi * yj);
+  p->py = fabs(zi * xj) + fabs(xi * zj);
+  p->pz = fabs(xi * yj) + fabs(yi * xj);
+}
+
+/* sign of (e_i x e_j) . e_k, exact */
+static inline int side(const rays *r, const pair *p, int i, int j, int k)
+{
+  double x = (double)r->dc[k], y = (double)r->dr[k], z = r->dz[k];
+  double det = p->nx * x + p->ny * y + p->nz * z;
+  double perm = p->px * fabs(x) + p->py * fabs(y) + p->pz * fabs(z);
+  double bound = 1e-15 * perm; /* > orient3d's (7 + 56 eps) eps */
+  if (det > bound)
+    return 1;
+  if (det < -bound)
+    return -1;
+  return exact_sign(r, i, j, k);
+}
+
+static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
+                      const star *s, rays *r)
+{
+  r->zv = m->v[v].z;
+  for (int i = 0; i < s->n; i++) {
+    const tt__mesh_vertex *w = &m->v[s->nb[i]];
+    r->dc[i] = (int64_t)w->c - m->v[v].c;
+    r->dr[i] = (int64_t)w->r - m->v[v].r;
+    r->zk[i] = w->z;
+    r->dz[i] = (double)w->z - (double)r->zv;
+    double dc = (double)r->dc[i], dr = (double)r->dr[i];
+    tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr,
+                  r->dz[i]};
+    r->g[i] = g;
+  }
+}
+
+/* |K| of v with star s; the class in *out_class. */
+static double star_curvature(const tt__mesh *m, const double fr[4],
+                             int32_t v, const star *s, rays *r,
+                             int *out_class)
+{
+  int n = s->n;
+  rays_load(m, fr, v, s, r);
+  double sum = 0;
+  int nang = s->boundary ? n - 1 : n;
+  for (int i = 0; i < nang; i++)
+    sum += tt__gangle(r->g[i], r->g[(i + 1) % n]);
+  if (s->boundary) {
+    *out_class = TT__VERTEX_BOUNDARY;
+    return fabs(TT__PI - sum);
+  }
+  int nsupport = 0, start = -1, sgn = 0;
+  for (int i = 0; i < n; i++) {
+    int j = (i + 1) % n;
+    pair p;
+    pair_make(r, i, j, &p);
+    bool pos = false, neg = false;
+    for (int k = 0; k < n && !(pos && neg); k++) {
+      if (k == i || k == j)
+        continue;
+      int sd = side(r, &p, i, j, k);
+      pos |= sd > 0;
+      neg |= sd < 0;
+    }
+    if (pos && neg)
+      continue;
+    nsupport++;
+    if (start < 0 && (pos || neg)) {
+      start = i;
+      sgn = pos ? 1 : -1;
+    }
+  }
+  if (nsupport == n) {
+    *out_class = TT__VERTEX_CONVEX;
+    return 2 * TT__PI - sum;
+  }
+  if (nsupport == 0 || start < 0) {
+    /* start < 0 with some support: every supporting pair has all rays in
+     * its plane, impossible unless the star is flat (then convex above) */
+    *out_class = TT__VERTEX_SADDLE;
+    return sum - 2 * TT__PI;
+  }
+  *out_class = TT__VERTEX_MIXED;
+  /* gift wrapping over positions t = 0..n (t = n is the start again) */
+  double hull = 0;
+  int tp = 0;
+  while (tp < n) {
+    int p = (start + tp) % n;
+    int tq = tp + 1, q = (start + tq) % n;
+    pair pq;
+    pair_make(r, p, q, &pq);
+    for (int tr = tp + 2; tr <= n; tr++) {
+      int x = (start + tr) % n;
+      if (sgn * side(r, &pq, p, q, x) < 0) {
+        tq = tr;
+        q = x;
+        pair_make(r, p, q, &pq);
+      }
+    }
+    hull += tt__gangle(r->g[p], r->g[q]);
+    tp = tq;
+  }
+  return 2 * TT__PI - 2 * hull + sum;
+}
+
+double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)
+{
+  double fr[4];
+  star s;
+  rays r;
+  int cls = -1;
+  double k = 0;
+  tt__geo_frame(env, fr);
+  if (star_gather(env->mesh, v, &s) && s.n >= 2)
+    k = star_curvature(env->mesh, fr, v, &s, &r, &cls);
+  if (out_class)
+    *out_class = cls;
+  return k;
+}
+
+static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
+{
+  const tt__mesh *m = env->mesh;
+  double fr[4];
+  tt__quad q;
+  tt__geo_frame(env, fr);
+  if (!tt__quad_load(env, e, fr, &q))
+    return 0.0;
+  int32_t vs[4] = {q.a, q.b, q.c, q.d};
+  double before = 0, after = 0;
+  star s;
+  rays r;
+  for (int i = 0; i < 4; i++) {
+    int cls;
+    if (!star_gather(m, vs[i], &s))
+      continue;
+    double kb = star_curvature(m, fr, vs[i], &s, &r, &cls);
+    bool ok = true;
+    switch (i) {
+    case 0: star_remove(&s, q.b); break;
+    case 1: star_remove(&s, q.a); break;
+    case 2: ok = star_insert_after(&s, q.a, q.d); break;
+    default: ok = star_insert_after(&s, q.b, q.c); break;
+    }
+    if (!ok)
+      continue;
+    double ka = star_curvature(m, fr, vs[i], &s, &r, &cls);
+    before += kb;
+    after += ka;
+  }
+  return tt__snap(before - after, fabs(before) + fabs(after));
+}
+
+/* Adds the three edges of the triangle of half-edge x, one half-edge per
+ * edge, skipping those already listed. */
+static int add_tri_edges(const tt__mesh *m, int32_t x, int32_t *out, int n,
+                         int max)
+{
+  int32_t t0 = x - x % 3;
+  for (int k = 0; k < 3; k++) {
+    int32_t y = t0 + k, ty = m->twin[y];
+    bool seen = false;
+    for (int i = 0; i < n && i < max && !seen; i++)
+      seen = out[i] == y || (ty >= 0 && out[i] == ty);
+    if (seen)
+      continue;
+    if (n < max)
+      out[n] = y;
+    n++;
+  }
+  return n;
+}
+
+/* Every edge of every triangle around the quad's four vertices. */
+static int gaussian_affected(const tt__crit_env *env, int32_t h,
+                             int32_t *out, int max)
+{
+  const tt__mesh *m = env->mesh;
+  int32_t g = m->twin[h];
+  int32_t vs[4] = {m->hv[h], m->hv[g], tt__mesh_apex(m, h),
+                   tt__mesh_apex(m, g)};
+  int n = 0;
+  for (int i = 0; i < 4; i++) {
+    int32_t h0 = m->v[vs[i]].edge, x = h0;
+    if (h0 < 0)
+      continue;
+    /* counter-clockwise: ccw(x) = twin[prev(x)] */
+    bool open = false;
+    for (;;) {
+      n = add_tri_edges(m, x, out, n, max);
+      int32_t t = m->twin[tt__prev(x)];
+      if (t < 0) {
+        open = true;
+        break;
+      }
+      x = t;
+      if (x == h0)
+        break;
+    }
+    if (!open)
+      continue;
+    /* clockwise from h0 for the rest of a boundary star */
+    x = h0;
+    for (;;) {
+      int32_t t = m->twin[x];
+      if (t < 0)
+        break;
+      x = tt__next(t);
+      n = add_tri_edges(m, x, out, n, max);
+    }
+  }
+  return n;
+}
+
+const tt__criterion_vt tt__criterion_gaussian = {
+    TT_CRITERION_GAUSSIAN_CURVATURE, "gaussian_curvature", true,
+    gaussian_swap_value, gaussian_affected};
