@@ -36,9 +36,9 @@
  * score 0 (geometry.h), so every star met is a proper fan. A vertex of
  * degree above TT__STAR_MAX (before or after) counts 0 on both sides: no
  * allocation ever happens here.
- * Cost: per vertex d atan2 and d(d-2) filtered triple products, plus the
- * hull for mixed vertices; eight vertices per swap value, about ten times
- * the geometric criteria, not a hundred.
+ * Cost: per vertex d square roots, one atan2 (angle sums as arguments of
+ * complex products, below) and d(d-2) filtered triple products, plus the
+ * hull for mixed vertices; eight vertices per swap value.
  */
 #include "geometry.h"
 
@@ -199,6 +199,8 @@ static inline int side(const rays *r, const pair *p, int i, int j, int k)
     return 1;
   if (det < -bound)
     return -1;
+  if (perm == 0)
+    return 0; /* every product is zero: rays in one vertical plane */
   return exact_sign(r, i, j, k);
 }
 
@@ -219,6 +221,51 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
   }
 }
 
+/* Sums of angles without an atan2 per angle: angle theta = atan2(c, d)
+ * in [0, pi] (c = |u x v|, d = u . v) is the argument of d + i c, so a sum
+ * of angles is the argument of the product, plus 2 pi for each time the
+ * running product passes the positive real axis -- detected as a move from
+ * the lower half-plane to the upper, since no step exceeds pi. One sqrt
+ * per angle and one atan2 per sum instead of an atan2 per angle (atan2
+ * costs eight times a square root). The product is rescaled by powers of
+ * two when it grows or shrinks far, which leaves its argument exact. */
+typedef struct turn {
+  double x, y;
+  int k;
+} turn;
+
+static inline bool upper(double x, double y)
+{
+  return y > 0 || (y == 0 && x > 0);
+}
+
+static inline void turn_add(turn *t, tt__gvec u, tt__gvec v)
+{
+  double c = tt__glen(tt__gcross(u, v)), d = tt__gdot(u, v);
+  if (c == 0 && d >= 0)
+    return; /* angle 0 (or a zero vector: atan2(0, 0) = 0) */
+  double x = t->x * d - t->y * c, y = t->x * c + t->y * d;
+  if (!upper(t->x, t->y) && upper(x, y))
+    t->k++;
+  double mag = fabs(x) + fabs(y);
+  if (mag > 0x1p200 || mag < 0x1p-200) {
+    int ex;
+    frexp(mag, &ex);
+    x = ldexp(x, -ex);
+    y = ldexp(y, -ex);
+  }
+  t->x = x;
+  t->y = y;
+}
+
+static inline double turn_angle(const turn *t)
+{
+  double a = atan2(t->y, t->x);
+  if (a < 0)
+    a += 2 * TT__PI;
+  return 2 * TT__PI * t->k + a;
+}
+
 /* |K| of v with star s; the class in *out_class. */
 static double star_curvature(const tt__mesh *m, const double fr[4],
                              int32_t v, const star *s, rays *r,
@@ -226,10 +273,11 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
 {
   int n = s->n;
   rays_load(m, fr, v, s, r);
-  double sum = 0;
+  turn tsum = {1, 0, 0};
   int nang = s->boundary ? n - 1 : n;
   for (int i = 0; i < nang; i++)
-    sum += tt__gangle(r->g[i], r->g[(i + 1) % n]);
+    turn_add(&tsum, r->g[i], r->g[(i + 1) % n]);
+  double sum = turn_angle(&tsum);
   if (s->boundary) {
     *out_class = TT__VERTEX_BOUNDARY;
     return fabs(TT__PI - sum);
@@ -267,7 +315,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
   }
   *out_class = TT__VERTEX_MIXED;
   /* gift wrapping over positions t = 0..n (t = n is the start again) */
-  double hull = 0;
+  turn thull = {1, 0, 0};
   int tp = 0;
   while (tp < n) {
     int p = (start + tp) % n;
@@ -276,16 +324,18 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
     pair_make(r, p, q, &pq);
     for (int tr = tp + 2; tr <= n; tr++) {
       int x = (start + tr) % n;
+      if (x == p)
+        continue; /* the start itself, seen from the start */
       if (sgn * side(r, &pq, p, q, x) < 0) {
         tq = tr;
         q = x;
         pair_make(r, p, q, &pq);
       }
     }
-    hull += tt__gangle(r->g[p], r->g[q]);
+    turn_add(&thull, r->g[p], r->g[q]);
     tp = tq;
   }
-  return 2 * TT__PI - 2 * hull + sum;
+  return 2 * TT__PI - 2 * turn_angle(&thull) + sum;
 }
 
 double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)

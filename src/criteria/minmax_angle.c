@@ -14,30 +14,50 @@
  * sign, so a positive value always improves the whole sorted vector.
  * Needs: the quad's four vertices only (no heights, no grid). A quad that
  * is not strictly convex scores 0 (geometry.h), so no hypothetical
- * triangle is degenerate. Cost: 4 atan2 (12 for the lexicographic form).
+ * triangle is degenerate. Angles are kept as points (cos, sin) scaled,
+ * compared by a cross product, and only their difference goes through
+ * atan2: one call per value (usually one for the lexicographic form too).
  */
 #include "geometry.h"
 
+/* An angle in [0, pi] as the point (d, c) = (u . v, |u x v|) of the upper
+ * half-plane (2-D, heights ignored): its argument. Comparing two angles
+ * or taking their difference needs no atan2 per angle. */
+typedef struct angle {
+  double d, c;
+} angle;
+
+static inline angle angle_of(tt__gvec u, tt__gvec v)
+{
+  angle a = {u.x * v.x + u.y * v.y, fabs(u.x * v.y - u.y * v.x)};
+  return a;
+}
+
+/* > 0 when p is the larger angle, < 0 when q is, 0 on a tie. */
+static inline double angle_cmp(angle p, angle q)
+{
+  return p.c * q.d - p.d * q.c;
+}
+
+/* p - q in radians: the argument of p / q. */
+static inline double angle_diff(angle p, angle q)
+{
+  return atan2(p.c * q.d - p.d * q.c, p.d * q.d + p.c * q.c);
+}
+
 /* The largest angle of triangle (p, q, r): the one opposite its longest
  * side. */
-static double max_angle(tt__gvec p, tt__gvec q, tt__gvec r)
+static angle max_angle(tt__gvec p, tt__gvec q, tt__gvec r)
 {
   tt__gvec pq = tt__gsub(q, p), qr = tt__gsub(r, q), rp = tt__gsub(p, r);
   double lpq = pq.x * pq.x + pq.y * pq.y;
   double lqr = qr.x * qr.x + qr.y * qr.y;
   double lrp = rp.x * rp.x + rp.y * rp.y;
-  tt__gvec u, v; /* the two sides at the vertex opposite the longest */
-  if (lpq >= lqr && lpq >= lrp) {
-    u = tt__gsub(p, r);
-    v = tt__gsub(q, r);
-  } else if (lqr >= lrp) {
-    u = tt__gsub(q, p);
-    v = tt__gsub(r, p);
-  } else {
-    u = tt__gsub(p, q);
-    v = tt__gsub(r, q);
-  }
-  return tt__gangle2(u, v);
+  if (lpq >= lqr && lpq >= lrp)
+    return angle_of(tt__gsub(p, r), tt__gsub(q, r));
+  if (lqr >= lrp)
+    return angle_of(tt__gsub(q, p), tt__gsub(r, p));
+  return angle_of(tt__gsub(p, q), tt__gsub(r, q));
 }
 
 static double minmax_swap_value(const tt__crit_env *env, int32_t e)
@@ -47,19 +67,31 @@ static double minmax_swap_value(const tt__crit_env *env, int32_t e)
   tt__geo_frame(env, fr);
   if (!tt__quad_load(env, e, fr, &q))
     return 0.0;
-  double b1 = max_angle(q.pa, q.pb, q.pc), b2 = max_angle(q.pb, q.pa, q.pd);
-  double a1 = max_angle(q.pc, q.pa, q.pd), a2 = max_angle(q.pd, q.pb, q.pc);
-  double before = b1 > b2 ? b1 : b2, after = a1 > a2 ? a1 : a2;
-  double d = before - after;
+  angle b1 = max_angle(q.pa, q.pb, q.pc), b2 = max_angle(q.pb, q.pa, q.pd);
+  angle a1 = max_angle(q.pc, q.pa, q.pd), a2 = max_angle(q.pd, q.pb, q.pc);
+  angle before = angle_cmp(b1, b2) >= 0 ? b1 : b2;
+  angle after = angle_cmp(a1, a2) >= 0 ? a1 : a2;
+  double d = angle_diff(before, after);
   return fabs(d) <= 1e-12 ? 0.0 : d;
 }
 
 /* The three angles of triangle (p, q, r) into out[0..2]. */
-static void angles(tt__gvec p, tt__gvec q, tt__gvec r, double *out)
+static void angles(tt__gvec p, tt__gvec q, tt__gvec r, angle *out)
 {
-  out[0] = tt__gangle2(tt__gsub(q, p), tt__gsub(r, p));
-  out[1] = tt__gangle2(tt__gsub(r, q), tt__gsub(p, q));
-  out[2] = tt__gangle2(tt__gsub(p, r), tt__gsub(q, r));
+  out[0] = angle_of(tt__gsub(q, p), tt__gsub(r, p));
+  out[1] = angle_of(tt__gsub(r, q), tt__gsub(p, q));
+  out[2] = angle_of(tt__gsub(p, r), tt__gsub(q, r));
+}
+
+static void sort_desc(angle *x)
+{
+  for (int i = 1; i < 6; i++) {
+    angle v = x[i];
+    int j = i;
+    for (; j > 0 && angle_cmp(x[j - 1], v) < 0; j--)
+      x[j] = x[j - 1];
+    x[j] = v;
+  }
 }
 
 static double minmax_lex_swap_value(const tt__crit_env *env, int32_t e)
@@ -69,14 +101,19 @@ static double minmax_lex_swap_value(const tt__crit_env *env, int32_t e)
   tt__geo_frame(env, fr);
   if (!tt__quad_load(env, e, fr, &q))
     return 0.0;
-  double before[6], after[6];
+  angle before[6], after[6];
   angles(q.pa, q.pb, q.pc, before);
   angles(q.pb, q.pa, q.pd, before + 3);
   angles(q.pc, q.pa, q.pd, after);
   angles(q.pd, q.pb, q.pc, after + 3);
-  tt__sort_desc(before, 6);
-  tt__sort_desc(after, 6);
-  return tt__lex_diff(before, after, 6);
+  sort_desc(before);
+  sort_desc(after);
+  for (int i = 0; i < 6; i++) {
+    double d = angle_diff(before[i], after[i]);
+    if (fabs(d) > 1e-12)
+      return d;
+  }
+  return 0.0;
 }
 
 const tt__criterion_vt tt__criterion_minmax_angle = {
