@@ -4,7 +4,7 @@
  *
  * The domain D is the union over grid cells of the valid part of each cell:
  * the whole cell when its four corners are valid, the triangle of its three
- * valid corners when one is nodata, nothing otherwise (raster_scan.h). Its
+ * valid corners when one is nodata, nothing otherwise. Its
  * outline is made of unit lattice segments: the long side of every
  * three-valid cell, and every axis edge between two valid samples that
  * exactly one of its two cells carries. Straight runs of the outline are
@@ -24,7 +24,6 @@
 #include "domain.h"
 
 #include "predicates.h"
-#include "raster_scan.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -278,6 +277,45 @@ static bool recover(tt__mesh *m, int32_t a, int32_t b, queue *q, int depth,
   return true;
 }
 
+/* Whether triangle t lies in the domain. No triangle crosses the outline
+ * once it is recovered, so one interior point decides: the centroid, exact
+ * in thrice-scaled integer coordinates. The cell holding it decides in
+ * turn: wholly valid, or three-valid with the point in its valid half. */
+static bool centroid_in_domain(const tt_grid *g, const tt__mesh *m,
+                               int32_t t)
+{
+  int64_t X = 0, Y = 0;
+  for (int k = 0; k < 3; k++) {
+    const tt__mesh_vertex *v = &m->v[m->hv[3 * t + k]];
+    X += v->c;
+    Y += v->r;
+  }
+  int64_t cx = X / 3, cy = Y / 3; /* coordinates are >= 0 */
+  int nvalid = cell_valid(g, cx, cy);
+  if (nvalid == 4)
+    return true;
+  if (nvalid < 3)
+    return false;
+  /* the three valid corners, scaled by 3 like the centroid */
+  int64_t vx[3], vy[3];
+  int n = 0;
+  for (int k = 0; k < 4; k++) {
+    int64_t x = cx + (k & 1), y = cy + (k >> 1);
+    if (ok_at(g, x, y)) {
+      vx[n] = 3 * x;
+      vy[n] = 3 * y;
+      n++;
+    }
+  }
+  int pos = 0, neg = 0;
+  for (int k = 0; k < 3; k++) {
+    int o = tt__orient_i(vx[k], vy[k], vx[(k + 1) % 3], vy[(k + 1) % 3], X, Y);
+    pos += o > 0;
+    neg += o < 0;
+  }
+  return pos == 0 || neg == 0;
+}
+
 /* --- the whole step ----------------------------------------------------- */
 
 tt_status tt__domain_build(tt_context *ctx, tt__mesh *m, const tt_grid *g,
@@ -423,15 +461,10 @@ tt_status tt__domain_build(tt_context *ctx, tt__mesh *m, const tt_grid *g,
     goto oom;
 
   /* 4. delete the triangles outside the domain */
-  for (size_t t = 0; t < m->nslots; t++) {
-    if (!tt__mesh_live(m, (int32_t)t))
-      continue;
-    tt__scan_tri st;
-    tt__scan_tri_from_mesh(m, (int32_t)t, &st);
-    if (!tt__tri_in_domain(g, &st) &&
+  for (size_t t = 0; t < m->nslots; t++)
+    if (tt__mesh_live(m, (int32_t)t) && !centroid_in_domain(g, m, (int32_t)t) &&
         !tt__mesh_delete_triangle(m, (int32_t)t))
       goto oom;
-  }
   tt__mesh_fix_vertex_edges(m);
   goto done;
 oom:

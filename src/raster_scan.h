@@ -64,24 +64,6 @@ TT_HIDDEN void tt__scan_candidate_rows(const tt_grid *g,
 TT_HIDDEN void tt__scan_prefetch(const tt_grid *g, const tt__scan_tri *st,
                                  int64_t ylo, int64_t yhi);
 
-/* For grids with nodata: over the closed triangle without its corners,
- * whether a nodata sample lies strictly inside (*out_nodata_inside), and
- * the valid sample with the largest |H - H'| (first in row order; its
- * error, possibly 0, in *out_err), or -1 when there is none. Scalar: run
- * only on triangles near nodata. */
-TT_HIDDEN void tt__scan_domain(const tt_grid *g, const tt__scan_tri *st,
-                               bool *out_nodata_inside, double *out_err,
-                               int64_t *out_index);
-
-/* Whether the triangle lies in the valid domain D of the grid: the union
- * over grid cells of the valid part of each cell (the whole cell when its
- * four corners are valid, the triangle of its three valid corners when
- * one is nodata, nothing otherwise). Exact, in integers: every cell that
- * is not wholly valid has a nodata corner, so only the cells around the
- * nodata samples of the triangle's box are tested, each by a separating
- * axis test of the interiors. */
-TT_HIDDEN bool tt__tri_in_domain(const tt_grid *g, const tt__scan_tri *st);
-
 typedef struct tt__scan_stats {
   size_t count;         /* valid owned samples */
   double max_err;
