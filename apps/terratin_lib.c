@@ -216,7 +216,8 @@ static const char help_top[] =
 static const char help_simplify[] =
     "Usage: terratin simplify [-b BAND] [-max_error E] [-max_points N]\n"
     "           [-max_triangles N] [-percent P] [-criterion NAME]\n"
-    "           [-srcnodata VALUE] [-z_factor F]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
     "           [-nln PREFIX] [-overwrite] [-q] [-json]\n"
     "           [--config KEY VALUE]... INPUT OUTPUT\n"
@@ -243,6 +244,21 @@ static const char help_simplify[] =
     "                    (default: the band's nodata value and mask)\n"
     "  -z_factor F       multiply heights by F, e.g. 0.3048 for feet to\n"
     "                    metres (default 1; after the band's scale/offset)\n"
+    "  -z_unit m         heights declared in ft or us-ft (band unit, else\n"
+    "                    vertical CRS) converted to metres. Combined:\n"
+    "                    z = (raw * scale + offset) * unit factor * F; with\n"
+    "                    an unknown unit it needs -z_factor, which then is\n"
+    "                    the whole conversion. Errors and -max_error are in\n"
+    "                    the output z unit, which the summary names\n"
+    "  -work_srs SRS     projected CRS in metres whose local affine frame\n"
+    "                    measures angles, areas and the Delaunay test\n"
+    "                    (default: the UTM zone of the DEM's centre for\n"
+    "                    geographic DEMs and map units that are not ground\n"
+    "                    metres, e.g. Web Mercator, feet; else the DEM's own\n"
+    "                    grid). Heights and output coordinates are unchanged\n"
+    "  -t_srs SRS        write the layers in SRS (vertices reprojected with\n"
+    "                    PROJ, triangles unchanged; default: the DEM's CRS).\n"
+    "                    A geographic output gets geodesic triangle areas\n"
     "  -criterion NAME   triangulation criterion: delaunay (default)\n"
     "  -of FORMAT        OGR vector driver that can create datasets: GPKG,\n"
     "                    \"ESRI Shapefile\", ... (default: guessed from\n"
@@ -308,7 +324,7 @@ static const char help_generate[] =
 
 static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-json] [-q]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m] [-json] [-q]\n"
     "\n"
     "Measures a layer of triangles (POLYGON Z, MULTIPOLYGON Z or TIN, from\n"
     "terratin or any other tool) against band BAND of the raster DEM: the\n"
@@ -321,6 +337,7 @@ static const char help_eval[] =
     "  -b BAND         band of DEM to read (default 1)\n"
     "  -srcnodata V    height to treat as nodata, a number or nan\n"
     "  -z_factor F     multiply heights by F (as given to simplify)\n"
+    "  -z_unit m       ft or us-ft heights to metres (as given to simplify)\n"
     "  -layer NAME     layer to measure (default: a layer named 'triangles'\n"
     "                  or ending in '_triangles', else the first polygon\n"
     "                  layer)\n"
@@ -406,7 +423,8 @@ enum opt_id {
   O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
   O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_JSON, O_LAYER, O_SIZE,
   O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE, O_ROUGHNESS,
-  O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR
+  O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT,
+  O_WORK_SRS, O_T_SRS
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -446,6 +464,9 @@ static const struct opt_def {
     {"-a_srs", O_A_SRS, 1, FOR_G},
     {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E},
     {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E},
+    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E},
+    {"-work_srs", O_WORK_SRS, 1, FOR_S},
+    {"-t_srs", O_T_SRS, 1, FOR_S},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -703,6 +724,10 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (!parse_size(v, &z) || z < 1)
         USAGE("%s: -max_triangles must be an integer >= 1, got '%s'",
               cmdname, v);
+      if (z > 2 * TT_MAX_VERTICES)
+        USAGE("%s: -max_triangles %s is above the limit of %zu triangles "
+              "(twice the %zu vertices a TIN may have)", cmdname, v,
+              2 * (size_t)TT_MAX_VERTICES, (size_t)TT_MAX_VERTICES);
       o->s.max_triangles = z;
       break;
     case O_PERCENT:
@@ -831,6 +856,21 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         USAGE("%s: -z_factor must be a finite non-zero number, got '%s'",
               cmdname, v);
       o->s.z_factor = x;
+      o->s.z_factor_set = 1;
+      break;
+    case O_Z_UNIT:
+      if (!str_ieq(v, "m"))
+        USAGE("%s: -z_unit must be m (heights in ft or us-ft converted to "
+              "metres), got '%s'", cmdname, v);
+      o->s.z_unit = "m";
+      break;
+    case O_WORK_SRS:
+    case O_T_SRS:
+      if (!*v)
+        USAGE("%s: %s needs a CRS (EPSG:n, WKT, ...)", cmdname, d->name);
+      if (!(*(d->id == O_WORK_SRS ? &o->s.work_srs : &o->s.t_srs) =
+                keep(o, v)))
+        NOMEM();
       break;
     case O_A_SRS:
       if (!*v)
@@ -1414,11 +1454,15 @@ static tt_status read_dem(app_run *r, GDALRasterBandH band, const char *path,
   char **ropts = NULL;
   if (r->s->srcnodata)
     ropts = CSLSetNameValue(ropts, "SRCNODATA", r->s->srcnodata);
-  if (r->s->z_factor != 1.0) {
+  if (r->s->z_factor != 1.0 || r->s->z_factor_set) {
     char num[40];
     format_double(num, sizeof num, r->s->z_factor);
     ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
   }
+  if (r->s->z_unit)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", r->s->z_unit);
+  if (r->s->work_srs)
+    ropts = CSLSetNameValue(ropts, "WORK_SRS", r->s->work_srs);
   r->msg.last[0] = '\0';
   tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
                                    progress_arg, &grid, &info);
@@ -1604,6 +1648,31 @@ static int same_file(const char *a, const char *b)
  * simplify
  * ========================================================================= */
 
+/* -work_srs and -t_srs: a CRS GDAL understands (usage error otherwise);
+ * -work_srs must also be projected. */
+static int check_srs(app_run *r, const char *option, const char *value,
+                     int projected)
+{
+  if (!value)
+    return 1;
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
+  r->msg.last[0] = '\0';
+  int ok = srs && OSRSetFromUserInput(srs, value) == OGRERR_NONE;
+  if (!ok)
+    run_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: %s '%s' is not a CRS GDAL understands%s%s", option,
+             value, r->msg.last[0] ? ": " : "", r->msg.last);
+  else if (projected && !OSRIsProjected(srs)) {
+    run_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: %s '%s' is not a projected CRS: the working frame "
+             "must be in metres", option, value);
+    ok = 0;
+  }
+  if (srs)
+    OSRDestroySpatialReference(srs);
+  return ok;
+}
+
 typedef struct simplify_report {
   const tt_raster_info *info;
   const char *driver;
@@ -1668,7 +1737,14 @@ static void print_simplify_json(app_run *r, const simplify_report *p)
     json_null(&j, "max_error_at");
   }
   json_str(&j, "z_unit", nonempty_or_null(p->info->z_unit));
+  json_str(&j, "z_unit_declared", nonempty_or_null(p->info->z_unit_declared));
+  json_str(&j, "z_unit_source", nonempty_or_null(p->info->z_unit_source));
+  json_num(&j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
+  json_str(&j, "pixel_is", nonempty_or_null(p->info->area_or_point));
   json_str(&j, "crs", nonempty_or_null(p->info->crs_name));
+  json_str(&j, "output_crs", r->s->t_srs ? r->s->t_srs
+                                          : nonempty_or_null(p->info->crs_name));
+  json_str(&j, "frame", p->info->frame_name);
   json_size(&j, "warnings", r->msg.warnings);
   json_open(&j, "seconds");
   json_num(&j, "read", p->t_read);
@@ -1704,13 +1780,27 @@ static void print_simplify_summary(app_run *r, const simplify_report *p)
     snprintf(num, sizeof num, "%.6g", ro->percent);
     snprintf(lim + n, sizeof lim - n, "%spercent %s", n ? ", " : "", num);
   }
+  /* Where the numbers stand: CRS, working frame, height unit. */
+  const tt_raster_info *in = p->info;
+  char zu[160];
+  if (in->z_unit_factor != 1.0)
+    snprintf(zu, sizeof zu, "%s (from %s, x%.10g)", unit,
+             in->z_unit_declared, in->z_unit_factor);
+  else if (in->z_unit && *in->z_unit)
+    snprintf(zu, sizeof zu, "%s (%s)", unit, in->z_unit_source);
+  else
+    snprintf(zu, sizeof zu, "unknown");
   fprintf(r->out,
           "%s: %zu cells, %zu valid samples -> %zu vertices, %zu triangles; "
-          "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; %.2f s\n",
+          "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s; "
+          "frame %s; z unit %s; %.2f s\n",
           r->s->output, p->cells, p->valid, p->sum.vertices,
           p->sum.triangles, p->sum.errors.max_error, unit,
           p->sum.errors.rmse, unit, lim,
-          tt_stop_reason_name(p->sum.stop_reason), p->t_total);
+          tt_stop_reason_name(p->sum.stop_reason),
+          in->crs_name && *in->crs_name ? in->crs_name : "none",
+          r->s->t_srs ? ", written in " : "", r->s->t_srs ? r->s->t_srs : "",
+          in->frame_name, zu, p->t_total);
   /* nodata outlines: what the TIN could not carry is said, not dropped */
   size_t lone = p->sum.errors.samples - p->sum.errors.covered;
   if (lone || p->sum.components > 1)
@@ -1743,6 +1833,9 @@ static tt_status run_simplify(app_run *r)
   if (same_file(s->input, s->output))
     return run_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
                     "is the input raster; refusing to replace it");
+  if (!check_srs(r, "-work_srs", s->work_srs, 1) ||
+      !check_srs(r, "-t_srs", s->t_srs, 0))
+    return r->res->status;
   GDALDriverH drv = output_driver(r);
   if (!drv)
     return r->res->status;
@@ -1884,7 +1977,14 @@ static tt_status run_simplify(app_run *r)
       {"ach_mean", TT_FIELD_REAL, NULL, 0, e->mean_abs},
       {"ach_l2", TT_FIELD_REAL, NULL, 0, e->l2},
       {"z_unit", TT_FIELD_STRING, info->z_unit ? info->z_unit : "", 0, 0},
+      {"z_unit_in", TT_FIELD_STRING,
+       info->z_unit_declared ? info->z_unit_declared : "", 0, 0},
+      {"z_factor", TT_FIELD_REAL, NULL, 0, info->z_unit_factor *
+                                               info->z_factor},
+      {"pixel_is", TT_FIELD_STRING,
+       info->area_or_point ? info->area_or_point : "", 0, 0},
       {"crs", TT_FIELD_STRING, info->crs_name ? info->crs_name : "", 0, 0},
+      {"out_crs", TT_FIELD_STRING, s->t_srs ? s->t_srs : "", 0, 0},
       {"frame", TT_FIELD_STRING, info->frame_name ? info->frame_name : "", 0,
        0},
       {"version", TT_FIELD_STRING, tt_version(), 0, 0},
@@ -1900,6 +2000,8 @@ static tt_status run_simplify(app_run *r)
   CPLFree(prefix);
   for (size_t i = 0; s->lco[i]; i++)
     wopts = CSLAddNameValue(wopts, "LCO", s->lco[i]);
+  if (s->t_srs)
+    wopts = CSLSetNameValue(wopts, "T_SRS", s->t_srs);
   /* GPKG R-trees: bulk-loaded on the closed file by tt_gpkg_build_rtree()
    * (GDAL 3.6 inserts them one by one); -lco SPATIAL_INDEX=NO: none. */
   const char *si = CSLFetchNameValue((CSLConstList)s->lco, "SPATIAL_INDEX");

@@ -80,6 +80,12 @@ typedef struct tt_app_settings {
   const char *srcnodata;     /* -srcnodata: a number or "nan"; NULL: the
                                 band's own mask (simplify, eval) */
   double z_factor;           /* -z_factor; default 1 (simplify, eval) */
+  int z_factor_set;          /* -z_factor was given */
+  const char *z_unit;        /* -z_unit: "m" or NULL (simplify, eval) */
+  const char *work_srs;      /* -work_srs: the working CRS; NULL: chosen
+                                from the DEM's CRS (simplify) */
+  const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the
+                                DEM's (simplify) */
 
   /* simplify; eval uses max_error as its threshold */
   double max_error;          /* -max_error; negative: not given */

@@ -61,6 +61,7 @@ typedef struct read_options {
   int srcnodata_is_nan;
   float srcnodata;       /* compared with the raw value read as Float32 */
   size_t max_memory;     /* bytes */
+  int max_memory_default; /* not given: 3/4 of physical memory */
 } read_options;
 
 static char *dup_str(const char *s)
@@ -186,6 +187,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
     if (s != TT_OK)
       return s;
   }
+  opt->max_memory_default = !has_max_memory;
   if (!has_max_memory)
     opt->max_memory = default_max_memory();
   return TT_OK;
@@ -442,8 +444,11 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   if (need > opt.max_memory) {
     char need_s[32], max_s[32];
     s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %s, "
-                  "more than MAX_MEMORY (%s)", path, nx, ny,
+                  "more than %s (%s); refused before reading", path, nx, ny,
                   fmt_bytes(need_s, sizeof need_s, need),
+                  opt.max_memory_default ? "3/4 of this machine's physical "
+                                           "memory"
+                                         : "MAX_MEMORY",
                   fmt_bytes(max_s, sizeof max_s, opt.max_memory));
     goto done;
   }
@@ -503,8 +508,9 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     if (unit_short) {
       unit_factor = unit_metres(unit_short);
     } else if (!opt.has_z_factor) {
-      s = tt__error(ctx, TT_ERR_DATA, "%s: Z_UNIT=m: the height unit is %s%s%s"
-                    "; give Z_FACTOR (the factor to metres) to convert it",
+      s = tt__error(ctx, TT_ERR_DATA, "%s: heights cannot be converted to "
+                    "metres (Z_UNIT=m, -z_unit m): the height unit is %s%s%s"
+                    "; give the factor to metres as Z_FACTOR (-z_factor)",
                     path, unit_declared[0] ? "\"" : "unknown (no band unit, no "
                     "vertical CRS)", unit_declared,
                     unit_declared[0] ? "\", which is not m, ft or us-ft" : "");

@@ -32,6 +32,22 @@
  * drivers index as their own options say (Shapefile: .qix at close with
  * LCO=SPATIAL_INDEX=YES). Shapefile layers default to ENCODING=UTF-8 (.cpg).
  *
+ * Output CRS: the layers get srs (the input CRS) unless T_SRS names
+ * another; then every vertex is transformed once, up front, from srs to
+ * T_SRS with OGR/PROJ (traditional GIS axis order on both sides, so x is
+ * easting or longitude) and the triangles' rings are made of the
+ * transformed vertices: the triangles themselves (which vertices, which
+ * order) do not change.
+ *
+ * Areas: per-triangle area_2d and area_3d come from the TIN (the ground
+ * frame, metres) when the output CRS is projected or absent. When it is
+ * geographic, area_2d is the geodesic area of the triangle whose corners
+ * are the output longitudes and latitudes, on the output CRS's ellipsoid
+ * (GeographicLib's geod_polygonarea, shipped with PROJ), and area_3d keeps
+ * the TIN's ratio area_3d / area_2d, which is 1 / cos(slope) of the
+ * triangle's plane: area_3d = geodesic area_2d * (frame area_3d / frame
+ * area_2d). Slope, aspect and angles stay those of the ground frame.
+ *
  * Each layer's feature and geometry are made once and reused: per feature
  * only field values and coordinates change. Progress is reported about
  * every 1% of the features.
@@ -45,6 +61,8 @@
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
+
+#include <geodesic.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -97,6 +115,12 @@ typedef struct write_state {
   int *run_idx;
   tt_progress_fn progress;
   void *progress_arg;
+  char *t_srs;             /* T_SRS as given, NULL: none */
+  OGRSpatialReferenceH out_srs; /* the layers' CRS (owned), NULL: none */
+  double *xy;              /* T_SRS: the transformed vertices, 2 per vertex */
+  int geodesic;            /* the output CRS is geographic */
+  struct geod_geodesic geod;
+  double deg_per_unit;     /* output angular unit in degrees */
   size_t done, total, next_report, step;
   double scale;            /* share of the progress range the rows take */
 } write_state;
@@ -131,6 +155,9 @@ static tt_status parse_options(write_state *w, char **options)
       else
         w->lco = CSLSetNameValue(w->lco, lkey, lvalue);
       CPLFree(lkey);
+    } else if (strcasecmp(key, "T_SRS") == 0) {
+      CPLFree(w->t_srs);
+      w->t_srs = *value ? CPLStrdup(value) : NULL;
     } else if (strcasecmp(key, "RTREE") == 0) {
       if (strcasecmp(value, "DEFERRED") == 0)
         w->rtree_deferred = 1;
@@ -141,7 +168,7 @@ static tt_status parse_options(write_state *w, char **options)
                       "DEFERRED", value);
     } else {
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
-                    "(known: NLN_PREFIX, LCO, RTREE)", key);
+                    "(known: NLN_PREFIX, LCO, RTREE, T_SRS)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -263,9 +290,25 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
                     "be read from the TIN", i, nt);
       break;
     }
+    double px[3], py[3];
+    for (int k = 0; k < 3; k++) {
+      px[k] = w->xy ? w->xy[2 * (size_t)t.v[k]] : v[k].x;
+      py[k] = w->xy ? w->xy[2 * (size_t)t.v[k] + 1] : v[k].y;
+    }
+    if (w->geodesic) {
+      double lats[3], lons[3], area = 0, perimeter = 0;
+      for (int k = 0; k < 3; k++) {
+        lons[k] = px[k] * w->deg_per_unit;
+        lats[k] = py[k] * w->deg_per_unit;
+      }
+      geod_polygonarea(&w->geod, lats, lons, 3, &area, &perimeter);
+      area = fabs(area);
+      t.area_3d = t.area_2d > 0 ? t.area_3d * (area / t.area_2d) : area;
+      t.area_2d = area;
+    }
     ring = OGR_G_GetGeometryRef(poly, 0);
     for (int k = 0; k < 4; k++)
-      OGR_G_SetPoint(ring, k, v[k % 3].x, v[k % 3].y, v[k % 3].z);
+      OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], v[k % 3].z);
     OGR_F_SetGeometry(f, poly);
     OGR_F_SetFieldInteger(f, idx[TF_V0], t.v[0]);
     OGR_F_SetFieldInteger(f, idx[TF_V1], t.v[1]);
@@ -302,7 +345,8 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
                     "be read from the TIN", i, nv);
       break;
     }
-    OGR_G_SetPoint(pt, 0, v.x, v.y, v.z);
+    OGR_G_SetPoint(pt, 0, w->xy ? w->xy[2 * i] : v.x,
+                   w->xy ? w->xy[2 * i + 1] : v.y, v.z);
     OGR_F_SetGeometry(f, pt);
     OGR_F_SetFieldInteger(f, idx[VF_ID], (int)i);
     OGR_F_SetFieldInteger(f, idx[VF_COL], v.col);
@@ -444,6 +488,109 @@ static tt_status check_run_fields(write_state *w, const tt_run_field *fields,
   return TT_OK;
 }
 
+/* The layers' CRS: srs, or T_SRS with every vertex transformed to it; and
+ * the ellipsoid for geodesic areas when that CRS is geographic. */
+static tt_status prepare_crs(write_state *w, const tt_tin *tin,
+                             OGRSpatialReferenceH srs)
+{
+  tt_status s = TT_OK;
+  OGRSpatialReferenceH src = NULL;
+  OGRCoordinateTransformationH ct = NULL;
+  if (w->t_srs) {
+    if (!srs)
+      return tt__error(w->ctx, TT_ERR_ARG, "T_SRS=%s: the TIN has no CRS "
+                       "to transform from", w->t_srs);
+    w->out_srs = OSRNewSpatialReference(NULL);
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRErr e = w->out_srs ? OSRSetFromUserInput(w->out_srs, w->t_srs)
+                          : OGRERR_FAILURE;
+    CPLPopErrorHandler();
+    if (e != OGRERR_NONE)
+      return tt__error(w->ctx, TT_ERR_ARG, "T_SRS '%s' is not a CRS GDAL "
+                       "understands", w->t_srs);
+    OSRSetAxisMappingStrategy(w->out_srs, OAMS_TRADITIONAL_GIS_ORDER);
+    src = OSRClone(srs);
+    if (src)
+      OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+    CPLErrorReset();
+    ct = src ? OCTNewCoordinateTransformation(src, w->out_srs) : NULL;
+    if (!ct) {
+      s = tt__error(w->ctx, TT_ERR_ARG, "PROJ cannot transform the TIN's "
+                    "CRS to T_SRS '%s': %s", w->t_srs, ogr_msg());
+      goto done;
+    }
+    const size_t nv = tt_tin_vertex_count(tin);
+    w->xy = malloc((nv ? nv : 1) * 2 * sizeof *w->xy);
+    double *bx = malloc(4096 * sizeof *bx), *by = malloc(4096 * sizeof *by);
+    int *ok = malloc(4096 * sizeof *ok);
+    if (!w->xy || !bx || !by || !ok) {
+      s = tt__error(w->ctx, TT_ERR_NOMEM, "out of memory for %zu "
+                    "transformed vertices", nv);
+    }
+    for (size_t i0 = 0; s == TT_OK && i0 < nv; i0 += 4096) {
+      size_t n = nv - i0 < 4096 ? nv - i0 : 4096;
+      for (size_t k = 0; k < n; k++) {
+        tt_vertex_info v;
+        tt_tin_vertex(tin, i0 + k, &v);
+        bx[k] = v.x;
+        by[k] = v.y;
+      }
+      if (!OCTTransformEx(ct, (int)n, bx, by, NULL, ok)) {
+        for (size_t k = 0; k < n; k++)
+          if (!ok[k]) {
+            s = tt__error(w->ctx, TT_ERR_DATA, "vertex %zu cannot be "
+                          "transformed to T_SRS '%s': %s", i0 + k, w->t_srs,
+                          ogr_msg());
+            break;
+          }
+        if (s == TT_OK)
+          s = tt__error(w->ctx, TT_ERR_DATA, "the vertices cannot be "
+                        "transformed to T_SRS '%s': %s", w->t_srs,
+                        ogr_msg());
+      }
+      for (size_t k = 0; s == TT_OK && k < n; k++) {
+        if (!isfinite(bx[k]) || !isfinite(by[k])) {
+          s = tt__error(w->ctx, TT_ERR_DATA, "vertex %zu has no finite "
+                        "coordinates in T_SRS '%s'", i0 + k, w->t_srs);
+          break;
+        }
+        w->xy[2 * (i0 + k)] = bx[k];
+        w->xy[2 * (i0 + k) + 1] = by[k];
+      }
+    }
+    free(bx);
+    free(by);
+    free(ok);
+    if (s != TT_OK)
+      goto done;
+  } else if (srs) {
+    w->out_srs = OSRClone(srs);
+    if (!w->out_srs)
+      return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
+  }
+  if (w->out_srs && OSRIsGeographic(w->out_srs)) {
+    OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
+    double a = OSRGetSemiMajor(w->out_srs, &e1);
+    double invf = OSRGetInvFlattening(w->out_srs, &e2);
+    double deg = OSRGetAngularUnits(w->out_srs, NULL) * 180.0 /
+                 3.14159265358979323846;
+    if (e1 == OGRERR_NONE && e2 == OGRERR_NONE && a > 0 && isfinite(a) &&
+        invf >= 0 && isfinite(invf) && deg > 0 && isfinite(deg)) {
+      geod_init(&w->geod, a, invf > 0 ? 1.0 / invf : 0.0);
+      w->deg_per_unit = deg;
+      w->geodesic = 1;
+    } else {
+      tt__warn(w->ctx, "the output CRS is geographic but has no usable "
+               "ellipsoid: triangle areas are those of the ground frame");
+    }
+  }
+done:
+  if (ct)
+    OCTDestroyCoordinateTransformation(ct);
+  OSRDestroySpatialReference(src);
+  return s;
+}
+
 /* After a failure without a transaction: drop the layers this call made. */
 static void delete_created_layers(write_state *w)
 {
@@ -495,6 +642,9 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                   "is too large for 32-bit feature fields", nv, nt);
     goto done;
   }
+  s = prepare_crs(&w, tin, srs);
+  if (s != TT_OK)
+    goto done;
   w.total = nv + nt + 1;
   w.step = (w.total + 99) / 100; /* at most 100 reports for the rows */
   w.next_report = w.step;
@@ -508,9 +658,9 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   /* The layers and their fields first, outside the transaction: GDAL 3.6's
    * GPKG driver keeps the layer objects of a rolled-back CREATE TABLE and
    * then breaks the file at close. On failure they are deleted instead. */
-  s = create_layer(&w, "triangles", srs, wkbPolygon25D, &w.tri_layer);
+  s = create_layer(&w, "triangles", w.out_srs, wkbPolygon25D, &w.tri_layer);
   if (s == TT_OK)
-    s = create_layer(&w, "vertices", srs, wkbPoint25D, &w.vtx_layer);
+    s = create_layer(&w, "vertices", w.out_srs, wkbPoint25D, &w.vtx_layer);
   if (s == TT_OK)
     s = create_layer(&w, "run_parameters", NULL, wkbNone, &w.run_layer);
   if (s == TT_OK)
@@ -582,6 +732,10 @@ done:
   for (int k = 0; k < w.ncreated; k++)
     CPLFree(w.created[k]);
   free(w.run_idx);
+  free(w.xy);
+  CPLFree(w.t_srs);
+  if (w.out_srs)
+    OSRDestroySpatialReference(w.out_srs);
   CPLFree(w.prefix);
   CSLDestroy(w.lco);
   return s;

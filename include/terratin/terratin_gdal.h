@@ -105,9 +105,15 @@ typedef struct tt_run_field {
  * <prefix>run_parameters from fields (names of at most 10 characters for a
  * shapefile). NaN reals are written as NULL. The rows go in one transaction
  * when the driver has them; on any failure or interruption nothing is
- * committed and the layers made are deleted again. srs may be NULL.
+ * committed and the layers made are deleted again. srs (the CRS of the
+ * TIN's map coordinates, the input raster's) may be NULL. The layers get
+ * srs, or T_SRS: then every vertex is transformed to it with OGR/PROJ
+ * (traditional GIS axis order), triangles unchanged. When the layers' CRS
+ * is geographic, area_2d is the geodesic area on its ellipsoid
+ * (GeographicLib's geod_polygonarea) and area_3d = area_2d / cos(slope);
+ * otherwise both are ground-frame areas (see io_ogr_write.c).
  * Options: NLN_PREFIX=<p>, LCO=<NAME=VALUE> (repeat for each layer creation
- * option), RTREE=NOW|DEFERRED. GPKG gets its R-trees built once after the
+ * option), RTREE=NOW|DEFERRED, T_SRS=<CRS> (any OSRSetFromUserInput form). GPKG gets its R-trees built once after the
  * inserts (LCO=SPATIAL_INDEX=NO: none): with RTREE=NOW (the default) by
  * GDAL before the commit; with RTREE=DEFERRED not at all, and the caller
  * builds them with tt_gpkg_build_rtree() on the closed file (layers
