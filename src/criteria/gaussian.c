@@ -204,6 +204,22 @@ static inline int side(const rays *r, const pair *p, int i, int j, int k)
   return exact_sign(r, i, j, k);
 }
 
+int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
+                        const float z[3], float zv)
+{
+  rays r;
+  r.zv = zv;
+  for (int i = 0; i < 3; i++) {
+    r.dc[i] = dc[i];
+    r.dr[i] = dr[i];
+    r.zk[i] = z[i];
+    r.dz[i] = (double)z[i] - (double)zv;
+  }
+  pair p;
+  pair_make(&r, 0, 1, &p);
+  return side(&r, &p, 0, 1, 2);
+}
+
 static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
                       const star *s, rays *r)
 {
@@ -406,7 +422,9 @@ static int add_tri_edges(const tt__mesh *m, int32_t x, int32_t *out, int n,
   return n;
 }
 
-/* Every edge of every triangle around the quad's four vertices. */
+/* Every edge of every triangle around the quad's four vertices, one
+ * half-edge per edge; at most max of them are written and counted (with
+ * max = 1024 that is four vertices of total degree about 340). */
 static int gaussian_affected(const tt__crit_env *env, int32_t h,
                              int32_t *out, int max)
 {
@@ -444,7 +462,7 @@ static int gaussian_affected(const tt__crit_env *env, int32_t h,
       n = add_tri_edges(m, x, out, n, max);
     }
   }
-  return n;
+  return n < max ? n : max;
 }
 
 const tt__criterion_vt tt__criterion_gaussian = {

@@ -261,6 +261,12 @@ enum {
 TT_HIDDEN double tt__gaussian_vertex(const tt__crit_env *env, int32_t v,
                                      int *out_class);
 
+/* The exact sign of (e0 x e1) . e2 for rays e_i = (dc_i, dr_i, z_i - zv)
+ * in pixel space (|dc|, |dr| < 2^28), as the Gaussian criterion's
+ * supporting-plane tests take it (gaussian.c). For tests. */
+TT_HIDDEN int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
+                                  const float z[3], float zv);
+
 /* The criteria defined beside Delaunay, one file each (registry.c lists
  * them). */
 TT_HIDDEN extern const tt__criterion_vt tt__criterion_minmax_angle;
@@ -276,7 +282,8 @@ TT_HIDDEN extern const tt__criterion_vt tt__criterion_l2;
 /* The affected-edges hook of the criteria whose swap value reads the
  * normals of the triangles across the quad's outer edges (mean curvature,
  * ABN): the new diagonal h, the 4 quad edges and the other edges of the
- * triangles across them, one half-edge per edge (mean_curvature.c). */
+ * triangles across them, one half-edge per edge (mean_curvature.c);
+ * returns how many it wrote, at most max (13 suffice). */
 TT_HIDDEN int tt__affected_quad_ring(const tt__crit_env *env, int32_t h,
                                      int32_t *out, int max);
 

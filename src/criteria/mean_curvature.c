@@ -68,7 +68,7 @@ int tt__affected_quad_ring(const tt__crit_env *env, int32_t h, int32_t *out,
     n = add_edge(m, tt__next(t), out, n, max, &total);
     n = add_edge(m, tt__prev(t), out, n, max, &total);
   }
-  return total;
+  return total < max ? total : max;
 }
 
 const tt__criterion_vt tt__criterion_mean_curvature = {

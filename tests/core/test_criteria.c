@@ -798,6 +798,82 @@ static void gaussian_stars(void)
   star_case("nearly flat dented pit", thin, 6, false, 0, TT__VERTEX_MIXED);
 }
 
+/* The supporting-plane sign against 128-bit integers, on rays made nearly
+ * coplanar: the third height is the float nearest the coplanar one, moved
+ * by a few ulps, so signs -1, 0 and +1 all occur and the rounded
+ * determinant cannot be trusted. Heights are floats in [8, 2^26], hence
+ * multiples of 2^-20: 2^20 z is an exact integer. */
+static void gaussian_exact_orient(uint64_t seed)
+{
+  uint64_t rng = seed;
+  int seen[3] = {0, 0, 0};
+  for (int it = 0; it < 20000; it++) {
+    int64_t dc[3], dr[3];
+    for (int i = 0; i < 3; i++) {
+      dc[i] = (int64_t)(tt_test_rand(&rng) % 201) - 100;
+      dr[i] = (int64_t)(tt_test_rand(&rng) % 201) - 100;
+    }
+    if (it % 3 == 0) { /* rays in one vertical plane, or sharing a line */
+      dc[2] = 2 * dc[0] - dc[1];
+      dr[2] = 2 * dr[0] - dr[1];
+    }
+    float z[3], zv = (float)(8 + tt_test_uniform(&rng) * 6.7e7);
+    for (int i = 0; i < 2; i++)
+      z[i] = (float)(8 + tt_test_uniform(&rng) * 6.7e7);
+    bool fib = it % 2 == 1;
+    if (fib) {
+      /* e0, e1 = consecutive Fibonacci pairs near 2^26 (their 2x2 minor
+       * is +-1), e2 parallel to e1 - e0 on the map, z0 = z1: the two big
+       * products (~2^80) cancel exactly and the sign is that of
+       * (z2 - zv), far below their rounding */
+      int64_t f[40] = {0, 1};
+      for (int i = 2; i < 40; i++)
+        f[i] = f[i - 1] + f[i - 2];
+      int n = 20 + (int)(tt_test_rand(&rng) % 19);
+      int64_t sc = 1 + (int64_t)(tt_test_rand(&rng) % 3);
+      dc[0] = f[n + 1];
+      dr[0] = f[n];
+      dc[1] = f[n];
+      dr[1] = f[n - 1];
+      dc[2] = sc * (dc[1] - dc[0]);
+      dr[2] = sc * (dr[1] - dr[0]);
+      z[1] = z[0];
+    }
+    int64_t mi = dc[1] * dr[2] - dr[1] * dc[2];
+    int64_t mj = dc[2] * dr[0] - dr[2] * dc[0];
+    int64_t mk = dc[0] * dr[1] - dr[0] * dc[1];
+    double zk = 8 + tt_test_uniform(&rng) * 6.7e7;
+    if (fib)
+      zk = zv;
+    else if (mk != 0)
+      zk = zv - ((z[0] - (double)zv) * mi + (z[1] - (double)zv) * mj) /
+                    (double)mk;
+    if (!(zk >= 8 && zk <= 6.7e7))
+      continue;
+    z[2] = (float)zk;
+    int steps = (int)(tt_test_rand(&rng) % 7) - 3;
+    for (; steps > 0; steps--)
+      z[2] = nextafterf(z[2], INFINITY);
+    for (; steps < 0; steps++)
+      z[2] = nextafterf(z[2], -INFINITY);
+    if (!(z[2] >= 8))
+      continue;
+    __int128 det = 0;
+    int64_t m[3] = {mi, mj, mk};
+    for (int i = 0; i < 3; i++)
+      det += (__int128)(int64_t)ldexp(z[i] - (double)zv, 20) * m[i];
+    int want = det > 0 ? 1 : det < 0 ? -1 : 0;
+    int got = tt__gaussian_orient(dc, dr, z, zv);
+    seen[want + 1]++;
+    if (got != want) {
+      TT_FAIL_("seed %#llx case %d: sign %d, exact %d",
+               (unsigned long long)seed, it, got, want);
+      return;
+    }
+  }
+  CHECK(seen[0] > 100 && seen[1] > 100 && seen[2] > 100);
+}
+
 /* On z = k (x^2 + y^2) (ground x, y) the Delaunay triangulation is the
  * lower convex hull: every interior vertex convex, and swapping any edge
  * away from the boundary makes a reflex edge and raises sum |K|. */
@@ -933,6 +1009,7 @@ int main(void)
   names(ctx);
   hand_quads(ctx);
   gaussian_stars();
+  gaussian_exact_orient(0x5eed0001u);
   gaussian_paraboloid(ctx);
   random_tests(ctx);
   timings(ctx);
