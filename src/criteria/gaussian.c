@@ -122,9 +122,14 @@ static bool star_insert_after(star *s, int32_t x, int32_t y)
 
 /* The rays of a star in pixel space (exact column and row steps, the
  * heights as floats) and on the ground. */
+typedef struct pray {
+  double x, y, z;                       /* column and row steps (exact),
+                                           z_k - z_v (rounded) */
+} pray;
+
 typedef struct rays {
+  pray p[TT__STAR_MAX + 1];             /* for the filter, contiguous */
   int64_t dc[TT__STAR_MAX + 1], dr[TT__STAR_MAX + 1];
-  double dz[TT__STAR_MAX + 1];          /* z_k - z_v, rounded */
   float zk[TT__STAR_MAX + 1];
   float zv;
   tt__gvec g[TT__STAR_MAX + 1];         /* ground vectors */
@@ -178,8 +183,8 @@ typedef struct pair {
 
 static inline void pair_make(const rays *r, int i, int j, pair *p)
 {
-  double xi = (double)r->dc[i], yi = (double)r->dr[i], zi = r->dz[i];
-  double xj = (double)r->dc[j], yj = (double)r->dr[j], zj = r->dz[j];
+  double xi = r->p[i].x, yi = r->p[i].y, zi = r->p[i].z;
+  double xj = r->p[j].x, yj = r->p[j].y, zj = r->p[j].z;
   p->nx = yi * zj - zi * yj;
   p->ny = zi * xj - xi * zj;
   p->nz = xi * yj - yi * xj;
@@ -191,7 +196,7 @@ static inline void pair_make(const rays *r, int i, int j, pair *p)
 /* sign of (e_i x e_j) . e_k, exact */
 static inline int side(const rays *r, const pair *p, int i, int j, int k)
 {
-  double x = (double)r->dc[k], y = (double)r->dr[k], z = r->dz[k];
+  double x = r->p[k].x, y = r->p[k].y, z = r->p[k].z;
   double det = p->nx * x + p->ny * y + p->nz * z;
   double perm = p->px * fabs(x) + p->py * fabs(y) + p->pz * fabs(z);
   double bound = 1e-15 * perm; /* > orient3d's (7 + 56 eps) eps */
@@ -213,7 +218,9 @@ int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
     r.dc[i] = dc[i];
     r.dr[i] = dr[i];
     r.zk[i] = z[i];
-    r.dz[i] = (double)z[i] - (double)zv;
+    r.p[i].x = (double)dc[i];
+    r.p[i].y = (double)dr[i];
+    r.p[i].z = (double)z[i] - (double)zv;
   }
   pair p;
   pair_make(&r, 0, 1, &p);
@@ -229,10 +236,12 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
     r->dc[i] = (int64_t)w->c - m->v[v].c;
     r->dr[i] = (int64_t)w->r - m->v[v].r;
     r->zk[i] = w->z;
-    r->dz[i] = (double)w->z - (double)r->zv;
     double dc = (double)r->dc[i], dr = (double)r->dr[i];
-    tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr,
-                  r->dz[i]};
+    double dz = (double)w->z - (double)r->zv;
+    r->p[i].x = dc;
+    r->p[i].y = dr;
+    r->p[i].z = dz;
+    tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr, dz};
     r->g[i] = g;
   }
 }
