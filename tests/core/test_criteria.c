@@ -650,9 +650,9 @@ static void hand_quads(tt_context *ctx)
     z[i] = 0;
   tt__mesh m;
 
-  /* Min-Max angle: a kite a(1,3) b(5,3) c(3,4) d(3,2) in a y-up frame
-   * ... with identity frame rows point up: c above ab. The diagonal a-b
-   * leaves an angle 2 atan 2 at c; c-d leaves at most (pi - 2 atan .5)/2. */
+  /* Min-Max angle: the kite a(1,3) b(5,3) c(3,4) d(3,2) (identity frame).
+   * The diagonal a-b leaves the angle 2 atan 2 at c (and at d); c-d leaves
+   * 2 atan 0.5 at a and b and (pi - 2 atan 0.5) / 2 at c and d. */
   {
     qpt p[4] = {{1, 3, 0}, {5, 3, 0}, {3, 4, 0}, {3, 2, 0}};
     int32_t e = quad_mesh(&m, g, p);
