@@ -18,7 +18,8 @@
  * Robustness: the signs of the triple products are exact. A triple product
  * in the ground frame is det(frame) times the same product in pixel space
  * (column, row, height), whose 2x2 minors are exact integers; it is
- * evaluated in doubles with Shewchuk's orient3d error bound and, when the
+ * evaluated in doubles with Shewchuk's orient3d error bound (loosened to
+ * one bound per pair of rays, see pair_make) and, when the
  * bound does not decide (slivers, coplanar rays), exactly, as a sum of
  * twelve exactly representable products (float height x 21-bit slice of a
  * minor) added by expansion arithmetic. The common factor det(frame) does
@@ -132,6 +133,7 @@ typedef struct rays {
   int64_t dc[TT__STAR_MAX + 1], dr[TT__STAR_MAX + 1];
   float zk[TT__STAR_MAX + 1];
   float zv;
+  double maxc;                          /* largest |x|, |y|, |z| of p[] */
   tt__gvec g[TT__STAR_MAX + 1];         /* ground vectors */
 } rays;
 
@@ -176,9 +178,9 @@ static int exact_sign(const rays *r, int i, int j, int k)
   return 0;
 }
 
-/* A pair's cross product and the absolute parts for the error bound. */
+/* A pair's cross product and its error bound. */
 typedef struct pair {
-  double nx, ny, nz, px, py, pz;
+  double nx, ny, nz, bound;
 } pair;
 
 static inline void pair_make(const rays *r, int i, int j, pair *p)
@@ -188,24 +190,25 @@ static inline void pair_make(const rays *r, int i, int j, pair *p)
   p->nx = yi * zj - zi * yj;
   p->ny = zi * xj - xi * zj;
   p->nz = xi * yj - yi * xj;
-  p->px = fabs(yi * zj) + fabs(zi * yj);
-  p->py = fabs(zi * xj) + fabs(xi * zj);
-  p->pz = fabs(xi * yj) + fabs(yi * xj);
+  /* Shewchuk's orient3d bound is (7 + 56 eps) eps times the permanent
+   * sum_k |x_k| (|yi zj| + |zi yj|) + ...; bounding every |x_k| by the
+   * star's largest coordinate gives one bound per pair, valid for every
+   * third ray, so a test costs a dot product and two comparisons. */
+  double per = fabs(yi * zj) + fabs(zi * yj) + fabs(zi * xj) +
+               fabs(xi * zj) + fabs(xi * yj) + fabs(yi * xj);
+  p->bound = 1e-15 * per * r->maxc;
 }
 
 /* sign of (e_i x e_j) . e_k, exact */
 static inline int side(const rays *r, const pair *p, int i, int j, int k)
 {
-  double x = r->p[k].x, y = r->p[k].y, z = r->p[k].z;
-  double det = p->nx * x + p->ny * y + p->nz * z;
-  double perm = p->px * fabs(x) + p->py * fabs(y) + p->pz * fabs(z);
-  double bound = 1e-15 * perm; /* > orient3d's (7 + 56 eps) eps */
-  if (det > bound)
+  double det = p->nx * r->p[k].x + p->ny * r->p[k].y + p->nz * r->p[k].z;
+  if (det > p->bound)
     return 1;
-  if (det < -bound)
+  if (det < -p->bound)
     return -1;
-  if (perm == 0)
-    return 0; /* every product is zero: rays in one vertical plane */
+  if (p->bound == 0)
+    return 0; /* the cross product is exactly zero */
   return exact_sign(r, i, j, k);
 }
 
@@ -222,6 +225,10 @@ int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
     r.p[i].y = (double)dr[i];
     r.p[i].z = (double)z[i] - (double)zv;
   }
+  r.maxc = 0;
+  for (int i = 0; i < 3; i++)
+    r.maxc = fmax(r.maxc, fmax(fabs(r.p[i].x),
+                               fmax(fabs(r.p[i].y), fabs(r.p[i].z))));
   pair p;
   pair_make(&r, 0, 1, &p);
   return side(&r, &p, 0, 1, 2);
@@ -231,6 +238,7 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
                       const star *s, rays *r)
 {
   r->zv = m->v[v].z;
+  double mx = 0;
   for (int i = 0; i < s->n; i++) {
     const tt__mesh_vertex *w = &m->v[s->nb[i]];
     r->dc[i] = (int64_t)w->c - m->v[v].c;
@@ -243,7 +251,9 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
     r->p[i].z = dz;
     tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr, dz};
     r->g[i] = g;
+    mx = fmax(mx, fmax(fabs(dc), fmax(fabs(dr), fabs(dz))));
   }
+  r->maxc = mx;
 }
 
 /* Sums of angles without an atan2 per angle: angle theta = atan2(c, d)
