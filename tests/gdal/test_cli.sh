@@ -446,6 +446,74 @@ if [ -n "$S" ] && [ -f "$S/usgs_dem_san_francisco/sanfranciscos.dem" ]; then
   check "the summary carries the z unit (ft)" grep -q "max error .* ft, RMS .* ft" out.txt
 fi
 
+# --- georeferencing, units, output CRS, robustness (issue 3) ----------------
+J=${TT_TESTDATA:-}/jacksboro_fault_dem.tif
+if [ -f "$J" ]; then
+  run simplify -json -max_error 10 "$J" out/geo.gpkg
+  check "geographic DEM: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  check "-json: frame UTM zone 16N" \
+    grep -q '"frame": "UTM zone 16N (EPSG:32616), affine at the centre' out.txt
+  check "-json: crs, z unit, pixel_is, valid samples" python3 -c '
+import json, sys
+d = json.load(open("out.txt"))
+assert d["crs"] == "WGS 84 (EPSG:4326)", d["crs"]
+assert d["z_unit"] == "m" and d["z_unit_source"] == "band unit", d
+assert d["pixel_is"] == "Area", d
+assert d["valid_samples"] == 138632, d'
+  check "run_parameters: frame, crs, z_unit, pixel_is, valid" bash -c \
+    'ogrinfo -q out/geo.gpkg run_parameters | grep -q "frame (String) = UTM zone 16N" &&
+     ogrinfo -q out/geo.gpkg run_parameters | grep -q "pixel_is (String) = Area" &&
+     ogrinfo -q out/geo.gpkg run_parameters | grep -q "z_unit (String) = m" &&
+     ogrinfo -q out/geo.gpkg run_parameters | grep -q "crs (String) = WGS 84" &&
+     ogrinfo -q out/geo.gpkg run_parameters | grep -q "valid (Integer64) = 138632"'
+  run simplify -max_error 10 "$J" out/geo_line.gpkg
+  check "summary line: CRS, frame, z unit" grep -q \
+    "138632 valid samples -> .*; CRS WGS 84 (EPSG:4326); frame UTM zone 16N (EPSG:32616), affine at the centre .*; z unit m (band unit); .* s$" out.txt
+  run simplify -q -max_error 10 -t_srs EPSG:32616 "$J" out/utm.gpkg
+  check "-t_srs: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  check "-t_srs: the layers are in UTM 16N" \
+    grep -q 'ID\["EPSG",32616\]' <(ogrinfo -so out/utm.gpkg triangles 2>/dev/null)
+  check "-t_srs: same triangles, eastings in metres" python3 -c '
+import subprocess, sys
+def ext(f):
+    o = subprocess.run(["ogrinfo", "-so", f, "triangles"], capture_output=True, text=True).stdout
+    n = [l for l in o.splitlines() if l.startswith("Feature Count")][0]
+    e = [l for l in o.splitlines() if l.startswith("Extent")][0]
+    return n, e
+ng, eg = ext("out/geo.gpkg"); nu, eu = ext("out/utm.gpkg")
+assert ng == nu, (ng, nu)
+x0 = float(eu.split("(")[1].split(",")[0])
+assert 700000 < x0 < 800000, eu'
+  run simplify -q -max_error 10 -work_srs EPSG:32617 "$J" out/w17.gpkg
+  check "-work_srs: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  check "-work_srs: the frame names it" bash -c \
+    'ogrinfo -q out/w17.gpkg run_parameters | grep -q "frame (String) = WGS 84 / UTM zone 17N (EPSG:32617), affine"'
+  rm -f out/*
+  expect_failure "-work_srs geographic" 2 out simplify -work_srs EPSG:4326 "$J" out/x.gpkg
+  expect_failure "-work_srs garbage" 2 out simplify -work_srs NOT_A_CRS "$J" out/x.gpkg
+  expect_failure "-t_srs garbage" 2 out simplify -t_srs NOT_A_CRS "$J" out/x.gpkg
+  expect_failure "-z_unit ft" 2 out simplify -z_unit ft "$J" out/x.gpkg
+fi
+expect_failure "-z_unit m, unknown unit" 1 out simplify -z_unit m in/fault.tif out/x.gpkg
+check "-z_unit m, unknown unit: says -z_factor" grep -q -- "-z_factor" err.txt
+run simplify -q -z_unit m -z_factor 0.5 in/fault.tif out/zf.gpkg
+check "-z_unit m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+rm -f out/*
+expect_failure "-max_points 0" 2 out simplify -max_points 0 in/fault.tif out/x.gpkg
+expect_failure "-max_triangles 0" 2 out simplify -max_triangles 0 in/fault.tif out/x.gpkg
+expect_failure "-max_triangles absurd" 2 out simplify -max_triangles 99999999999999 in/fault.tif out/x.gpkg
+expect_failure "-max_points absurd" 2 out simplify -max_points 99999999999999999999 in/fault.tif out/x.gpkg
+# 100k x 100k: refused before anything is allocated, with the size needed
+gdal_translate -q -of VRT -outsize 100000 100000 in/fault.tif in/huge.vrt
+expect_failure "100k x 100k raster" 1 out simplify in/huge.vrt out/x.gpkg
+check "100k x 100k: says how much memory (37.3 GiB)" grep -q "need 37.3 GiB" err.txt
+# GCPs only, no geotransform
+gdal_translate -q -of VRT -gcp 0 0 10 10 -gcp 100 0 20 10 -gcp 0 100 10 0 \
+  in/fault.tif in/gcp.vrt
+sed -i -e 's|<GeoTransform>.*</GeoTransform>||' in/gcp.vrt
+expect_failure "GCP-only raster" 1 out simplify in/gcp.vrt out/x.gpkg
+check "GCP-only raster: says so" grep -q "ground control points only" err.txt
+
 # help and version
 run --help
 check "--help: exit 0" [ "$rc" -eq 0 ]
