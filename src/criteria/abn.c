@@ -22,8 +22,10 @@
  */
 #include "geometry.h"
 
+/* The five alphas before and after in the quad's canonical form; *sign
+ * as in tt__quad. */
 static bool abn_load(const tt__crit_env *env, int32_t e, double before[5],
-                     double after[5])
+                     double after[5], double *sign)
 {
   double fr[4], len[5], len_cd;
   tt__quad q;
@@ -31,43 +33,44 @@ static bool abn_load(const tt__crit_env *env, int32_t e, double before[5],
   if (!tt__quad_load(env, e, fr, &q))
     return false;
   tt__quad_alphas(env, fr, &q, before, after, len, &len_cd);
+  *sign = q.sign;
   return true;
 }
 
 static double abn_swap_value(const tt__crit_env *env, int32_t e)
 {
-  double b[5], a[5];
-  if (!abn_load(env, e, b, a))
+  double b[5], a[5], sign;
+  if (!abn_load(env, e, b, a, &sign))
     return 0.0;
   tt__sort_desc(b, 5);
   tt__sort_desc(a, 5);
-  return tt__lex_diff(b, a, 5);
+  return sign * tt__lex_diff(b, a, 5);
 }
 
 static double abn_sum_swap_value(const tt__crit_env *env, int32_t e)
 {
-  double b[5], a[5];
-  if (!abn_load(env, e, b, a))
+  double b[5], a[5], sign;
+  if (!abn_load(env, e, b, a, &sign))
     return 0.0;
   double sb = 0, sa = 0;
   for (int k = 0; k < 5; k++) {
     sb += b[k];
     sa += a[k];
   }
-  return tt__snap(sb - sa, sb + sa);
+  return sign * tt__snap(sb - sa, sb + sa);
 }
 
 static double abn_sumsq_swap_value(const tt__crit_env *env, int32_t e)
 {
-  double b[5], a[5];
-  if (!abn_load(env, e, b, a))
+  double b[5], a[5], sign;
+  if (!abn_load(env, e, b, a, &sign))
     return 0.0;
   double sb = 0, sa = 0;
   for (int k = 0; k < 5; k++) {
     sb += b[k] * b[k];
     sa += a[k] * a[k];
   }
-  return tt__snap(sb - sa, sb + sa);
+  return sign * tt__snap(sb - sa, sb + sa);
 }
 
 const tt__criterion_vt tt__criterion_abn = {

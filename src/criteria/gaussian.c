@@ -34,7 +34,10 @@
  * 1e-12 of the total read 0. Needs: the stars of the quad's four vertices
  * (heights included), so the affected hook returns every edge of every
  * triangle incident to a quad vertex. Quads that are not strictly convex
- * score 0 (geometry.h), so every star met is a proper fan. A vertex of
+ * score 0 (geometry.h), so every star met is a proper fan. Quad and stars
+ * are read in a canonical order (geometry.h; interior stars start at
+ * their smallest neighbour), so a swap and the swap back have exactly
+ * opposite values. A vertex of
  * degree above TT__STAR_MAX (before or after) counts 0 on both sides: no
  * allocation ever happens here.
  * Cost: per vertex d square roots, one atan2 (angle sums as arguments of
@@ -117,6 +120,34 @@ static bool star_insert_after(star *s, int32_t x, int32_t y)
       return true;
     }
   return false;
+}
+
+/* Rotates an interior star to start at its smallest neighbour index, so
+ * that a star reached from either configuration of a quad is the same
+ * array and gives the same bits. (A boundary star starts at the boundary
+ * either way.) Three reversals, in place. */
+static void reverse(int32_t *x, int lo, int hi)
+{
+  for (; lo < hi; lo++, hi--) {
+    int32_t t = x[lo];
+    x[lo] = x[hi];
+    x[hi] = t;
+  }
+}
+
+static void star_canon(star *s)
+{
+  if (s->boundary || s->n < 2)
+    return;
+  int r = 0;
+  for (int i = 1; i < s->n; i++)
+    if (s->nb[i] < s->nb[r])
+      r = i;
+  if (r == 0)
+    return;
+  reverse(s->nb, 0, r - 1);
+  reverse(s->nb, r, s->n - 1);
+  reverse(s->nb, 0, s->n - 1);
 }
 
 /* --- exact sign of a triple product in pixel space -------------------- */
@@ -381,8 +412,10 @@ double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)
   int cls = -1;
   double k = 0;
   tt__geo_frame(env, fr);
-  if (star_gather(env->mesh, v, &s) && s.n >= 2)
+  if (star_gather(env->mesh, v, &s) && s.n >= 2) {
+    star_canon(&s);
     k = star_curvature(env->mesh, fr, v, &s, &r, &cls);
+  }
   if (out_class)
     *out_class = cls;
   return k;
@@ -396,29 +429,40 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
   tt__geo_frame(env, fr);
   if (!tt__quad_load(env, e, fr, &q))
     return 0.0;
+  /* canonical order a, b, c, d; "mine" is the mesh's configuration, the
+   * other one is made by editing the stars: with a-b in the mesh, a and b
+   * lose each other, c gains d after a, d gains c after b; with c-d in the
+   * mesh, c and d lose each other, a gains b after d, b gains a after c */
+  bool ab = q.sign > 0;
   int32_t vs[4] = {q.a, q.b, q.c, q.d};
-  double before = 0, after = 0;
+  double sa = 0, sb = 0; /* sum |K| with diagonal a-b, with c-d */
   star s;
   rays r;
   for (int i = 0; i < 4; i++) {
     int cls;
     if (!star_gather(m, vs[i], &s))
       continue;
-    double kb = star_curvature(m, fr, vs[i], &s, &r, &cls);
+    star_canon(&s);
+    double kmine = star_curvature(m, fr, vs[i], &s, &r, &cls);
     bool ok = true;
     switch (i) {
-    case 0: star_remove(&s, q.b); break;
-    case 1: star_remove(&s, q.a); break;
-    case 2: ok = star_insert_after(&s, q.a, q.d); break;
-    default: ok = star_insert_after(&s, q.b, q.c); break;
+    case 0: ok = ab ? (star_remove(&s, q.b), true)
+                    : star_insert_after(&s, q.d, q.b); break;
+    case 1: ok = ab ? (star_remove(&s, q.a), true)
+                    : star_insert_after(&s, q.c, q.a); break;
+    case 2: ok = ab ? star_insert_after(&s, q.a, q.d)
+                    : (star_remove(&s, q.d), true); break;
+    default: ok = ab ? star_insert_after(&s, q.b, q.c)
+                     : (star_remove(&s, q.c), true); break;
     }
     if (!ok)
       continue;
-    double ka = star_curvature(m, fr, vs[i], &s, &r, &cls);
-    before += kb;
-    after += ka;
+    star_canon(&s);
+    double kother = star_curvature(m, fr, vs[i], &s, &r, &cls);
+    sa += ab ? kmine : kother;
+    sb += ab ? kother : kmine;
   }
-  return tt__snap(before - after, fabs(before) + fabs(after));
+  return q.sign * tt__snap(sa - sb, fabs(sa) + fabs(sb));
 }
 
 /* Adds the three edges of the triangle of half-edge x, one half-edge per

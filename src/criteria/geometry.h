@@ -111,8 +111,10 @@ static inline double tt__garea(tt__gvec p, tt__gvec q, tt__gvec r)
   return 0.5 * tt__glen(tt__gnormal(p, q, r));
 }
 
-/* The quadrilateral of half-edge e = a->b in triangle (a, b, c), its twin
- * b->a in (b, a, d):
+/* The quadrilateral of an edge, in a canonical form. Its corners in
+ * counter-clockwise order are w0, w1, w2, w3, w0 the one of smallest
+ * index; the quad is then described as if its diagonal were w0-w2:
+ * a = w0, d = w1, b = w2, c = w3, so that
  *
  *          c                       c
  *         / \                     /|\
@@ -122,15 +124,20 @@ static inline double tt__garea(tt__gvec p, tt__gvec q, tt__gvec r)
  *         \ /                     \|/
  *          d                       d
  *
- * Before: (a, b, c) and (b, a, d); after: (c, a, d) and (d, b, c), as
- * tt__mesh_flip builds them. The outer edges are b-c and c-a (e's
- * triangle), a-d and d-b (the twin's); out[k] is the half-edge across
- * outer edge k (in that order) in the neighbouring triangle, or -1 on the
- * boundary. Points are ground coordinates relative to a. */
+ * "before" is (a, b, c) and (b, a, d), "after" is (c, a, d) and (d, b, c),
+ * and sign is +1 when the mesh's diagonal is a-b, -1 when it is c-d. Every
+ * criterion computes Quality(before) - Quality(after) from this form and
+ * multiplies by sign: an edge and the edge that replaces it after a swap
+ * see the same quad the same way, so their swap values are exact
+ * negatives of each other, bit for bit, and an optimiser can never undo a
+ * swap on rounding. The outer edges are b-c, c-a, a-d, d-b; in[k] is the
+ * half-edge of outer edge k inside the quad (b->c, c->a, a->d, d->b) and
+ * out[k] its twin across, or -1 on the boundary. Points are ground
+ * coordinates relative to a. */
 typedef struct tt__quad {
   int32_t a, b, c, d;
-  int32_t in[4];            /* the outer edges' half-edges inside the quad:
-                               b->c, c->a, a->d, d->b */
+  double sign;              /* +1: the mesh has a-b, -1: it has c-d */
+  int32_t in[4];            /* b->c, c->a, a->d, d->b inside the quad */
   int32_t out[4];           /* their twins, or -1 */
   tt__gvec pa, pb, pc, pd;  /* ground points, pa = 0 */
 } tt__quad;
@@ -144,17 +151,29 @@ static inline bool tt__quad_load(const tt__crit_env *env, int32_t e,
 {
   const tt__mesh *m = env->mesh;
   int32_t f = m->twin[e];
-  q->a = m->hv[e];
-  q->b = m->hv[f];
-  q->c = m->hv[tt__prev(e)];
-  q->d = m->hv[tt__prev(f)];
-  if (tt__mesh_orient(m, q->c, q->d, q->b) <= 0 ||
-      tt__mesh_orient(m, q->d, q->c, q->a) <= 0)
+  int32_t va = m->hv[e], vb = m->hv[f];
+  int32_t vc = m->hv[tt__prev(e)], vd = m->hv[tt__prev(f)];
+  if (tt__mesh_orient(m, vc, vd, vb) <= 0 ||
+      tt__mesh_orient(m, vd, vc, va) <= 0)
     return false;
-  q->in[0] = tt__next(e);
-  q->in[1] = tt__prev(e);
-  q->in[2] = tt__next(f);
-  q->in[3] = tt__prev(f);
+  /* counter-clockwise corners and the side half-edges leaving them:
+   * a->d, d->b, b->c, c->a */
+  int32_t w[4] = {va, vd, vb, vc};
+  int32_t side[4] = {tt__next(f), tt__prev(f), tt__next(e), tt__prev(e)};
+  int r = 0;
+  for (int k = 1; k < 4; k++)
+    if (w[k] < w[r])
+      r = k;
+  q->a = w[r];
+  q->d = w[(r + 1) & 3];
+  q->b = w[(r + 2) & 3];
+  q->c = w[(r + 3) & 3];
+  q->sign = (r & 1) ? -1.0 : 1.0; /* the mesh's diagonal is w0-w2 iff r
+                                     is even */
+  q->in[0] = side[(r + 2) & 3];   /* b->c */
+  q->in[1] = side[(r + 3) & 3];   /* c->a */
+  q->in[2] = side[r];             /* a->d */
+  q->in[3] = side[(r + 1) & 3];   /* d->b */
   for (int k = 0; k < 4; k++)
     q->out[k] = m->twin[q->in[k]];
   tt__gvec zero = {0, 0, 0};

@@ -21,6 +21,9 @@
  * residual there is the same either way (to the rounding of the plane
  * expression) and cancels. Vertex samples are exact and owned by nobody.
  *
+ * The quad is read in geometry.h's canonical form, each triangle scanned
+ * with the same corner order whichever diagonal the mesh has, so a swap and
+ * the swap back have exactly opposite values.
  * Needs: the grid (env->grid; without one the value is 0). Quads that are
  * not strictly convex score 0 (geometry.h), so the scans never meet a
  * degenerate triangle. Cost: a scan of the quad's samples twice -- the
@@ -70,22 +73,22 @@ static double tri_sse(const tt_grid *g, const tt__mesh *m, int32_t p0,
 static double l2_swap_value(const tt__crit_env *env, int32_t e)
 {
   const tt__mesh *m = env->mesh;
+  double fr[4];
+  tt__quad q;
   if (!env->grid)
     return 0.0;
-  int32_t f = m->twin[e];
-  int32_t a = m->hv[e], b = m->hv[f];
-  int32_t c = tt__mesh_apex(m, e), d = tt__mesh_apex(m, f);
-  if (tt__mesh_orient(m, c, d, b) <= 0 || tt__mesh_orient(m, d, c, a) <= 0)
-    return 0.0; /* not strictly convex: cannot be swapped */
-  bool o_bc = owns(m, tt__next(e)), o_ca = owns(m, tt__prev(e));
-  bool o_ad = owns(m, tt__next(f)), o_db = owns(m, tt__prev(f));
-  bool o_ab = owns_seg(m, a, b), o_cd = owns_seg(m, c, d);
+  tt__geo_frame(env, fr);
+  if (!tt__quad_load(env, e, fr, &q))
+    return 0.0;
+  bool o_bc = owns(m, q.in[0]), o_ca = owns(m, q.in[1]);
+  bool o_ad = owns(m, q.in[2]), o_db = owns(m, q.in[3]);
+  bool o_ab = owns_seg(m, q.a, q.b), o_cd = owns_seg(m, q.c, q.d);
   const tt_grid *g = env->grid;
-  double before = tri_sse(g, m, a, b, c, o_ab, o_bc, o_ca) +
-                  tri_sse(g, m, b, a, d, !o_ab, o_ad, o_db);
-  double after = tri_sse(g, m, c, a, d, o_ca, o_ad, !o_cd) +
-                 tri_sse(g, m, d, b, c, o_db, o_bc, o_cd);
-  return tt__snap(before - after, before + after);
+  double before = tri_sse(g, m, q.a, q.b, q.c, o_ab, o_bc, o_ca) +
+                  tri_sse(g, m, q.b, q.a, q.d, !o_ab, o_ad, o_db);
+  double after = tri_sse(g, m, q.c, q.a, q.d, o_ca, o_ad, !o_cd) +
+                 tri_sse(g, m, q.d, q.b, q.c, o_db, o_bc, o_cd);
+  return q.sign * tt__snap(before - after, before + after);
 }
 
 const tt__criterion_vt tt__criterion_l2 = {

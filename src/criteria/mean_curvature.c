@@ -33,7 +33,7 @@ static double mean_curvature_swap_value(const tt__crit_env *env, int32_t e)
     before += len[k] * ab[k];
     after += len[k] * aa[k];
   }
-  return tt__snap(before - after, before + after);
+  return q.sign * tt__snap(before - after, before + after);
 }
 
 /* Adds the edge of half-edge x to out unless it is there (as either

@@ -8,7 +8,9 @@
  * area. Differences below 1e-12 of the four areas' sum are rounding noise
  * and read 0 (a flat quad has the same area either way). Needs: the quad's
  * four vertices and their heights. A quad that is not strictly convex
- * scores 0 (geometry.h); a zero-area triangle has area 0, never NaN.
+ * scores 0 (geometry.h); a zero-area triangle has area 0, never NaN. The
+ * quad is read in geometry.h's canonical form, so a swap and the swap back
+ * have exactly opposite values.
  * Cost: four cross products and four square roots.
  */
 #include "geometry.h"
@@ -22,7 +24,7 @@ static double min_area_swap_value(const tt__crit_env *env, int32_t e)
     return 0.0;
   double b = tt__garea(q.pa, q.pb, q.pc) + tt__garea(q.pb, q.pa, q.pd);
   double a = tt__garea(q.pc, q.pa, q.pd) + tt__garea(q.pd, q.pb, q.pc);
-  return tt__snap(b - a, b + a);
+  return q.sign * tt__snap(b - a, b + a);
 }
 
 const tt__criterion_vt tt__criterion_min_area = {

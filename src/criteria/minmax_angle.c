@@ -72,7 +72,7 @@ static double minmax_swap_value(const tt__crit_env *env, int32_t e)
   angle before = angle_cmp(b1, b2) >= 0 ? b1 : b2;
   angle after = angle_cmp(a1, a2) >= 0 ? a1 : a2;
   double d = angle_diff(before, after);
-  return fabs(d) <= 1e-12 ? 0.0 : d;
+  return fabs(d) <= 1e-12 ? 0.0 : q.sign * d;
 }
 
 /* The three angles of triangle (p, q, r) into out[0..2]. */
@@ -111,7 +111,7 @@ static double minmax_lex_swap_value(const tt__crit_env *env, int32_t e)
   for (int i = 0; i < 6; i++) {
     double d = angle_diff(before[i], after[i]);
     if (fabs(d) > 1e-12)
-      return d;
+      return q.sign * d;
   }
   return 0.0;
 }
