@@ -18,7 +18,8 @@
  * Needs: the quad and the apexes across its outer edges, so the affected
  * hook is mean curvature's (the quad edges and the edges of the triangles
  * across them). Quads that are not strictly convex score 0 (geometry.h).
- * Cost: 8 cross products and 10 atan2.
+ * The quad is read in geometry.h's canonical form, so a swap and the swap
+ * back have exactly opposite values. Cost: 8 cross products and 10 atan2.
  */
 #include "geometry.h"
 

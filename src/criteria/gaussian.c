@@ -19,10 +19,10 @@
  * in the ground frame is det(frame) times the same product in pixel space
  * (column, row, height), whose 2x2 minors are exact integers; it is
  * evaluated in doubles with Shewchuk's orient3d error bound (loosened to
- * one bound per pair of rays, see pair_make) and, when the
- * bound does not decide (slivers, coplanar rays), exactly, as a sum of
- * twelve exactly representable products (float height x 21-bit slice of a
- * minor) added by expansion arithmetic. The common factor det(frame) does
+ * one bound per pair of rays, see pair_make) and, when the bound does not
+ * decide (slivers, coplanar rays), exactly, as a sum of twelve exactly
+ * representable products (float height x 21-bit slice of a minor) added
+ * by expansion arithmetic. The common factor det(frame) does
  * not change which side the rays are on, so it is never needed.
  * The hull cone: from a ray of a supporting pair (a hull ray), gift
  * wrapping in the star's cyclic order (the hull rays keep that order)
@@ -37,12 +37,12 @@
  * score 0 (geometry.h), so every star met is a proper fan. Quad and stars
  * are read in a canonical order (geometry.h; interior stars start at
  * their smallest neighbour), so a swap and the swap back have exactly
- * opposite values. A vertex of
- * degree above TT__STAR_MAX (before or after) counts 0 on both sides: no
- * allocation ever happens here.
+ * opposite values. A vertex of degree above TT__STAR_MAX (before or after)
+ * counts 0 on both sides: no allocation ever happens here.
  * Cost: per vertex d square roots, one atan2 (angle sums as arguments of
- * complex products, below) and d(d-2) filtered triple products, plus the
- * hull for mixed vertices; eight vertices per swap value.
+ * complex products, below) and up to d(d-2) filtered triple products,
+ * plus the hull for mixed vertices; eight stars per swap value, about
+ * 1.5 us per value on a terrain mesh (100 times Delaunay's incircle).
  */
 #include "geometry.h"
 

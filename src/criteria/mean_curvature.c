@@ -15,7 +15,9 @@
  * and the other edges of the triangles across them (at most 13).
  * Degenerate triangles (only hypothetical, in quads that are not strictly
  * convex, which score 0 anyway) would have zero normals and alpha = 0.
- * Cost: 8 cross products and 5 + 5 atan2.
+ * The quad is read in geometry.h's canonical form, so a swap and the swap
+ * back have exactly opposite values. Cost: 8 cross products and 5 + 5
+ * atan2.
  */
 #include "geometry.h"
 

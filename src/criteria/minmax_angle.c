@@ -17,6 +17,8 @@
  * triangle is degenerate. Angles are kept as points (cos, sin) scaled,
  * compared by a cross product, and only their difference goes through
  * atan2: one call per value (usually one for the lexicographic form too).
+ * The quad is read in geometry.h's canonical form, so a swap and the swap
+ * back have exactly opposite values.
  */
 #include "geometry.h"
 
