@@ -354,9 +354,11 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
     pair p;
     pair_make(r, i, j, &p);
     bool pos = false, neg = false;
-    for (int k = 0; k < n && !(pos && neg); k++) {
-      if (k == i || k == j)
-        continue;
+    /* the other rays from the pair outwards, alternating sides (i+2, i-1,
+     * i+3, i-2, ...): a ray that breaks the plane is most often next to
+     * the pair, so saddles are rejected after a test or two */
+    for (int t = 0; t < n - 2 && !(pos && neg); t++) {
+      int k = (t & 1) ? (i - 1 - t / 2 + n) % n : (j + 1 + t / 2) % n;
       int sd = side(r, &p, i, j, k);
       pos |= sd > 0;
       neg |= sd < 0;
