@@ -165,6 +165,9 @@ typedef struct rays {
   float zk[TT__STAR_MAX + 1];
   float zv;
   double maxc;                          /* largest |x|, |y|, |z| of p[] */
+  unsigned char sides[TT__STAR_MAX + 1];/* pair (i, i+1): 1 when a ray lies
+                                           on its positive side, 2 on its
+                                           negative side (both: stopped) */
   tt__gvec g[TT__STAR_MAX + 1];         /* ground vectors */
 } rays;
 
@@ -363,6 +366,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
       pos |= sd > 0;
       neg |= sd < 0;
     }
+    r->sides[i] = (unsigned char)((pos ? 1 : 0) | (neg ? 2 : 0));
     if (pos && neg)
       continue;
     nsupport++;
@@ -382,12 +386,20 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
     return sum - 2 * TT__PI;
   }
   *out_class = TT__VERTEX_MIXED;
-  /* gift wrapping over positions t = 0..n (t = n is the start again) */
+  /* gift wrapping over positions t = 0..n (t = n is the start again);
+   * a consecutive pair that supports on the hull's side is a hull face, so
+   * runs of those are walked without a test */
   turn thull = {1, 0, 0};
   int tp = 0;
+  unsigned char wrong = sgn > 0 ? 2 : 1;
   while (tp < n) {
     int p = (start + tp) % n;
     int tq = tp + 1, q = (start + tq) % n;
+    if (!(r->sides[p] & wrong)) {
+      turn_add(&thull, r->g[p], r->g[q]);
+      tp = tq;
+      continue;
+    }
     pair pq;
     pair_make(r, p, q, &pq);
     for (int tr = tp + 2; tr <= n; tr++) {
