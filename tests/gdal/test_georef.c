@@ -586,6 +586,73 @@ static void test_feet(const char *path)
   tt_app_options_destroy(opts);
 }
 
+/* No band unit: the vertical part of a compound CRS says US survey feet
+ * (NAD83 + NAVD88 height (ftUS), EPSG:4269+6360). */
+static void test_vertical_crs(const char *path)
+{
+  GDALDatasetH src = GDALOpen(path, GA_ReadOnly);
+  if (!src) {
+    TT_FAIL_("cannot open %s", path);
+    return;
+  }
+  GDALDatasetH d = GDALCreateCopy(GDALGetDriverByName("GTiff"),
+                                  tmp_path("compound.tif"), src, FALSE, NULL,
+                                  NULL, NULL);
+  GDALClose(src);
+  CHECK(d != NULL);
+  if (!d)
+    return;
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
+  CHECK(OSRSetFromUserInput(srs, "EPSG:4269+6360") == OGRERR_NONE);
+  GDALSetSpatialRef(d, srs);
+  GDALSetRasterUnitType(GDALGetRasterBand(d, 1), "");
+  GDALClose(d);
+  OSRDestroySpatialReference(srs);
+  /* GTiff reports the vertical unit as the band's unit type; a VRT of it
+   * without a unit type leaves only the CRS to say. */
+  CPLSetConfigOption("GTIFF_REPORT_COMPD_CS", "YES");
+  GDALDatasetH t = GDALOpen(tmp_path("compound.tif"), GA_ReadOnly);
+  GDALDatasetH v = t ? GDALCreateCopy(GDALGetDriverByName("VRT"),
+                                      tmp_path("compound.vrt"), t, FALSE,
+                                      NULL, NULL, NULL)
+                     : NULL;
+  if (v) {
+    GDALSetRasterUnitType(GDALGetRasterBand(v, 1), "");
+    GDALClose(v);
+  }
+  if (t)
+    GDALClose(t);
+  tt_raster_info *info = NULL;
+  char **o = CSLSetNameValue(NULL, "Z_UNIT", "m");
+  tt_grid *g = read_dem(tmp_path("compound.tif"), o, &info);
+  if (g) {
+    printf("compound CRS GeoTIFF: band unit \"%s\" (%s), x%.12g to %s\n",
+           info->z_unit_declared, info->z_unit_source, info->z_unit_factor,
+           info->z_unit);
+    CHECK_DBL_NEAR(info->z_unit_factor, 1200.0 / 3937.0, 1e-15);
+    CHECK_STR_EQ(info->z_unit, "m");
+  }
+  tt_grid_destroy(g);
+  tt_raster_info_destroy(info);
+  info = NULL;
+  g = read_dem(tmp_path("compound.vrt"), o, &info);
+  CSLDestroy(o);
+  CPLSetConfigOption("GTIFF_REPORT_COMPD_CS", NULL);
+  if (g) {
+    printf("compound CRS %s: heights declared in %s (%s), converted x%.12g "
+           "to %s; frame %s\n", info->crs_name, info->z_unit_declared,
+           info->z_unit_source, info->z_unit_factor, info->z_unit,
+           info->frame_name);
+    CHECK_STR_EQ(info->z_unit_declared, "us-ft");
+    CHECK_STR_EQ(info->z_unit_source, "vertical CRS");
+    CHECK_STR_EQ(info->z_unit, "m");
+    CHECK_DBL_NEAR(info->z_unit_factor, 1200.0 / 3937.0, 1e-15);
+    CHECK(strstr(info->frame_name, "UTM zone 16N") != NULL);
+  }
+  tt_grid_destroy(g);
+  tt_raster_info_destroy(info);
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -611,6 +678,7 @@ int main(void)
   CHECK_DBL_LE(inner, 1e-3);
   test_jacksboro_tin(p);
   test_warped(p);
+  test_vertical_crs(p);
 
   struct stat st;
   if (sd && stat(sd, &st) == 0) {
