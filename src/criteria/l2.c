@@ -7,9 +7,10 @@
  * changes H' only inside the quad. Swap value: the squared residuals of
  * the samples the two triangles own before the swap minus those the two
  * hypothetical triangles own after, each triangle summed by
- * tt__scan_stats_run (raster_scan.h), so the sums are bit for bit those
- * of a whole-mesh scan of the same triangles. Positive: the swap lowers
- * the error. Differences below 1e-12 of the total read 0.
+ * tt__scan_stats_run (raster_scan.h), the scan a whole-mesh measure uses
+ * (the same samples; the residuals agree to the rounding of the plane,
+ * whose origin corner may differ). Positive: the swap lowers the error.
+ * Differences below 1e-12 of the total read 0.
  *
  * Ownership: the diagonal's samples go to one of its two triangles by the
  * top-left rule, before and after alike; the outer edges keep the mesh's
