@@ -680,6 +680,29 @@ int main(void)
   test_warped(p);
   test_vertical_crs(p);
 
+  /* Twenty degrees in one frame: said in the frame's name and warned. */
+  GDALDatasetH jd = GDALOpen(p, GA_ReadOnly);
+  const char *targv[] = {"-of", "VRT", "-a_ullr", "-100", "50", "-80", "30",
+                         NULL};
+  GDALTranslateOptions *to = GDALTranslateOptionsNew((char **)targv, NULL);
+  GDALDatasetH big = jd ? GDALTranslate(tmp_path("big.vrt"), jd, to, NULL)
+                        : NULL;
+  GDALTranslateOptionsFree(to);
+  if (big)
+    GDALClose(big);
+  if (jd)
+    GDALClose(jd);
+  size_t warnings = tt_context_warning_count(ctx);
+  tt_raster_info *bi = NULL;
+  tt_grid *bg = read_dem(tmp_path("big.vrt"), NULL, &bi);
+  if (bg) {
+    printf("20-degree grid: frame %s\n", bi->frame_name);
+    CHECK(strstr(bi->frame_name, "% off at the corners") != NULL);
+    CHECK_INT_EQ(tt_context_warning_count(ctx), warnings + 1);
+  }
+  tt_grid_destroy(bg);
+  tt_raster_info_destroy(bi);
+
   struct stat st;
   if (sd && stat(sd, &st) == 0) {
     snprintf(p, sizeof p, "%s/gdal_autotest/n43.dt0", sd);
