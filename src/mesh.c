@@ -628,3 +628,57 @@ done:
   return ok;
 #undef FAIL
 }
+
+/* --- undoable flips (optimize.c) ----------------------------------------
+ * The look-ahead optimiser tries a flip, scores the edges around it and
+ * takes it back. A second flip would give the same triangles back, but in
+ * the other slots and rotated, so every half-edge index would change and
+ * both slots would need rescanning. tt__mesh_flip_revert instead restores
+ * the saved words exactly, and the touched log with them. */
+
+int32_t tt__mesh_flip_undoable(tt__mesh *m, int32_t e,
+                               tt__mesh_flip_undo *out_undo)
+{
+  int32_t f = m->twin[e];
+  int32_t slot[2] = {e / 3, f / 3};
+  out_undo->ntouched = m->ntouched;
+  for (int s = 0; s < 2; s++) {
+    out_undo->slot[s] = slot[s];
+    for (int k = 0; k < 3; k++) {
+      int32_t h = 3 * slot[s] + k;
+      out_undo->hv[3 * s + k] = m->hv[h];
+      out_undo->twin[3 * s + k] = m->twin[h];
+      out_undo->eflag[3 * s + k] = m->eflag[h];
+    }
+  }
+  int32_t quad[4] = {m->hv[e], m->hv[f], m->hv[tt__prev(e)],
+                     m->hv[tt__prev(f)]};
+  for (int k = 0; k < 4; k++) {
+    out_undo->vert[k] = quad[k];
+    out_undo->vedge[k] = m->v[quad[k]].edge;
+  }
+  return tt__mesh_flip(m, e);
+}
+
+void tt__mesh_flip_revert(tt__mesh *m, const tt__mesh_flip_undo *undo)
+{
+  for (int s = 0; s < 2; s++)
+    for (int k = 0; k < 3; k++) {
+      int32_t h = 3 * undo->slot[s] + k;
+      m->hv[h] = undo->hv[3 * s + k];
+      m->twin[h] = undo->twin[3 * s + k];
+      m->eflag[h] = undo->eflag[3 * s + k];
+    }
+  /* the outer neighbours point back at the restored half-edges */
+  for (int s = 0; s < 2; s++)
+    for (int k = 0; k < 3; k++) {
+      int32_t h = 3 * undo->slot[s] + k, o = m->twin[h];
+      if (o >= 0) {
+        m->twin[o] = h;
+        m->eflag[o] = m->eflag[h];
+      }
+    }
+  for (int k = 0; k < 4; k++)
+    m->v[undo->vert[k]].edge = undo->vedge[k];
+  m->ntouched = undo->ntouched;
+}

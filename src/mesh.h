@@ -122,6 +122,24 @@ TT_HIDDEN bool tt__mesh_flippable(const tt__mesh *m, int32_t e);
  * Returns -1 (mesh unchanged) when out of memory. */
 TT_HIDDEN int32_t tt__mesh_flip(tt__mesh *m, int32_t e);
 
+/* Undoable flips (optimize.c's look-ahead): tt__mesh_flip_undoable flips
+ * the flippable edge of e like tt__mesh_flip and saves what it overwrote;
+ * tt__mesh_flip_revert restores the two slots word for word (half-edge
+ * indices included), the vertex edges and the touched log. Reverts must
+ * come in the reverse order of the flips, with no other write between. */
+typedef struct tt__mesh_flip_undo {
+  int32_t slot[2];
+  int32_t hv[6], twin[6];
+  uint8_t eflag[6];
+  int32_t vert[4], vedge[4];
+  size_t ntouched;
+} tt__mesh_flip_undo;
+
+TT_HIDDEN int32_t tt__mesh_flip_undoable(tt__mesh *m, int32_t e,
+                                         tt__mesh_flip_undo *out_undo);
+TT_HIDDEN void tt__mesh_flip_revert(tt__mesh *m,
+                                    const tt__mesh_flip_undo *undo);
+
 /* Removes live triangle t: its neighbours' edges across it become
  * boundary edges (a hole or a new outline). Vertex edges that pointed into
  * t are left stale: call tt__mesh_fix_vertex_edges() after a batch of

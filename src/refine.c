@@ -28,6 +28,7 @@
 #include "domain.h"
 #include "heap.h"
 #include "mesh.h"
+#include "optimize.h" /* [optimize.c hook] */
 #include "parallel.h"
 #include "predicates.h"
 #include "raster_scan.h"
@@ -535,8 +536,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       ok = tt__mesh_split_edge(&r.m, on, v, opposite);
       nopp = 4;
     }
-    if (!ok || tt__swap_repair(&r.m, r.crit, &r.env, opposite, nopp,
-                               &r.stack) < 0 ||
+    /* [optimize.c hook] Delaunay's incircle repair, or the local swap of
+     * any other criterion over the new vertex's star */
+    if (!ok || tt__optimize_insert(&r.m, r.crit, &r.env, v, opposite, nopp,
+                                   &r.stack) < 0 ||
         !drain(&r)) {
       status = oom(&r);
       goto done;
@@ -548,6 +551,19 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
                          "vertices", r.m.nv);
       goto done;
     }
+  }
+  /* [optimize.c hook] the final whole-mesh pass (opt->optimize). Flips
+   * of unconstrained edges keep every triangle in the domain. A move that
+   * would give one of its triangles an error above the larger of max_error
+   * and the worst error left is refused, so the bound the loop reached
+   * still holds. */
+  if (!tt__optimize_final(&r.m, r.crit, &r.env, opt->optimize,
+                          fmax(r.max_error, tt__heap_size(&r.heap)
+                                                ? tt__heap_top(&r.heap).key
+                                                : 0.0),
+                          NULL)) {
+    status = oom(&r);
+    goto done;
   }
   /* The insertion state is no longer needed: free it before the TIN's
    * arrays are made, to keep the peak low. */

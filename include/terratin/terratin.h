@@ -172,6 +172,25 @@ const char *tt_criterion_name(tt_criterion criterion);
 tt_status tt_criterion_parse(tt_context *ctx, const char *name,
                              tt_criterion *out_criterion);
 
+/* Swap optimisation of the criterion over the whole mesh once the
+ * insertions are done (SPEC section 3.2). Whatever the choice, every
+ * criterion but Delaunay restores itself around each inserted vertex by
+ * local swaps, and Delaunay by its exact incircle flips. */
+typedef enum tt_optimize {
+  TT_OPTIMIZE_AUTO = 0,    /* local for every criterion but Delaunay (which
+                              is already optimal), none for Delaunay */
+  TT_OPTIMIZE_NONE,
+  TT_OPTIMIZE_LOCAL,       /* maximal-reduction local swap */
+  TT_OPTIMIZE_LOOKAHEAD    /* local swap, then two-swap look-ahead moves
+                              (Dyn, Hormann, Kim, Levin) */
+} tt_optimize;
+
+/* "auto", "none", "local", "lookahead"; NULL for an unknown value. */
+const char *tt_optimize_name(tt_optimize optimize);
+/* Parses one of those names; TT_ERR_ARG for an unknown one. */
+tt_status tt_optimize_parse(tt_context *ctx, const char *name,
+                            tt_optimize *out_optimize);
+
 typedef struct tt_refine_options {
   /* Stop when the worst remaining sample error is <= max_error (z units).
    * Negative: no error limit. */
@@ -183,6 +202,10 @@ typedef struct tt_refine_options {
   /* Stop at floor(percent/100 * valid samples) vertices; 0: none. */
   double percent;
   tt_criterion criterion;
+  /* The final whole-mesh pass. Its swaps never raise a triangle's error
+   * above the larger of max_error and the worst error left when the
+   * insertions stopped, so the error bound of the run still holds. */
+  tt_optimize optimize;
   /* Threads for the raster scans: 0 = automatic (all online CPUs for grids
    * of a million samples or more, else 1), 1 = the caller's only, N = N.
    * The result does not depend on it. */
