@@ -216,6 +216,7 @@ static const char help_top[] =
 static const char help_simplify[] =
     "Usage: terratin simplify [-b BAND] [-max_error E] [-max_points N]\n"
     "           [-max_triangles N] [-percent P] [-criterion NAME]\n"
+    "           [-optimize local|lookahead|none]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
     "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
@@ -260,6 +261,9 @@ static const char help_simplify[] =
     "                    PROJ, triangles unchanged; default: the DEM's CRS).\n"
     "                    A geographic output gets geodesic triangle areas\n"
     "  -criterion NAME   triangulation criterion: delaunay (default)\n"
+    "  -optimize MODE    final swap pass over the whole mesh: local,\n"
+    "                    lookahead or none (default: local, none for\n"
+    "                    delaunay); it never lifts an error past the bound\n"
     "  -of FORMAT        OGR vector driver that can create datasets: GPKG,\n"
     "                    \"ESRI Shapefile\", ... (default: guessed from\n"
     "                    OUTPUT's extension, else GPKG)\n"
@@ -421,7 +425,7 @@ static int parse_size(const char *w, size_t *out)
  * error messages and the tests agree. */
 enum opt_id {
   O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
-  O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_JSON, O_LAYER, O_SIZE,
+  O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_OPTIMIZE, O_JSON, O_LAYER, O_SIZE,
   O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE, O_ROUGHNESS,
   O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT,
   O_WORK_SRS, O_T_SRS
@@ -451,6 +455,7 @@ static const struct opt_def {
     {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E},
     {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E},
     {"-criterion", O_CRITERION, 1, FOR_S},
+    {"-optimize", O_OPTIMIZE, 1, FOR_S},
     {"-json", O_JSON, 0, FOR_S | FOR_E},
     {"-layer", O_LAYER, 1, FOR_E},
     {"-size", O_SIZE, 1, FOR_G},
@@ -776,6 +781,11 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.criterion = c;
       break;
     }
+    case O_OPTIMIZE:
+      if (tt_optimize_parse(ctx, v, &o->s.optimize) != TT_OK)
+        USAGE("%s: unknown -optimize '%s'; known: local, lookahead, none, "
+              "auto", cmdname, v);
+      break;
     case O_LAYER:
       if (!*v)
         USAGE("%s: -layer needs a layer name", cmdname);
@@ -1695,6 +1705,7 @@ static void print_simplify_json(app_run *r, const simplify_report *p)
   json_str(&j, "output", r->s->output);
   json_str(&j, "format", p->driver);
   json_str(&j, "criterion", tt_criterion_name(p->sum.criterion));
+  json_str(&j, "optimize", tt_optimize_name(r->s->optimize));
   json_size(&j, "width", p->info->width);
   json_size(&j, "height", p->info->height);
   json_size(&j, "cells", p->cells);
@@ -1905,6 +1916,7 @@ static tt_status run_simplify(app_run *r)
   ro.max_triangles = s->max_triangles;
   ro.percent = s->percent;
   ro.criterion = s->criterion;
+  ro.optimize = s->optimize;
   if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
       !(s->percent > 0)) {
     ro.max_error = 0.005 * (rep.zmax - rep.zmin);
@@ -1959,6 +1971,7 @@ static tt_status run_simplify(app_run *r)
       {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
       {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
       {"criterion", TT_FIELD_STRING, tt_criterion_name(ro.criterion), 0, 0},
+      {"optimize", TT_FIELD_STRING, tt_optimize_name(ro.optimize), 0, 0},
       {"max_error", TT_FIELD_REAL, NULL, 0, ro.max_error},
       {"max_points", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_points, 0},
       {"max_tris", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_triangles, 0},
