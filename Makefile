@@ -42,7 +42,7 @@ build-san: deps $(BUILD_SAN)/CMakeCache.txt
 
 demo: build
 	@mkdir -p $(dir $(DEMO_OUT))
-	$(BUILD)/terratin simplify -overwrite -max_error 5 $(DEMO_IN) $(DEMO_OUT)
+	$(BUILD)/terratin simplify -overwrite -max_error 20 $(DEMO_IN) $(DEMO_OUT)
 	@echo "demo: wrote $(DEMO_OUT) (layers triangles, vertices, run_parameters); open it in QGIS or run: ogrinfo -so $(DEMO_OUT) triangles"
 
 test: build
