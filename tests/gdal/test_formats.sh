@@ -2,8 +2,8 @@
 # test_formats.sh -- the DEM formats the issue names, made on the spot with
 # GDAL from the bundled Jacksboro DEM (real heights, real georeferencing):
 # SRTM HGT and DTED tiles (the DEM fills part of each one-degree tile, the
-# rest is nodata), a VRT, and an ASCII grid inside a zip read through
-# /vsizip/. Each is simplified, then measured by `terratin eval`: every
+# rest is nodata), a VRT, an ASCII grid inside a zip read through /vsizip/,
+# and validity from an alpha band and from an external .msk mask. Each is simplified, then measured by `terratin eval`: every
 # valid sample covered once, the bound met, the valid count right.
 set -u
 T=${TT_TERRATIN:?} D=${TT_TESTDATA:?}
@@ -29,7 +29,18 @@ gdal_translate -q -of DTED tile30.tif n36.dt0
 gdal_translate -q -of VRT "$src" dem.vrt
 gdal_translate -q -of AAIGrid "$src" dem.asc && zip -q dem.zip dem.asc dem.prj 2>/dev/null
 
-for spec in "N36W085.hgt:$valid" "n36.dt0:" "dem.vrt:$valid" "/vsizip/dem.zip/dem.asc:$valid"; do
+# validity from GDAL's mask band: an alpha band (the area the warp adds is
+# transparent, its heights 0, no nodata value), and an external .msk file
+gdalwarp -q -te -84.6 36.3 -83.9 36.9 -tr 0.000833333333333 0.000833333333333 \
+  -r near -dstalpha -ot UInt16 "$src" alpha.tif
+gdalwarp -q -te -84.6 36.3 -83.9 36.9 -tr 0.000833333333333 0.000833333333333 \
+  -r near -dstnodata -32768 -ot Int16 "$src" nd.tif
+gdal_translate -q -b 1 -mask 1 -a_nodata none \
+  --config GDAL_TIFF_INTERNAL_MASK NO nd.tif msk.tif
+check "the .msk file was made" [ -f msk.tif.msk ]
+
+for spec in "N36W085.hgt:$valid" "n36.dt0:" "dem.vrt:$valid" \
+            "/vsizip/dem.zip/dem.asc:$valid" "alpha.tif:$valid" "msk.tif:$valid"; do
   f=${spec%%:*} want=${spec##*:}
   case $f in /vsizip/*) [ -f dem.zip ] || { echo "SKIP: no zip command"; continue; } ;; esac
   out=$(echo "$f" | tr '/.' '__').gpkg
