@@ -39,6 +39,7 @@
  * Workload: five coordinate transformations and the creation of one PROJ
  * pipeline per grid read.
  */
+#include "georef.h"
 #include "internal.h"
 
 #include <math.h>
@@ -59,15 +60,6 @@
  * this relative tolerance (UTM's own scale varies by 0.1% across a zone). */
 #define TT_METRIC_TOLERANCE 0.01
 
-/* Declared again in io_gdal_read.c, the only caller (the glue has no
- * private header of its own yet); keep the declarations in step. */
-TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
-                                                OGRSpatialReferenceH srs,
-                                                const double gt[6],
-                                                size_t nx, size_t ny,
-                                                double out_frame[4],
-                                                char *out_name,
-                                                size_t name_size);
 TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
                                             OGRSpatialReferenceH srs,
                                             const char *work_srs,

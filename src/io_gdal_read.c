@@ -14,6 +14,7 @@
  * read unless the user set GDAL_CACHEMAX (the cache limit is process-wide
  * state of GDAL's: it is restored afterwards).
  */
+#include "georef.h"
 #include "internal.h"
 #include "terratin/terratin_gdal.h"
 
@@ -29,14 +30,6 @@
 #include <strings.h>
 #include <unistd.h>
 
-/* Defined in georef_proj.c; keep the two declarations in step. */
-TT_HIDDEN tt_status tt__georef_geographic_frame(tt_context *ctx,
-                                                OGRSpatialReferenceH srs,
-                                                const double gt[6],
-                                                size_t nx, size_t ny,
-                                                double out_frame[4],
-                                                char *out_name,
-                                                size_t name_size);
 TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
                                             OGRSpatialReferenceH srs,
                                             const char *work_srs,
