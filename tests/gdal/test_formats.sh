@@ -38,9 +38,18 @@ gdalwarp -q -te -84.6 36.3 -83.9 36.9 -tr 0.000833333333333 0.000833333333333 \
 gdal_translate -q -b 1 -mask 1 -a_nodata none \
   --config GDAL_TIFF_INTERNAL_MASK NO nd.tif msk.tif
 check "the .msk file was made" [ -f msk.tif.msk ]
+# a real DEM with NaN voids: two lakes burnt into a Float32 copy
+gdal_translate -q -ot Float32 -a_nodata nan "$src" voids.tif
+cat >lakes.geojson <<'JSON'
+{"type":"FeatureCollection","features":[
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[-84.30,36.60],[-84.25,36.62],[-84.22,36.58],[-84.27,36.55],[-84.30,36.60]]]}},
+{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[-84.15,36.50],[-84.12,36.51],[-84.13,36.48],[-84.15,36.50]]]}}]}
+JSON
+gdal_rasterize -q -burn nan lakes.geojson voids.tif
 
 for spec in "N36W085.hgt:$valid" "n36.dt0:" "dem.vrt:$valid" \
-            "/vsizip/dem.zip/dem.asc:$valid" "alpha.tif:$valid" "msk.tif:$valid"; do
+            "/vsizip/dem.zip/dem.asc:$valid" "alpha.tif:$valid" "msk.tif:$valid" \
+            "voids.tif:"; do
   f=${spec%%:*} want=${spec##*:}
   case $f in /vsizip/*) [ -f dem.zip ] || { echo "SKIP: no zip command"; continue; } ;; esac
   out=$(echo "$f" | tr '/.' '__').gpkg
@@ -56,6 +65,17 @@ e, s = json.load(open("e.json")), json.load(open("s.json"))
 assert e["overlapped"] == 0 and e["uncovered"] == s["lone_samples"], (e, s)
 assert e["valid_samples"] == s["valid_samples"], (e, s)'
 done
+# the lakes stay holes: no triangle holds a point inside the big one, and
+# one does hold a point on land
+n_in_lake() {
+  ogrinfo -q -dialect SQLite -sql "SELECT COUNT(*) AS n FROM triangles WHERE ST_Intersects(geom, MakePoint($1, $2, 4326))" \
+    voids_tif.gpkg 2>/dev/null | sed -n 's/.*n (Integer) = //p'
+}
+check "NaN voids: the lake is a hole" [ "$(n_in_lake -84.26 36.59)" = 0 ]
+check "NaN voids: the land is covered" [ "$(n_in_lake -84.20 36.65)" = 1 ]
+check "NaN voids: fewer valid samples than the DEM" python3 -c '
+import json; d = json.load(open("s.json")); assert d["valid_samples"] < 138632, d'
+
 # the HGT tile holds exactly the Jacksboro samples; its working frame is
 # fitted at the tile's centre, not the DEM's, and its outline is a nodata
 # outline, so the TINs differ a little: vertex counts within 1 %

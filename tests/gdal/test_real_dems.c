@@ -198,6 +198,9 @@ static void test_shared_dems(const char *shared)
       {"Rsagacmd/srtm.tif", 20},
       {"spatial.tools_tahoe_lidar/tahoe_lidar_bareearth.tif", 0.25},
       {"tin-terrain/valid_raster.tif", 0.1},
+      /* non-square pixels (89.98 x 90.02), no CRS */
+      {"whitebox-tools_testdata/DEM.tif", 5},
+      {"whitebox-tools_testdata/DEM.rst", 5},
   };
   for (size_t i = 0; i < sizeof dems / sizeof dems[0]; i++) {
     char path[4096];
