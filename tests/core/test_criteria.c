@@ -250,38 +250,6 @@ static void score(const tt__mesh *m, const tt_grid *g, const double a[4],
 /* ---------------------------------------------------------------------
  * Meshes.
  * ------------------------------------------------------------------- */
-static int32_t find_half(const tt__mesh *m, int32_t u, int32_t w)
-{
-  for (size_t e = 0; e < 3 * m->nslots; e++)
-    if (tt__mesh_live(m, (int32_t)(e / 3)) && m->hv[e] == u &&
-        m->hv[tt__next((int32_t)e)] == w)
-      return (int32_t)e;
-  return -1;
-}
-
-static int32_t locate(const tt__mesh *m, int64_t c, int64_t r, int32_t *on)
-{
-  for (size_t t = 0; t < m->nslots; t++) {
-    if (!tt__mesh_live(m, (int32_t)t))
-      continue;
-    int zero = -1, neg = 0;
-    for (int k = 0; k < 3; k++) {
-      int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
-      int o = m->metric.det_sign *
-              tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, c, r);
-      if (o < 0)
-        neg = 1;
-      else if (o == 0)
-        zero = zero == -1 ? (int)(3 * t) + k : -2;
-    }
-    if (neg)
-      continue;
-    *on = zero;
-    return (int32_t)t;
-  }
-  return -1;
-}
-
 static void add_tri_ccw(tt__mesh *m, int32_t a, int32_t b, int32_t c)
 {
   if (tt__mesh_orient(m, a, b, c) > 0)
@@ -333,8 +301,8 @@ static bool random_mesh(tt__mesh *m, const tt_grid *g, uint64_t *rng,
     if (used[(size_t)r * (W + 1) + c])
       continue;
     int32_t on, opp[4];
-    int32_t t = locate(m, c, r, &on);
-    if (t < 0 || on == -2)
+    int32_t t = tt__mesh_locate(m, -1, c, r, &on);
+    if (t < 0 || on <= -2)
       continue;
     used[(size_t)r * (W + 1) + c] = 1;
     int32_t v = tt__mesh_add_vertex(m, c, r, gz(g, c, r));
@@ -448,7 +416,7 @@ static void check_values(tt__mesh *m, const tt_grid *g, uint64_t seed)
   for (size_t ci = 0; ci < NALL; ci++) {
     const tt__criterion_vt *vt = tt__criterion_get(ALL[ci]);
     for (size_t i = 0; i < ne; i++) {
-      int32_t e = find_half(m, u[i], w[i]);
+      int32_t e = tt__mesh_find_edge(m, u[i], w[i]);
       double val = vt->swap_value(&env, e);
       CHECK(isfinite(val));
       if (!tt__mesh_flippable(m, e)) {
@@ -514,7 +482,7 @@ static void all_values(const tt__mesh *m, const tt__criterion_vt *vt,
                        const int32_t *w, size_t n, double *out)
 {
   for (size_t i = 0; i < n; i++) {
-    int32_t e = find_half(m, u[i], w[i]);
+    int32_t e = tt__mesh_find_edge(m, u[i], w[i]);
     out[i] = e < 0 ? NAN : vt->swap_value(env, e);
   }
 }
@@ -531,7 +499,7 @@ static void check_affected(tt__mesh *m, const tt_grid *g, uint64_t seed,
     const tt__criterion_vt *vt = tt__criterion_get(ALL[ci]);
     for (int trial = 0; trial < 12; trial++) {
       size_t i = (size_t)(tt_test_rand(rng) % ne);
-      int32_t e = find_half(m, u[i], w[i]);
+      int32_t e = tt__mesh_find_edge(m, u[i], w[i]);
       if (!tt__mesh_flippable(m, e))
         continue;
       all_values(m, vt, &env, u, w, ne, vb);
@@ -632,7 +600,7 @@ static int32_t quad_mesh(tt__mesh *m, tt_grid *g, const qpt p[4])
   tt__mesh_add_triangle(m, v[0], v[1], v[2]);
   tt__mesh_add_triangle(m, v[1], v[0], v[3]);
   tt__mesh_link_all(m);
-  return find_half(m, v[0], v[1]);
+  return tt__mesh_find_edge(m, v[0], v[1]);
 }
 
 static double value_of(tt__mesh *m, tt_grid *g, tt_criterion id, int32_t e)

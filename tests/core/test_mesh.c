@@ -1,7 +1,9 @@
 /* test_mesh.c -- mesh invariants after random sequences of splits and
  * flips, in several ground frames (square, non-square, sheared, mirrored
  * north-up), with tt__mesh_validate() after every operation; a Delaunay
- * repair leaves every interior edge legal under the exact incircle test. */
+ * repair leaves every interior edge legal under the exact incircle test.
+ * Points are placed with tt__mesh_locate (its walk, and its scan fallback
+ * on the non-Delaunay meshes that random flips make). */
 #include "mesh.h"
 #include "predicates.h"
 #include "swap.h"
@@ -15,31 +17,6 @@ static bool validate(const tt__mesh *m, uint64_t seed, int step)
     return false;
   }
   return true;
-}
-
-/* Locates the triangle containing (c, r) by a linear scan: returns a slot
- * and sets *on to the half-edge it lies on or -1; -2 if at a vertex. */
-static int32_t locate(const tt__mesh *m, int64_t c, int64_t r, int32_t *on)
-{
-  for (size_t t = 0; t < m->nslots; t++) {
-    if (!tt__mesh_live(m, (int32_t)t))
-      continue;
-    int zero = -1, neg = 0;
-    for (int k = 0; k < 3; k++) {
-      int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
-      int o = m->metric.det_sign *
-              tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, c, r);
-      if (o < 0)
-        neg = 1;
-      else if (o == 0)
-        zero = zero == -1 ? (int)(3 * t) + k : -2;
-    }
-    if (neg)
-      continue;
-    *on = zero;
-    return (int32_t)t;
-  }
-  return -1;
 }
 
 static void run(const double frame[4], uint64_t seed)
@@ -75,9 +52,9 @@ static void run(const double frame[4], uint64_t seed)
       if (used[c][r])
         continue;
       int32_t on;
-      int32_t t = locate(&m, c, r, &on);
-      CHECK(t >= 0 && on != -2);
-      if (t < 0 || on == -2)
+      int32_t t = tt__mesh_locate(&m, -1, c, r, &on);
+      CHECK(t >= 0 && on > -2);
+      if (t < 0 || on <= -2)
         goto out;
       used[c][r] = 1;
       int32_t v = tt__mesh_add_vertex(&m, c, r, 0.0f);
