@@ -462,6 +462,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   tt__heap_init(&r.heap);
   r.env.mesh = &r.m;
   r.env.grid = grid;
+  r.env.cache = r.crit->cache_new ? r.crit->cache_new(&r.env) : NULL;
 
   int nthreads = opt->threads;
   if (nthreads == 0 && grid->nx * grid->ny < ((size_t)1 << 20))
@@ -588,6 +589,8 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
 done:
+  if (r.env.cache)
+    r.crit->cache_free(r.env.cache);
   tt__pool_destroy(r.pool);
   free(r.jobs);
   tt__heap_free(&r.heap);

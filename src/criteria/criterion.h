@@ -22,6 +22,8 @@ typedef struct tt__crit_env {
                             ground frame is grid->frame: a pixel step
                             (dc, dr) is (a0 dc + a1 dr, a2 dc + a3 dr) on
                             the ground, and heights are in ground units */
+  void *cache;           /* the criterion's own per-run state (cache_new),
+                            or NULL: every criterion works without it */
 } tt__crit_env;
 
 typedef struct tt__criterion_vt {
@@ -38,6 +40,13 @@ typedef struct tt__criterion_vt {
    * an edge only; Gaussian curvature needs the edges around the quad's
    * vertices). */
   int (*affected)(const tt__crit_env *env, int32_t h, int32_t *out, int max);
+  /* Optional per-run state (a cache of values that only depend on the
+   * mesh around a vertex, say): cache_new returns it for env->cache, NULL
+   * when out of memory (the run then goes on without); cache_free frees
+   * it. The state must never change a swap value, only its cost. Both
+   * NULL: no state. */
+  void *(*cache_new)(const tt__crit_env *env);
+  void (*cache_free)(void *cache);
 } tt__criterion_vt;
 
 /* The criterion of an id, or NULL for an unknown id. */

@@ -544,4 +544,4 @@ static int gaussian_affected(const tt__crit_env *env, int32_t h,
 
 const tt__criterion_vt tt__criterion_gaussian = {
     TT_CRITERION_GAUSSIAN_CURVATURE, "gaussian_curvature", true,
-    gaussian_swap_value, gaussian_affected};
+    gaussian_swap_value, gaussian_affected, NULL, NULL};

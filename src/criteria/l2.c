@@ -93,4 +93,4 @@ static double l2_swap_value(const tt__crit_env *env, int32_t e)
 }
 
 const tt__criterion_vt tt__criterion_l2 = {
-    TT_CRITERION_L2, "l2", true, l2_swap_value, NULL};
+    TT_CRITERION_L2, "l2", true, l2_swap_value, NULL, NULL, NULL};

@@ -294,7 +294,7 @@ static bool random_mesh(tt__mesh *m, const tt_grid *g, uint64_t *rng,
   used[0] = used[W] = used[(size_t)H * (W + 1)] =
       used[(size_t)H * (W + 1) + W] = 1;
   tt__edge_stack stack = {0};
-  tt__crit_env env = {m, g};
+  tt__crit_env env = {m, g, NULL};
   for (int i = 0; i < npts * 4 && (int)m->nv < npts + 4; i++) {
     int c = (int)(tt_test_rand(rng) % (uint64_t)(W + 1));
     int r = (int)(tt_test_rand(rng) % (uint64_t)(H + 1));
@@ -407,7 +407,7 @@ static void quad_angles(const tt__mesh *m, const double a[4], int32_t e,
 static void check_values(tt__mesh *m, const tt_grid *g, uint64_t seed)
 {
   const double *a = g->frame;
-  tt__crit_env env = {m, g};
+  tt__crit_env env = {m, g, NULL};
   size_t cap = 3 * m->nslots;
   int32_t *u = malloc(cap * sizeof *u), *w = malloc(cap * sizeof *w);
   size_t ne = edge_pairs(m, u, w);
@@ -490,7 +490,7 @@ static void all_values(const tt__mesh *m, const tt__criterion_vt *vt,
 static void check_affected(tt__mesh *m, const tt_grid *g, uint64_t seed,
                            uint64_t *rng)
 {
-  tt__crit_env env = {m, g};
+  tt__crit_env env = {m, g, NULL};
   size_t cap = 3 * m->nslots;
   int32_t *u = malloc(cap * sizeof *u), *w = malloc(cap * sizeof *w);
   double *vb = malloc(cap * sizeof *vb), *va = malloc(cap * sizeof *va);
@@ -605,7 +605,7 @@ static int32_t quad_mesh(tt__mesh *m, tt_grid *g, const qpt p[4])
 
 static double value_of(tt__mesh *m, tt_grid *g, tt_criterion id, int32_t e)
 {
-  tt__crit_env env = {m, g};
+  tt__crit_env env = {m, g, NULL};
   return tt__criterion_get(id)->swap_value(&env, e);
 }
 
@@ -714,7 +714,7 @@ static void star_case(const char *what, const double *zn, int n,
   tt__mesh_link_all(&m);
   char why[256];
   CHECK(tt__mesh_validate(&m, why, sizeof why));
-  tt__crit_env env = {&m, NULL};
+  tt__crit_env env = {&m, NULL, NULL};
   int cls, ocls;
   double k = tt__gaussian_vertex(&env, c, &cls);
   double ko = oracle_gauss(&m, id, c, &ocls);
@@ -874,7 +874,7 @@ static void gaussian_paraboloid(tt_context *ctx)
       add_tri_ccw(&m, v00, v11, v01);
     }
   tt__mesh_link_all(&m);
-  tt__crit_env env = {&m, g};
+  tt__crit_env env = {&m, g, NULL};
   tt__edge_stack stack = {0};
   tt__swap_all(&m, &tt__criterion_delaunay, &env, &stack);
   tt__edge_stack_free(&stack);
@@ -946,7 +946,7 @@ static void timings(tt_context *ctx)
                                tt_test_uniform(&rng));
   tt__mesh m;
   if (random_mesh(&m, g, &rng, 600)) {
-    tt__crit_env env = {&m, g};
+    tt__crit_env env = {&m, g, NULL};
     printf("swap value cost on a %zu-vertex mesh (ns per call):\n", m.nv);
     for (int ci = 0; ci < 10; ci++) {
       const tt__criterion_vt *vt = tt__criterion_get((tt_criterion)ci);

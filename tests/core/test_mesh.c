@@ -70,7 +70,7 @@ static void run(const double frame[4], uint64_t seed)
         goto out;
       if (op == 1) {
         /* Delaunay repair around v */
-        tt__crit_env env = {&m, NULL};
+        tt__crit_env env = {&m, NULL, NULL};
         CHECK(tt__swap_repair(&m, &tt__criterion_delaunay, &env, opp, nopp,
                               &stack) >= 0);
         if (!validate(&m, seed, step))
@@ -91,7 +91,7 @@ static void run(const double frame[4], uint64_t seed)
   }
   /* make it Delaunay and check every interior edge */
   {
-    tt__crit_env env = {&m, NULL};
+    tt__crit_env env = {&m, NULL, NULL};
     CHECK(tt__swap_all(&m, &tt__criterion_delaunay, &env, &stack) >= 0);
     validate(&m, seed, 9999);
     for (size_t e = 0; e < 3 * m.nslots; e++) {

@@ -73,7 +73,7 @@ static double area_swap_value(const tt__crit_env *env, int32_t e)
 }
 
 static const tt__criterion_vt area_crit = {
-    (tt_criterion)1000, "test_area", true, area_swap_value, NULL};
+    (tt_criterion)1000, "test_area", true, area_swap_value, NULL, NULL, NULL};
 
 static double total_area(const tt__mesh *m)
 {
@@ -100,7 +100,7 @@ static bool insert_point(tt__mesh *m, const tt_grid *g, int32_t c, int32_t r,
 {
   const float *z = tt_grid_heights_const(g);
   int32_t v = tt__mesh_add_vertex(m, c, r, z[(size_t)r * tt_grid_width(g) + c]);
-  tt__crit_env env = {m, g};
+  tt__crit_env env = {m, g, NULL};
   for (size_t t = 0; t < m->nslots; t++) {
     if (!tt__mesh_live(m, (int32_t)t))
       continue;
@@ -219,7 +219,7 @@ static tt_grid *bumpy(size_t nx, size_t ny, uint64_t seed)
 static double max_swap_value(const tt__mesh *m, const tt__criterion_vt *crit,
                              const tt_grid *g)
 {
-  tt__crit_env env = {m, g};
+  tt__crit_env env = {m, g, NULL};
   double best = -INFINITY;
   for (size_t e = 0; e < 3 * m->nslots; e++)
     if (tt__mesh_live(m, (int32_t)(e / 3)) && m->twin[e] > (int32_t)e &&
@@ -295,7 +295,7 @@ static void test_local_and_lookahead(uint64_t seed)
     CHECK(build(&a, g, pts, n, NULL));
     CHECK(build(&b, g, pts, n, NULL));
     double q0 = total_area(&a);
-    tt__crit_env ea = {&a, g}, eb = {&b, g};
+    tt__crit_env ea = {&a, g, NULL}, eb = {&b, g, NULL};
     tt__opt_params pa = {&area_crit, &ea, false, NULL, NULL};
     tt__opt_params pb = {&area_crit, &eb, true, NULL, NULL};
     tt__opt_stats sa, sb;
@@ -414,7 +414,7 @@ static double exhaustive(const tt__mesh *start, const tt__criterion_vt *crit,
   for (size_t i = 0; i < n; i++) {
     tt__mesh m;
     mesh_of_key(start, &keys[i], &m);
-    tt__crit_env env = {&m, g};
+    tt__crit_env env = {&m, g, NULL};
     for (size_t e = 0; e < 3 * m.nslots; e++) {
       if (m.twin[e] < (int32_t)e || !tt__mesh_flippable(&m, (int32_t)e))
         continue;
@@ -466,7 +466,7 @@ static void exhaustive_case(const tt__criterion_vt *crit, const tt_grid *g,
   tt__mesh start, opt;
   CHECK(build_box(&start, g, box, pts, nin, NULL));
   CHECK(build_box(&opt, g, box, pts, nin, NULL));
-  tt__crit_env env = {&opt, g};
+  tt__crit_env env = {&opt, g, NULL};
   tt__opt_params p = {crit, &env, false, NULL, NULL};
   tt__opt_stats st;
   CHECK(tt__optimize_run(&opt, &p, NULL, 0, &st));
@@ -554,7 +554,7 @@ static void test_l2_from_delaunay(uint64_t seed)
       tt__mesh m;
       CHECK(build(&m, g, pts, 80, NULL));
       double d = total_sq(&m, g);
-      tt__crit_env env = {&m, g};
+      tt__crit_env env = {&m, g, NULL};
       tt__opt_params p = {l2, &env, look == 1, NULL, NULL};
       CHECK(tt__optimize_run(&m, &p, NULL, 0, NULL));
       check_valid(&m, "l2");
@@ -698,7 +698,7 @@ static void test_final_veto(uint64_t seed)
     tt__mesh m;
     CHECK(build(&m, g, pts, 90, NULL));
     double before = worst_error(&m, g);
-    tt__crit_env env = {&m, g};
+    tt__crit_env env = {&m, g, NULL};
     tt__opt_stats st;
     double bound = 0.8 * before; /* already passed: nothing may rise */
     CHECK(tt__optimize_final(&m, &area_crit, &env, (tt_optimize)mode, bound,
