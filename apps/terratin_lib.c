@@ -216,6 +216,7 @@ static const char help_top[] =
 static const char help_simplify[] =
     "Usage: terratin simplify [-b BAND] [-max_error E] [-max_points N]\n"
     "           [-max_triangles N] [-percent P] [-criterion NAME]\n"
+    "           [-repair flip|local|lookahead|delaunay]\n"
     "           [-optimize local|lookahead|none]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
     "           [-work_srs SRS] [-t_srs SRS]\n"
@@ -264,9 +265,17 @@ static const char help_simplify[] =
     "                    delaunay (default), minmax_angle, minmax_angle_lex,\n"
     "                    min_area, mean_curvature, gaussian_curvature, abn,\n"
     "                    abn_sum, abn_sumsq, l2\n"
+    "  -repair MODE      how the criterion is restored around each new\n"
+    "                    vertex: flip (Lawson flips outward from it; the\n"
+    "                    default, min_area also re-triangulates the hole\n"
+    "                    around it exactly), local, lookahead (swaps over\n"
+    "                    the region around it), delaunay (Delaunay while\n"
+    "                    inserting, the criterion in the final pass only;\n"
+    "                    the default for l2)\n"
     "  -optimize MODE    final swap pass over the whole mesh: local,\n"
-    "                    lookahead or none (default: local, none for\n"
-    "                    delaunay); it never lifts an error past the bound\n"
+    "                    lookahead or none (default: local after -repair\n"
+    "                    delaunay with another criterion, else none); it\n"
+    "                    never lifts an error past the bound\n"
     "  -of FORMAT        OGR vector driver that can create datasets: GPKG,\n"
     "                    \"ESRI Shapefile\", ... (default: guessed from\n"
     "                    OUTPUT's extension, else GPKG)\n"
@@ -428,7 +437,7 @@ static int parse_size(const char *w, size_t *out)
  * error messages and the tests agree. */
 enum opt_id {
   O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
-  O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_OPTIMIZE, O_JSON, O_LAYER, O_SIZE,
+  O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_OPTIMIZE, O_REPAIR, O_JSON, O_LAYER, O_SIZE,
   O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE, O_ROUGHNESS,
   O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT,
   O_WORK_SRS, O_T_SRS
@@ -459,6 +468,7 @@ static const struct opt_def {
     {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E},
     {"-criterion", O_CRITERION, 1, FOR_S},
     {"-optimize", O_OPTIMIZE, 1, FOR_S},
+    {"-repair", O_REPAIR, 1, FOR_S},
     {"-json", O_JSON, 0, FOR_S | FOR_E},
     {"-layer", O_LAYER, 1, FOR_E},
     {"-size", O_SIZE, 1, FOR_G},
@@ -788,6 +798,11 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (tt_optimize_parse(ctx, v, &o->s.optimize) != TT_OK)
         USAGE("%s: unknown -optimize '%s'; known: local, lookahead, none, "
               "auto", cmdname, v);
+      break;
+    case O_REPAIR:
+      if (tt_repair_parse(ctx, v, &o->s.repair) != TT_OK)
+        USAGE("%s: unknown -repair '%s'; known: flip, local, lookahead, "
+              "delaunay, auto", cmdname, v);
       break;
     case O_LAYER:
       if (!*v)
@@ -1708,7 +1723,11 @@ static void print_simplify_json(app_run *r, const simplify_report *p)
   json_str(&j, "output", r->s->output);
   json_str(&j, "format", p->driver);
   json_str(&j, "criterion", tt_criterion_name(p->sum.criterion));
-  json_str(&j, "optimize", tt_optimize_name(r->s->optimize));
+  tt_repair rep = tt_repair_resolve(r->s->repair, p->sum.criterion);
+  json_str(&j, "repair", tt_repair_name(rep));
+  json_str(&j, "optimize",
+           tt_optimize_name(tt_optimize_resolve(r->s->optimize,
+                                                p->sum.criterion, rep)));
   json_size(&j, "width", p->info->width);
   json_size(&j, "height", p->info->height);
   json_size(&j, "cells", p->cells);
@@ -1920,6 +1939,7 @@ static tt_status run_simplify(app_run *r)
   ro.percent = s->percent;
   ro.criterion = s->criterion;
   ro.optimize = s->optimize;
+  ro.repair = s->repair;
   if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
       !(s->percent > 0)) {
     ro.max_error = 0.005 * (rep.zmax - rep.zmin);
@@ -1974,7 +1994,11 @@ static tt_status run_simplify(app_run *r)
       {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
       {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
       {"criterion", TT_FIELD_STRING, tt_criterion_name(ro.criterion), 0, 0},
-      {"optimize", TT_FIELD_STRING, tt_optimize_name(ro.optimize), 0, 0},
+      {"repair", TT_FIELD_STRING,
+       tt_repair_name(tt_repair_resolve(ro.repair, ro.criterion)), 0, 0},
+      {"optimize", TT_FIELD_STRING,
+       tt_optimize_name(tt_optimize_resolve(ro.optimize, ro.criterion,
+                                            ro.repair)), 0, 0},
       {"max_error", TT_FIELD_REAL, NULL, 0, ro.max_error},
       {"max_points", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_points, 0},
       {"max_tris", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_triangles, 0},

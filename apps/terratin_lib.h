@@ -93,8 +93,8 @@ typedef struct tt_app_settings {
   size_t max_triangles;      /* -max_triangles; 0: not given */
   double percent;            /* -percent; 0: not given */
   tt_criterion criterion;    /* -criterion; default delaunay */
-  tt_optimize optimize;      /* -optimize; default auto (local for every
-                                criterion but delaunay) */
+  tt_optimize optimize;      /* -optimize; default auto (tt_optimize_resolve) */
+  tt_repair repair;          /* -repair; default auto (tt_repair_resolve) */
   const char *format;        /* -of; NULL: guessed from the output's
                                 extension, else GPKG */
   const char *const *lco;    /* -lco NAME=VALUE, in order */

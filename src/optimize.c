@@ -47,6 +47,47 @@ tt_status tt_optimize_parse(tt_context *ctx, const char *name,
                    "none, local, lookahead)", name ? name : "(null)");
 }
 
+static const char *const repair_names[] = {"auto", "flip", "local",
+                                           "lookahead", "delaunay"};
+#define NREP (sizeof repair_names / sizeof repair_names[0])
+
+const char *tt_repair_name(tt_repair repair)
+{
+  return (unsigned)repair < NREP ? repair_names[repair] : NULL;
+}
+
+tt_status tt_repair_parse(tt_context *ctx, const char *name,
+                          tt_repair *out_repair)
+{
+  if (name && out_repair)
+    for (size_t i = 0; i < NREP; i++)
+      if (strcmp(repair_names[i], name) == 0) {
+        *out_repair = (tt_repair)i;
+        return TT_OK;
+      }
+  return tt__error(ctx, TT_ERR_ARG, "unknown repair '%s' (known: auto, "
+                   "flip, local, lookahead, delaunay)",
+                   name ? name : "(null)");
+}
+
+tt_repair tt_repair_resolve(tt_repair repair, tt_criterion criterion)
+{
+  if (repair != TT_REPAIR_AUTO)
+    return repair;
+  return criterion == TT_CRITERION_L2 ? TT_REPAIR_DELAUNAY : TT_REPAIR_FLIP;
+}
+
+tt_optimize tt_optimize_resolve(tt_optimize optimize, tt_criterion criterion,
+                                tt_repair repair)
+{
+  if (optimize != TT_OPTIMIZE_AUTO)
+    return optimize;
+  return criterion != TT_CRITERION_DELAUNAY &&
+                 tt_repair_resolve(repair, criterion) == TT_REPAIR_DELAUNAY
+             ? TT_OPTIMIZE_LOCAL
+             : TT_OPTIMIZE_NONE;
+}
+
 /* --- the run's state ----------------------------------------------------- */
 
 typedef struct opt {
@@ -539,12 +580,15 @@ static bool push_ring(const tt__mesh *m, int32_t x, tt__edge_stack *s)
 }
 
 long tt__optimize_insert(tt__mesh *m, const tt__criterion_vt *crit,
-                         const tt__crit_env *env, int32_t v,
-                         const int32_t *opposite, int n,
+                         const tt__crit_env *env, tt_repair repair,
+                         int32_t v, const int32_t *opposite, int n,
                          tt__edge_stack *stack)
 {
   (void)v;
-  if (crit->id == TT_CRITERION_DELAUNAY)
+  if (crit->id == TT_CRITERION_DELAUNAY || repair == TT_REPAIR_DELAUNAY)
+    return tt__swap_repair(m, &tt__criterion_delaunay, env, opposite, n,
+                           stack);
+  if (repair == TT_REPAIR_FLIP)
     return tt__swap_repair(m, crit, env, opposite, n, stack);
   stack->n = 0;
   for (int i = 0; i < n; i++) {
@@ -558,11 +602,11 @@ long tt__optimize_insert(tt__mesh *m, const tt__criterion_vt *crit,
                            !push_ring(m, m->hv[tt__next(o)], stack)))
       return -1;
   }
-  tt__opt_params p = {crit, env, false, NULL, NULL};
+  tt__opt_params p = {crit, env, repair == TT_REPAIR_LOOKAHEAD, NULL, NULL};
   tt__opt_stats st;
   if (!tt__optimize_run(m, &p, stack->e, stack->n, &st))
     return -1;
-  return st.swaps;
+  return st.swaps + 2 * st.pairs;
 }
 
 typedef struct bound_arg {
@@ -588,13 +632,12 @@ static bool within_bound(void *arg, const tt__mesh *m, const int32_t *slots,
 
 bool tt__optimize_final(tt__mesh *m, const tt__criterion_vt *crit,
                         const tt__crit_env *env, tt_optimize mode,
-                        double bound, tt__opt_stats *out_stats)
+                        tt_repair repair, double bound,
+                        tt__opt_stats *out_stats)
 {
   if (out_stats)
     memset(out_stats, 0, sizeof *out_stats);
-  if (mode == TT_OPTIMIZE_AUTO)
-    mode = crit->id == TT_CRITERION_DELAUNAY ? TT_OPTIMIZE_NONE
-                                             : TT_OPTIMIZE_LOCAL;
+  mode = tt_optimize_resolve(mode, crit->id, repair);
   if (mode == TT_OPTIMIZE_NONE)
     return true;
   bound_arg b = {env->grid, bound};

@@ -79,23 +79,29 @@ TT_HIDDEN bool tt__optimize_run(tt__mesh *m, const tt__opt_params *p,
                                 const int32_t *seeds, size_t nseeds,
                                 tt__opt_stats *out_stats);
 
-/* Restores the criterion after vertex v was inserted (refine.c): the
- * exact incircle repair for Delaunay (swap.c), else the local swap seeded
+/* Restores the criterion after vertex v was inserted (refine.c), as
+ * repair says (resolved, not TT_REPAIR_AUTO): the exact incircle repair
+ * for Delaunay and for TT_REPAIR_DELAUNAY (swap.c); TT_REPAIR_FLIP, the
+ * Lawson flips outward from v under the criterion (each flip gives v one
+ * more spoke, so they end after fewer flips than v can have neighbours);
+ * TT_REPAIR_LOCAL / LOOKAHEAD, the local swap (with look-ahead) seeded
  * with the spokes and the link of v's star (and, for criteria with an
- * affected-edges hook, every edge around the link's vertices). opposite:
- * the n half-edges opposite v that the split returned (entries < 0
- * ignored). Returns the number of swaps, or -1 when out of memory. */
+ * affected-edges hook, every edge around the link's vertices).
+ * opposite: the n half-edges opposite v (entries < 0 ignored). Returns the
+ * number of swaps, or -1 when out of memory. */
 TT_HIDDEN long tt__optimize_insert(tt__mesh *m, const tt__criterion_vt *crit,
-                                   const tt__crit_env *env, int32_t v,
-                                   const int32_t *opposite, int n,
+                                   const tt__crit_env *env, tt_repair repair,
+                                   int32_t v, const int32_t *opposite, int n,
                                    tt__edge_stack *stack);
 
-/* The final whole-mesh pass of refinement: mode as in tt_refine_options
- * (TT_OPTIMIZE_AUTO resolved here). A move is refused when one of the
- * triangles it makes has an owned sample with |H - H'| > bound, so the
- * run's error bound survives the pass. False when out of memory. */
+/* The final whole-mesh pass of refinement: mode as in tt_refine_options,
+ * TT_OPTIMIZE_AUTO resolved here for the criterion and repair
+ * (tt_optimize_resolve). A move is refused when one of the triangles it
+ * makes has an owned sample with |H - H'| > bound, so the run's error
+ * bound survives the pass. False when out of memory. */
 TT_HIDDEN bool tt__optimize_final(tt__mesh *m, const tt__criterion_vt *crit,
                                   const tt__crit_env *env, tt_optimize mode,
-                                  double bound, tt__opt_stats *out_stats);
+                                  tt_repair repair, double bound,
+                                  tt__opt_stats *out_stats);
 
 #endif /* TT_OPTIMIZE_H */

@@ -52,6 +52,7 @@ typedef struct refine {
   const tt_grid *g;
   const tt_refine_options *opt;
   const tt__criterion_vt *crit;
+  tt_repair repair;    /* resolved */
   tt__crit_env env;
   tt__mesh m;
   tt__heap heap;
@@ -429,6 +430,11 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
   if (!tt__criterion_get(o->criterion))
     return tt__error(ctx, TT_ERR_ARG, "unknown criterion %d",
                      (int)o->criterion);
+  if (!tt_optimize_name(o->optimize))
+    return tt__error(ctx, TT_ERR_ARG, "unknown optimisation %d",
+                     (int)o->optimize);
+  if (!tt_repair_name(o->repair))
+    return tt__error(ctx, TT_ERR_ARG, "unknown repair %d", (int)o->repair);
   return TT_OK;
 }
 
@@ -456,6 +462,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.g = grid;
   r.opt = opt;
   r.crit = tt__criterion_get(opt->criterion);
+  r.repair = tt_repair_resolve(opt->repair, opt->criterion);
   tt__metric metric;
   tt__metric_from_frame(grid->frame, &metric);
   tt__mesh_init(&r.m, &metric);
@@ -539,8 +546,8 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     }
     /* [optimize.c hook] Delaunay's incircle repair, or the local swap of
      * any other criterion over the new vertex's star */
-    if (!ok || tt__optimize_insert(&r.m, r.crit, &r.env, v, opposite, nopp,
-                                   &r.stack) < 0 ||
+    if (!ok || tt__optimize_insert(&r.m, r.crit, &r.env, r.repair, v,
+                                   opposite, nopp, &r.stack) < 0 ||
         !drain(&r)) {
       status = oom(&r);
       goto done;
@@ -558,7 +565,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
    * would give one of its triangles an error above the larger of max_error
    * and the worst error left is refused, so the bound the loop reached
    * still holds. */
-  if (!tt__optimize_final(&r.m, r.crit, &r.env, opt->optimize,
+  if (!tt__optimize_final(&r.m, r.crit, &r.env, opt->optimize, r.repair,
                           fmax(r.max_error, tt__heap_size(&r.heap)
                                                 ? tt__heap_top(&r.heap).key
                                                 : 0.0),

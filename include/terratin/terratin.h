@@ -172,13 +172,43 @@ const char *tt_criterion_name(tt_criterion criterion);
 tt_status tt_criterion_parse(tt_context *ctx, const char *name,
                              tt_criterion *out_criterion);
 
+/* How the criterion is restored around each inserted vertex (SPEC
+ * sections 3.1 and 3.2). */
+typedef enum tt_repair {
+  TT_REPAIR_AUTO = 0,      /* delaunay for l2 (measured: the vertices that
+                              Delaunay insertion picks, then the L2 swaps
+                              of the final pass, fit the grid best), flip
+                              for every other criterion */
+  TT_REPAIR_FLIP,          /* Lawson flips outward from the new vertex: an
+                              edge opposite it is swapped while its swap
+                              value is positive (exact incircle flips for
+                              Delaunay); min_area first re-triangulates the
+                              hole around the vertex by exact dynamic
+                              programming */
+  TT_REPAIR_LOCAL,         /* maximal-reduction local swap over the edges
+                              around the new vertex and every edge a swap
+                              reaches from them */
+  TT_REPAIR_LOOKAHEAD,     /* that, then two-swap look-ahead moves */
+  TT_REPAIR_DELAUNAY       /* Delaunay during the insertions; the criterion
+                              acts in the final pass only (optimize) */
+} tt_repair;
+
+/* "auto", "flip", "local", "lookahead", "delaunay"; NULL for an unknown
+ * value. */
+const char *tt_repair_name(tt_repair repair);
+/* Parses one of those names; TT_ERR_ARG for an unknown one. */
+tt_status tt_repair_parse(tt_context *ctx, const char *name,
+                          tt_repair *out_repair);
+/* What TT_REPAIR_AUTO means for a criterion (other values are returned as
+ * they are). */
+tt_repair tt_repair_resolve(tt_repair repair, tt_criterion criterion);
+
 /* Swap optimisation of the criterion over the whole mesh once the
- * insertions are done (SPEC section 3.2). Whatever the choice, every
- * criterion but Delaunay restores itself around each inserted vertex by
- * local swaps, and Delaunay by its exact incircle flips. */
+ * insertions are done (SPEC section 3.2). */
 typedef enum tt_optimize {
-  TT_OPTIMIZE_AUTO = 0,    /* local for every criterion but Delaunay (which
-                              is already optimal), none for Delaunay */
+  TT_OPTIMIZE_AUTO = 0,    /* local when the criterion was not restored
+                              during the insertions (repair delaunay with
+                              a criterion other than Delaunay), else none */
   TT_OPTIMIZE_NONE,
   TT_OPTIMIZE_LOCAL,       /* maximal-reduction local swap */
   TT_OPTIMIZE_LOOKAHEAD    /* local swap, then two-swap look-ahead moves
@@ -190,6 +220,10 @@ const char *tt_optimize_name(tt_optimize optimize);
 /* Parses one of those names; TT_ERR_ARG for an unknown one. */
 tt_status tt_optimize_parse(tt_context *ctx, const char *name,
                             tt_optimize *out_optimize);
+/* What TT_OPTIMIZE_AUTO means for a criterion and a resolved repair
+ * (other values are returned as they are). */
+tt_optimize tt_optimize_resolve(tt_optimize optimize, tt_criterion criterion,
+                                tt_repair repair);
 
 typedef struct tt_refine_options {
   /* Stop when the worst remaining sample error is <= max_error (z units).
@@ -206,6 +240,8 @@ typedef struct tt_refine_options {
    * above the larger of max_error and the worst error left when the
    * insertions stopped, so the error bound of the run still holds. */
   tt_optimize optimize;
+  /* The criterion's restoration around each inserted vertex. */
+  tt_repair repair;
   /* Threads for the raster scans: 0 = automatic (all online CPUs for grids
    * of a million samples or more, else 1), 1 = the caller's only, N = N.
    * The result does not depend on it. */

@@ -93,8 +93,14 @@ static void check_valid(const tt__mesh *m, const char *what)
     TT_FAIL_("%s: invalid mesh: %s", what, why);
 }
 
+/* How insert_point repairs with a criterion (test_flip_repair changes it),
+ * and the swaps of its last repair. */
+static tt_repair insert_repair = TT_REPAIR_LOCAL;
+static long last_flips;
+
 /* Inserts (c, r) into the mesh (brute-force location), repaired by
- * Delaunay flips, or by the criterion's region repair when crit is given. */
+ * Delaunay flips, or by the criterion's repair (insert_repair) when crit is
+ * given. */
 static bool insert_point(tt__mesh *m, const tt_grid *g, int32_t c, int32_t r,
                          const tt__criterion_vt *crit, tt__edge_stack *stack)
 {
@@ -127,10 +133,12 @@ static bool insert_point(tt__mesh *m, const tt_grid *g, int32_t c, int32_t r,
     }
     if (!ok)
       return false;
-    long flips = crit ? tt__optimize_insert(m, crit, &env, v, opp, n, stack)
+    long flips = crit ? tt__optimize_insert(m, crit, &env, insert_repair, v,
+                                            opp, n, stack)
                       : tt__swap_repair(m, &tt__criterion_delaunay, &env, opp,
                                         n, stack);
     tt__mesh_clear_touched(m);
+    last_flips = flips;
     return flips >= 0;
   }
   return false;
@@ -688,6 +696,61 @@ static double worst_error(const tt__mesh *m, const tt_grid *g)
   return w;
 }
 
+/* The flip repair (Lawson outward from the new vertex): after each
+ * insertion no edge opposite the new vertex has a positive swap value, the
+ * mesh is valid and the criterion acted (it flipped; its total area is
+ * printed beside Delaunay's: a flip repair only ever looks at the new
+ * vertex's link, so it need not beat Delaunay). The look-ahead repair: a valid mesh at a local optimum
+ * (its first phase is the local swap). */
+static void test_flip_repair(uint64_t seed)
+{
+  uint64_t rng = seed ^ 0xf11f;
+  tt_grid *g = bumpy(50, 40, rng);
+  int32_t pts[2 * 120];
+  random_points(&rng, 50, 40, pts, 120);
+  tt__mesh m, d;
+  tt__edge_stack stack = {NULL, 0, 0};
+  insert_repair = TT_REPAIR_FLIP;
+  CHECK(build(&m, g, pts, 0, &area_crit));
+  tt__crit_env env = {&m, g, NULL};
+  long bad = 0, flips = 0;
+  for (int i = 0; i < 120; i++) {
+    CHECK(insert_point(&m, g, pts[2 * i], pts[2 * i + 1], &area_crit,
+                       &stack));
+    flips += last_flips;
+    int32_t v = (int32_t)m.nv - 1;
+    for (size_t t = 0; t < m.nslots; t++)
+      for (int k = 0; k < 3 && tt__mesh_live(&m, (int32_t)t); k++) {
+        int32_t e = (int32_t)(3 * t) + k;
+        if (tt__mesh_apex(&m, e) != v || m.twin[e] < 0 ||
+            !tt__mesh_flippable(&m, e))
+          continue;
+        if (area_crit.swap_value(&env, e) > 1e-9)
+          bad++;
+      }
+  }
+  check_valid(&m, "flip repair");
+  CHECK_INT_EQ(bad, 0);
+  CHECK(build(&d, g, pts, 120, NULL));
+  double a_flip = total_area(&m), a_del = total_area(&d);
+  printf("flip repair: %ld flips, total area %.6f, Delaunay %.6f\n", flips,
+         a_flip, a_del);
+  CHECK(flips > 0);
+  tt__mesh_free(&m);
+  tt__mesh_free(&d);
+  insert_repair = TT_REPAIR_LOOKAHEAD;
+  CHECK(build(&m, g, pts, 120, &area_crit));
+  check_valid(&m, "look-ahead repair");
+  double v = max_swap_value(&m, &area_crit, g);
+  if (!(v <= 1e-9))
+    TT_FAIL_("seed %" PRIu64 ": after look-ahead repairs an edge has swap "
+             "value %g", seed, v);
+  tt__mesh_free(&m);
+  insert_repair = TT_REPAIR_LOCAL;
+  tt__edge_stack_free(&stack);
+  tt_grid_destroy(g);
+}
+
 static void test_final_veto(uint64_t seed)
 {
   uint64_t rng = seed ^ 0xfeed;
@@ -701,7 +764,8 @@ static void test_final_veto(uint64_t seed)
     tt__crit_env env = {&m, g, NULL};
     tt__opt_stats st;
     double bound = 0.8 * before; /* already passed: nothing may rise */
-    CHECK(tt__optimize_final(&m, &area_crit, &env, (tt_optimize)mode, bound,
+    CHECK(tt__optimize_final(&m, &area_crit, &env, (tt_optimize)mode,
+                             TT_REPAIR_FLIP, bound,
                              &st));
     check_valid(&m, "final pass");
     double after = worst_error(&m, g);
@@ -728,6 +792,32 @@ static void test_names(void)
   tt_refine_options ro;
   tt_refine_options_init(&ro);
   CHECK_INT_EQ(ro.optimize, TT_OPTIMIZE_AUTO);
+  CHECK_INT_EQ(ro.repair, TT_REPAIR_AUTO);
+  /* repair names and what auto means */
+  CHECK_STR_EQ(tt_repair_name(TT_REPAIR_FLIP), "flip");
+  CHECK_STR_EQ(tt_repair_name(TT_REPAIR_DELAUNAY), "delaunay");
+  CHECK(tt_repair_name((tt_repair)9) == NULL);
+  tt_repair rp = TT_REPAIR_AUTO;
+  CHECK_OK(ctx, tt_repair_parse(ctx, "lookahead", &rp));
+  CHECK_INT_EQ(rp, TT_REPAIR_LOOKAHEAD);
+  CHECK_INT_EQ(tt_repair_parse(ctx, "lawson", &rp), TT_ERR_ARG);
+  CHECK(strstr(tt_context_errmsg(ctx), "lawson") != NULL);
+  CHECK_INT_EQ(tt_repair_resolve(TT_REPAIR_AUTO, TT_CRITERION_L2),
+               TT_REPAIR_DELAUNAY);
+  CHECK_INT_EQ(tt_repair_resolve(TT_REPAIR_AUTO, TT_CRITERION_ABN),
+               TT_REPAIR_FLIP);
+  CHECK_INT_EQ(tt_repair_resolve(TT_REPAIR_LOCAL, TT_CRITERION_L2),
+               TT_REPAIR_LOCAL);
+  CHECK_INT_EQ(tt_optimize_resolve(TT_OPTIMIZE_AUTO, TT_CRITERION_L2,
+                                   TT_REPAIR_AUTO), TT_OPTIMIZE_LOCAL);
+  CHECK_INT_EQ(tt_optimize_resolve(TT_OPTIMIZE_AUTO, TT_CRITERION_L2,
+                                   TT_REPAIR_FLIP), TT_OPTIMIZE_NONE);
+  CHECK_INT_EQ(tt_optimize_resolve(TT_OPTIMIZE_AUTO, TT_CRITERION_DELAUNAY,
+                                   TT_REPAIR_DELAUNAY), TT_OPTIMIZE_NONE);
+  CHECK_INT_EQ(tt_optimize_resolve(TT_OPTIMIZE_AUTO, TT_CRITERION_GAUSSIAN_CURVATURE,
+                                   TT_REPAIR_DELAUNAY), TT_OPTIMIZE_LOCAL);
+  CHECK_INT_EQ(tt_optimize_resolve(TT_OPTIMIZE_LOOKAHEAD, TT_CRITERION_L2,
+                                   TT_REPAIR_FLIP), TT_OPTIMIZE_LOOKAHEAD);
 }
 
 int main(void)
@@ -751,6 +841,7 @@ int main(void)
   RUN(test_undo(seed));
   RUN(test_local_and_lookahead(seed));
   RUN(test_region_repair(seed));
+  RUN(test_flip_repair(seed));
   RUN(test_exhaustive(seed));
   RUN(test_l2_from_delaunay(seed));
   RUN(test_ruled());
