@@ -140,6 +140,8 @@ expect_failure "-max_error abc" 2 out simplify -max_error abc in/fault.tif \
   out/o.gpkg
 expect_failure "-criterion unknown" 2 out simplify -criterion nope \
   in/fault.tif out/o.gpkg
+expect_failure "-repair unknown" 2 out simplify -repair lawson \
+  in/fault.tif out/o.gpkg
 expect_failure "missing OUTPUT" 2 out simplify in/fault.tif
 expect_failure "missing option value" 2 out simplify in/fault.tif \
   out/o.gpkg -b
@@ -205,6 +207,7 @@ assert d["format"] == "GPKG" and d["criterion"] == "delaunay"
 assert d["limits"]["max_error"] == 2 and d["cells"] == 12000
 assert d["valid_samples"] == 12000 and d["max_error"] <= 2
 assert d["stop_reason"] == "max_error"
+assert d["repair"] == "flip" and d["optimize"] == "none", d
 assert "32633" in d["crs"] or "UTM" in d["crs"], d["crs"]
 ' <tin.json
 check "-json: no progress bar" bash -c '! grep -q "\.\.\.10" tin.json'
@@ -227,6 +230,30 @@ grep -q "created (String) = 20[0-9-]*T[0-9:]*Z" rp.txt'
 check "the layers carry the raster's CRS" \
   grep -q 'ID\["EPSG",32633\]' <(ogrinfo -so out/tin.gpkg triangles 2>&1)
 check "only the output in the folder" [ "$(ls -A out)" = "tin.gpkg" ]
+
+# l2 by default: Delaunay while inserting, then the L2 swaps of the final
+# pass; an explicit -repair and -optimize are recorded as given
+run simplify -json -criterion l2 -max_error 2 in/fault.tif out/l2.gpkg
+check "l2: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "l2: resolved repair and optimize in -json" python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert d["repair"] == "delaunay" and d["optimize"] == "local", d
+assert d["max_error"] <= 2, d' <out.txt
+check "l2: run_parameters names them" bash -c '
+ogrinfo -q out/l2.gpkg run_parameters >rp2.txt 2>&1
+grep -q "repair (String) = delaunay" rp2.txt &&
+grep -q "optimize (String) = local" rp2.txt &&
+grep -q "criterion (String) = l2" rp2.txt'
+run simplify -json -criterion abn -repair lookahead -optimize lookahead \
+  -max_error 2 in/fault.tif out/abn.gpkg
+check "abn lookahead: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "abn lookahead: recorded, bound kept" python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert d["repair"] == "lookahead" and d["optimize"] == "lookahead", d
+assert d["max_error"] <= 2, d' <out.txt
+rm -f out/l2.gpkg out/abn.gpkg
 
 # the error bound, measured independently by eval
 run eval -json in/fault.tif out/tin.gpkg

@@ -96,7 +96,8 @@ static void test_simplify_all_options(void)
            "-MAX_TRIANGLES", "2000", "-percent", "12.5", "-of",
            "ESRI Shapefile", "-lco", "SPATIAL_INDEX=YES", "-lco",
            "ENCODING=UTF-8", "-dsco", "A=B", "-nln", "dem_", "-overwrite",
-           "-q", "-criterion", "delaunay", "-json", "out.shp", "--config",
+           "-q", "-criterion", "delaunay", "-repair", "lookahead",
+           "-optimize", "none", "-json", "out.shp", "--config",
            "CPL_TMPDIR=/tmp", "--debug", "on", "-srcnodata", "nan",
            "-z_factor", "0.3048");
   const tt_app_settings *s = tt_app_options_settings(o);
@@ -108,6 +109,8 @@ static void test_simplify_all_options(void)
   CHECK_INT_EQ(s->band, 2);
   CHECK_DBL_NEAR(s->max_error, 0.25, 0);
   CHECK_INT_EQ(s->max_points, 1000);
+  CHECK_INT_EQ(s->repair, TT_REPAIR_LOOKAHEAD);
+  CHECK_INT_EQ(s->optimize, TT_OPTIMIZE_NONE);
   CHECK_INT_EQ(s->max_triangles, 2000);
   CHECK_DBL_NEAR(s->percent, 12.5, 0);
   CHECK_STR_EQ(s->format, "ESRI Shapefile");
@@ -194,6 +197,9 @@ static void test_simplify_usage_errors(void)
   CHECK_USAGE("-b", "simplify", "-b", "0", "a", "b");
   CHECK_USAGE("-b", "simplify", "-b", "x", "a", "b");
   CHECK_USAGE("-criterion 'foo'", "simplify", "-criterion", "foo", "a", "b");
+  CHECK_USAGE("-repair 'lawson'", "simplify", "-repair", "lawson", "a", "b");
+  CHECK_USAGE("-optimize 'global'", "simplify", "-optimize", "global", "a",
+              "b");
   CHECK_USAGE("NAME=VALUE", "simplify", "-lco", "SPATIAL_INDEX", "a", "b");
   CHECK_USAGE("NAME=VALUE", "simplify", "-dsco", "=x", "a", "b");
   CHECK_USAGE("-of", "simplify", "-of", "", "a", "b");
@@ -260,7 +266,7 @@ static void test_help_and_version(void)
   static const char *const simplify_opts[] = {
       "-b ", "-max_error", "-max_points", "-max_triangles", "-percent",
       "-of ", "-lco", "-dsco", "-nln", "-overwrite", "-q ", "-criterion",
-      "-json", "Exit codes"};
+      "-repair", "-optimize", "-json", "Exit codes"};
   for (size_t i = 0; i < sizeof simplify_opts / sizeof *simplify_opts; i++)
     if (!strstr(sim, simplify_opts[i]))
       TT_FAIL_("simplify help lacks %s", simplify_opts[i]);
