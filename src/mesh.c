@@ -682,3 +682,145 @@ void tt__mesh_flip_revert(tt__mesh *m, const tt__mesh_flip_undo *undo)
     m->v[undo->vert[k]].edge = undo->vedge[k];
   m->ntouched = undo->ntouched;
 }
+
+/* --- region replacement (hole_dp.c) ---------------------------------------
+ * Swaps a set of triangles for another triangulation of the same outline.
+ * Everything that can fail (the outline check, memory) happens before the
+ * first write, so a refusal leaves the mesh as it was. Regions are small
+ * (the hole around one vertex): the edge matching is quadratic. */
+
+bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots, int nold,
+                             const int32_t (*tris)[3], int ntri)
+{
+  if (nold < 1 || ntri < 1 || nold > INT32_MAX / 3 || ntri > INT32_MAX / 3)
+    return false;
+  bool ok = false;
+  int nhalf = 3 * ntri, nouter = 0, ntaken = 0;
+  size_t nextra = ntri > nold ? (size_t)(ntri - nold) : 0;
+  /* the outline: half-edges of the region whose twin is outside it, with
+   * that twin and the constraint flag (read before any slot is rewritten) */
+  int32_t *outer = malloc(3 * (size_t)nold * sizeof *outer);
+  int32_t *otwin = malloc(3 * (size_t)nold * sizeof *otwin);
+  uint8_t *oflag = malloc(3 * (size_t)nold);
+  /* per new half-edge 3 * t + k: the new half-edge it pairs with (>= 0),
+   * or -2 - o for outline half-edge o */
+  int32_t *pair = malloc((size_t)nhalf * sizeof *pair);
+  int32_t *slot = malloc((size_t)ntri * sizeof *slot);
+  /* constrained edges inside the region (a vertex inserted on one): the
+   * new triangles must have them too, and they stay constrained */
+  int32_t *icons = malloc(3 * (size_t)nold * sizeof *icons);
+  uint8_t *iflag = malloc((size_t)nhalf);
+  int nicons = 0;
+  if (!outer || !otwin || !oflag || !pair || !slot || !icons || !iflag)
+    goto done;
+  for (int i = 0; i < nold; i++)
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * old_slots[i] + k, f = m->twin[e];
+      bool inside = false;
+      for (int j = 0; j < nold && f >= 0 && !inside; j++)
+        inside = f / 3 == old_slots[j];
+      if (!inside) {
+        outer[nouter] = e;
+        otwin[nouter] = f;
+        oflag[nouter] = m->eflag[e];
+        nouter++;
+      } else if ((m->eflag[e] & TT__EDGE_CONSTRAINED) && e < f) {
+        icons[nicons++] = e; /* an inner constrained edge, once */
+      }
+    }
+  /* each new half-edge pairs with its reverse among the new triangles or
+   * with the outline half-edge it takes the place of; each outline
+   * half-edge exactly once */
+  int used = 0;
+  for (int h = 0; h < nhalf; h++) {
+    int32_t a = tris[h / 3][h % 3], b = tris[h / 3][(h % 3 + 1) % 3];
+    pair[h] = -1;
+    for (int g = 0; g < nhalf && pair[h] == -1; g++)
+      if (g != h && tris[g / 3][g % 3] == b &&
+          tris[g / 3][(g % 3 + 1) % 3] == a)
+        pair[h] = g;
+    for (int o = 0; o < nouter && pair[h] == -1; o++)
+      if (m->hv[outer[o]] == a && m->hv[tt__next(outer[o])] == b)
+        pair[h] = -2 - o;
+    if (pair[h] == -1)
+      goto done; /* an edge of the new triangulation leads nowhere */
+    used += pair[h] <= -2;
+  }
+  for (int h = 0; h < nhalf; h++) {
+    if (pair[h] >= 0 && pair[pair[h]] != h)
+      goto done; /* an inner edge used twice */
+    for (int g = 0; g < h && pair[h] <= -2; g++)
+      if (pair[g] == pair[h])
+        goto done; /* an outline edge used twice */
+  }
+  if (used != nouter)
+    goto done; /* part of the outline is not covered */
+  for (int h = 0; h < nhalf; h++)
+    iflag[h] = 0;
+  for (int i = 0; i < nicons; i++) {
+    int32_t a = m->hv[icons[i]], b = m->hv[tt__next(icons[i])];
+    bool kept = false;
+    for (int h = 0; h < nhalf; h++) {
+      int32_t x = tris[h / 3][h % 3], y = tris[h / 3][(h % 3 + 1) % 3];
+      if ((x == a && y == b) || (x == b && y == a)) {
+        iflag[h] = TT__EDGE_CONSTRAINED;
+        kept = true;
+      }
+    }
+    if (!kept)
+      goto done; /* a constrained edge would vanish */
+  }
+  for (int t = 0; t < ntri; t++)
+    if (tris[t][0] == tris[t][1] || tris[t][1] == tris[t][2] ||
+        tris[t][2] == tris[t][0] ||
+        tt__mesh_orient(m, tris[t][0], tris[t][1], tris[t][2]) <= 0)
+      goto done;
+  /* memory: the touched log, the free list, extra slots */
+  if (!tt__grow((void **)&m->touched, &m->touchedcap,
+                m->ntouched + (size_t)ntri + 4, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->freelist, &m->freecap,
+                m->nfree + (size_t)nold, sizeof(int32_t)))
+    goto done;
+  for (int t = 0; t < ntri && t < nold; t++)
+    slot[t] = old_slots[t];
+  for (; (size_t)ntaken < nextra; ntaken++) {
+    int32_t s = take_slot(m);
+    if (s < 0) {
+      while (ntaken > 0)
+        give_back(m, slot[nold + --ntaken]);
+      goto done;
+    }
+    slot[nold + ntaken] = s;
+  }
+  /* write. The region's vertices lose their edges; set_triangle gives one
+   * back to every corner of a new triangle (the outline's vertices among
+   * them), so only a vertex no triangle uses any more keeps -1. */
+  for (int i = 0; i < nold; i++)
+    for (int k = 0; k < 3; k++)
+      m->v[m->hv[3 * old_slots[i] + k]].edge = -1;
+  for (int i = 0; i < nold; i++) {
+    m->hv[3 * old_slots[i]] = -1;
+    m->nlive--;
+  }
+  for (int t = 0; t < ntri; t++)
+    set_triangle(m, slot[t], tris[t][0], tris[t][1], tris[t][2]);
+  for (int i = ntri; i < nold; i++)
+    m->freelist[m->nfree++] = old_slots[i];
+  for (int h = 0; h < nhalf; h++) {
+    int32_t e = 3 * slot[h / 3] + h % 3;
+    if (pair[h] >= 0)
+      link(m, e, 3 * slot[pair[h] / 3] + pair[h] % 3, iflag[h]);
+    else
+      link(m, e, otwin[-2 - pair[h]], oflag[-2 - pair[h]]);
+  }
+  ok = true;
+done:
+  free(outer);
+  free(otwin);
+  free(oflag);
+  free(pair);
+  free(slot);
+  free(icons);
+  free(iflag);
+  return ok;
+}

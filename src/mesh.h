@@ -179,4 +179,22 @@ TT_HIDDEN bool tt__mesh_validate(const tt__mesh *m, char *why, size_t whylen);
 /* Empties the touched log. */
 static inline void tt__mesh_clear_touched(tt__mesh *m) { m->ntouched = 0; }
 
+/* Replaces the nold live triangles in old_slots (distinct, one connected
+ * region) by the ntri triangles tris (vertex triples, counter-clockwise in
+ * the ground frame) triangulating the same outline: every edge of tris is
+ * either shared by two of them or is an outline edge of the region, and
+ * every outline edge is used once. The old slots are reused (then slots
+ * from the free list or new ones; unused old slots go to the free list);
+ * twins are set inside and to the outside neighbours, outline edges keep
+ * their constraint flags, a constrained edge inside the region stays
+ * constrained (tris must contain it), other inner edges are not
+ * constrained, vertex edges point into the new triangles (-1 for a vertex
+ * left in no triangle), and the written slots are logged as touched.
+ * False, with the mesh unchanged, when tris does not fit the outline that
+ * way, drops an inner constrained edge, has a triangle that is not
+ * strictly counter-clockwise, or when out of memory. O((nold + ntri)^2). */
+TT_HIDDEN bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots,
+                                       int nold, const int32_t (*tris)[3],
+                                       int ntri);
+
 #endif /* TT_MESH_H */

@@ -1,0 +1,865 @@
+/* test_hole_dp.c -- the min-area hole re-triangulation (hole_dp.c) and
+ * tt__mesh_replace_region (mesh.c).
+ *
+ * Random meshes on small grids (collinear points everywhere) in several
+ * ground frames, some edges marked constrained by hand (both half-edges,
+ * as a domain boundary would be). After each split (of a triangle, an
+ * inner edge, a constrained edge or a boundary edge) the test builds the
+ * hole of the new vertex itself, from the definition in
+ * docs/min_area_hole.md, and enumerates every triangulation of it
+ * directly: every set of pairwise non-crossing segments between its
+ * points that lie inside the outline (an even-odd test in doubled
+ * coordinates, independent of polygon_dp.c), with the constrained spokes
+ * forced in, read off as faces. tt__hole_min_area must leave the hole
+ * with the enumeration's minimum area (1e-9 relative), never more than
+ * before, the outline and every constrained edge in place, v's link edges
+ * in opposite[], and the mesh valid. Flat and planar terrains (every
+ * triangulation ties) must leave the mesh untouched. Two identical runs
+ * give identical meshes. The mean time per call on a larger terrain is
+ * printed, never checked. Seeded; TT_SEED=<n> replays a run. */
+#include "criteria/geometry.h"
+#include "hole_dp.h"
+#include "mesh.h"
+#include "predicates.h"
+#include "swap.h"
+#include "tt_test.h"
+
+#include <time.h>
+
+#define MAXP 12 /* enumeration limit: points of a hole (outline + v) */
+
+static uint64_t g_seed;
+
+/* --- a small world: grid heights, frame, mesh ----------------------------- */
+
+typedef struct world {
+  tt__mesh m;
+  struct tt_grid g;
+  int W, H;             /* vertices at 0..W x 0..H */
+  unsigned char *used;  /* (W + 1) * (H + 1) */
+  tt__crit_env env;
+} world;
+
+enum { Z_RANDOM = 0, Z_FLAT, Z_PLANE, Z_SMOOTH };
+
+static void world_init(world *w, const double frame[4], int W, int H,
+                       int zkind, uint64_t *rng)
+{
+  memset(w, 0, sizeof *w);
+  w->W = W;
+  w->H = H;
+  w->g.nx = (size_t)W + 1;
+  w->g.ny = (size_t)H + 1;
+  w->g.z = malloc(w->g.nx * w->g.ny * sizeof(float));
+  w->used = calloc(w->g.nx * w->g.ny, 1);
+  memcpy(w->g.frame, frame, 4 * sizeof(double));
+  double scale = sqrt(fabs(frame[0] * frame[3] - frame[1] * frame[2]));
+  for (int r = 0; r <= H; r++)
+    for (int c = 0; c <= W; c++) {
+      double z = 0;
+      if (zkind == Z_RANDOM)
+        z = 3 * scale * tt_test_uniform(rng);
+      else if (zkind == Z_PLANE)
+        z = 0.25 * c - 0.5 * r + 7; /* exact in float */
+      else if (zkind == Z_SMOOTH)
+        z = scale * (4 * sin(c / 7.0) * cos(r / 5.0) +
+                     0.3 * tt_test_uniform(rng));
+      w->g.z[(size_t)r * w->g.nx + c] = (float)z;
+    }
+  tt__metric metric;
+  tt__metric_from_frame(frame, &metric);
+  tt__mesh_init(&w->m, &metric);
+  tt__mesh *m = &w->m;
+  int32_t v[4];
+  const int cs[4] = {0, W, W, 0}, rs[4] = {0, 0, H, H};
+  for (int k = 0; k < 4; k++) {
+    v[k] = tt__mesh_add_vertex(m, cs[k], rs[k],
+                               w->g.z[(size_t)rs[k] * w->g.nx + cs[k]]);
+    w->used[(size_t)rs[k] * w->g.nx + cs[k]] = 1;
+  }
+  if (tt__mesh_orient(m, v[0], v[1], v[2]) > 0) {
+    tt__mesh_add_triangle(m, v[0], v[1], v[2]);
+    tt__mesh_add_triangle(m, v[0], v[2], v[3]);
+  } else {
+    tt__mesh_add_triangle(m, v[0], v[2], v[1]);
+    tt__mesh_add_triangle(m, v[0], v[3], v[2]);
+  }
+  tt__mesh_link_all(m);
+  w->env.mesh = m;
+  w->env.grid = &w->g;
+  w->env.cache = NULL;
+}
+
+static void world_free(world *w)
+{
+  tt__mesh_free(&w->m);
+  free(w->g.z);
+  free(w->used);
+}
+
+static bool validate(const tt__mesh *m, const char *what, int step)
+{
+  char why[256];
+  if (!tt__mesh_validate(m, why, sizeof why)) {
+    TT_FAIL_("seed %" PRIu64 " %s step %d: %s", g_seed, what, step, why);
+    return false;
+  }
+  return true;
+}
+
+/* Inserts the sample (c, r): splits the triangle or edge it falls in.
+ * Returns the new vertex, or -1 (sample used, or outside). */
+static int32_t insert(world *w, int c, int r, int32_t opp[4], int *nopp)
+{
+  size_t at = (size_t)r * w->g.nx + c;
+  if (w->used[at])
+    return -1;
+  int32_t on;
+  int32_t t = tt__mesh_locate(&w->m, -1, c, r, &on);
+  if (t < 0 || on <= -2)
+    return -1;
+  int32_t v = tt__mesh_add_vertex(&w->m, c, r, w->g.z[at]);
+  if (v < 0)
+    return -1;
+  w->used[at] = 1;
+  bool ok;
+  if (on < 0) {
+    ok = tt__mesh_split_triangle(&w->m, t, v, opp);
+    *nopp = 3;
+  } else {
+    ok = tt__mesh_split_edge(&w->m, on, v, opp);
+    *nopp = 4;
+  }
+  CHECK(ok);
+  return ok ? v : -1;
+}
+
+/* Grows a mesh of about npts vertices: random samples, each followed by a
+ * Delaunay repair, a few random flips, or nothing (so the meshes are not
+ * all Delaunay), then marks some inner edges constrained. */
+static void grow(world *w, int npts, double pconstrained, uint64_t *rng)
+{
+  tt__edge_stack stack = {0};
+  for (int tries = 0; tries < 20 * npts && (int)w->m.nv < npts; tries++) {
+    int c = (int)(tt_test_rand(rng) % (uint64_t)(w->W + 1));
+    int r = (int)(tt_test_rand(rng) % (uint64_t)(w->H + 1));
+    int32_t opp[4];
+    int nopp;
+    if (insert(w, c, r, opp, &nopp) < 0)
+      continue;
+    int op = (int)(tt_test_rand(rng) % 3);
+    if (op == 0) {
+      CHECK(tt__swap_repair(&w->m, &tt__criterion_delaunay, &w->env, opp,
+                            nopp, &stack) >= 0);
+    } else if (op == 1) {
+      for (int k = 0; k < 3; k++) {
+        int32_t e = (int32_t)(tt_test_rand(rng) % (3 * w->m.nslots));
+        if (tt__mesh_live(&w->m, e / 3) && tt__mesh_flippable(&w->m, e))
+          tt__mesh_flip(&w->m, e);
+      }
+    }
+  }
+  for (size_t e = 0; e < 3 * w->m.nslots; e++) {
+    int32_t f = w->m.twin[e];
+    if (!tt__mesh_live(&w->m, (int32_t)(e / 3)) || f < (int32_t)e)
+      continue;
+    if (tt_test_uniform(rng) < pconstrained)
+      w->m.eflag[e] = w->m.eflag[f] = TT__EDGE_CONSTRAINED;
+  }
+  tt__mesh_clear_touched(&w->m);
+  tt__edge_stack_free(&stack);
+}
+
+/* --- independent geometry ------------------------------------------------- */
+
+static double tri_area(const world *w, int32_t a, int32_t b, int32_t c)
+{
+  const tt__mesh_vertex *p = w->m.v;
+  const double *f = w->g.frame;
+  double P[3][3];
+  int32_t id[3] = {a, b, c};
+  for (int k = 0; k < 3; k++) {
+    P[k][0] = f[0] * p[id[k]].c + f[1] * p[id[k]].r;
+    P[k][1] = f[2] * p[id[k]].c + f[3] * p[id[k]].r;
+    P[k][2] = p[id[k]].z;
+  }
+  double u[3], v[3];
+  for (int k = 0; k < 3; k++) {
+    u[k] = P[1][k] - P[0][k];
+    v[k] = P[2][k] - P[0][k];
+  }
+  double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2],
+         z = u[0] * v[1] - u[1] * v[0];
+  return 0.5 * sqrt(x * x + y * y + z * z);
+}
+
+static double total_area(const world *w)
+{
+  double s = 0;
+  for (size_t t = 0; t < w->m.nslots; t++)
+    if (tt__mesh_live(&w->m, (int32_t)t))
+      s += tri_area(w, w->m.hv[3 * t], w->m.hv[3 * t + 1],
+                    w->m.hv[3 * t + 2]);
+  return s;
+}
+
+static int64_t cross(int64_t ax, int64_t ay, int64_t bx, int64_t by,
+                     int64_t cx, int64_t cy)
+{
+  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+static int sgn(int64_t x) { return (x > 0) - (x < 0); }
+
+static bool on_seg(int64_t ax, int64_t ay, int64_t bx, int64_t by,
+                   int64_t px, int64_t py)
+{
+  return cross(ax, ay, bx, by, px, py) == 0 && px >= (ax < bx ? ax : bx) &&
+         px <= (ax < bx ? bx : ax) && py >= (ay < by ? ay : by) &&
+         py <= (ay < by ? by : ay);
+}
+
+static bool seg_meet(const int64_t *x, const int64_t *y, int a, int b, int c,
+                     int d)
+{
+  int o1 = sgn(cross(x[a], y[a], x[b], y[b], x[c], y[c]));
+  int o2 = sgn(cross(x[a], y[a], x[b], y[b], x[d], y[d]));
+  int o3 = sgn(cross(x[c], y[c], x[d], y[d], x[a], y[a]));
+  int o4 = sgn(cross(x[c], y[c], x[d], y[d], x[b], y[b]));
+  if (o1 * o2 < 0 && o3 * o4 < 0)
+    return true;
+  return on_seg(x[a], y[a], x[b], y[b], x[c], y[c]) ||
+         on_seg(x[a], y[a], x[b], y[b], x[d], y[d]) ||
+         on_seg(x[c], y[c], x[d], y[d], x[a], y[a]) ||
+         on_seg(x[c], y[c], x[d], y[d], x[b], y[b]);
+}
+
+/* --- the hole, built from its definition ----------------------------------
+ * Points 0..nq-1 are the outline in order (it passes through v when v is
+ * on the mesh's boundary), point nq is v when v is strictly inside. */
+
+typedef struct thole {
+  int32_t v;
+  int nq, np;            /* outline points, all points */
+  int32_t id[MAXP + 8];  /* vertex of each point */
+  int64_t x[MAXP + 8], y[MAXP + 8];
+  int32_t slots[MAXP + 8];
+  int nslots;
+  bool closed;
+  double area;           /* the current triangles' area */
+  int forced[8][2];      /* constrained spokes (point pairs) */
+  int nforced;
+  int32_t outline[MAXP + 8][2]; /* outline edges as vertex pairs */
+  uint8_t outflag[MAXP + 8];
+} thole;
+
+static bool in_set(const int32_t *s, int n, int32_t x)
+{
+  for (int i = 0; i < n; i++)
+    if (s[i] == x)
+      return true;
+  return false;
+}
+
+/* False when the hole has more than MAXP points (not enumerated). */
+static bool build_thole(const world *w, int32_t v, thole *h)
+{
+  const tt__mesh *m = &w->m;
+  memset(h, 0, sizeof *h);
+  h->v = v;
+  int32_t star[64], sv[64];
+  int ns = 0, nsv = 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    if (tt__mesh_live(m, (int32_t)t))
+      for (int k = 0; k < 3; k++)
+        if (m->hv[3 * t + k] == v) {
+          if (ns >= 64)
+            return false;
+          star[ns++] = (int32_t)t;
+        }
+  for (int i = 0; i < ns; i++)
+    for (int k = 0; k < 3; k++)
+      if (!in_set(sv, nsv, m->hv[3 * star[i] + k]))
+        sv[nsv++] = m->hv[3 * star[i] + k];
+  /* neighbours across link edges */
+  int32_t nb[64], nbapex[64];
+  int nn = 0;
+  for (int i = 0; i < ns; i++)
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * star[i] + k;
+      if (m->hv[e] == v || m->hv[tt__next(e)] == v)
+        continue; /* a spoke */
+      int32_t f = m->twin[e];
+      if (f < 0 || (m->eflag[e] & TT__EDGE_CONSTRAINED))
+        continue;
+      int32_t apex = m->hv[tt__prev(f)];
+      if (in_set(sv, nsv, apex))
+        continue;
+      nb[nn] = f / 3;
+      nbapex[nn++] = apex;
+    }
+  int nslots = 0;
+  int32_t slots[128];
+  for (int i = 0; i < ns; i++)
+    slots[nslots++] = star[i];
+  for (int i = 0; i < nn; i++) {
+    bool shared = false;
+    for (int j = 0; j < nn; j++)
+      shared |= j != i && nbapex[j] == nbapex[i];
+    if (!shared)
+      slots[nslots++] = nb[i];
+  }
+  /* the outline: region half-edges whose twin is outside, chained */
+  int32_t oe[128];
+  int no = 0;
+  for (int i = 0; i < nslots; i++)
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * slots[i] + k, f = m->twin[e];
+      if (f < 0 || !in_set(slots, nslots, f / 3))
+        oe[no++] = e;
+    }
+  h->closed = true;
+  int start = 0;
+  for (int i = 0; i < no; i++)
+    if (m->hv[oe[i]] == v) {
+      h->closed = false;
+      start = i;
+    }
+  if (no + (h->closed ? 1 : 0) > MAXP)
+    return false;
+  int32_t cur = oe[start];
+  for (int i = 0; i < no; i++) {
+    h->id[i] = m->hv[cur];
+    h->outline[i][0] = m->hv[cur];
+    h->outline[i][1] = m->hv[tt__next(cur)];
+    h->outflag[i] = m->eflag[cur];
+    int32_t nx = -1;
+    for (int j = 0; j < no; j++)
+      if (m->hv[oe[j]] == m->hv[tt__next(cur)])
+        nx = oe[j];
+    CHECK(nx >= 0);
+    if (nx < 0)
+      return false;
+    cur = nx;
+  }
+  CHECK(cur == oe[start]); /* one loop */
+  h->nq = no;
+  h->np = no;
+  if (h->closed)
+    h->id[h->np++] = v;
+  for (int i = 0; i < h->np; i++) {
+    h->x[i] = m->v[h->id[i]].c;
+    h->y[i] = m->v[h->id[i]].r;
+  }
+  h->nslots = nslots;
+  for (int i = 0; i < nslots; i++) {
+    h->slots[i] = slots[i];
+    h->area += tri_area(w, m->hv[3 * slots[i]], m->hv[3 * slots[i] + 1],
+                        m->hv[3 * slots[i] + 2]);
+  }
+  /* constrained spokes of v that are not outline sides */
+  int vp = h->closed ? h->nq : 0;
+  for (int i = 0; i < ns; i++)
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * star[i] + k;
+      if (m->hv[e] != v || !(m->eflag[e] & TT__EDGE_CONSTRAINED))
+        continue;
+      int32_t x = m->hv[tt__next(e)];
+      for (int j = 0; j < h->np; j++)
+        if (h->id[j] == x && !(!h->closed && (j == 1 || j == h->nq - 1)))
+          if (h->nforced < 8) {
+            h->forced[h->nforced][0] = vp;
+            h->forced[h->nforced][1] = j;
+            h->nforced++;
+          }
+    }
+  return true;
+}
+
+/* segment i-j (points, not an outline side) inside the outline, through
+ * no other point */
+static bool seg_inside(const thole *h, int i, int j)
+{
+  for (int k = 0; k < h->np; k++)
+    if (k != i && k != j &&
+        on_seg(h->x[i], h->y[i], h->x[j], h->y[j], h->x[k], h->y[k]))
+      return false;
+  for (int k = 0; k < h->nq; k++) {
+    int k1 = (k + 1) % h->nq;
+    if (k == i || k == j || k1 == i || k1 == j)
+      continue;
+    if (seg_meet(h->x, h->y, i, j, k, k1))
+      return false;
+  }
+  /* midpoint strictly inside, even-odd in doubled coordinates */
+  int64_t mx = h->x[i] + h->x[j], my = h->y[i] + h->y[j];
+  bool in = false;
+  for (int k = 0; k < h->nq; k++) {
+    int k1 = (k + 1) % h->nq;
+    int64_t ax = 2 * h->x[k], ay = 2 * h->y[k], bx = 2 * h->x[k1],
+            by = 2 * h->y[k1];
+    if (on_seg(ax, ay, bx, by, mx, my))
+      return false;
+    if ((ay > my) != (by > my)) {
+      int64_t c = cross(ax, ay, bx, by, mx, my);
+      if ((by > ay) ? c > 0 : c < 0)
+        in = !in;
+    }
+  }
+  return in;
+}
+
+typedef struct oracle {
+  const world *w;
+  const thole *h;
+  int seg[80][2];
+  int nseg, need;
+  int pick[MAXP + 4];
+  int npick;
+  double best;
+  long count;
+} oracle;
+
+static bool is_outline_side(const thole *h, int a, int b)
+{
+  return a < h->nq && b < h->nq &&
+         ((a + 1) % h->nq == b || (b + 1) % h->nq == a);
+}
+
+static bool present(const oracle *o, int a, int b)
+{
+  if (is_outline_side(o->h, a, b))
+    return true;
+  for (int i = 0; i < o->npick; i++) {
+    int c = o->seg[o->pick[i]][0], d = o->seg[o->pick[i]][1];
+    if ((c == a && d == b) || (c == b && d == a))
+      return true;
+  }
+  return false;
+}
+
+static void evaluate(oracle *o)
+{
+  const thole *h = o->h;
+  for (int f = 0; f < h->nforced; f++)
+    if (!present(o, h->forced[f][0], h->forced[f][1]))
+      return;
+  int nt = 0;
+  double s = 0;
+  for (int a = 0; a < h->np; a++)
+    for (int b = a + 1; b < h->np; b++)
+      for (int c = b + 1; c < h->np; c++) {
+        if (!present(o, a, b) || !present(o, b, c) || !present(o, a, c))
+          continue;
+        int or = sgn(cross(h->x[a], h->y[a], h->x[b], h->y[b], h->x[c],
+                           h->y[c]));
+        if (or == 0)
+          return; /* cannot happen: no segment passes through a point */
+        bool empty = true;
+        for (int k = 0; k < h->np && empty; k++) {
+          if (k == a || k == b || k == c)
+            continue;
+          int o1 = sgn(cross(h->x[a], h->y[a], h->x[b], h->y[b], h->x[k],
+                             h->y[k]));
+          int o2 = sgn(cross(h->x[b], h->y[b], h->x[c], h->y[c], h->x[k],
+                             h->y[k]));
+          int o3 = sgn(cross(h->x[c], h->y[c], h->x[a], h->y[a], h->x[k],
+                             h->y[k]));
+          if (o1 * or >= 0 && o2 * or >= 0 && o3 * or >= 0)
+            empty = false;
+        }
+        if (!empty)
+          continue; /* three edges around another point: not a face */
+        s += tri_area(o->w, h->id[a], h->id[b], h->id[c]);
+        nt++;
+      }
+  int want = h->closed ? h->nq : h->nq - 2;
+  if (nt != want) {
+    TT_FAIL_("seed %" PRIu64 ": enumeration read %d faces, want %d", g_seed,
+             nt, want);
+    return;
+  }
+  o->count++;
+  if (s < o->best)
+    o->best = s;
+}
+
+static void choose(oracle *o, int from)
+{
+  if (o->npick == o->need) {
+    evaluate(o);
+    return;
+  }
+  for (int u = from; u < o->nseg; u++) {
+    bool ok = true;
+    for (int i = 0; i < o->npick && ok; i++) {
+      int a = o->seg[o->pick[i]][0], b = o->seg[o->pick[i]][1];
+      int c = o->seg[u][0], d = o->seg[u][1];
+      if (a == c || a == d || b == c || b == d)
+        continue;
+      ok = !seg_meet(o->h->x, o->h->y, a, b, c, d);
+    }
+    if (!ok)
+      continue;
+    o->pick[o->npick++] = u;
+    choose(o, u + 1);
+    o->npick--;
+  }
+}
+
+/* The least area over every triangulation of the hole; *out_count of
+ * them. */
+static double enumerate(const world *w, const thole *h, long *out_count)
+{
+  oracle o;
+  memset(&o, 0, sizeof o);
+  o.w = w;
+  o.h = h;
+  o.best = INFINITY;
+  for (int i = 0; i < h->np; i++)
+    for (int j = i + 1; j < h->np; j++)
+      if (!is_outline_side(h, i, j) && seg_inside(h, i, j)) {
+        o.seg[o.nseg][0] = i;
+        o.seg[o.nseg][1] = j;
+        o.nseg++;
+      }
+  /* inner edges: closed, n outline points and v: n; open: n - 3 */
+  o.need = h->closed ? h->nq : h->nq - 3;
+  choose(&o, 0);
+  *out_count = o.count;
+  return o.best;
+}
+
+/* --- one checked call ----------------------------------------------------- */
+
+static int g_calls, g_enumerated, g_changed, g_open, g_fixed;
+
+/* v's star size: live triangles with v as a corner. */
+static int degree(const tt__mesh *m, int32_t v)
+{
+  int d = 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    if (tt__mesh_live(m, (int32_t)t))
+      for (int k = 0; k < 3; k++)
+        d += m->hv[3 * t + k] == v;
+  return d;
+}
+
+static void checked_call(world *w, int32_t v, const char *what, int step,
+                         bool ties_only)
+{
+  tt__mesh *m = &w->m;
+  thole h;
+  bool small = build_thole(w, v, &h);
+  /* every constrained edge before */
+  int32_t (*cons)[2] = malloc(3 * m->nslots * sizeof *cons + 1);
+  int ncons = 0;
+  for (size_t e = 0; e < 3 * m->nslots; e++)
+    if (tt__mesh_live(m, (int32_t)(e / 3)) &&
+        (m->eflag[e] & TT__EDGE_CONSTRAINED)) {
+      cons[ncons][0] = m->hv[e];
+      cons[ncons][1] = m->hv[tt__next((int32_t)e)];
+      ncons++;
+    }
+  double best = NAN;
+  long count = 0;
+  if (small) {
+    best = enumerate(w, &h, &count);
+    CHECK(count > 0);
+    g_enumerated++;
+    g_open += !h.closed;
+    g_fixed += h.nforced > 0;
+  }
+  double before = total_area(w);
+  size_t nslots0 = m->nslots;
+  int32_t *hv0 = malloc(3 * nslots0 * sizeof *hv0);
+  memcpy(hv0, m->hv, 3 * nslots0 * sizeof *hv0);
+  tt__mesh_clear_touched(m);
+  int32_t opp[TT__HOLE_MAX_N];
+  int k = tt__hole_min_area(m, &w->env, v, opp, TT__HOLE_MAX_N);
+  g_calls++;
+  CHECK(k > 0);
+  if (!validate(m, what, step))
+    goto out;
+  double after = total_area(w);
+  bool changed = m->ntouched > 0;
+  g_changed += changed;
+  if (!changed)
+    CHECK(m->nslots == nslots0 &&
+          memcmp(hv0, m->hv, 3 * nslots0 * sizeof *hv0) == 0);
+  if (ties_only && changed)
+    TT_FAIL_("seed %" PRIu64 " %s step %d: every triangulation ties, yet "
+             "the mesh changed (%.17g -> %.17g)", g_seed, what, step, before,
+             after);
+  /* never larger than the split it started from */
+  if (!(after <= before + 1e-12 * before))
+    TT_FAIL_("seed %" PRIu64 " %s step %d: area grew %.17g -> %.17g", g_seed,
+             what, step, before, after);
+  if (small && count > 0) {
+    double hole_after = h.area + (after - before);
+    double tol = 1e-9 * h.area + 1e-12 * before;
+    if (!(fabs(hole_after - best) <= tol))
+      TT_FAIL_("seed %" PRIu64 " %s step %d: hole (%d points, %s, %d "
+               "forced) has area %.17g, the best of %ld triangulations "
+               "%.17g (it was %.17g)", g_seed, what, step, h.np,
+               h.closed ? "v inside" : "v on the boundary", h.nforced,
+               hole_after, count, best, h.area);
+    /* the outline is still there, flags kept */
+    for (int i = 0; i < h.nq; i++) {
+      int32_t e = tt__mesh_find_edge(m, h.outline[i][0], h.outline[i][1]);
+      CHECK(e >= 0);
+      if (e >= 0)
+        CHECK_INT_EQ(m->eflag[e], h.outflag[i]);
+    }
+  }
+  for (int i = 0; i < ncons; i++) {
+    int32_t e = tt__mesh_find_edge(m, cons[i][0], cons[i][1]);
+    if (e < 0 || !(m->eflag[e] & TT__EDGE_CONSTRAINED)) {
+      TT_FAIL_("seed %" PRIu64 " %s step %d: constrained edge %d-%d lost "
+               "(e %d, v %d, changed %d)",
+               g_seed, what, step, cons[i][0], cons[i][1], e, v, changed);
+      break;
+    }
+  }
+  /* opposite[]: every link edge of v once, v the apex of each */
+  CHECK_INT_EQ(k, degree(m, v));
+  for (int i = 0; i < k; i++) {
+    CHECK(tt__mesh_live(m, opp[i] / 3));
+    CHECK_INT_EQ(tt__mesh_apex(m, opp[i]), v);
+    for (int j = 0; j < i; j++)
+      CHECK(opp[i] != opp[j]);
+  }
+out:
+  free(cons);
+  free(hv0);
+}
+
+/* --- the scenarios -------------------------------------------------------- */
+
+static const double frames[][4] = {
+    {1, 0, 0, 1},            /* pixel units */
+    {30, 0, 0, -30},         /* north-up, square pixels: mirrored */
+    {89.98, 0, 0, -90.02},   /* non-square pixels */
+    {2, 1, 0, 3},            /* sheared */
+    {0.7, -0.2, 0.3, -1.1},  /* rotated, mirrored */
+    {8.660254037844386, -5, 5, 8.660254037844386}, /* rotated 30 degrees */
+};
+#define NFRAMES (int)(sizeof frames / sizeof frames[0])
+
+/* Random worlds, then splits at random samples and at edge midpoints
+ * (inner, constrained and boundary edges), each checked. */
+static void random_holes(uint64_t *rng)
+{
+  for (int round = 0; round < 120; round++) {
+    world w;
+    int W = 4 + (int)(tt_test_rand(rng) % 9), H = 4 + (int)(tt_test_rand(rng) % 7);
+    int zkind = round % 7 == 5 ? Z_FLAT : round % 7 == 6 ? Z_PLANE
+                : round % 2 ? Z_SMOOTH : Z_RANDOM;
+    world_init(&w, frames[round % NFRAMES], W, H, zkind, rng);
+    int npts = 4 + (int)(tt_test_rand(rng) % (unsigned)((W + 1) * (H + 1) / 3));
+    grow(&w, npts, 0.15 + 0.3 * (round % 3 == 0), rng);
+    if (!validate(&w.m, "grow", round))
+      goto next;
+    for (int step = 0; step < 12; step++) {
+      int c, r;
+      if (tt_test_rand(rng) % 2) {
+        c = (int)(tt_test_rand(rng) % (uint64_t)(W + 1));
+        r = (int)(tt_test_rand(rng) % (uint64_t)(H + 1));
+      } else {
+        /* the midpoint of a random edge, when it is a sample */
+        int32_t e = (int32_t)(tt_test_rand(rng) % (3 * w.m.nslots));
+        if (!tt__mesh_live(&w.m, e / 3))
+          continue;
+        const tt__mesh_vertex *a = &w.m.v[w.m.hv[e]],
+                              *b = &w.m.v[w.m.hv[tt__next(e)]];
+        if ((a->c + b->c) % 2 || (a->r + b->r) % 2)
+          continue;
+        c = (a->c + b->c) / 2;
+        r = (a->r + b->r) / 2;
+      }
+      int32_t opp[4];
+      int nopp;
+      int32_t v = insert(&w, c, r, opp, &nopp);
+      if (v < 0)
+        continue;
+      if (!validate(&w.m, "split", step))
+        goto next;
+      checked_call(&w, v, "random hole", round * 100 + step,
+                   zkind == Z_FLAT || zkind == Z_PLANE);
+      if (tt_test_failures > 20)
+        goto next;
+    }
+  next:
+    world_free(&w);
+  }
+}
+
+/* A refinement-like run: insert samples, re-triangulate the hole, then
+ * min-area swaps from v's link edges. Returns a copy of the final mesh
+ * arrays (the caller frees) and the call count. */
+static int32_t *refine_like(const double frame[4], uint64_t seed, int W,
+                            int H, int n, size_t *out_len, double *out_secs,
+                            int *out_calls)
+{
+  uint64_t rng = seed;
+  world w;
+  world_init(&w, frame, W, H, Z_SMOOTH, &rng);
+  tt__edge_stack stack = {0};
+  double secs = 0;
+  int calls = 0;
+  for (int tries = 0; tries < 50 * n && (int)w.m.nv < n; tries++) {
+    int c = (int)(tt_test_rand(&rng) % (uint64_t)(W + 1));
+    int r = (int)(tt_test_rand(&rng) % (uint64_t)(H + 1));
+    int32_t opp[4];
+    int nopp;
+    int32_t v = insert(&w, c, r, opp, &nopp);
+    if (v < 0)
+      continue;
+    int32_t link[TT__HOLE_MAX_N];
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    int k = tt__hole_min_area(&w.m, &w.env, v, link, TT__HOLE_MAX_N);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    secs += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    calls++;
+    CHECK(k > 0);
+    if (k <= 0)
+      break;
+    CHECK(tt__swap_repair(&w.m, &tt__criterion_min_area, &w.env, link, k,
+                          &stack) >= 0);
+    tt__mesh_clear_touched(&w.m);
+  }
+  validate(&w.m, "refine-like", calls);
+  size_t len = 3 * w.m.nslots;
+  int32_t *copy = malloc((2 * len + 1) * sizeof *copy);
+  memcpy(copy, w.m.hv, len * sizeof *copy);
+  memcpy(copy + len, w.m.twin, len * sizeof *copy);
+  *out_len = 2 * len;
+  *out_secs = secs;
+  *out_calls = calls;
+  tt__edge_stack_free(&stack);
+  world_free(&w);
+  return copy;
+}
+
+/* replace_region refuses what does not fit the outline, mesh unchanged. */
+static void replace_refusals(void)
+{
+  world w;
+  uint64_t rng = 7;
+  world_init(&w, frames[0], 4, 4, Z_RANDOM, &rng);
+  int32_t opp[4];
+  int nopp;
+  int32_t v = insert(&w, 1, 2, opp, &nopp);
+  CHECK(v >= 0 && nopp == 3);
+  tt__mesh *m = &w.m;
+  int32_t slots[3] = {opp[0] / 3, opp[1] / 3, opp[2] / 3};
+  int32_t tris[3][3];
+  for (int t = 0; t < 3; t++)
+    for (int k = 0; k < 3; k++)
+      tris[t][k] = m->hv[3 * slots[t] + k];
+  size_t len = 3 * m->nslots;
+  int32_t *hv0 = malloc(len * sizeof *hv0), *tw0 = malloc(len * sizeof *tw0);
+  memcpy(hv0, m->hv, len * sizeof *hv0);
+  memcpy(tw0, m->twin, len * sizeof *tw0);
+  /* the same triangles, rotated and in another order: accepted */
+  int32_t same[3][3] = {{tris[2][1], tris[2][2], tris[2][0]},
+                        {tris[0][0], tris[0][1], tris[0][2]},
+                        {tris[1][2], tris[1][0], tris[1][1]}};
+  CHECK(tt__mesh_replace_region(m, slots, 3, (const int32_t(*)[3])same, 3));
+  validate(m, "replace same", 0);
+  CHECK_INT_EQ(m->ntouched >= 3, 1);
+  /* two of them only: part of the outline not covered */
+  memcpy(hv0, m->hv, len * sizeof *hv0);
+  memcpy(tw0, m->twin, len * sizeof *tw0);
+  CHECK(!tt__mesh_replace_region(m, slots, 3, (const int32_t(*)[3])same, 2));
+  /* a clockwise triangle */
+  int32_t cw[3][3];
+  memcpy(cw, same, sizeof cw);
+  cw[0][1] = same[0][2];
+  cw[0][2] = same[0][1];
+  CHECK(!tt__mesh_replace_region(m, slots, 3, (const int32_t(*)[3])cw, 3));
+  /* the big triangle without v: its outline fits, so it is accepted and v
+   * is left in no triangle */
+  CHECK(memcmp(hv0, m->hv, len * sizeof *hv0) == 0 &&
+        memcmp(tw0, m->twin, len * sizeof *tw0) == 0);
+  int32_t big[1][3];
+  int nb = 0;
+  for (int t = 0; t < 3; t++)
+    for (int k = 0; k < 3; k++)
+      if (same[t][k] != v && same[t][(k + 1) % 3] != v) {
+        big[0][0] = same[t][k];
+        big[0][1] = same[t][(k + 1) % 3];
+      }
+  for (int t = 0; t < 3; t++)
+    for (int k = 0; k < 3; k++)
+      if (same[t][k] != v && same[t][k] != big[0][0] &&
+          same[t][k] != big[0][1])
+        big[0][2] = same[t][k], nb++;
+  CHECK(nb > 0);
+  CHECK(tt__mesh_replace_region(m, slots, 3, (const int32_t(*)[3])big, 1));
+  validate(m, "replace big", 0);
+  CHECK_INT_EQ(m->v[v].edge, -1);
+  CHECK_INT_EQ(m->nfree, 2);
+  /* and back into three (slots from the free list) */
+  int32_t one[1] = {slots[0]};
+  for (int t = 0; t < 3; t++)
+    if (tt__mesh_live(m, slots[t]))
+      one[0] = slots[t];
+  CHECK(tt__mesh_replace_region(m, one, 1, (const int32_t(*)[3])same, 3));
+  validate(m, "replace back", 0);
+  CHECK_INT_EQ(m->nfree, 0);
+  CHECK(m->v[v].edge >= 0);
+  free(hv0);
+  free(tw0);
+  world_free(&w);
+}
+
+int main(void)
+{
+  g_seed = 20261122;
+  const char *env = getenv("TT_SEED");
+  if (env)
+    g_seed = strtoull(env, NULL, 10);
+  printf("seed %" PRIu64 " (TT_SEED=%" PRIu64 " replays it)\n", g_seed,
+         g_seed);
+  uint64_t rng = g_seed;
+
+  replace_refusals();
+
+  random_holes(&rng);
+  printf("%d calls, %d holes enumerated (%d with v on the mesh boundary, "
+         "%d with constrained spokes), %d re-triangulated\n",
+         g_calls, g_enumerated, g_open, g_fixed, g_changed);
+  CHECK(g_enumerated >= 300);
+  CHECK(g_open >= 10);
+  CHECK(g_fixed >= 10);
+  CHECK(g_changed >= 50);
+
+  /* determinism: two runs, identical meshes */
+  for (int f = 0; f < NFRAMES; f += 2) {
+    size_t la, lb;
+    double sa, sb;
+    int ca, cb;
+    int32_t *a = refine_like(frames[f], g_seed + (uint64_t)f, 60, 50, 400,
+                             &la, &sa, &ca);
+    int32_t *b = refine_like(frames[f], g_seed + (uint64_t)f, 60, 50, 400,
+                             &lb, &sb, &cb);
+    CHECK(la == lb && ca == cb && memcmp(a, b, la * sizeof *a) == 0);
+    free(a);
+    free(b);
+  }
+
+  /* speed on a larger terrain (printed, never checked) */
+  {
+    size_t len;
+    double secs;
+    int calls;
+    int32_t *a = refine_like(frames[1], g_seed, 1000, 1000, 20000, &len,
+                             &secs, &calls);
+    printf("tt__hole_min_area: %d calls, mean %.2f us per call\n", calls,
+           calls ? 1e6 * secs / calls : 0.0);
+    free(a);
+  }
+  TT_TEST_DONE();
+}
