@@ -533,6 +533,7 @@ static double enumerate(const world *w, const thole *h, long *out_count)
 /* --- one checked call ----------------------------------------------------- */
 
 static int g_calls, g_enumerated, g_changed, g_open, g_fixed;
+static int g_size[2][MAXP + 1]; /* holes by outline size, v inside/on it */
 
 /* v's star size: live triangles with v as a corner. */
 static int degree(const tt__mesh *m, int32_t v)
@@ -569,6 +570,7 @@ static void checked_call(world *w, int32_t v, const char *what, int step,
     g_enumerated++;
     g_open += !h.closed;
     g_fixed += h.nforced > 0;
+    g_size[h.closed][h.nq]++;
   }
   double before = total_area(w);
   size_t nslots0 = m->nslots;
@@ -650,7 +652,7 @@ static const double frames[][4] = {
  * (inner, constrained and boundary edges), each checked. */
 static void random_holes(uint64_t *rng)
 {
-  for (int round = 0; round < 120; round++) {
+  for (int round = 0; round < 300; round++) {
     world w;
     int W = 4 + (int)(tt_test_rand(rng) % 9), H = 4 + (int)(tt_test_rand(rng) % 7);
     int zkind = round % 7 == 5 ? Z_FLAT : round % 7 == 6 ? Z_PLANE
@@ -831,10 +833,19 @@ int main(void)
   printf("%d calls, %d holes enumerated (%d with v on the mesh boundary, "
          "%d with constrained spokes), %d re-triangulated\n",
          g_calls, g_enumerated, g_open, g_fixed, g_changed);
-  CHECK(g_enumerated >= 300);
-  CHECK(g_open >= 10);
-  CHECK(g_fixed >= 10);
-  CHECK(g_changed >= 50);
+  for (int c = 1; c >= 0; c--) {
+    printf("  outline sizes, v %s:", c ? "inside" : "on the mesh boundary");
+    for (int n = 3; n <= MAXP; n++)
+      if (g_size[c][n])
+        printf(" %d: %d", n, g_size[c][n]);
+    printf("\n");
+  }
+  CHECK(g_enumerated >= 1000);
+  CHECK(g_size[1][6] >= 20); /* triangle splits, three neighbours */
+  CHECK(g_size[1][8] >= 20); /* edge splits, four neighbours */
+  CHECK(g_open >= 100);
+  CHECK(g_fixed >= 50);
+  CHECK(g_changed >= 300);
 
   /* determinism: two runs, identical meshes */
   for (int f = 0; f < NFRAMES; f += 2) {
