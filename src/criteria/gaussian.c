@@ -46,6 +46,9 @@
  */
 #include "geometry.h"
 
+#include <stdlib.h>
+#include <string.h>
+
 #define TT__STAR_MAX 256
 
 /* A star: the neighbours of v in counter-clockwise (ground) order. */
@@ -56,7 +59,9 @@ typedef struct star {
 } star;
 
 /* Gathers v's star from the mesh; false when the degree exceeds the cap or
- * v is in no triangle. */
+ * v is in no triangle. An interior star is read in one counter-clockwise
+ * walk from v's edge; only when that walk meets the boundary is the star
+ * read again from its clockwise end (boundary vertices are few). */
 static bool star_gather(const tt__mesh *m, int32_t v, star *s)
 {
   int32_t h0 = m->v[v].edge;
@@ -64,19 +69,25 @@ static bool star_gather(const tt__mesh *m, int32_t v, star *s)
   s->boundary = false;
   if (h0 < 0)
     return false;
-  /* walk clockwise to the boundary, if any: cw(h) = next(twin[h]) */
   int32_t h = h0;
   for (;;) {
-    int32_t t = m->twin[h];
-    if (t < 0) {
-      s->boundary = true;
+    if (s->n >= TT__STAR_MAX)
+      return false;
+    s->nb[s->n++] = m->hv[tt__next(h)];
+    int32_t t = m->twin[tt__prev(h)];
+    if (t < 0)
       break;
-    }
-    h = tt__next(t);
+    h = t;
     if (h == h0)
-      break;
+      return true;
   }
-  int32_t start = h;
+  /* a boundary star: walk clockwise to the boundary, cw(h) =
+   * next(twin[h]), then read it counter-clockwise from there */
+  s->n = 0;
+  s->boundary = true;
+  h = h0;
+  for (int32_t t; (t = m->twin[h]) >= 0;)
+    h = tt__next(t);
   for (;;) {
     if (s->n >= TT__STAR_MAX)
       return false;
@@ -87,13 +98,10 @@ static bool star_gather(const tt__mesh *m, int32_t v, star *s)
       if (s->n >= TT__STAR_MAX)
         return false;
       s->nb[s->n++] = m->hv[p];
-      break;
+      return true;
     }
     h = t;
-    if (h == start)
-      break;
   }
-  return true;
 }
 
 static void star_remove(star *s, int32_t x)
@@ -165,6 +173,9 @@ typedef struct rays {
   float zk[TT__STAR_MAX + 1];
   float zv;
   double maxc;                          /* largest |x|, |y|, |z| of p[] */
+  bool ints;                            /* p[] are integers of at most
+                                           2^16: every triple product is
+                                           exact in doubles (below) */
   unsigned char sides[TT__STAR_MAX + 1];/* pair (i, i+1): 1 when a ray lies
                                            on its positive side, 2 on its
                                            negative side (both: stopped) */
@@ -228,6 +239,15 @@ static inline void pair_make(const rays *r, int i, int j, pair *p)
    * sum_k |x_k| (|yi zj| + |zi yj|) + ...; bounding every |x_k| by the
    * star's largest coordinate gives one bound per pair, valid for every
    * third ray, so a test costs a dot product and two comparisons. */
+  if (r->ints) {
+    /* integers up to 2^16: the products are below 2^32, n below 2^33,
+     * n . e_k below 3 2^49 < 2^53, so the double result is exact and a
+     * zero bound lets side() take its sign as it is (integer heights,
+     * the common case, meet many exact zeros on flats, which the bound
+     * below would send to the exact sum) */
+    p->bound = 0;
+    return;
+  }
   double per = fabs(yi * zj) + fabs(zi * yj) + fabs(zi * xj) +
                fabs(xi * zj) + fabs(xi * yj) + fabs(yi * xj);
   p->bound = 1e-15 * per * r->maxc;
@@ -242,9 +262,11 @@ static inline int side(const rays *r, const pair *p, int i, int j, int k)
   if (det < -p->bound)
     return -1;
   if (p->bound == 0)
-    return 0; /* the cross product is exactly zero */
+    return 0; /* exact (r->ints) or the cross product is exactly zero */
   return exact_sign(r, i, j, k);
 }
+
+static void rays_finish(rays *r, int n);
 
 int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
                         const float z[3], float zv)
@@ -259,24 +281,45 @@ int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
     r.p[i].y = (double)dr[i];
     r.p[i].z = (double)z[i] - (double)zv;
   }
-  r.maxc = 0;
-  for (int i = 0; i < 3; i++)
-    r.maxc = fmax(r.maxc, fmax(fabs(r.p[i].x),
-                               fmax(fabs(r.p[i].y), fabs(r.p[i].z))));
+  rays_finish(&r, 3);
   pair p;
   pair_make(&r, 0, 1, &p);
   return side(&r, &p, 0, 1, 2);
 }
 
+static inline double max3abs(double m, double x, double y, double z)
+{
+  x = fabs(x);
+  y = fabs(y);
+  z = fabs(z);
+  m = x > m ? x : m;
+  m = y > m ? y : m;
+  return z > m ? z : m;
+}
+
+/* Sets maxc and ints from the n rays in p[]. */
+static void rays_finish(rays *r, int n)
+{
+  double mx = 0;
+  for (int i = 0; i < n; i++)
+    mx = max3abs(mx, r->p[i].x, r->p[i].y, r->p[i].z);
+  r->maxc = mx;
+  bool ints = mx <= 65536.0;
+  for (int i = 0; i < n && ints; i++)
+    ints = fabs(r->p[i].z) <= 65536.0 && /* (and not NaN) */
+           r->p[i].z == (double)(int32_t)r->p[i].z; /* x, y are integers */
+  r->ints = ints;
+}
+
 static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
                       const star *s, rays *r)
 {
-  r->zv = m->v[v].z;
-  double mx = 0;
+  const tt__mesh_vertex *o = &m->v[v];
+  r->zv = o->z;
   for (int i = 0; i < s->n; i++) {
     const tt__mesh_vertex *w = &m->v[s->nb[i]];
-    r->dc[i] = (int64_t)w->c - m->v[v].c;
-    r->dr[i] = (int64_t)w->r - m->v[v].r;
+    r->dc[i] = (int64_t)w->c - o->c;
+    r->dr[i] = (int64_t)w->r - o->r;
     r->zk[i] = w->z;
     double dc = (double)r->dc[i], dr = (double)r->dr[i];
     double dz = (double)w->z - (double)r->zv;
@@ -285,9 +328,8 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
     r->p[i].z = dz;
     tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr, dz};
     r->g[i] = g;
-    mx = fmax(mx, fmax(fabs(dc), fmax(fabs(dr), fabs(dz))));
   }
-  r->maxc = mx;
+  rays_finish(r, s->n);
 }
 
 /* Sums of angles without an atan2 per angle: angle theta = atan2(c, d)
@@ -335,6 +377,9 @@ static inline double turn_angle(const turn *t)
   return 2 * TT__PI * t->k + a;
 }
 
+/* x mod n for 0 <= x < 2n, without a division */
+static inline int wrap(int x, int n) { return x >= n ? x - n : x; }
+
 /* |K| of v with star s; the class in *out_class. */
 static double star_curvature(const tt__mesh *m, const double fr[4],
                              int32_t v, const star *s, rays *r,
@@ -345,7 +390,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
   turn tsum = {1, 0, 0};
   int nang = s->boundary ? n - 1 : n;
   for (int i = 0; i < nang; i++)
-    turn_add(&tsum, r->g[i], r->g[(i + 1) % n]);
+    turn_add(&tsum, r->g[i], r->g[wrap(i + 1, n)]);
   double sum = turn_angle(&tsum);
   if (s->boundary) {
     *out_class = TT__VERTEX_BOUNDARY;
@@ -353,15 +398,23 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
   }
   int nsupport = 0, start = -1, sgn = 0;
   for (int i = 0; i < n; i++) {
-    int j = (i + 1) % n;
+    int j = wrap(i + 1, n);
     pair p;
     pair_make(r, i, j, &p);
     bool pos = false, neg = false;
     /* the other rays from the pair outwards, alternating sides (i+2, i-1,
      * i+3, i-2, ...): a ray that breaks the plane is most often next to
      * the pair, so saddles are rejected after a test or two */
+    int kf = wrap(j + 1, n), kb = i == 0 ? n - 1 : i - 1;
     for (int t = 0; t < n - 2 && !(pos && neg); t++) {
-      int k = (t & 1) ? (i - 1 - t / 2 + n) % n : (j + 1 + t / 2) % n;
+      int k;
+      if (t & 1) {
+        k = kb;
+        kb = kb == 0 ? n - 1 : kb - 1;
+      } else {
+        k = kf;
+        kf = wrap(kf + 1, n);
+      }
       int sd = side(r, &p, i, j, k);
       pos |= sd > 0;
       neg |= sd < 0;
@@ -393,8 +446,8 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
   int tp = 0;
   unsigned char wrong = sgn > 0 ? 2 : 1;
   while (tp < n) {
-    int p = (start + tp) % n;
-    int tq = tp + 1, q = (start + tq) % n;
+    int p = wrap(start + tp, n);
+    int tq = tp + 1, q = wrap(start + tq, n);
     if (!(r->sides[p] & wrong)) {
       turn_add(&thull, r->g[p], r->g[q]);
       tp = tq;
@@ -403,7 +456,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
     pair pq;
     pair_make(r, p, q, &pq);
     for (int tr = tp + 2; tr <= n; tr++) {
-      int x = (start + tr) % n;
+      int x = wrap(start + tr, n);
       if (x == p)
         continue; /* the start itself, seen from the start */
       if (sgn * side(r, &pq, p, q, x) < 0) {
@@ -435,6 +488,120 @@ double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)
   return k;
 }
 
+/* --- the per-run cache of |K| ------------------------------------------
+ *
+ * |K(v)| depends on v's neighbours, their order and whether the star is
+ * open, and on nothing else: vertices never move and the frame is the
+ * run's. So a value computed once for a canonical neighbour list (star_canon)
+ * stays true for that list, and an entry keyed by the whole list can be
+ * trusted whenever the list matches -- a proof, not a hash. Two entries per
+ * vertex: [0] the star last met in the mesh, [1] the last star made by
+ * editing one ("the other configuration" of a quad), which becomes the
+ * mesh's own when that swap is taken. Stars of degree above GC_KEY are not
+ * cached (a terrain TIN has degree 6 on average; the few higher ones are
+ * computed each time). Refinement's flips around a new vertex meet the same
+ * stars again and again: the new vertex's in every quad, each neighbour's
+ * in two, and after a flip the three stars it changed are the ones just
+ * computed as "other". The cache grows with the mesh (vertex ids are
+ * dense); when it cannot, values are computed as without it. */
+#define GC_KEY 13
+
+typedef struct gentry {
+  double k;              /* |K| */
+  int32_t tag;           /* 2 * degree + boundary; 0: empty */
+  int32_t nb[GC_KEY];    /* the canonical neighbour list */
+} gentry;                /* 64 bytes: one cache line */
+
+typedef struct gcache {
+  const tt__mesh *mesh;  /* the mesh and frame it was made for; another */
+  double fr[4];          /* environment is served without it */
+  gentry (*e)[2];        /* per vertex */
+  size_t cap;            /* vertices covered */
+} gcache;
+
+static void *gaussian_cache_new(const tt__crit_env *env)
+{
+  gcache *c = calloc(1, sizeof *c);
+  if (!c)
+    return NULL;
+  c->mesh = env->mesh;
+  tt__geo_frame(env, c->fr);
+  return c;
+}
+
+static void gaussian_cache_free(void *cache)
+{
+  gcache *c = cache;
+  if (!c)
+    return;
+  free(c->e);
+  free(c);
+}
+
+/* The cache of env when it serves env's mesh and frame, else NULL. */
+static gcache *cache_of(const tt__crit_env *env, const double fr[4])
+{
+  gcache *c = env->cache;
+  if (!c || c->mesh != env->mesh || c->fr[0] != fr[0] || c->fr[1] != fr[1] ||
+      c->fr[2] != fr[2] || c->fr[3] != fr[3])
+    return NULL;
+  return c;
+}
+
+/* v's two entries, the cache grown to the mesh first; NULL when out of
+ * memory. */
+static gentry *cache_slots(gcache *c, const tt__mesh *m, int32_t v)
+{
+  if ((size_t)v >= c->cap) {
+    size_t old = c->cap, need = m->nv > (size_t)v ? m->nv : (size_t)v + 1;
+    if (!tt__grow((void **)&c->e, &c->cap, need, sizeof c->e[0]))
+      return NULL;
+    memset(c->e + old, 0, (c->cap - old) * sizeof c->e[0]);
+  }
+  return c->e[v];
+}
+
+static bool entry_is(const gentry *x, int32_t tag, const star *s)
+{
+  if (x->tag != tag)
+    return false;
+  for (int i = 0; i < s->n; i++)
+    if (x->nb[i] != s->nb[i])
+      return false;
+  return true;
+}
+
+/* |K| of v with canonical star s, through the cache c (may be NULL);
+ * mine: s is v's star in the mesh (else an edited one). */
+static double star_k(const tt__mesh *m, const double fr[4], gcache *c,
+                     int32_t v, const star *s, bool mine, rays *r)
+{
+  gentry *slot = NULL;
+  int32_t tag = 2 * s->n + (s->boundary ? 1 : 0);
+  gentry *x = c && s->n <= GC_KEY ? cache_slots(c, m, v) : NULL;
+  if (x) {
+    if (entry_is(&x[0], tag, s))
+      return x[0].k;
+    if (entry_is(&x[1], tag, s)) {
+      if (!mine)
+        return x[1].k;
+      gentry t = x[0]; /* the mesh took the other configuration */
+      x[0] = x[1];
+      x[1] = t;
+      return x[0].k;
+    }
+    slot = &x[mine ? 0 : 1];
+  }
+  int cls;
+  double k = star_curvature(m, fr, v, s, r, &cls);
+  if (slot) {
+    slot->k = k;
+    slot->tag = tag;
+    memcpy(slot->nb, s->nb, (size_t)s->n * sizeof s->nb[0]);
+  }
+  return k;
+}
+
 static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
 {
   const tt__mesh *m = env->mesh;
@@ -443,6 +610,7 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
   tt__geo_frame(env, fr);
   if (!tt__quad_load(env, e, fr, &q))
     return 0.0;
+  gcache *c = cache_of(env, fr);
   /* canonical order a, b, c, d; "mine" is the mesh's configuration, the
    * other one is made by editing the stars: with a-b in the mesh, a and b
    * lose each other, c gains d after a, d gains c after b; with c-d in the
@@ -450,29 +618,31 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
   bool ab = q.sign > 0;
   int32_t vs[4] = {q.a, q.b, q.c, q.d};
   double sa = 0, sb = 0; /* sum |K| with diagonal a-b, with c-d */
-  star s;
+  star s, o;
   rays r;
   for (int i = 0; i < 4; i++) {
-    int cls;
     if (!star_gather(m, vs[i], &s))
       continue;
     star_canon(&s);
-    double kmine = star_curvature(m, fr, vs[i], &s, &r, &cls);
+    o.n = s.n;
+    o.boundary = s.boundary;
+    memcpy(o.nb, s.nb, (size_t)s.n * sizeof s.nb[0]);
     bool ok = true;
     switch (i) {
-    case 0: ok = ab ? (star_remove(&s, q.b), true)
-                    : star_insert_after(&s, q.d, q.b); break;
-    case 1: ok = ab ? (star_remove(&s, q.a), true)
-                    : star_insert_after(&s, q.c, q.a); break;
-    case 2: ok = ab ? star_insert_after(&s, q.a, q.d)
-                    : (star_remove(&s, q.d), true); break;
-    default: ok = ab ? star_insert_after(&s, q.b, q.c)
-                     : (star_remove(&s, q.c), true); break;
+    case 0: ok = ab ? (star_remove(&o, q.b), true)
+                    : star_insert_after(&o, q.d, q.b); break;
+    case 1: ok = ab ? (star_remove(&o, q.a), true)
+                    : star_insert_after(&o, q.c, q.a); break;
+    case 2: ok = ab ? star_insert_after(&o, q.a, q.d)
+                    : (star_remove(&o, q.d), true); break;
+    default: ok = ab ? star_insert_after(&o, q.b, q.c)
+                     : (star_remove(&o, q.c), true); break;
     }
     if (!ok)
-      continue;
-    star_canon(&s);
-    double kother = star_curvature(m, fr, vs[i], &s, &r, &cls);
+      continue; /* a star past the cap: the vertex counts 0 both ways */
+    star_canon(&o);
+    double kmine = star_k(m, fr, c, vs[i], &s, true, &r);
+    double kother = star_k(m, fr, c, vs[i], &o, false, &r);
     sa += ab ? kmine : kother;
     sb += ab ? kother : kmine;
   }
@@ -544,4 +714,5 @@ static int gaussian_affected(const tt__crit_env *env, int32_t h,
 
 const tt__criterion_vt tt__criterion_gaussian = {
     TT_CRITERION_GAUSSIAN_CURVATURE, "gaussian_curvature", true,
-    gaussian_swap_value, gaussian_affected, NULL, NULL};
+    gaussian_swap_value, gaussian_affected, gaussian_cache_new,
+    gaussian_cache_free};

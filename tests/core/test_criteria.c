@@ -913,6 +913,123 @@ static void gaussian_paraboloid(tt_context *ctx)
   tt_grid_destroy(g);
 }
 
+/* Gaussian curvature's per-run cache (cache_new) never changes a value:
+ * random insertions (Lawson flips under the criterion, through the cached
+ * environment, so the cache grows and follows the stars as they change)
+ * and random swaps, swaps back and swaps kept; at every step the cached
+ * and the uncached swap value are identical (==, not close), and a swap
+ * and its swap back have exactly opposite values both ways. Heights:
+ * integers (the exact-in-doubles sign path), terraces (flats: coplanar
+ * rays), floats, and integers past that path's 2^16 limit. A cache made
+ * for one mesh and handed another is not used. */
+static void gaussian_cache(tt_context *ctx, uint64_t seed)
+{
+  const tt__criterion_vt *vt =
+      tt__criterion_get(TT_CRITERION_GAUSSIAN_CURVATURE);
+  CHECK(vt->cache_new != NULL && vt->cache_free != NULL);
+  if (!vt->cache_new || !vt->cache_free)
+    return;
+  const double frames[][4] = {{1, 0, 0, 1}, {30, 0, 0, -30},
+                              {2, 1, 0, 3}, {0.7, -0.2, 0.3, -1.1}};
+  long compared = 0, kept = 0;
+  for (int mode = 0; mode < 4; mode++)
+    for (int fi = 0; fi < 4; fi++) {
+      uint64_t s0 = seed + 16 * (uint64_t)mode + (uint64_t)fi, rng = s0;
+      int nx = 40 + (int)(tt_test_rand(&rng) % 20);
+      int ny = 40 + (int)(tt_test_rand(&rng) % 20);
+      tt_grid *g = make_grid(ctx, nx, ny, frames[fi]);
+      if (!g)
+        return;
+      float *z = tt_grid_heights(g);
+      for (int r = 0; r < ny; r++)
+        for (int c = 0; c < nx; c++) {
+          double h = 150 * sin(c * 0.13) * cos(r * 0.11) + 20 * sin(0.4 * c);
+          double u = tt_test_uniform(&rng);
+          z[r * nx + c] =
+              (float)(mode == 0   ? floor(1500 + h + 3 * u)
+                      : mode == 1 ? 25 * floor((1500 + h) / 25)
+                      : mode == 2 ? 1500 + h + u
+                                  : floor(70000 + h / 10 + 3 * u));
+        }
+      tt__mesh m;
+      if (!random_mesh(&m, g, &rng, 12)) {
+        tt__mesh_free(&m);
+        tt_grid_destroy(g);
+        continue;
+      }
+      tt__crit_env plain = {&m, g, NULL}, cached = {&m, g, NULL};
+      cached.cache = vt->cache_new(&cached);
+      CHECK(cached.cache != NULL);
+      tt__edge_stack stack = {0};
+      for (int it = 0; it < 3000; it++) {
+        if (tt_test_rand(&rng) % 8 == 0) {
+          int c = (int)(tt_test_rand(&rng) % (uint64_t)nx);
+          int r = (int)(tt_test_rand(&rng) % (uint64_t)ny);
+          int32_t on, opp[4];
+          int32_t t = tt__mesh_locate(&m, -1, c, r, &on);
+          if (t < 0 || on <= -2)
+            continue;
+          int32_t v = tt__mesh_add_vertex(&m, c, r, z[r * nx + c]);
+          int nopp = 3;
+          if (on < 0)
+            tt__mesh_split_triangle(&m, t, v, opp);
+          else {
+            tt__mesh_split_edge(&m, on, v, opp);
+            nopp = 4;
+          }
+          CHECK(tt__swap_repair(&m, vt, &cached, opp, nopp, &stack) >= 0);
+          continue;
+        }
+        int32_t e = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
+        if (!tt__mesh_live(&m, e / 3) || m.twin[e] < 0)
+          continue;
+        double a = vt->swap_value(&plain, e), b = vt->swap_value(&cached, e);
+        compared++;
+        if (a != b)
+          TT_FAIL_("seed %#llx: edge %d uncached %.17g, cached %.17g",
+                   (unsigned long long)s0, e, a, b);
+        if (!tt__mesh_flippable(&m, e) ||
+            !(a > 0 || tt_test_rand(&rng) % 3 == 0))
+          continue;
+        int32_t h = tt__mesh_flip(&m, e);
+        double bc = vt->swap_value(&cached, h), bp = vt->swap_value(&plain, h);
+        if (bc != -a || bp != -a)
+          TT_FAIL_("seed %#llx: edge %d value %.17g, back %.17g (cached) "
+                   "%.17g (uncached)", (unsigned long long)s0, e, a, bc, bp);
+        if (tt_test_rand(&rng) % 2) {
+          int32_t h2 = tt__mesh_flip(&m, h);
+          double again = vt->swap_value(&cached, h2);
+          if (again != a)
+            TT_FAIL_("seed %#llx: edge %d value %.17g, after swap and "
+                     "swap back %.17g", (unsigned long long)s0, e, a, again);
+        } else {
+          kept++;
+        }
+      }
+      char why[256];
+      if (!tt__mesh_validate(&m, why, sizeof why))
+        TT_FAIL_("seed %#llx: mesh invalid: %s", (unsigned long long)s0, why);
+      /* the cache handed a different mesh is bypassed, not trusted */
+      tt__mesh other;
+      if (random_mesh(&other, g, &rng, 40)) {
+        tt__crit_env wrong = {&other, g, cached.cache}, right = {&other, g,
+                                                                 NULL};
+        for (size_t e = 0; e < 3 * other.nslots; e++)
+          if (tt__mesh_live(&other, (int32_t)(e / 3)) && other.twin[e] >= 0 &&
+              vt->swap_value(&wrong, (int32_t)e) !=
+                  vt->swap_value(&right, (int32_t)e))
+            TT_FAIL_("seed %#llx: a cache of another mesh changed edge %zu",
+                     (unsigned long long)s0, e);
+      }
+      tt__mesh_free(&other);
+      vt->cache_free(cached.cache);
+      tt__edge_stack_free(&stack);
+      tt__mesh_free(&m);
+      tt_grid_destroy(g);
+    }
+  CHECK(compared > 10000 && kept > 1000);
+}
+
 /* ---------------------------------------------------------------------
  * Names and timings.
  * ------------------------------------------------------------------- */
@@ -984,6 +1101,7 @@ int main(void)
   gaussian_stars();
   gaussian_exact_orient(0x5eed0001u);
   gaussian_paraboloid(ctx);
+  gaussian_cache(ctx, 0xcac4e000u);
   random_tests(ctx);
   timings(ctx);
   tt_context_destroy(ctx);
