@@ -22,9 +22,18 @@
  * residual there is the same either way (to the rounding of the plane
  * expression) and cancels. Vertex samples are exact and owned by nobody.
  *
- * The quad is read in geometry.h's canonical form, each triangle scanned
- * with the same corner order whichever diagonal the mesh has, so a swap and
- * the swap back have exactly opposite values.
+ * Each triangle is scanned from its smallest vertex id (rotated, so its
+ * orientation and the ownership of its edges stay), so its sum is a
+ * function of the triangle alone, whichever quad asks for it: a swap and
+ * the swap back have exactly opposite values, and the sums can be cached.
+ *
+ * Cache (cache_new, per run): a direct-mapped table of triangle sums keyed
+ * by the rotated vertex triple and the three ownership bits, for the real
+ * triangles (the "before" of every edge of a triangle) and the
+ * hypothetical ones (the "after", which become real when the swap is
+ * taken). A hit returns the very bits the scan would, so the cache never
+ * changes a value; a collision overwrites. Vertices never move and the
+ * grid does not change during a run, so an entry never goes stale.
  * Needs: the grid (env->grid; without one the value is 0). Quads that are
  * not strictly convex score 0 (geometry.h), so the scans never meet a
  * degenerate triangle. Cost: a scan of the quad's samples twice -- the
@@ -32,6 +41,9 @@
  */
 #include "geometry.h"
 #include "../raster_scan.h"
+
+#include <stdlib.h>
+#include <string.h>
 
 /* The mesh's ownership rule for half-edge x (raster_scan.c). */
 static bool owns(const tt__mesh *m, int32_t x)
@@ -51,23 +63,87 @@ static bool owns_seg(const tt__mesh *m, int32_t p, int32_t q)
   return dy > 0 || (dy == 0 && dx > 0);
 }
 
-/* Sum of squared residuals of triangle (p0, p1, p2) with edge ownership
- * o0 (p0->p1), o1, o2. */
-static double tri_sse(const tt_grid *g, const tt__mesh *m, int32_t p0,
-                      int32_t p1, int32_t p2, bool o0, bool o1, bool o2)
+typedef struct l2_entry {
+  int32_t v[3];        /* rotated triple; v[0] = -1: empty */
+  uint32_t own;        /* ownership bits */
+  double sse;
+} l2_entry;
+
+typedef struct l2_cache {
+  l2_entry *e;
+  size_t mask;
+} l2_cache;
+
+static void *l2_cache_new(const tt__crit_env *env)
 {
-  tt__scan_tri st;
-  int32_t p[3] = {p0, p1, p2};
-  for (int k = 0; k < 3; k++) {
-    st.x[k] = m->v[p[k]].c;
-    st.y[k] = m->v[p[k]].r;
-    st.z[k] = (double)m->v[p[k]].z;
+  if (!env->grid)
+    return NULL;
+  /* about one entry per 16 samples, 2^12 .. 2^22 entries */
+  size_t n = (size_t)1 << 12;
+  while (n < ((size_t)1 << 22) && n * 16 < env->grid->nx * env->grid->ny)
+    n <<= 1;
+  l2_cache *c = malloc(sizeof *c);
+  if (!c)
+    return NULL;
+  c->e = malloc(n * sizeof *c->e);
+  if (!c->e) {
+    free(c);
+    return NULL;
   }
-  st.own[0] = o0;
-  st.own[1] = o1;
-  st.own[2] = o2;
+  for (size_t i = 0; i < n; i++)
+    c->e[i].v[0] = -1;
+  c->mask = n - 1;
+  return c;
+}
+
+static void l2_cache_free(void *cache)
+{
+  l2_cache *c = cache;
+  if (c) {
+    free(c->e);
+    free(c);
+  }
+}
+
+/* Sum of squared residuals of triangle (p0, p1, p2) with edge ownership
+ * o0 (p0->p1), o1, o2: scanned from its smallest vertex, or read from the
+ * cache. */
+static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
+                      int32_t p2, bool o0, bool o1, bool o2)
+{
+  const tt__mesh *m = env->mesh;
+  int32_t p[3] = {p0, p1, p2};
+  bool o[3] = {o0, o1, o2};
+  int r = p[1] < p[0] ? (p[2] < p[1] ? 2 : 1) : (p[2] < p[0] ? 2 : 0);
+  int32_t v[3] = {p[r], p[(r + 1) % 3], p[(r + 2) % 3]};
+  uint32_t own = (uint32_t)o[r] | (uint32_t)o[(r + 1) % 3] << 1 |
+                 (uint32_t)o[(r + 2) % 3] << 2;
+  l2_cache *c = env->cache;
+  l2_entry *slot = NULL;
+  if (c) {
+    uint64_t h = ((uint64_t)(uint32_t)v[0] * 0x9e3779b97f4a7c15ull) ^
+                 ((uint64_t)(uint32_t)v[1] * 0xc2b2ae3d27d4eb4full) ^
+                 ((uint64_t)(uint32_t)v[2] * 0x165667b19e3779f9ull) ^ own;
+    h ^= h >> 29;
+    slot = &c->e[h & c->mask];
+    if (slot->v[0] == v[0] && slot->v[1] == v[1] && slot->v[2] == v[2] &&
+        slot->own == own)
+      return slot->sse;
+  }
+  tt__scan_tri st;
+  for (int k = 0; k < 3; k++) {
+    st.x[k] = m->v[v[k]].c;
+    st.y[k] = m->v[v[k]].r;
+    st.z[k] = (double)m->v[v[k]].z;
+    st.own[k] = (own >> k) & 1u;
+  }
   tt__scan_stats s;
-  tt__scan_stats_run(g, &st, &s);
+  tt__scan_stats_run(env->grid, &st, &s);
+  if (slot) {
+    memcpy(slot->v, v, sizeof v);
+    slot->own = own;
+    slot->sse = s.sum_sq;
+  }
   return s.sum_sq;
 }
 
@@ -84,13 +160,13 @@ static double l2_swap_value(const tt__crit_env *env, int32_t e)
   bool o_bc = owns(m, q.in[0]), o_ca = owns(m, q.in[1]);
   bool o_ad = owns(m, q.in[2]), o_db = owns(m, q.in[3]);
   bool o_ab = owns_seg(m, q.a, q.b), o_cd = owns_seg(m, q.c, q.d);
-  const tt_grid *g = env->grid;
-  double before = tri_sse(g, m, q.a, q.b, q.c, o_ab, o_bc, o_ca) +
-                  tri_sse(g, m, q.b, q.a, q.d, !o_ab, o_ad, o_db);
-  double after = tri_sse(g, m, q.c, q.a, q.d, o_ca, o_ad, !o_cd) +
-                 tri_sse(g, m, q.d, q.b, q.c, o_db, o_bc, o_cd);
+  double before = tri_sse(env, q.a, q.b, q.c, o_ab, o_bc, o_ca) +
+                  tri_sse(env, q.b, q.a, q.d, !o_ab, o_ad, o_db);
+  double after = tri_sse(env, q.c, q.a, q.d, o_ca, o_ad, !o_cd) +
+                 tri_sse(env, q.d, q.b, q.c, o_db, o_bc, o_cd);
   return q.sign * tt__snap(before - after, before + after);
 }
 
 const tt__criterion_vt tt__criterion_l2 = {
-    TT_CRITERION_L2, "l2", true, l2_swap_value, NULL, NULL, NULL};
+    TT_CRITERION_L2, "l2", true, l2_swap_value, NULL, l2_cache_new,
+    l2_cache_free};

@@ -751,6 +751,66 @@ static void test_flip_repair(uint64_t seed)
   tt_grid_destroy(g);
 }
 
+/* A criterion's per-run cache (cache_new) never changes a swap value: on a
+ * mesh that random flips keep changing, every edge's value with the cache
+ * (cold and warm) is the very value without it, and a swap and the swap
+ * back stay exact opposites. */
+static void test_caches(uint64_t seed)
+{
+  uint64_t rng = seed ^ 0xcace;
+  tt_grid *g = bumpy(48, 36, rng);
+  int32_t pts[2 * 80];
+  random_points(&rng, 48, 36, pts, 80);
+  int tested = 0;
+  for (int id = 0; id < 64; id++) {
+    const tt__criterion_vt *crit = tt__criterion_get((tt_criterion)id);
+    if (!crit || !crit->cache_new)
+      continue;
+    tt__mesh m;
+    CHECK(build(&m, g, pts, 80, NULL));
+    tt__crit_env plain = {&m, g, NULL}, cached = {&m, g, NULL};
+    cached.cache = crit->cache_new(&cached);
+    CHECK(cached.cache != NULL);
+    long differ = 0, asym = 0, flips = 0;
+    for (int round = 0; round < 40; round++) {
+      for (int pass = 0; pass < 2; pass++) /* cold, then warm */
+        for (size_t e = 0; e < 3 * m.nslots; e++)
+          if (tt__mesh_live(&m, (int32_t)(e / 3)) && m.twin[e] >= 0) {
+            double a = crit->swap_value(&plain, (int32_t)e);
+            double b = crit->swap_value(&cached, (int32_t)e);
+            if (memcmp(&a, &b, sizeof a) != 0)
+              differ++;
+          }
+      /* a random flippable edge: flip, compare the swap back, maybe keep */
+      for (int tries = 0; tries < 100; tries++) {
+        int32_t e = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
+        if (!tt__mesh_live(&m, e / 3) || m.twin[e] < 0 ||
+            (m.eflag[e] & TT__EDGE_CONSTRAINED) || !tt__mesh_flippable(&m, e))
+          continue;
+        double v = crit->swap_value(&cached, e);
+        int32_t h = tt__mesh_flip(&m, e);
+        CHECK(h >= 0);
+        double r = crit->swap_value(&cached, h);
+        if (v != -r)
+          asym++;
+        flips++;
+        break;
+      }
+    }
+    check_valid(&m, "cache test");
+    printf("%s cache: %ld flips, %ld differing values, %ld asymmetric\n",
+           crit->name, flips, differ, asym);
+    CHECK_INT_EQ(differ, 0);
+    CHECK_INT_EQ(asym, 0);
+    CHECK(flips > 20);
+    crit->cache_free(cached.cache);
+    tt__mesh_free(&m);
+    tested++;
+  }
+  CHECK(tested >= 1);
+  tt_grid_destroy(g);
+}
+
 static void test_final_veto(uint64_t seed)
 {
   uint64_t rng = seed ^ 0xfeed;
@@ -842,6 +902,7 @@ int main(void)
   RUN(test_local_and_lookahead(seed));
   RUN(test_region_repair(seed));
   RUN(test_flip_repair(seed));
+  RUN(test_caches(seed));
   RUN(test_exhaustive(seed));
   RUN(test_l2_from_delaunay(seed));
   RUN(test_ruled());
