@@ -17,6 +17,7 @@
 #include "optimize.h"
 
 #include "heap.h"
+#include "hole_dp.h"
 #include "raster_scan.h"
 
 #include <math.h>
@@ -584,10 +585,19 @@ long tt__optimize_insert(tt__mesh *m, const tt__criterion_vt *crit,
                          int32_t v, const int32_t *opposite, int n,
                          tt__edge_stack *stack)
 {
-  (void)v;
   if (crit->id == TT_CRITERION_DELAUNAY || repair == TT_REPAIR_DELAUNAY)
     return tt__swap_repair(m, &tt__criterion_delaunay, env, opposite, n,
                            stack);
+  int32_t link[TT__HOLE_MAX_N];
+  if (crit->id == TT_CRITERION_MIN_AREA) {
+    /* the exact least-area triangulation of the hole around v (SPEC 2.3,
+     * docs/min_area_hole.md), then the swaps carry on from its link */
+    int k = tt__hole_min_area(m, env, v, link, TT__HOLE_MAX_N);
+    if (k < 0)
+      return -1;
+    opposite = link;
+    n = k;
+  }
   if (repair == TT_REPAIR_FLIP)
     return tt__swap_repair(m, crit, env, opposite, n, stack);
   stack->n = 0;

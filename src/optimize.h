@@ -86,7 +86,9 @@ TT_HIDDEN bool tt__optimize_run(tt__mesh *m, const tt__opt_params *p,
  * more spoke, so they end after fewer flips than v can have neighbours);
  * TT_REPAIR_LOCAL / LOOKAHEAD, the local swap (with look-ahead) seeded
  * with the spokes and the link of v's star (and, for criteria with an
- * affected-edges hook, every edge around the link's vertices).
+ * affected-edges hook, every edge around the link's vertices). For
+ * min_area, those swaps start from the exact least-area triangulation of
+ * the hole around v (hole_dp.h).
  * opposite: the n half-edges opposite v (entries < 0 ignored). Returns the
  * number of swaps, or -1 when out of memory. */
 TT_HIDDEN long tt__optimize_insert(tt__mesh *m, const tt__criterion_vt *crit,

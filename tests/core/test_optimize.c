@@ -20,6 +20,7 @@
  * negatives. */
 #include "criteria/criterion.h"
 #include "mesh.h"
+#include "hole_dp.h"
 #include "optimize.h"
 #include "raster_scan.h"
 #include "swap.h"
@@ -641,14 +642,20 @@ static void test_bound(uint64_t seed)
     const char *name = tt_criterion_name((tt_criterion)k);
     if (!name)
       break;
+    /* every repair with no final pass, then every final pass after the
+     * default repair */
     for (int gi = 0; gi < 2; gi++)
-      for (int mode = TT_OPTIMIZE_NONE; mode <= TT_OPTIMIZE_LOOKAHEAD;
-           mode++)
+      for (int run = 0; run < 7; run++)
         for (int bi = 0; bi < 2; bi++) {
           tt_refine_options o;
           tt_refine_options_init(&o);
           o.criterion = (tt_criterion)k;
-          o.optimize = (tt_optimize)mode;
+          if (run < 4) {
+            o.repair = (tt_repair)(TT_REPAIR_FLIP + run);
+            o.optimize = TT_OPTIMIZE_NONE;
+          } else {
+            o.optimize = (tt_optimize)(TT_OPTIMIZE_NONE + run - 4);
+          }
           o.max_error = bounds[bi];
           o.threads = 1;
           tt_tin *tin = NULL;
@@ -657,8 +664,9 @@ static void test_bound(uint64_t seed)
           if (!tin)
             continue;
           if (getenv("TT_VERBOSE"))
-            printf("  %s grid %d %s bound %g: %zu vertices, %.3f s\n", name,
-                   gi, tt_optimize_name(o.optimize), o.max_error,
+            printf("  %s grid %d %s/%s bound %g: %zu vertices, %.3f s\n",
+                   name, gi, tt_repair_name(o.repair),
+                   tt_optimize_name(o.optimize), o.max_error,
                    tt_tin_vertex_count(tin),
                    (double)(clock() - c0) / CLOCKS_PER_SEC);
           double *xyz = tt_oracle_pixel_triangles(tin);
@@ -667,8 +675,9 @@ static void test_bound(uint64_t seed)
                                           tt_tin_triangle_count(tin), xyz,
                                           &ev));
           if (!(ev.errors.max_error <= o.max_error + 1e-9))
-            TT_FAIL_("criterion %s, optimize %s, grid %d: max error %.17g "
-                     "above the bound %g", name, tt_optimize_name(o.optimize),
+            TT_FAIL_("criterion %s, repair %s, optimize %s, grid %d: max "
+                     "error %.17g above the bound %g", name,
+                     tt_repair_name(o.repair), tt_optimize_name(o.optimize),
                      gi, ev.errors.max_error, o.max_error);
           CHECK_INT_EQ(ev.overlapped, 0);
           free(xyz);
@@ -748,6 +757,63 @@ static void test_flip_repair(uint64_t seed)
   tt__mesh_free(&m);
   insert_repair = TT_REPAIR_LOCAL;
   tt__edge_stack_free(&stack);
+  tt_grid_destroy(g);
+}
+
+/* min_area's repair is the exact hole re-triangulation (hole_dp.h) and
+ * then the flips from the hole's link: the same mesh as doing those two
+ * steps by hand, insertion after insertion. */
+static void test_min_area_hole_repair(uint64_t seed)
+{
+  uint64_t rng = seed ^ 0xa4ea;
+  tt_grid *g = bumpy(50, 40, rng);
+  int32_t pts[2 * 100];
+  random_points(&rng, 50, 40, pts, 100);
+  const tt__criterion_vt *ma = tt__criterion_get(TT_CRITERION_MIN_AREA);
+  tt__mesh a, b;
+  tt__edge_stack stack = {NULL, 0, 0};
+  CHECK(build(&a, g, pts, 0, NULL));
+  CHECK(build(&b, g, pts, 0, NULL));
+  const float *z = tt_grid_heights_const(g);
+  long replaced = 0;
+  for (int i = 0; i < 100; i++) {
+    int32_t c = pts[2 * i], r = pts[2 * i + 1];
+    float zz = z[(size_t)r * 50 + (size_t)c];
+    tt__mesh *ms[2] = {&a, &b};
+    for (int w = 0; w < 2; w++) {
+      tt__mesh *m = ms[w];
+      int32_t v = tt__mesh_add_vertex(m, c, r, zz);
+      int32_t on;
+      int32_t t = tt__mesh_locate(m, -1, c, r, &on);
+      CHECK(t >= 0 && on >= -1);
+      int32_t opp[4];
+      int n = on < 0 ? 3 : 4;
+      CHECK(on < 0 ? tt__mesh_split_triangle(m, t, v, opp)
+                   : tt__mesh_split_edge(m, on, v, opp));
+      tt__crit_env env = {m, g, NULL};
+      if (w == 0) {
+        CHECK(tt__optimize_insert(m, ma, &env, TT_REPAIR_FLIP, v, opp, n,
+                                  &stack) >= 0);
+      } else {
+        int32_t link[TT__HOLE_MAX_N];
+        size_t before = m->ntouched;
+        int k = tt__hole_min_area(m, &env, v, link, TT__HOLE_MAX_N);
+        CHECK(k >= 3);
+        replaced += m->ntouched > before + (size_t)n;
+        CHECK(tt__swap_repair(m, ma, &env, link, k, &stack) >= 0);
+      }
+      tt__mesh_clear_touched(m);
+    }
+  }
+  check_valid(&a, "min-area repair");
+  CHECK_INT_EQ(a.nslots, b.nslots);
+  CHECK(memcmp(a.hv, b.hv, 3 * a.nslots * sizeof *a.hv) == 0);
+  CHECK(memcmp(a.twin, b.twin, 3 * a.nslots * sizeof *a.twin) == 0);
+  printf("min-area repair: %ld of 100 holes re-triangulated\n", replaced);
+  CHECK(replaced > 0);
+  tt__edge_stack_free(&stack);
+  tt__mesh_free(&a);
+  tt__mesh_free(&b);
   tt_grid_destroy(g);
 }
 
@@ -903,6 +969,7 @@ int main(void)
   RUN(test_region_repair(seed));
   RUN(test_flip_repair(seed));
   RUN(test_caches(seed));
+  RUN(test_min_area_hole_repair(seed));
   RUN(test_exhaustive(seed));
   RUN(test_l2_from_delaunay(seed));
   RUN(test_ruled());
