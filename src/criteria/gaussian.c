@@ -167,6 +167,11 @@ typedef struct pray {
                                            z_k - z_v (rounded) */
 } pray;
 
+/* A pair's cross product and its error bound. */
+typedef struct pair {
+  double nx, ny, nz, bound;
+} pair;
+
 typedef struct rays {
   pray p[TT__STAR_MAX + 1];             /* for the filter, contiguous */
   int64_t dc[TT__STAR_MAX + 1], dr[TT__STAR_MAX + 1];
@@ -180,6 +185,10 @@ typedef struct rays {
                                            on its positive side, 2 on its
                                            negative side (both: stopped) */
   tt__gvec g[TT__STAR_MAX + 1];         /* ground vectors */
+  pair pr[TT__STAR_MAX + 1];            /* consecutive pairs (i, i+1) */
+  double x[2 * TT__STAR_MAX + 2], y[2 * TT__STAR_MAX + 2],
+      z[2 * TT__STAR_MAX + 2];          /* p[] again, column by column,
+                                           twice over (x[n + k] = x[k]) */
 } rays;
 
 static inline void two_sum(double a, double b, double *x, double *y)
@@ -223,10 +232,6 @@ static int exact_sign(const rays *r, int i, int j, int k)
   return 0;
 }
 
-/* A pair's cross product and its error bound. */
-typedef struct pair {
-  double nx, ny, nz, bound;
-} pair;
 
 static inline void pair_make(const rays *r, int i, int j, pair *p)
 {
@@ -323,9 +328,9 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
     r->zk[i] = w->z;
     double dc = (double)r->dc[i], dr = (double)r->dr[i];
     double dz = (double)w->z - (double)r->zv;
-    r->p[i].x = dc;
-    r->p[i].y = dr;
-    r->p[i].z = dz;
+    r->p[i].x = r->x[i] = r->x[i + s->n] = dc;
+    r->p[i].y = r->y[i] = r->y[i + s->n] = dr;
+    r->p[i].z = r->z[i] = r->z[i + s->n] = dz;
     tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr, dz};
     r->g[i] = g;
   }
@@ -397,35 +402,46 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
     return fabs(TT__PI - sum);
   }
   int nsupport = 0, start = -1, sgn = 0;
+  /* Every consecutive pair against every other ray, without early exits:
+   * on a terrain the signs are a coin toss, and a branch per test that the
+   * processor cannot predict cost more than the tests it saved. The rays
+   * are stored twice over (x[n + k] = x[k]), so the n - 2 rays after pair
+   * (i, i+1) are x[i+2 .. i+n-1], in order and without wrapping. A product
+   * within the pair's bound is undecided: that pair is redone with the
+   * exact signs (never with integer heights, where the bound is 0). */
+  pair *pr = r->pr;
+  for (int i = 0; i < n; i++)
+    pair_make(r, i, wrap(i + 1, n), &pr[i]);
   for (int i = 0; i < n; i++) {
-    int j = wrap(i + 1, n);
-    pair p;
-    pair_make(r, i, j, &p);
-    bool pos = false, neg = false;
-    /* the other rays from the pair outwards, alternating sides (i+2, i-1,
-     * i+3, i-2, ...): a ray that breaks the plane is most often next to
-     * the pair, so saddles are rejected after a test or two */
-    int kf = wrap(j + 1, n), kb = i == 0 ? n - 1 : i - 1;
-    for (int t = 0; t < n - 2 && !(pos && neg); t++) {
-      int k;
-      if (t & 1) {
-        k = kb;
-        kb = kb == 0 ? n - 1 : kb - 1;
-      } else {
-        k = kf;
-        kf = wrap(kf + 1, n);
-      }
-      int sd = side(r, &p, i, j, k);
-      pos |= sd > 0;
-      neg |= sd < 0;
+    const pair *p = &pr[i];
+    double nx = p->nx, ny = p->ny, nz = p->nz, b = p->bound;
+    const double *x = r->x + i + 2, *y = r->y + i + 2, *z = r->z + i + 2;
+    int fp = 0, fn = 0, near = 0;
+    for (int t = 0; t < n - 2; t++) {
+      double det = nx * x[t] + ny * y[t] + nz * z[t];
+      fp |= det > b;
+      fn |= det < -b;
+      near |= fabs(det) <= b;
     }
-    r->sides[i] = (unsigned char)((pos ? 1 : 0) | (neg ? 2 : 0));
-    if (pos && neg)
+    if (near && b > 0) {
+      int j = wrap(i + 1, n);
+      fp = fn = 0;
+      for (int t = 2; t < n; t++) {
+        int sd = side(r, p, i, j, wrap(i + t, n));
+        fp |= sd > 0;
+        fn |= sd < 0;
+      }
+    }
+    r->sides[i] = (unsigned char)(fp | fn << 1);
+  }
+  for (int i = 0; i < n; i++) {
+    int sd = r->sides[i];
+    if (sd == 3)
       continue;
     nsupport++;
-    if (start < 0 && (pos || neg)) {
+    if (start < 0 && sd != 0) {
       start = i;
-      sgn = pos ? 1 : -1;
+      sgn = sd == 1 ? 1 : -1;
     }
   }
   if (nsupport == n) {
@@ -453,8 +469,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
       tp = tq;
       continue;
     }
-    pair pq;
-    pair_make(r, p, q, &pq);
+    pair pq = r->pr[p]; /* q = p + 1 */
     for (int tr = tp + 2; tr <= n; tr++) {
       int x = wrap(start + tr, n);
       if (x == p)
@@ -487,6 +502,12 @@ double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)
     *out_class = cls;
   return k;
 }
+
+#if defined(__GNUC__)
+#define tt__prefetch(p) __builtin_prefetch(p)
+#else
+#define tt__prefetch(p) ((void)(p))
+#endif
 
 /* --- the per-run cache of |K| ------------------------------------------
  *
@@ -618,15 +639,25 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
   bool ab = q.sign > 0;
   int32_t vs[4] = {q.a, q.b, q.c, q.d};
   double sa = 0, sb = 0; /* sum |K| with diagonal a-b, with c-d */
-  star s, o;
+  star st[4], o;
+  bool got[4];
   rays r;
+  /* Most of a cached value's cost is waiting for memory (the mesh around
+   * four scattered vertices, their cache entries): ask for the entries
+   * first and walk the four stars back to back, so the waits overlap. */
+  for (int i = 0; i < 4 && c; i++)
+    if ((size_t)vs[i] < c->cap)
+      tt__prefetch(c->e[vs[i]]);
+  for (int i = 0; i < 4; i++)
+    got[i] = star_gather(m, vs[i], &st[i]);
   for (int i = 0; i < 4; i++) {
-    if (!star_gather(m, vs[i], &s))
+    star *s = &st[i];
+    if (!got[i])
       continue;
-    star_canon(&s);
-    o.n = s.n;
-    o.boundary = s.boundary;
-    memcpy(o.nb, s.nb, (size_t)s.n * sizeof s.nb[0]);
+    star_canon(s);
+    o.n = s->n;
+    o.boundary = s->boundary;
+    memcpy(o.nb, s->nb, (size_t)s->n * sizeof s->nb[0]);
     bool ok = true;
     switch (i) {
     case 0: ok = ab ? (star_remove(&o, q.b), true)
@@ -641,7 +672,7 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
     if (!ok)
       continue; /* a star past the cap: the vertex counts 0 both ways */
     star_canon(&o);
-    double kmine = star_k(m, fr, c, vs[i], &s, true, &r);
+    double kmine = star_k(m, fr, c, vs[i], s, true, &r);
     double kother = star_k(m, fr, c, vs[i], &o, false, &r);
     sa += ab ? kmine : kother;
     sb += ab ? kother : kmine;
