@@ -302,18 +302,25 @@ static inline double max3abs(double m, double x, double y, double z)
   return z > m ? z : m;
 }
 
-/* Sets maxc and ints from the n rays in p[]. */
+/* 1 when z is an integer (not NaN nor infinite) of at most 2^16: adding
+ * and taking away 1.5 2^52 rounds z to an integer in one step, without a
+ * call and without a conversion that could overflow */
+static inline int small_int(double z)
+{
+  return (fabs(z) <= 65536.0) & ((z + 0x1.8p52) - 0x1.8p52 == z);
+}
+
+/* Sets maxc and ints from the n rays in p[] (x, y are integers). */
 static void rays_finish(rays *r, int n)
 {
   double mx = 0;
-  for (int i = 0; i < n; i++)
+  int ints = 1;
+  for (int i = 0; i < n; i++) {
     mx = max3abs(mx, r->p[i].x, r->p[i].y, r->p[i].z);
+    ints &= small_int(r->p[i].z);
+  }
   r->maxc = mx;
-  bool ints = mx <= 65536.0;
-  for (int i = 0; i < n && ints; i++)
-    ints = fabs(r->p[i].z) <= 65536.0 && /* (and not NaN) */
-           r->p[i].z == (double)(int32_t)r->p[i].z; /* x, y are integers */
-  r->ints = ints;
+  r->ints = ints && mx <= 65536.0;
 }
 
 static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
@@ -321,6 +328,8 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
 {
   const tt__mesh_vertex *o = &m->v[v];
   r->zv = o->z;
+  double mx = 0;
+  int ints = 1;
   for (int i = 0; i < s->n; i++) {
     const tt__mesh_vertex *w = &m->v[s->nb[i]];
     r->dc[i] = (int64_t)w->c - o->c;
@@ -333,8 +342,11 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
     r->p[i].z = r->z[i] = r->z[i + s->n] = dz;
     tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr, dz};
     r->g[i] = g;
+    mx = max3abs(mx, dc, dr, dz);
+    ints &= small_int(dz);
   }
-  rays_finish(r, s->n);
+  r->maxc = mx;
+  r->ints = ints && mx <= 65536.0; /* as rays_finish, in the same loop */
 }
 
 /* Sums of angles without an atan2 per angle: angle theta = atan2(c, d)
@@ -348,6 +360,7 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
 typedef struct turn {
   double x, y;
   int k;
+  bool up;                              /* upper(x, y), carried */
 } turn;
 
 static inline bool upper(double x, double y)
@@ -361,8 +374,9 @@ static inline void turn_add(turn *t, tt__gvec u, tt__gvec v)
   if (c == 0 && d >= 0)
     return; /* angle 0 (or a zero vector: atan2(0, 0) = 0) */
   double x = t->x * d - t->y * c, y = t->x * c + t->y * d;
-  if (!upper(t->x, t->y) && upper(x, y))
-    t->k++;
+  bool up = upper(x, y); /* (the rescaling below keeps it) */
+  t->k += !t->up & up;
+  t->up = up;
   double mag = fabs(x) + fabs(y);
   if (mag > 0x1p200 || mag < 0x1p-200) {
     int ex;
@@ -392,7 +406,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
 {
   int n = s->n;
   rays_load(m, fr, v, s, r);
-  turn tsum = {1, 0, 0};
+  turn tsum = {1, 0, 0, true};
   int nang = s->boundary ? n - 1 : n;
   for (int i = 0; i < nang; i++)
     turn_add(&tsum, r->g[i], r->g[wrap(i + 1, n)]);
@@ -417,11 +431,19 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
     double nx = p->nx, ny = p->ny, nz = p->nz, b = p->bound;
     const double *x = r->x + i + 2, *y = r->y + i + 2, *z = r->z + i + 2;
     int fp = 0, fn = 0, near = 0;
-    for (int t = 0; t < n - 2; t++) {
-      double det = nx * x[t] + ny * y[t] + nz * z[t];
-      fp |= det > b;
-      fn |= det < -b;
-      near |= fabs(det) <= b;
+    if (r->ints) {
+      for (int t = 0; t < n - 2; t++) {
+        double det = nx * x[t] + ny * y[t] + nz * z[t];
+        fp |= det > 0;
+        fn |= det < 0;
+      }
+    } else {
+      for (int t = 0; t < n - 2; t++) {
+        double det = nx * x[t] + ny * y[t] + nz * z[t];
+        fp |= det > b;
+        fn |= det < -b;
+        near |= fabs(det) <= b;
+      }
     }
     if (near && b > 0) {
       int j = wrap(i + 1, n);
@@ -458,7 +480,7 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
   /* gift wrapping over positions t = 0..n (t = n is the start again);
    * a consecutive pair that supports on the hull's side is a hull face, so
    * runs of those are walked without a test */
-  turn thull = {1, 0, 0};
+  turn thull = {1, 0, 0, true};
   int tp = 0;
   unsigned char wrong = sgn > 0 ? 2 : 1;
   while (tp < n) {
@@ -646,8 +668,10 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
    * four scattered vertices, their cache entries): ask for the entries
    * first and walk the four stars back to back, so the waits overlap. */
   for (int i = 0; i < 4 && c; i++)
-    if ((size_t)vs[i] < c->cap)
-      tt__prefetch(c->e[vs[i]]);
+    if ((size_t)vs[i] < c->cap) {
+      tt__prefetch(&c->e[vs[i]][0]);
+      tt__prefetch(&c->e[vs[i]][1]);
+    }
   for (int i = 0; i < 4; i++)
     got[i] = star_gather(m, vs[i], &st[i]);
   for (int i = 0; i < 4; i++) {
