@@ -104,45 +104,10 @@ static bool star_gather(const tt__mesh *m, int32_t v, star *s)
   }
 }
 
-static void star_remove(star *s, int32_t x)
-{
-  for (int i = 0; i < s->n; i++)
-    if (s->nb[i] == x) {
-      for (int j = i + 1; j < s->n; j++)
-        s->nb[j - 1] = s->nb[j];
-      s->n--;
-      return;
-    }
-}
-
-static bool star_insert_after(star *s, int32_t x, int32_t y)
-{
-  if (s->n >= TT__STAR_MAX)
-    return false;
-  for (int i = 0; i < s->n; i++)
-    if (s->nb[i] == x) {
-      for (int j = s->n; j > i + 1; j--)
-        s->nb[j] = s->nb[j - 1];
-      s->nb[i + 1] = y;
-      s->n++;
-      return true;
-    }
-  return false;
-}
-
 /* Rotates an interior star to start at its smallest neighbour index, so
  * that a star reached from either configuration of a quad is the same
  * array and gives the same bits. (A boundary star starts at the boundary
- * either way.) Three reversals, in place. */
-static void reverse(int32_t *x, int lo, int hi)
-{
-  for (; lo < hi; lo++, hi--) {
-    int32_t t = x[lo];
-    x[lo] = x[hi];
-    x[hi] = t;
-  }
-}
-
+ * either way.) */
 static void star_canon(star *s)
 {
   if (s->boundary || s->n < 2)
@@ -153,9 +118,53 @@ static void star_canon(star *s)
       r = i;
   if (r == 0)
     return;
-  reverse(s->nb, 0, r - 1);
-  reverse(s->nb, r, s->n - 1);
-  reverse(s->nb, 0, s->n - 1);
+  int32_t head[TT__STAR_MAX + 1];
+  memcpy(head, s->nb, (size_t)r * sizeof head[0]);
+  memmove(s->nb, s->nb + r, (size_t)(s->n - r) * sizeof head[0]);
+  memcpy(s->nb + s->n - r, head, (size_t)r * sizeof head[0]);
+}
+
+/* o = canonical star s without neighbour x (its first occurrence). The
+ * smallest neighbour stays in front unless it is x, so only then does the
+ * result need star_canon. */
+static void star_without(const star *s, int32_t x, star *o)
+{
+  int n = 0;
+  bool seen = false;
+  for (int i = 0; i < s->n; i++) {
+    if (!seen && s->nb[i] == x) {
+      seen = true;
+      continue;
+    }
+    o->nb[n++] = s->nb[i];
+  }
+  o->n = n;
+  o->boundary = s->boundary;
+  if (s->n > 0 && s->nb[0] == x)
+    star_canon(o);
+}
+
+/* o = canonical star s with y inserted after neighbour x (its first
+ * occurrence); false when x is not there or the star is full. Canonical
+ * as it is unless y is the new smallest. */
+static bool star_with(const star *s, int32_t x, int32_t y, star *o)
+{
+  if (s->n >= TT__STAR_MAX)
+    return false;
+  int i = 0;
+  while (i < s->n && s->nb[i] != x)
+    i++;
+  if (i == s->n)
+    return false;
+  memcpy(o->nb, s->nb, (size_t)(i + 1) * sizeof o->nb[0]);
+  o->nb[i + 1] = y;
+  memcpy(o->nb + i + 2, s->nb + i + 1,
+         (size_t)(s->n - i - 1) * sizeof o->nb[0]);
+  o->n = s->n + 1;
+  o->boundary = s->boundary;
+  if (y < s->nb[0])
+    star_canon(o);
+  return true;
 }
 
 /* --- exact sign of a triple product in pixel space -------------------- */
@@ -679,23 +688,19 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
     if (!got[i])
       continue;
     star_canon(s);
-    o.n = s->n;
-    o.boundary = s->boundary;
-    memcpy(o.nb, s->nb, (size_t)s->n * sizeof s->nb[0]);
     bool ok = true;
     switch (i) {
-    case 0: ok = ab ? (star_remove(&o, q.b), true)
-                    : star_insert_after(&o, q.d, q.b); break;
-    case 1: ok = ab ? (star_remove(&o, q.a), true)
-                    : star_insert_after(&o, q.c, q.a); break;
-    case 2: ok = ab ? star_insert_after(&o, q.a, q.d)
-                    : (star_remove(&o, q.d), true); break;
-    default: ok = ab ? star_insert_after(&o, q.b, q.c)
-                     : (star_remove(&o, q.c), true); break;
+    case 0: ok = ab ? (star_without(s, q.b, &o), true)
+                    : star_with(s, q.d, q.b, &o); break;
+    case 1: ok = ab ? (star_without(s, q.a, &o), true)
+                    : star_with(s, q.c, q.a, &o); break;
+    case 2: ok = ab ? star_with(s, q.a, q.d, &o)
+                    : (star_without(s, q.d, &o), true); break;
+    default: ok = ab ? star_with(s, q.b, q.c, &o)
+                     : (star_without(s, q.c, &o), true); break;
     }
     if (!ok)
       continue; /* a star past the cap: the vertex counts 0 both ways */
-    star_canon(&o);
     double kmine = star_k(m, fr, c, vs[i], s, true, &r);
     double kother = star_k(m, fr, c, vs[i], &o, false, &r);
     sa += ab ? kmine : kother;
