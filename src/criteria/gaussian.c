@@ -22,8 +22,10 @@
  * one bound per pair of rays, see pair_make) and, when the bound does not
  * decide (slivers, coplanar rays), exactly, as a sum of twelve exactly
  * representable products (float height x 21-bit slice of a minor) added
- * by expansion arithmetic. The common factor det(frame) does
- * not change which side the rays are on, so it is never needed.
+ * by expansion arithmetic. With integer heights (most DEMs) within 2^16
+ * of each other the double products are exact and the bound is 0: no
+ * exact sums at all. The common factor det(frame) does not change which
+ * side the rays are on, so it is never needed.
  * The hull cone: from a ray of a supporting pair (a hull ray), gift
  * wrapping in the star's cyclic order (the hull rays keep that order)
  * with the same exact signs; O(d h) for degree d and h hull rays.
@@ -38,11 +40,24 @@
  * are read in a canonical order (geometry.h; interior stars start at
  * their smallest neighbour), so a swap and the swap back have exactly
  * opposite values. A vertex of degree above TT__STAR_MAX (before or after)
- * counts 0 on both sides: no allocation ever happens here.
- * Cost: per vertex d square roots, one atan2 (angle sums as arguments of
- * complex products, below) and up to d(d-2) filtered triple products,
- * plus the hull for mixed vertices; eight stars per swap value, about
- * 1.5 us per value on a terrain mesh (100 times Delaunay's incircle).
+ * counts 0 on both sides.
+ *
+ * Cache (cache_new, below): |K| of a star depends on its canonical
+ * neighbour list only, so values are kept per vertex under that whole list
+ * (the key proves the star, it is no hash) for the star in the mesh and
+ * the last edited one; a cached and an uncached value are the same bits.
+ * Its only allocation is its growth with the mesh.
+ *
+ * Cost: per star d square roots, one atan2 (angle sums as arguments of
+ * complex products, below), d(d-2) triple products without a branch each
+ * (two atan2 and the hull for mixed vertices); eight stars per swap value.
+ * Without the cache about 1.1 us per value on a terrain mesh (1.4 us
+ * before the branch-free tests and exact integer signs). In greedy
+ * insertion with Lawson flips from the new vertex the star in the mesh is
+ * found in the cache three times in four, but the edited star of the other
+ * configuration never is (it only returns when the swap is taken): about
+ * three stars computed per value, 1.1-1.2 us per value on Crater Lake at
+ * 10 % (1.8 us before), half of it the stars, a third waiting for memory.
  */
 #include "geometry.h"
 
