@@ -51,13 +51,16 @@
  * Cost: per star d square roots, one atan2 (angle sums as arguments of
  * complex products, below), d(d-2) triple products without a branch each
  * (two atan2 and the hull for mixed vertices); eight stars per swap value.
- * Without the cache about 1.1 us per value on a terrain mesh (1.4 us
- * before the branch-free tests and exact integer signs). In greedy
+ * Without the cache: 1.1 us per value on test_criteria's mesh (float
+ * heights; 1.3 us before the branch-free tests), 1.1 us with integer
+ * heights (1.6 us before: exact products, no exact sums). In greedy
  * insertion with Lawson flips from the new vertex the star in the mesh is
- * found in the cache three times in four, but the edited star of the other
- * configuration never is (it only returns when the swap is taken): about
- * three stars computed per value, 1.1-1.2 us per value on Crater Lake at
- * 10 % (1.8 us before), half of it the stars, a third waiting for memory.
+ * found in the cache three times in four, but the edited star of the
+ * other configuration never is (it only comes back when the swap is
+ * taken): about three stars computed per value, 1.15 us per value on
+ * Crater Lake at 10 % (1.8 us before), two thirds of it computing stars,
+ * the rest walking the mesh and the cache. Gaussian then runs 5 times
+ * Delaunay's insertion time (7 to 9 before).
  */
 #include "geometry.h"
 
