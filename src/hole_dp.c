@@ -20,27 +20,33 @@
  * starts at the first. When v is on the mesh's boundary ("open") the
  * outline is v, p_0, ..., p_{n-1}; the path runs from spoke 0 to n-1.
  *
- * Validity, all exact integer tests in pixel space with the frame's
- * handedness: a chord is a side or a diagonal of the outline
- * (tt__polygon_diagonal_ok) not passing through v; a spoke v-p_i meets no
- * side of the outline away from p_i; a triangle turns strictly
- * counter-clockwise. A triangle whose three edges are valid lies in the
- * hole and holds no other vertex (the hole is a disk), which is why these
- * edge tests are all the DP needs.
+ * Validity: every triangle turns strictly counter-clockwise (exact
+ * integer orientation in pixel space with the frame's handedness). That
+ * alone makes every path the DP can complete a triangulation of the hole
+ * (the argument is at fill_pockets), so no chord or spoke "inside the
+ * outline" test is needed; earlier versions made them and no result
+ * changed when they were dropped.
  *
  * Areas are computed from the triangle's corners in one canonical order
  * (smallest vertex index first), so the same triangle has the same area,
  * bit for bit, in the current sum and in the DP. Workload: one call per
- * inserted vertex, n <= 8 after a split: a few hundred area evaluations,
- * all on the stack.
+ * inserted vertex (about 90% of them change the hole on real terrain),
+ * n <= 8 after a split. Each of the C(n + 1, 3) triangles of the hole's
+ * points has its orientation and area computed at most once per call, in
+ * tables on the stack; pockets that cannot beat the best apex found so
+ * far skip theirs, and start spokes of the fan path stop as soon as their
+ * value cannot beat the current area or the best start. About 1.5 us per
+ * call plus the mesh update (tt__mesh_replace_region).
  */
 #include "hole_dp.h"
 
 #include "criteria/geometry.h"
-#include "polygon_dp.h"
-#include "predicates.h"
 
 #define MAXN TT__HOLE_MAX_N
+
+__extension__ typedef __int128 hole_i128;
+/* triangles of hole points (local indices 0..MAXN, v last): C(MAXN + 1, 3) */
+#define MAXT ((MAXN + 1) * MAXN * (MAXN - 1) / 6)
 
 typedef struct hole {
   const tt__mesh *m;
@@ -50,11 +56,19 @@ typedef struct hole {
   int n;                /* outline vertices without v */
   int32_t p[MAXN];
   bool fixed[MAXN];     /* spoke v-p_i must stay */
+  int nstar;            /* v's triangles: slots[0..nstar-1] */
   int nslots;           /* the hole's current triangles */
   int32_t slots[MAXN];
-  /* the outline for the diagonal tests: p, or v followed by p (open) */
-  int nq;
-  int64_t qx[MAXN + 1], qy[MAXN + 1];
+  /* the hole's points by local index (p_0..p_{n-1}, then v at n), copied
+   * once from the mesh: vertex id, pixel coordinates, height */
+  int32_t id[MAXN + 1];
+  int64_t c[MAXN + 1], r[MAXN + 1];
+  double z[MAXN + 1];
+  /* per triangle of local indices i < j < k (tri_index): its orientation
+   * in that order, -1, 0 or +1, or 2: not yet computed, 3: +1 and area[]
+   * holds its area; each computed at most once per call */
+  int8_t orient[MAXT];
+  double area[MAXT];
 } hole;
 
 /* The star of v counter-clockwise: spokes[i] leaves v, link vertex i is its
@@ -91,14 +105,48 @@ static int walk_star(const tt__mesh *m, int32_t v, int32_t *spokes, int cap,
   return d;
 }
 
-static int orient3(const tt__mesh *m, int32_t a, int32_t b, int32_t c)
+/* Index of the triangle of local indices i < j < k in hole.orient/area
+ * (the combinatorial number system: dense over 0 <= i < j < k <= n). */
+static int tri_index(int i, int j, int k)
 {
-  return tt__mesh_orient(m, a, b, c);
+  return k * (k - 1) * (k - 2) / 6 + j * (j - 1) / 2 + i;
 }
 
-/* 3-D area of triangle (a, b, c), the corners taken from the smallest
- * index on (a rotation: the same triangle gives the same bits). */
-static double area(const hole *h, int32_t a, int32_t b, int32_t c)
+/* Ground vector from local point a to local point b: tt__geo_vec's
+ * arithmetic on the copied coordinates, so the same bits. */
+static tt__gvec gvec(const hole *h, int a, int b)
+{
+  double dc = (double)(h->c[b] - h->c[a]);
+  double dr = (double)(h->r[b] - h->r[a]);
+  tt__gvec g = {h->fr[0] * dc + h->fr[1] * dr, h->fr[2] * dc + h->fr[3] * dr,
+                h->z[b] - h->z[a]};
+  return g;
+}
+
+/* 3-D area of triangle (a, b, c) of local points, the corners taken from
+ * the smallest vertex id on (a rotation: the same triangle gives the same
+ * bits, here and in mesh_area). */
+static double tri_area(const hole *h, int a, int b, int c)
+{
+  const int32_t *id = h->id;
+  if (id[b] < id[a] && id[b] < id[c]) {
+    int t = a;
+    a = b;
+    b = c;
+    c = t;
+  } else if (id[c] < id[a] && id[c] < id[b]) {
+    int t = c;
+    c = b;
+    b = a;
+    a = t;
+  }
+  tt__gvec o = {0, 0, 0};
+  return tt__garea(o, gvec(h, a, b), gvec(h, a, c));
+}
+
+/* 3-D area of the mesh triangle (a, b, c) (vertex ids), the same
+ * canonical order and arithmetic as tri_area. */
+static double mesh_area(const hole *h, int32_t a, int32_t b, int32_t c)
 {
   if (b < a && b < c) {
     int32_t t = a;
@@ -116,61 +164,32 @@ static double area(const hole *h, int32_t a, int32_t b, int32_t c)
                    tt__geo_vec(h->fr, h->m, a, c));
 }
 
-/* Whether the closed segments a-b and c-d (vertex ids) meet. */
-static bool segments_meet(const tt__mesh *m, int32_t a, int32_t b, int32_t c,
-                          int32_t d)
+/* Orientation of local points (i, j, k), i < j < k, in the ground frame
+ * (tt__mesh_orient's sign: the same formula on the same coordinates),
+ * from the table: > 0 when counter-clockwise (1, or 3 once its area is
+ * known). */
+static int tri_orient(hole *h, int t, int i, int j, int k)
 {
-  int o1 = orient3(m, a, b, c), o2 = orient3(m, a, b, d);
-  int o3 = orient3(m, c, d, a), o4 = orient3(m, c, d, b);
-  if (o1 * o2 < 0 && o3 * o4 < 0)
-    return true;
-  const tt__mesh_vertex *w = m->v;
-#define BETWEEN(s, t, u)                                                     \
-  ((w[s].c < w[t].c ? w[s].c : w[t].c) <= w[u].c &&                          \
-   w[u].c <= (w[s].c < w[t].c ? w[t].c : w[s].c) &&                          \
-   (w[s].r < w[t].r ? w[s].r : w[t].r) <= w[u].r &&                          \
-   w[u].r <= (w[s].r < w[t].r ? w[t].r : w[s].r))
-  return (o1 == 0 && BETWEEN(a, b, c)) || (o2 == 0 && BETWEEN(a, b, d)) ||
-         (o3 == 0 && BETWEEN(c, d, a)) || (o4 == 0 && BETWEEN(c, d, b));
-#undef BETWEEN
-}
-
-static bool is_side(const hole *h, int a, int b)
-{
-  if (h->closed)
-    return (a + 1) % h->n == b || (b + 1) % h->n == a;
-  return a + 1 == b || b + 1 == a;
-}
-
-/* Chord p_a-p_b: a side of the hole, or a diagonal inside it that misses
- * v. */
-static bool chord_ok(const hole *h, int a, int b)
-{
-  if (a == b)
-    return false;
-  if (is_side(h, a, b))
-    return true;
-  int s = h->m->metric.det_sign, off = h->closed ? 0 : 1;
-  if (!tt__polygon_diagonal_ok(h->nq, h->qx, h->qy, s, a + off, b + off))
-    return false;
-  /* (open: v is an outline vertex, the test above covers it) */
-  return !h->closed || !segments_meet(h->m, h->p[a], h->p[b], h->v, h->v);
-}
-
-/* Spoke v-p_i inside the hole. */
-static bool spoke_ok(const hole *h, int i)
-{
-  if (!h->closed)
-    return i == 0 || i == h->n - 1 ||
-           tt__polygon_diagonal_ok(h->nq, h->qx, h->qy,
-                                   h->m->metric.det_sign, 0, i + 1);
-  for (int k = 0; k < h->n; k++) {
-    int k1 = (k + 1) % h->n;
-    if (k != i && k1 != i &&
-        segments_meet(h->m, h->v, h->p[i], h->p[k], h->p[k1]))
-      return false;
+  if (h->orient[t] == 2) {
+    /* tt__orient_i's exact 128-bit determinant, inline here: it is most
+     * of this file's predicate calls */
+    hole_i128 det = (hole_i128)(h->c[i] - h->c[k]) * (h->r[j] - h->r[k]) -
+                    (hole_i128)(h->r[i] - h->r[k]) * (h->c[j] - h->c[k]);
+    int o = det > 0 ? 1 : (det < 0 ? -1 : 0);
+    h->orient[t] = (int8_t)(h->m->metric.det_sign * o);
   }
-  return true;
+  return h->orient[t];
+}
+
+/* The area of a triangle (i, j, k), i < j < k, already found
+ * counter-clockwise: computed on first use. */
+static double tri_area_at(hole *h, int t, int i, int j, int k)
+{
+  if (h->orient[t] != 3) { /* 3: counter-clockwise, area known */
+    h->area[t] = tri_area(h, i, j, k);
+    h->orient[t] = 3;
+  }
+  return h->area[t];
 }
 
 /* The DP tables and the best fan path. */
@@ -178,12 +197,41 @@ typedef struct dp {
   double P[MAXN][MAXN];   /* pocket a..b (cyclic when closed) */
   int8_t K[MAXN][MAXN];   /* its best apex */
   double W[MAXN][MAXN];   /* fan step a -> b */
-  bool spoke[MAXN];
+  /* the finite fan steps from each spoke a, in order: to spoke
+   * (a + off[a][k]) mod n at cost ws[a][k], up to and including the first
+   * fixed spoke after a (no step jumps over it) */
+  int nstep[MAXN];
+  int8_t off[MAXN][MAXN];
+  double ws[MAXN][MAXN];
   double D[MAXN + 1];     /* path values over positions from the start */
   int8_t from[MAXN + 1];  /* the position each came from */
 } dp;
 
-static void fill_pockets(const hole *h, dp *t)
+/* Why only orientations are tested (no "chord inside the polygon" or
+ * "spoke misses the outline" test, which earlier versions had):
+ * every combination the DP can form -- a closed fan path of steps
+ * (v, p_a, p_b) with a triangulated pocket behind each, or, when v is on
+ * the outline, the path from spoke 0 to n-1 -- has triangles whose
+ * boundaries sum, as oriented edge chains, to the outline (each chord and
+ * spoke is crossed once each way). So at every point off the edges the
+ * number of triangles covering it with sign (+1 counter-clockwise, -1
+ * clockwise) equals the outline's winding number: 1 inside the hole, 0
+ * outside. With every triangle strictly counter-clockwise all signs are
+ * +1, so every point inside is covered exactly once and no point outside
+ * at all: the triangles tile the hole. Then no edge can pass through v or
+ * an outline vertex, or leave the outline (a neighbourhood of that point
+ * would be covered twice, or a point outside covered), so every chord
+ * and spoke of such a combination is one the old tests accepted, and
+ * every triangulation they accepted is such a combination. Dropping the
+ * tests lets the tables hold values for chords and spokes that can never
+ * be part of a complete combination (any completion would have a
+ * triangle that is not counter-clockwise, which the DP never forms), and
+ * no completed path uses them. Since sums of non-negative doubles only
+ * grow, every P, W and path value is at most the old one and equal to it
+ * on every piece of the chosen triangulation, and with the strict "<"
+ * scans the same first minimum (apex, step, start) is picked: the result
+ * is the same, bit for bit. */
+static void fill_pockets(hole *h, dp *t)
 {
   int n = h->n;
   for (int a = 0; a < n; a++)
@@ -194,22 +242,46 @@ static void fill_pockets(const hole *h, dp *t)
   for (int a = 0; a < n; a++)
     if (h->closed || a + 1 < n)
       t->P[a][(a + 1) % n] = 0.0;
-  for (int len = 2; len < n; len++)
+  /* Closed, a pocket of n - 1 sides is never needed: it is no part of a
+   * longer pocket, and its fan step a -> a - 1 closes a path only with the
+   * step back, the same triangle the other way round, which cannot also
+   * turn counter-clockwise; so W of such a step, finite or not, never
+   * enters a finite path value or the chosen path. Open, it is the
+   * pocket behind a single fan triangle (v, p_0, p_{n-1}). */
+  int maxlen = h->closed ? n - 2 : n - 1;
+  for (int len = 2; len <= maxlen; len++)
     for (int a = 0; a < n; a++) {
       if (!h->closed && a + len >= n)
         break;
-      int b = (a + len) % n;
-      if (!chord_ok(h, a, b))
-        continue;
+      int b = a + len < n ? a + len : a + len - n;
       double best = INFINITY;
       int bk = -1;
-      for (int i = 1; i < len; i++) {
-        int k = (a + i) % n;
+      for (int i = 1, k = a + 1 < n ? a + 1 : 0; i < len;
+           i++, k = k + 1 < n ? k + 1 : 0) {
         double pa = t->P[a][k], pb = t->P[k][b];
-        if (pa == INFINITY || pb == INFINITY ||
-            orient3(h->m, h->p[a], h->p[k], h->p[b]) <= 0)
+        if (pa == INFINITY || pb == INFINITY)
           continue;
-        double val = pa + pb + area(h, h->p[a], h->p[k], h->p[b]);
+        /* (a, k, b) in the outline's cyclic order: its sorted order is a
+         * rotation of it, same orientation and area */
+        int x = a, y = k, w = b;
+        if (k < a) { /* k wrapped, so did b: k < b < a */
+          x = k;
+          y = b;
+          w = a;
+        } else if (b < a) { /* only b wrapped: b < a < k */
+          x = b;
+          y = a;
+          w = k;
+        }
+        /* an area is >= 0 and a rounded sum never below a term, so
+         * pa + pb >= best already loses: skip its orientation and area */
+        double papb = pa + pb;
+        if (!(papb < best))
+          continue;
+        int ti = tri_index(x, y, w);
+        if (tri_orient(h, ti, x, y, w) <= 0)
+          continue;
+        double val = papb + tri_area_at(h, ti, x, y, w);
         if (val < best) {
           best = val;
           bk = k;
@@ -218,21 +290,46 @@ static void fill_pockets(const hole *h, dp *t)
       t->P[a][b] = best;
       t->K[a][b] = (int8_t)bk;
     }
-  for (int i = 0; i < n; i++)
-    t->spoke[i] = spoke_ok(h, i);
+  /* fan steps: (v, p_a, p_b) has the orientation of (p_a, p_b, v), and v
+   * is local point n, the largest */
   for (int a = 0; a < n; a++)
-    for (int b = 0; b < n; b++) {
-      t->W[a][b] = INFINITY;
-      if (a != b && t->spoke[a] && t->spoke[b] && t->P[a][b] < INFINITY &&
-          orient3(h->m, h->v, h->p[a], h->p[b]) > 0)
-        t->W[a][b] = area(h, h->v, h->p[a], h->p[b]) + t->P[a][b];
+    t->W[a][a] = INFINITY;
+  for (int a = 0; a < n; a++)
+    for (int b = a + 1; b < n; b++) {
+      t->W[a][b] = t->W[b][a] = INFINITY;
+      int ti = tri_index(a, b, n);
+      int o = tri_orient(h, ti, a, b, n);
+      if (o > 0 && t->P[a][b] < INFINITY)
+        t->W[a][b] = tri_area_at(h, ti, a, b, n) + t->P[a][b];
+      else if (o < 0 && t->P[b][a] < INFINITY) {
+        /* (b, a) turns counter-clockwise: its area, the same bits */
+        t->W[b][a] = tri_area(h, n, b, a) + t->P[b][a];
+      }
     }
+  for (int a = 0; a < n; a++) {
+    int c = 0;
+    for (int o = 1, b = a + 1 == n ? 0 : a + 1; o <= n;
+         o++, b = b + 1 == n ? 0 : b + 1) {
+      if (t->W[a][b] < INFINITY) {
+        t->off[a][c] = (int8_t)o;
+        t->ws[a][c++] = t->W[a][b];
+      }
+      if (h->fixed[b])
+        break;
+    }
+    t->nstep[a] = c;
+  }
 }
 
 /* Shortest fan path from spoke `start` once around v (closed) or from
  * spoke 0 to n-1 (open); positions j = 0..last stand for spoke
- * (start + j) mod n. Returns its value (INFINITY: none). */
-static double fan_path(const hole *h, dp *t, int start)
+ * (start + j) mod n. Returns its value when below `bound`; otherwise
+ * something not below it. Positions whose value reached the bound are not
+ * expanded: a step adds a non-negative area, and a rounded sum of
+ * non-negative doubles is never below either term, so no path through
+ * them ends below the bound, and every value below it is the same as
+ * without the cut (same bits, same `from`). bound INFINITY: no cut. */
+static double fan_path(const hole *h, dp *t, int start, double bound)
 {
   int n = h->n, last = h->closed ? n : n - 1;
   for (int j = 0; j <= last; j++) {
@@ -240,19 +337,21 @@ static double fan_path(const hole *h, dp *t, int start)
     t->from[j] = -1;
   }
   t->D[0] = 0.0;
-  for (int i = 0; i < last; i++) {
-    if (t->D[i] == INFINITY)
+  /* a: spoke (start + i) mod n, kept by wrapping instead of dividing; the
+   * steps with infinite cost, which never lower a value, are not listed */
+  for (int i = 0, a = start; i < last; i++, a = a + 1 == n ? 0 : a + 1) {
+    if (!(t->D[i] < bound))
       continue;
-    int a = (start + i) % n;
-    for (int j = i + 1; j <= last; j++) {
-      int b = (start + j) % n;
-      double val = t->D[i] + t->W[a][b];
+    double di = t->D[i];
+    for (int k = 0; k < t->nstep[a]; k++) {
+      int j = i + t->off[a][k];
+      if (j > last)
+        break;
+      double val = di + t->ws[a][k];
       if (val < t->D[j]) {
         t->D[j] = val;
         t->from[j] = (int8_t)i;
       }
-      if (h->fixed[b])
-        break; /* no step jumps over a fixed spoke */
     }
   }
   return t->D[last];
@@ -306,20 +405,25 @@ static bool build_hole(const tt__mesh *m, int32_t v, hole *h)
     link[d] = m->hv[tt__prev(spokes[d - 1])];
     fixed[d] = true;
   }
-  h->nslots = d;
+  h->nstar = h->nslots = d;
   /* the neighbours across the link edges */
   bool grow = (closed ? 2 * d : 2 * d + 1) <= MAXN;
+  /* first every neighbour's apex, then the tests: the loads of the
+   * neighbours (often cache misses) overlap instead of waiting on each
+   * other's tests */
   for (int i = 0; i < d; i++) {
     int32_t le = tt__next(spokes[i]), f = m->twin[le];
-    apex[i] = -1;
-    if (!grow || f < 0 || (m->eflag[le] & TT__EDGE_CONSTRAINED))
-      continue;
-    int32_t w = tt__mesh_apex(m, f);
+    apex[i] = !grow || f < 0 || (m->eflag[le] & TT__EDGE_CONSTRAINED)
+                  ? -1
+                  : tt__mesh_apex(m, f);
+  }
+  for (int i = 0; i < d; i++) {
+    int32_t w = apex[i];
     bool in_star = w == v;
     for (int k = 0; k < nlink && !in_star; k++)
       in_star = link[k] == w;
-    if (!in_star)
-      apex[i] = w;
+    if (in_star)
+      apex[i] = -1;
   }
   /* a neighbour whose apex another neighbour shares is left out, both of
    * them (so the hole does not depend on where the walk started) */
@@ -342,17 +446,16 @@ static bool build_hole(const tt__mesh *m, int32_t v, hole *h)
       h->slots[h->nslots++] = m->twin[tt__next(spokes[i])] / 3;
     }
   }
-  h->nq = 0;
-  if (!closed) {
-    h->qx[0] = m->v[v].c;
-    h->qy[0] = m->v[v].r;
-    h->nq = 1;
+  for (int i = 0; i <= h->n; i++) {
+    int32_t w = i < h->n ? h->p[i] : v;
+    h->id[i] = w;
+    h->c[i] = m->v[w].c;
+    h->r[i] = m->v[w].r;
+    h->z[i] = (double)m->v[w].z;
   }
-  for (int i = 0; i < h->n; i++) {
-    h->qx[h->nq] = m->v[h->p[i]].c;
-    h->qy[h->nq] = m->v[h->p[i]].r;
-    h->nq++;
-  }
+  int nt = tri_index(h->n - 2, h->n - 1, h->n) + 1;
+  for (int i = 0; i < nt; i++)
+    h->orient[i] = 2;
   return true;
 }
 
@@ -387,9 +490,29 @@ int tt__hole_min_area(tt__mesh *m, const tt__crit_env *env, int32_t v,
   dp t;
   if (!build_hole(m, v, &h))
     return link_edges(m, v, opposite, max);
+  /* Just the star, no neighbour admitted, around 3 outline points: the
+   * current triangles are then the only triangulation with v as a vertex
+   * and every triangle strictly counter-clockwise -- closed: a fan step
+   * over a link vertex would pair (v, p_a, p_a+2) with its reverse; open
+   * (v on the outline between p_2 and p_0): the only other one has
+   * (v, p_0, p_2), which must then not turn counter-clockwise (v on the
+   * boundary segment p_0-p_2 after a split). The DP would find their area
+   * again, summed in another order: a few ulps apart, a tie by tt__snap,
+   * kept. */
+  if (h.n == 3 && h.nslots == h.nstar &&
+      (h.closed || tt__mesh_orient(m, v, h.p[0], h.p[2]) <= 0))
+    return link_edges(m, v, opposite, max);
   tt__geo_frame(env, h.fr);
+  double now = 0.0;
+  for (int i = 0; i < h.nslots; i++) {
+    int32_t e = 3 * h.slots[i];
+    now += mesh_area(&h, m->hv[e], m->hv[e + 1], m->hv[e + 2]);
+  }
   fill_pockets(&h, &t);
-  /* the best start: the first fixed spoke, or every spoke */
+  /* the best start: the first fixed spoke, or every spoke; only a value
+   * below `now` can replace the current triangles, so it bounds the
+   * search from the start (a start whose value is not below the bound
+   * cannot be the first strict minimum that changes anything) */
   int first = 0, nstart = h.closed ? h.n : 1;
   for (int i = 0; i < h.n && h.closed; i++)
     if (h.fixed[i]) {
@@ -397,24 +520,19 @@ int tt__hole_min_area(tt__mesh *m, const tt__crit_env *env, int32_t v,
       nstart = 1;
       break;
     }
-  double best = INFINITY;
+  double best = now < INFINITY ? now : INFINITY;
   int bstart = -1;
   for (int s = first; s < first + nstart; s++) {
-    double val = fan_path(&h, &t, s);
+    double val = fan_path(&h, &t, s, best);
     if (val < best) {
       best = val;
       bstart = s;
     }
   }
-  double now = 0.0;
-  for (int i = 0; i < h.nslots; i++) {
-    int32_t e = 3 * h.slots[i];
-    now += area(&h, m->hv[e], m->hv[e + 1], m->hv[e + 2]);
-  }
   if (bstart < 0 || !(tt__snap(now - best, now + best) > 0))
     return link_edges(m, v, opposite, max); /* keep the current one */
   /* the triangles: the fan steps of the best path, then their pockets */
-  fan_path(&h, &t, bstart);
+  fan_path(&h, &t, bstart, INFINITY);
   int32_t tris[MAXN][3];
   int nt = 0, last = h.closed ? h.n : h.n - 1;
   for (int j = last; j > 0; j = t.from[j]) {

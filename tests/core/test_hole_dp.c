@@ -15,11 +15,15 @@
  * before, the outline and every constrained edge in place, v's link edges
  * in opposite[], and the mesh valid. Flat and planar terrains (every
  * triangulation ties) must leave the mesh untouched. Two identical runs
- * give identical meshes. The mean time per call on a larger terrain is
+ * give identical meshes. Every call is also compared with a reference
+ * copy of the DP as it was before it was made faster (every chord and
+ * spoke tested, nothing cached or cut): the same triangles in the same
+ * slots, or the same holes kept, tie rule included. The mean time per call on a larger terrain is
  * printed, never checked. Seeded; TT_SEED=<n> replays a run. */
 #include "criteria/geometry.h"
 #include "hole_dp.h"
 #include "mesh.h"
+#include "polygon_dp.h"
 #include "predicates.h"
 #include "swap.h"
 #include "tt_test.h"
@@ -536,6 +540,411 @@ static int g_calls, g_enumerated, g_changed, g_open, g_fixed;
 static int g_size[2][MAXP + 1]; /* holes by outline size, v inside/on it */
 
 /* v's star size: live triangles with v as a corner. */
+/* --- the reference: hole_dp.c as it was before the speed-up ------------ */
+
+/* The version of tt__hole_min_area that tested every chord and spoke for
+ * lying inside the outline, evaluated every orientation and area where it
+ * was met and ran every fan path to the end. The current one must choose
+ * exactly the same triangulation (same triangles in the same slots) or
+ * keep the same holes: ref_decide returns the number of triangles it
+ * would write (their slots and corners in out_*), 0 to keep. */
+#define RMAXN TT__HOLE_MAX_N
+
+typedef struct ref_hole {
+  const tt__mesh *m;
+  double fr[4];
+  int32_t v;
+  bool closed;          /* v strictly inside; else on the outline */
+  int n;                /* outline vertices without v */
+  int32_t p[RMAXN];
+  bool fixed[RMAXN];     /* spoke v-p_i must stay */
+  int nslots;           /* the ref_hole's current triangles */
+  int32_t slots[RMAXN];
+  /* the outline for the diagonal tests: p, or v followed by p (open) */
+  int nq;
+  int64_t qx[RMAXN + 1], qy[RMAXN + 1];
+} ref_hole;
+
+/* The star of v counter-clockwise: spokes[i] leaves v, link vertex i is its
+ * end. Returns the number of triangles (-1: more than cap), with
+ * *out_closed false when v is on the boundary (then spokes[0] has no twin
+ * and the last link vertex is the end of the last triangle's edge into v). */
+static int ref_walk_star(const tt__mesh *m, int32_t v, int32_t *spokes, int cap,
+                     bool *out_closed)
+{
+  int32_t e0 = m->v[v].edge, s = e0;
+  *out_closed = true;
+  for (int guard = 0;; guard++) { /* clockwise to the boundary, if any */
+    int32_t f = m->twin[s];
+    if (f < 0) {
+      *out_closed = false;
+      break;
+    }
+    s = tt__next(f);
+    if (s == e0)
+      break;
+    if (guard > cap)
+      return -1;
+  }
+  int d = 0;
+  for (int32_t e = s;;) {
+    if (d >= cap)
+      return -1;
+    spokes[d++] = e;
+    int32_t f = m->twin[tt__prev(e)];
+    if (f < 0 || f == s)
+      break;
+    e = f;
+  }
+  return d;
+}
+
+static int ref_orient3(const tt__mesh *m, int32_t a, int32_t b, int32_t c)
+{
+  return tt__mesh_orient(m, a, b, c);
+}
+
+/* 3-D ref_area of triangle (a, b, c), the corners taken from the smallest
+ * index on (a rotation: the same triangle gives the same bits). */
+static double ref_area(const ref_hole *h, int32_t a, int32_t b, int32_t c)
+{
+  if (b < a && b < c) {
+    int32_t t = a;
+    a = b;
+    b = c;
+    c = t;
+  } else if (c < a && c < b) {
+    int32_t t = c;
+    c = b;
+    b = a;
+    a = t;
+  }
+  tt__gvec o = {0, 0, 0};
+  return tt__garea(o, tt__geo_vec(h->fr, h->m, a, b),
+                   tt__geo_vec(h->fr, h->m, a, c));
+}
+
+/* Whether the closed segments a-b and c-d (vertex ids) meet. */
+static bool ref_segments_meet(const tt__mesh *m, int32_t a, int32_t b, int32_t c,
+                          int32_t d)
+{
+  int o1 = ref_orient3(m, a, b, c), o2 = ref_orient3(m, a, b, d);
+  int o3 = ref_orient3(m, c, d, a), o4 = ref_orient3(m, c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0)
+    return true;
+  const tt__mesh_vertex *w = m->v;
+#define BETWEEN(s, t, u)                                                     \
+  ((w[s].c < w[t].c ? w[s].c : w[t].c) <= w[u].c &&                          \
+   w[u].c <= (w[s].c < w[t].c ? w[t].c : w[s].c) &&                          \
+   (w[s].r < w[t].r ? w[s].r : w[t].r) <= w[u].r &&                          \
+   w[u].r <= (w[s].r < w[t].r ? w[t].r : w[s].r))
+  return (o1 == 0 && BETWEEN(a, b, c)) || (o2 == 0 && BETWEEN(a, b, d)) ||
+         (o3 == 0 && BETWEEN(c, d, a)) || (o4 == 0 && BETWEEN(c, d, b));
+#undef BETWEEN
+}
+
+static bool ref_is_side(const ref_hole *h, int a, int b)
+{
+  if (h->closed)
+    return (a + 1) % h->n == b || (b + 1) % h->n == a;
+  return a + 1 == b || b + 1 == a;
+}
+
+/* Chord p_a-p_b: a side of the ref_hole, or a diagonal inside it that misses
+ * v. */
+static bool ref_chord_ok(const ref_hole *h, int a, int b)
+{
+  if (a == b)
+    return false;
+  if (ref_is_side(h, a, b))
+    return true;
+  int s = h->m->metric.det_sign, off = h->closed ? 0 : 1;
+  if (!tt__polygon_diagonal_ok(h->nq, h->qx, h->qy, s, a + off, b + off))
+    return false;
+  /* (open: v is an outline vertex, the test above covers it) */
+  return !h->closed || !ref_segments_meet(h->m, h->p[a], h->p[b], h->v, h->v);
+}
+
+/* Spoke v-p_i inside the ref_hole. */
+static bool ref_spoke_ok(const ref_hole *h, int i)
+{
+  if (!h->closed)
+    return i == 0 || i == h->n - 1 ||
+           tt__polygon_diagonal_ok(h->nq, h->qx, h->qy,
+                                   h->m->metric.det_sign, 0, i + 1);
+  for (int k = 0; k < h->n; k++) {
+    int k1 = (k + 1) % h->n;
+    if (k != i && k1 != i &&
+        ref_segments_meet(h->m, h->v, h->p[i], h->p[k], h->p[k1]))
+      return false;
+  }
+  return true;
+}
+
+/* The DP tables and the best fan path. */
+typedef struct ref_dp {
+  double P[RMAXN][RMAXN];   /* pocket a..b (cyclic when closed) */
+  int8_t K[RMAXN][RMAXN];   /* its best apex */
+  double W[RMAXN][RMAXN];   /* fan step a -> b */
+  bool spoke[RMAXN];
+  double D[RMAXN + 1];     /* path values over positions from the start */
+  int8_t from[RMAXN + 1];  /* the position each came from */
+} ref_dp;
+
+static void ref_fill_pockets(const ref_hole *h, ref_dp *t)
+{
+  int n = h->n;
+  for (int a = 0; a < n; a++)
+    for (int b = 0; b < n; b++) {
+      t->P[a][b] = INFINITY;
+      t->K[a][b] = -1;
+    }
+  for (int a = 0; a < n; a++)
+    if (h->closed || a + 1 < n)
+      t->P[a][(a + 1) % n] = 0.0;
+  for (int len = 2; len < n; len++)
+    for (int a = 0; a < n; a++) {
+      if (!h->closed && a + len >= n)
+        break;
+      int b = (a + len) % n;
+      if (!ref_chord_ok(h, a, b))
+        continue;
+      double best = INFINITY;
+      int bk = -1;
+      for (int i = 1; i < len; i++) {
+        int k = (a + i) % n;
+        double pa = t->P[a][k], pb = t->P[k][b];
+        if (pa == INFINITY || pb == INFINITY ||
+            ref_orient3(h->m, h->p[a], h->p[k], h->p[b]) <= 0)
+          continue;
+        double val = pa + pb + ref_area(h, h->p[a], h->p[k], h->p[b]);
+        if (val < best) {
+          best = val;
+          bk = k;
+        }
+      }
+      t->P[a][b] = best;
+      t->K[a][b] = (int8_t)bk;
+    }
+  for (int i = 0; i < n; i++)
+    t->spoke[i] = ref_spoke_ok(h, i);
+  for (int a = 0; a < n; a++)
+    for (int b = 0; b < n; b++) {
+      t->W[a][b] = INFINITY;
+      if (a != b && t->spoke[a] && t->spoke[b] && t->P[a][b] < INFINITY &&
+          ref_orient3(h->m, h->v, h->p[a], h->p[b]) > 0)
+        t->W[a][b] = ref_area(h, h->v, h->p[a], h->p[b]) + t->P[a][b];
+    }
+}
+
+/* Shortest fan path from spoke `start` once around v (closed) or from
+ * spoke 0 to n-1 (open); positions j = 0..last stand for spoke
+ * (start + j) mod n. Returns its value (INFINITY: none). */
+static double ref_fan_path(const ref_hole *h, ref_dp *t, int start)
+{
+  int n = h->n, last = h->closed ? n : n - 1;
+  for (int j = 0; j <= last; j++) {
+    t->D[j] = INFINITY;
+    t->from[j] = -1;
+  }
+  t->D[0] = 0.0;
+  for (int i = 0; i < last; i++) {
+    if (t->D[i] == INFINITY)
+      continue;
+    int a = (start + i) % n;
+    for (int j = i + 1; j <= last; j++) {
+      int b = (start + j) % n;
+      double val = t->D[i] + t->W[a][b];
+      if (val < t->D[j]) {
+        t->D[j] = val;
+        t->from[j] = (int8_t)i;
+      }
+      if (h->fixed[b])
+        break; /* no step jumps over a fixed spoke */
+    }
+  }
+  return t->D[last];
+}
+
+/* Appends the triangles of pocket a..b. */
+static void ref_emit_pocket(const ref_hole *h, const ref_dp *t, int a, int b,
+                        int32_t (*tris)[3], int *nt)
+{
+  int stack[2 * RMAXN], sp = 0;
+  stack[sp++] = a;
+  stack[sp++] = b;
+  while (sp > 0) {
+    int j = stack[--sp], i = stack[--sp];
+    int k = t->K[i][j];
+    if ((i + 1) % h->n == j || k < 0)
+      continue;
+    tris[*nt][0] = h->p[i];
+    tris[*nt][1] = h->p[k];
+    tris[*nt][2] = h->p[j];
+    (*nt)++;
+    stack[sp++] = i;
+    stack[sp++] = k;
+    stack[sp++] = k;
+    stack[sp++] = j;
+  }
+}
+
+/* Builds the ref_hole of v (the definition in hole_dp.h). False when v's star
+ * is too large to handle. */
+static bool ref_build_hole(const tt__mesh *m, int32_t v, ref_hole *h)
+{
+  int32_t spokes[RMAXN];
+  bool closed;
+  int d = ref_walk_star(m, v, spokes, RMAXN, &closed);
+  int nlink = closed ? d : d + 1;
+  if (d < 1 || nlink > RMAXN)
+    return false;
+  h->m = m;
+  h->v = v;
+  h->closed = closed;
+  int32_t link[RMAXN], apex[RMAXN];
+  bool fixed[RMAXN];
+  for (int i = 0; i < d; i++) {
+    link[i] = m->hv[tt__next(spokes[i])];
+    fixed[i] = m->twin[spokes[i]] < 0 ||
+               (m->eflag[spokes[i]] & TT__EDGE_CONSTRAINED);
+    h->slots[i] = spokes[i] / 3;
+  }
+  if (!closed) {
+    link[d] = m->hv[tt__prev(spokes[d - 1])];
+    fixed[d] = true;
+  }
+  h->nslots = d;
+  /* the neighbours across the link edges */
+  bool grow = (closed ? 2 * d : 2 * d + 1) <= RMAXN;
+  for (int i = 0; i < d; i++) {
+    int32_t le = tt__next(spokes[i]), f = m->twin[le];
+    apex[i] = -1;
+    if (!grow || f < 0 || (m->eflag[le] & TT__EDGE_CONSTRAINED))
+      continue;
+    int32_t w = tt__mesh_apex(m, f);
+    bool in_star = w == v;
+    for (int k = 0; k < nlink && !in_star; k++)
+      in_star = link[k] == w;
+    if (!in_star)
+      apex[i] = w;
+  }
+  /* a neighbour whose apex another neighbour shares is left out, both of
+   * them (so the ref_hole does not depend on where the walk started) */
+  int32_t keep[RMAXN];
+  for (int i = 0; i < d; i++) {
+    keep[i] = apex[i];
+    for (int k = 0; k < d && keep[i] >= 0; k++)
+      if (k != i && apex[k] == apex[i])
+        keep[i] = -1;
+  }
+  h->n = 0;
+  for (int i = 0; i < nlink; i++) {
+    h->p[h->n] = link[i];
+    h->fixed[h->n] = fixed[i];
+    h->n++;
+    if (i < d && keep[i] >= 0) {
+      h->p[h->n] = keep[i];
+      h->fixed[h->n] = false; /* an apex is never a spoke end yet */
+      h->n++;
+      h->slots[h->nslots++] = m->twin[tt__next(spokes[i])] / 3;
+    }
+  }
+  h->nq = 0;
+  if (!closed) {
+    h->qx[0] = m->v[v].c;
+    h->qy[0] = m->v[v].r;
+    h->nq = 1;
+  }
+  for (int i = 0; i < h->n; i++) {
+    h->qx[h->nq] = m->v[h->p[i]].c;
+    h->qy[h->nq] = m->v[h->p[i]].r;
+    h->nq++;
+  }
+  return true;
+}
+
+static int ref_decide(const tt__mesh *m, const tt__crit_env *env,
+                      int32_t v, int32_t *out_slots, int32_t (*out_tris)[3])
+{
+  ref_hole h;
+  ref_dp t;
+  if (!ref_build_hole(m, v, &h))
+    return 0;
+  tt__geo_frame(env, h.fr);
+  ref_fill_pockets(&h, &t);
+  /* the best start: the first fixed spoke, or every spoke */
+  int first = 0, nstart = h.closed ? h.n : 1;
+  for (int i = 0; i < h.n && h.closed; i++)
+    if (h.fixed[i]) {
+      first = i;
+      nstart = 1;
+      break;
+    }
+  double best = INFINITY;
+  int bstart = -1;
+  for (int s = first; s < first + nstart; s++) {
+    double val = ref_fan_path(&h, &t, s);
+    if (val < best) {
+      best = val;
+      bstart = s;
+    }
+  }
+  double now = 0.0;
+  for (int i = 0; i < h.nslots; i++) {
+    int32_t e = 3 * h.slots[i];
+    now += ref_area(&h, m->hv[e], m->hv[e + 1], m->hv[e + 2]);
+  }
+  if (bstart < 0 || !(tt__snap(now - best, now + best) > 0))
+    return 0; /* keep the current one */
+  /* the triangles: the fan steps of the best path, then their pockets */
+  ref_fan_path(&h, &t, bstart);
+  int32_t tris[RMAXN][3];
+
+  int nt = 0, last = h.closed ? h.n : h.n - 1;
+  for (int j = last; j > 0; j = t.from[j]) {
+    int i = t.from[j];
+    int a = (bstart + i) % h.n, b = (bstart + j) % h.n;
+    tris[nt][0] = v;
+    tris[nt][1] = h.p[a];
+    tris[nt][2] = h.p[b];
+    nt++;
+    ref_emit_pocket(&h, &t, a, b, tris, &nt);
+  }
+  if (nt != h.nslots) /* cannot happen: every triangulation of the hole
+                          has as many triangles */
+    return 0;
+  for (int i = 0; i < nt; i++) {
+    out_slots[i] = h.slots[i];
+    for (int k = 0; k < 3; k++)
+      out_tris[i][k] = tris[i][k];
+  }
+  return nt;
+}
+
+/* Checks the mesh after tt__hole_min_area against ref_decide's answer
+ * taken before the call: the same slots hold the same corners in the same
+ * order, or nothing changed. */
+static void check_ref(const tt__mesh *m, int rn, const int32_t *rslots,
+                      const int32_t (*rtris)[3], const char *what, int step)
+{
+  bool changed = m->ntouched > 0;
+  if (changed != (rn > 0)) {
+    TT_FAIL_("seed %" PRIu64 " %s step %d: the reference %s, the DP %s",
+             g_seed, what, step, rn > 0 ? "changes the hole" : "keeps it",
+             changed ? "changed it" : "kept it");
+    return;
+  }
+  for (int i = 0; i < rn; i++)
+    for (int k = 0; k < 3; k++)
+      if (m->hv[3 * rslots[i] + k] != rtris[i][k]) {
+        TT_FAIL_("seed %" PRIu64 " %s step %d: slot %d corner %d is %d, "
+                 "the reference has %d", g_seed, what, step, rslots[i], k,
+                 m->hv[3 * rslots[i] + k], rtris[i][k]);
+        return;
+      }
+}
+
 static int degree(const tt__mesh *m, int32_t v)
 {
   int d = 0;
@@ -577,12 +986,15 @@ static void checked_call(world *w, int32_t v, const char *what, int step,
   int32_t *hv0 = malloc(3 * nslots0 * sizeof *hv0);
   memcpy(hv0, m->hv, 3 * nslots0 * sizeof *hv0);
   tt__mesh_clear_touched(m);
+  int32_t rslots[TT__HOLE_MAX_N], rtris[TT__HOLE_MAX_N][3];
+  int rn = ref_decide(m, &w->env, v, rslots, rtris);
   int32_t opp[TT__HOLE_MAX_N];
   int k = tt__hole_min_area(m, &w->env, v, opp, TT__HOLE_MAX_N);
   g_calls++;
   CHECK(k > 0);
   if (!validate(m, what, step))
     goto out;
+  check_ref(m, rn, rslots, (const int32_t(*)[3])rtris, what, step);
   double after = total_area(w);
   bool changed = m->ntouched > 0;
   g_changed += changed;
@@ -700,8 +1112,8 @@ static void random_holes(uint64_t *rng)
  * min-area swaps from v's link edges. Returns a copy of the final mesh
  * arrays (the caller frees) and the call count. */
 static int32_t *refine_like(const double frame[4], uint64_t seed, int W,
-                            int H, int n, size_t *out_len, double *out_secs,
-                            int *out_calls)
+                            int H, int n, bool check, size_t *out_len,
+                            double *out_secs, int *out_calls)
 {
   uint64_t rng = seed;
   world w;
@@ -718,6 +1130,12 @@ static int32_t *refine_like(const double frame[4], uint64_t seed, int W,
     if (v < 0)
       continue;
     int32_t link[TT__HOLE_MAX_N];
+    int32_t rslots[TT__HOLE_MAX_N], rtris[TT__HOLE_MAX_N][3];
+    int rn = 0;
+    if (check) { /* the split's triangles out of the touched log */
+      tt__mesh_clear_touched(&w.m);
+      rn = ref_decide(&w.m, &w.env, v, rslots, rtris);
+    }
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     int k = tt__hole_min_area(&w.m, &w.env, v, link, TT__HOLE_MAX_N);
@@ -727,6 +1145,9 @@ static int32_t *refine_like(const double frame[4], uint64_t seed, int W,
     CHECK(k > 0);
     if (k <= 0)
       break;
+    if (check)
+      check_ref(&w.m, rn, rslots, (const int32_t(*)[3])rtris, "refine-like",
+                calls);
     CHECK(tt__swap_repair(&w.m, &tt__criterion_min_area, &w.env, link, k,
                           &stack) >= 0);
     tt__mesh_clear_touched(&w.m);
@@ -853,9 +1274,9 @@ int main(void)
     double sa, sb;
     int ca, cb;
     int32_t *a = refine_like(frames[f], g_seed + (uint64_t)f, 60, 50, 400,
-                             &la, &sa, &ca);
+                             true, &la, &sa, &ca);
     int32_t *b = refine_like(frames[f], g_seed + (uint64_t)f, 60, 50, 400,
-                             &lb, &sb, &cb);
+                             true, &lb, &sb, &cb);
     CHECK(la == lb && ca == cb && memcmp(a, b, la * sizeof *a) == 0);
     free(a);
     free(b);
@@ -866,8 +1287,8 @@ int main(void)
     size_t len;
     double secs;
     int calls;
-    int32_t *a = refine_like(frames[1], g_seed, 1000, 1000, 20000, &len,
-                             &secs, &calls);
+    int32_t *a = refine_like(frames[1], g_seed, 1000, 1000, 20000, false,
+                             &len, &secs, &calls);
     printf("tt__hole_min_area: %d calls, mean %.2f us per call\n", calls,
            calls ? 1e6 * secs / calls : 0.0);
     free(a);
