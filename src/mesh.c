@@ -698,18 +698,24 @@ bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots, int nold,
   int nhalf = 3 * ntri, nouter = 0, ntaken = 0;
   size_t nextra = ntri > nold ? (size_t)(ntri - nold) : 0;
   /* the outline: half-edges of the region whose twin is outside it, with
-   * that twin and the constraint flag (read before any slot is rewritten) */
-  int32_t *outer = malloc(3 * (size_t)nold * sizeof *outer);
-  int32_t *otwin = malloc(3 * (size_t)nold * sizeof *otwin);
-  uint8_t *oflag = malloc(3 * (size_t)nold);
-  /* per new half-edge 3 * t + k: the new half-edge it pairs with (>= 0),
-   * or -2 - o for outline half-edge o */
-  int32_t *pair = malloc((size_t)nhalf * sizeof *pair);
-  int32_t *slot = malloc((size_t)ntri * sizeof *slot);
-  /* constrained edges inside the region (a vertex inserted on one): the
-   * new triangles must have them too, and they stay constrained */
-  int32_t *icons = malloc(3 * (size_t)nold * sizeof *icons);
-  uint8_t *iflag = malloc((size_t)nhalf);
+   * that twin and the constraint flag (read before any slot is rewritten);
+   * per new half-edge 3 * t + k: the new half-edge it pairs with (>= 0),
+   * or -2 - o for outline half-edge o; constrained edges inside the region
+   * (a vertex inserted on one): the new triangles must have them too, and
+   * they stay constrained. Small regions (every hole of refinement) live
+   * on the stack, larger ones on the heap. */
+  enum { SMALL = 32 };
+  int32_t s_outer[3 * SMALL], s_otwin[3 * SMALL], s_pair[3 * SMALL],
+      s_slot[SMALL], s_icons[3 * SMALL];
+  uint8_t s_oflag[3 * SMALL], s_iflag[3 * SMALL];
+  bool small = nold <= SMALL && ntri <= SMALL;
+  int32_t *outer = small ? s_outer : malloc(3 * (size_t)nold * sizeof *outer);
+  int32_t *otwin = small ? s_otwin : malloc(3 * (size_t)nold * sizeof *otwin);
+  uint8_t *oflag = small ? s_oflag : malloc(3 * (size_t)nold);
+  int32_t *pair = small ? s_pair : malloc((size_t)nhalf * sizeof *pair);
+  int32_t *slot = small ? s_slot : malloc((size_t)ntri * sizeof *slot);
+  int32_t *icons = small ? s_icons : malloc(3 * (size_t)nold * sizeof *icons);
+  uint8_t *iflag = small ? s_iflag : malloc((size_t)nhalf);
   int nicons = 0;
   if (!outer || !otwin || !oflag || !pair || !slot || !icons || !iflag)
     goto done;
@@ -815,12 +821,14 @@ bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots, int nold,
   }
   ok = true;
 done:
-  free(outer);
-  free(otwin);
-  free(oflag);
-  free(pair);
-  free(slot);
-  free(icons);
-  free(iflag);
+  if (!small) {
+    free(outer);
+    free(otwin);
+    free(oflag);
+    free(pair);
+    free(slot);
+    free(icons);
+    free(iflag);
+  }
   return ok;
 }

@@ -1238,6 +1238,45 @@ static void replace_refusals(void)
   world_free(&w);
 }
 
+/* A region larger than the stack buffers of replace_region (its heap
+ * path): every live triangle of a mesh, replaced by the same triangles in
+ * reverse order, rotated; the mesh stays valid and holds the same set. */
+static void replace_large(void)
+{
+  world w;
+  uint64_t rng = 11;
+  world_init(&w, frames[0], 12, 10, Z_RANDOM, &rng);
+  int32_t opp[4];
+  int nopp, added = 0;
+  for (int i = 0; i < 60; i++)
+    added += insert(&w, 1 + (int)(tt_test_rand(&rng) % 10),
+                    1 + (int)(tt_test_rand(&rng) % 8), opp, &nopp) >= 0;
+  tt__mesh *m = &w.m;
+  int n = 0;
+  int32_t *slots = malloc(m->nslots * sizeof *slots);
+  int32_t(*tris)[3] = malloc(m->nslots * sizeof *tris);
+  for (size_t t = 0; t < m->nslots; t++)
+    if (tt__mesh_live(m, (int32_t)t))
+      slots[n++] = (int32_t)t;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++)
+      tris[n - 1 - i][k] = m->hv[3 * slots[i] + (k + 1) % 3];
+  printf("replace_region: %d points added, a region of %d triangles\n",
+         added, n);
+  CHECK(n > 64);
+  size_t live = m->nlive;
+  CHECK(tt__mesh_replace_region(m, slots, n, (const int32_t(*)[3])tris, n));
+  validate(m, "replace large", 0);
+  CHECK_INT_EQ(m->nlive, live);
+  /* one triangle fewer cannot fit the outline: refused, mesh unchanged */
+  CHECK(!tt__mesh_replace_region(m, slots, n, (const int32_t(*)[3])tris,
+                                 n - 1));
+  validate(m, "replace large refused", 0);
+  free(slots);
+  free(tris);
+  world_free(&w);
+}
+
 int main(void)
 {
   g_seed = 20261122;
@@ -1249,6 +1288,7 @@ int main(void)
   uint64_t rng = g_seed;
 
   replace_refusals();
+  replace_large();
 
   random_holes(&rng);
   printf("%d calls, %d holes enumerated (%d with v on the mesh boundary, "
