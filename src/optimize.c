@@ -504,7 +504,12 @@ bool tt__optimize_run(tt__mesh *m, const tt__opt_params *p,
   o.m = m;
   o.p = p;
   tt__heap_init(&o.heap);
-  bool ok = rehash(&o, 64);
+  /* the hash at most half full without rehashing: a whole-mesh run meets
+   * about 1.5 edges per triangle slot and the edges its swaps make */
+  size_t hcap = 64;
+  while (!seeds && hcap < 4 * m->nslots)
+    hcap <<= 1;
+  bool ok = rehash(&o, hcap);
   size_t scope = 0;
   if (ok && !seeds) {
     for (size_t e = 0; e < 3 * m->nslots && ok; e++)

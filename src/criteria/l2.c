@@ -28,7 +28,9 @@
  * the swap back have exactly opposite values, and the sums can be cached.
  *
  * Cache (cache_new, per run): a direct-mapped table of triangle sums keyed
- * by the rotated vertex triple and the three ownership bits, for the real
+ * by the rotated vertex triple and the three ownership bits, about two
+ * entries per triangle of the mesh (grown with it, up to a cap), for the
+ * real
  * triangles (the "before" of every edge of a triangle) and the
  * hypothetical ones (the "after", which become real when the swap is
  * taken). A hit returns the very bits the scan would, so the cache never
@@ -74,25 +76,39 @@ typedef struct l2_cache {
   size_t mask;
 } l2_cache;
 
+/* The table holds about two entries per triangle of the mesh: it starts
+ * small and is re-made (emptied) twice as large whenever the mesh has
+ * outgrown it, up to L2_CACHE_MAX entries (24 bytes each, 1.5 MiB: the
+ * hits come from edges of the same triangles scored one after the other,
+ * and a table larger than the processor's caches measured slower). */
+#define L2_CACHE_MIN ((size_t)1 << 12)
+#define L2_CACHE_MAX ((size_t)1 << 16)
+
+static bool l2_cache_size(l2_cache *c, size_t n)
+{
+  l2_entry *e = malloc(n * sizeof *e);
+  if (!e)
+    return false;
+  for (size_t i = 0; i < n; i++)
+    e[i].v[0] = -1;
+  free(c->e);
+  c->e = e;
+  c->mask = n - 1;
+  return true;
+}
+
 static void *l2_cache_new(const tt__crit_env *env)
 {
   if (!env->grid)
     return NULL;
-  /* about one entry per 16 samples, 2^12 .. 2^22 entries */
-  size_t n = (size_t)1 << 12;
-  while (n < ((size_t)1 << 22) && n * 16 < env->grid->nx * env->grid->ny)
-    n <<= 1;
   l2_cache *c = malloc(sizeof *c);
   if (!c)
     return NULL;
-  c->e = malloc(n * sizeof *c->e);
-  if (!c->e) {
+  c->e = NULL;
+  if (!l2_cache_size(c, L2_CACHE_MIN)) {
     free(c);
     return NULL;
   }
-  for (size_t i = 0; i < n; i++)
-    c->e[i].v[0] = -1;
-  c->mask = n - 1;
   return c;
 }
 
@@ -120,6 +136,12 @@ static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
                  (uint32_t)o[(r + 2) % 3] << 2;
   l2_cache *c = env->cache;
   l2_entry *slot = NULL;
+  if (c && c->mask + 1 < 2 * m->nslots && c->mask + 1 < L2_CACHE_MAX) {
+    size_t n = 2 * (c->mask + 1);
+    while (n < 2 * m->nslots && n < L2_CACHE_MAX)
+      n <<= 1;
+    l2_cache_size(c, n); /* out of memory: the old table goes on */
+  }
   if (c) {
     uint64_t h = ((uint64_t)(uint32_t)v[0] * 0x9e3779b97f4a7c15ull) ^
                  ((uint64_t)(uint32_t)v[1] * 0xc2b2ae3d27d4eb4full) ^
