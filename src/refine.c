@@ -544,8 +544,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       ok = tt__mesh_split_edge(&r.m, on, v, opposite);
       nopp = 4;
     }
-    /* [optimize.c hook] Delaunay's incircle repair, or the local swap of
-     * any other criterion over the new vertex's star */
+    /* [optimize.c hook] the criterion restored around the new vertex as
+     * opt->repair says: flips outward from it (Delaunay's exact incircle
+     * flips, or any other criterion's swap values; min_area's exact hole
+     * first), the local swap over its region, or Delaunay's flips alone */
     if (!ok || tt__optimize_insert(&r.m, r.crit, &r.env, r.repair, v,
                                    opposite, nopp, &r.stack) < 0 ||
         !drain(&r)) {
