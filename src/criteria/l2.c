@@ -30,12 +30,13 @@
  * Cache (cache_new, per run): a direct-mapped table of triangle sums keyed
  * by the rotated vertex triple and the three ownership bits, about two
  * entries per triangle of the mesh (grown with it, up to a cap), for the
- * real
- * triangles (the "before" of every edge of a triangle) and the
+ * real triangles (the "before" of every edge of a triangle) and the
  * hypothetical ones (the "after", which become real when the swap is
  * taken). A hit returns the very bits the scan would, so the cache never
  * changes a value; a collision overwrites. Vertices never move and the
- * grid does not change during a run, so an entry never goes stale.
+ * grid does not change during a run, so an entry never goes stale; a
+ * cache handed another mesh or grid than the one it was made for is not
+ * used.
  * Needs: the grid (env->grid; without one the value is 0). Quads that are
  * not strictly convex score 0 (geometry.h), so the scans never meet a
  * degenerate triangle. Cost: a scan of the quad's samples twice -- the
@@ -74,6 +75,8 @@ typedef struct l2_entry {
 typedef struct l2_cache {
   l2_entry *e;
   size_t mask;
+  const tt__mesh *mesh;   /* what the entries belong to */
+  const tt_grid *grid;
 } l2_cache;
 
 /* The table holds about two entries per triangle of the mesh: it starts
@@ -105,6 +108,8 @@ static void *l2_cache_new(const tt__crit_env *env)
   if (!c)
     return NULL;
   c->e = NULL;
+  c->mesh = env->mesh;
+  c->grid = env->grid;
   if (!l2_cache_size(c, L2_CACHE_MIN)) {
     free(c);
     return NULL;
@@ -135,6 +140,8 @@ static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
   uint32_t own = (uint32_t)o[r] | (uint32_t)o[(r + 1) % 3] << 1 |
                  (uint32_t)o[(r + 2) % 3] << 2;
   l2_cache *c = env->cache;
+  if (c && (c->mesh != m || c->grid != env->grid))
+    c = NULL;
   l2_entry *slot = NULL;
   if (c && c->mask + 1 < 2 * m->nslots && c->mask + 1 < L2_CACHE_MAX) {
     size_t n = 2 * (c->mask + 1);
