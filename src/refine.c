@@ -411,6 +411,61 @@ static int32_t locate_in(const refine *r, int32_t t, int64_t col, int64_t row)
   return -1;
 }
 
+/* The insertion after this one is most often the heap's second entry (the
+ * new triangles of this one tend to fit better). Its data is cold: ask for
+ * it one insertion early, in two stages, so the misses overlap this
+ * insertion's work instead of stalling the next one. Stage 2 (for the
+ * triangle named last time, whose slot words are now near): its corners,
+ * its neighbours' slots and the samples around its candidate. Stage 1:
+ * the slot words and the candidate of the current second entry. Only hints: nothing here changes what is computed. */
+static void prefetch_next(const refine *r, int32_t *ahead)
+{
+#if defined(__GNUC__)
+  const tt__mesh *m = &r->m;
+  int32_t t = *ahead;
+  if (t >= 0 && (size_t)t < m->nslots && tt__mesh_live(m, t)) {
+    for (int k = 0; k < 3; k++) {
+      __builtin_prefetch(&m->v[m->hv[3 * t + k]]);
+      int32_t f = m->twin[3 * t + k];
+      if (f >= 0)
+        __builtin_prefetch(&m->hv[f - f % 3]);
+    }
+    int64_t s = r->cand[t];
+    if (s >= 0) {
+      /* the rows around the sample it will insert */
+      int64_t nx = (int64_t)r->g->nx, ny = (int64_t)r->g->ny;
+      int64_t col = s % nx, row = s / nx;
+      int64_t x0 = col >= 16 ? col - 16 : 0, x1 = col + 16 < nx ? col + 16
+                                                                : nx - 1;
+      for (int64_t y = row >= 4 ? row - 4 : 0; y <= row + 4 && y < ny; y++) {
+        const float *z = r->g->z + (size_t)(y * nx);
+        __builtin_prefetch(z + x0);
+        __builtin_prefetch(z + x1);
+        if (x1 - x0 > 16)
+          __builtin_prefetch(z + (x0 + x1) / 2);
+      }
+    }
+  }
+  *ahead = -1;
+  const tt__heap *h = &r->heap;
+  size_t n = tt__heap_size(h);
+  if (n < 2)
+    return;
+  size_t best = 1;
+  for (size_t i = 2; i <= 4 && i < n; i++)
+    if (h->e[i].key > h->e[best].key)
+      best = i;
+  int32_t t2 = h->e[best].item;
+  __builtin_prefetch(&m->hv[3 * t2]);
+  __builtin_prefetch(&m->twin[3 * t2]);
+  __builtin_prefetch(&r->cand[t2]);
+  *ahead = t2;
+#else
+  (void)r;
+  *ahead = -1;
+#endif
+}
+
 static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
 {
   if (isnan(o->max_error) || isinf(o->max_error))
@@ -504,7 +559,9 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
     goto done;
   }
 
+  int32_t ahead = -1; /* the likely next insertion's triangle (prefetch) */
   for (size_t iter = 1;; iter++) {
+    prefetch_next(&r, &ahead);
     if (tt__heap_size(&r.heap) == 0) {
       /* every sample is exact: an error limit, if any, is met */
       reason = r.max_error >= 0 ? TT_STOP_MAX_ERROR : TT_STOP_EXHAUSTED;
