@@ -91,6 +91,11 @@ tt_optimize tt_optimize_resolve(tt_optimize optimize, tt_criterion criterion,
 
 /* --- the run's state ----------------------------------------------------- */
 
+typedef struct edge_list {
+  int32_t *e;
+  size_t n, cap;
+} edge_list;
+
 typedef struct opt {
   tt__mesh *m;
   const tt__opt_params *p;
@@ -108,6 +113,7 @@ typedef struct opt {
   bool phase2, oom;
   long moves, budget;
   tt__opt_stats st;
+  edge_list batch_edges; /* rescore's list, kept from move to move */
 } opt;
 
 static void opt_free(opt *o)
@@ -120,6 +126,7 @@ static void opt_free(opt *o)
   free(o->led);
   free(o->stamp);
   free(o->hash);
+  free(o->batch_edges.e);
 }
 
 static size_t hash_pair(int32_t a, int32_t b, size_t hcap)
@@ -297,11 +304,6 @@ static bool score(opt *o, int32_t id)
 
 /* --- re-scoring after a move --------------------------------------------- */
 
-typedef struct edge_list {
-  int32_t *e;
-  size_t n, cap;
-} edge_list;
-
 static bool list_push(edge_list *l, int32_t e)
 {
   if (!tt__grow((void **)&l->e, &l->cap, l->n + 1, sizeof(int32_t)))
@@ -331,7 +333,8 @@ static bool rescore(opt *o, const int32_t *slots, int ns, const int32_t *diag,
                     int nd, bool wake)
 {
   const tt__mesh *m = o->m;
-  edge_list l = {NULL, 0, 0};
+  edge_list l = o->batch_edges;
+  l.n = 0;
   bool ok = true;
   o->batch++;
   for (int i = 0; i < ns && ok; i++)
@@ -367,7 +370,7 @@ static bool rescore(opt *o, const int32_t *slots, int ns, const int32_t *diag,
       o->rest[id] = 0;
     ok = score(o, id);
   }
-  free(l.e);
+  o->batch_edges = l;
   return ok && !o->oom;
 }
 
