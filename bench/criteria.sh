@@ -7,7 +7,8 @@
 #   TERRATIN=path bench/criteria.sh   # another binary (default build/terratin)
 #   PERCENTS="10 25" BENCH_TIMEOUT=300 bench/criteria.sh
 #
-# Each run is repeated REPEAT times (default 3) and the fastest counts, so a
+# Each criterion is run REPEAT times (default 3) in alternation with
+# Delaunay at the same percentage and the fastest of each counts, so a
 # busy machine disturbs the ratios less; EXTRA adds options to every run
 # (e.g. EXTRA="-repair local"). Printed with each time: its ratio to
 # Delaunay's at the same percentage and the mean absolute error reached.
@@ -69,36 +70,58 @@ modes() { # json file -> repair/optimize as resolved
   python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d["repair"] + "/" + d["optimize"])' "$1"
 }
 
+# one timed run: run_once NAME DEM CRITERION P -> prints seconds.simplify
+# (">T" on a timeout or failure); the JSON stays in $OUT for the errors
+run_once() {
+  local js="$OUT/$1.$3.$4.json"
+  if timeout "$BENCH_TIMEOUT" "$TT" simplify -percent "$4" -criterion "$3" \
+       $EXTRA -json -overwrite "$2" "$OUT/$1.$3.$4.gpkg" > "$js" 2> "$js.err"
+  then
+    seconds "$js"
+  else
+    echo ">T"
+  fi
+  rm -f "$OUT/$1.$3.$4.gpkg"
+}
+fmin() { # fmin A B: the smaller, ">T" counting as infinite
+  if [[ $1 == ">T" ]]; then echo "$2"; elif [[ $2 == ">T" || -z $2 ]]; then
+    echo "$1"; else python3 -c "print(min($1, $2))"; fi
+}
+
 for entry in "${dems[@]}"; do
   name=${entry%%:*}
   dem=${entry#*:}
-  declare -A sec=() err=() mode=()
+  declare -A sec=() ref=() err=() mode=()
+  # Each criterion is timed right beside Delaunay: REPEAT alternating pairs
+  # (Delaunay, criterion), the fastest of each; the ratio is taken against
+  # the Delaunay runs of the same pairs, so that a slow spell of a shared
+  # machine weighs on both sides of the ratio.
   for c in $criteria; do
     for p in $PERCENTS; do
-      js="$OUT/$name.$c.$p.json"
-      best=""
+      best="" dbest=""
       for ((k = 0; k < REPEAT; k++)); do
-        if timeout "$BENCH_TIMEOUT" "$TT" simplify -percent "$p" \
-             -criterion "$c" $EXTRA -json -overwrite "$dem" \
-             "$OUT/$name.$c.$p.gpkg" > "$js" 2> "$js.err"
-        then
-          s=$(seconds "$js")
-          if [ -z "$best" ] || python3 -c "import sys; sys.exit(0 if $s < $best else 1)"; then
-            best=$s
-          fi
-          err[$c.$p]=$(meanerr "$js")
-          mode[$c]=$(modes "$js")
-        else
-          best=">T"
-          break
+        d=$(run_once "$name" "$dem" delaunay "$p")
+        dbest=$(fmin "$d" "$dbest")
+        if [ "$c" = delaunay ]; then
+          best=$dbest
+          continue
         fi
+        s=$(run_once "$name" "$dem" "$c" "$p")
+        best=$(fmin "$s" "$best")
+        [[ $s == ">T" ]] && break
       done
       sec[$c.$p]=$best
-      rm -f "$OUT/$name.$c.$p.gpkg"
+      ref[$c.$p]=$dbest
+      js="$OUT/$name.$c.$p.json"
+      if [[ $best != ">T" ]]; then
+        err[$c.$p]=$(meanerr "$js")
+        mode[$c]=$(modes "$js")
+      fi
     done
   done
   echo
-  echo "== $name ($dem): seconds.simplify (fastest of $REPEAT), x Delaunay, mean |error|"
+  echo "== $name ($dem): seconds.simplify (fastest of $REPEAT), x Delaunay" \
+       "(timed in alternation with it), mean |error|"
   printf '%-18s%-16s' criterion repair/optimize
   for p in $PERCENTS; do printf '%27s' "$p%"; done
   echo
@@ -106,7 +129,7 @@ for entry in "${dems[@]}"; do
     printf '%-18s%-16s' "$c" "${mode[$c]:-?}"
     for p in $PERCENTS; do
       s=${sec[$c.$p]}
-      d=${sec[delaunay.$p]}
+      d=${ref[$c.$p]}
       if [[ $s == ">T" || $d == ">T" ]]; then
         printf '%27s' "$s"
       else
@@ -115,5 +138,5 @@ for entry in "${dems[@]}"; do
     done
     echo
   done
-  unset sec err mode
+  unset sec ref err mode
 done

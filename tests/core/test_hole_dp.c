@@ -27,6 +27,7 @@
 #include "predicates.h"
 #include "swap.h"
 #include "tt_test.h"
+#include "tt_test_geom.h"
 
 #include <time.h>
 
@@ -210,32 +211,21 @@ static double total_area(const world *w)
 static int64_t cross(int64_t ax, int64_t ay, int64_t bx, int64_t by,
                      int64_t cx, int64_t cy)
 {
-  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+  return tt_test_cross(ax, ay, bx, by, cx, cy);
 }
 
-static int sgn(int64_t x) { return (x > 0) - (x < 0); }
+static int sgn(int64_t x) { return tt_test_sgn(x); }
 
 static bool on_seg(int64_t ax, int64_t ay, int64_t bx, int64_t by,
                    int64_t px, int64_t py)
 {
-  return cross(ax, ay, bx, by, px, py) == 0 && px >= (ax < bx ? ax : bx) &&
-         px <= (ax < bx ? bx : ax) && py >= (ay < by ? ay : by) &&
-         py <= (ay < by ? by : ay);
+  return tt_test_on_segment(ax, ay, bx, by, px, py);
 }
 
 static bool seg_meet(const int64_t *x, const int64_t *y, int a, int b, int c,
                      int d)
 {
-  int o1 = sgn(cross(x[a], y[a], x[b], y[b], x[c], y[c]));
-  int o2 = sgn(cross(x[a], y[a], x[b], y[b], x[d], y[d]));
-  int o3 = sgn(cross(x[c], y[c], x[d], y[d], x[a], y[a]));
-  int o4 = sgn(cross(x[c], y[c], x[d], y[d], x[b], y[b]));
-  if (o1 * o2 < 0 && o3 * o4 < 0)
-    return true;
-  return on_seg(x[a], y[a], x[b], y[b], x[c], y[c]) ||
-         on_seg(x[a], y[a], x[b], y[b], x[d], y[d]) ||
-         on_seg(x[c], y[c], x[d], y[d], x[a], y[a]) ||
-         on_seg(x[c], y[c], x[d], y[d], x[b], y[b]);
+  return tt_test_segments_meet(x, y, a, b, c, d);
 }
 
 /* --- the hole, built from its definition ----------------------------------
@@ -395,22 +385,8 @@ static bool seg_inside(const thole *h, int i, int j)
     if (seg_meet(h->x, h->y, i, j, k, k1))
       return false;
   }
-  /* midpoint strictly inside, even-odd in doubled coordinates */
-  int64_t mx = h->x[i] + h->x[j], my = h->y[i] + h->y[j];
-  bool in = false;
-  for (int k = 0; k < h->nq; k++) {
-    int k1 = (k + 1) % h->nq;
-    int64_t ax = 2 * h->x[k], ay = 2 * h->y[k], bx = 2 * h->x[k1],
-            by = 2 * h->y[k1];
-    if (on_seg(ax, ay, bx, by, mx, my))
-      return false;
-    if ((ay > my) != (by > my)) {
-      int64_t c = cross(ax, ay, bx, by, mx, my);
-      if ((by > ay) ? c > 0 : c < 0)
-        in = !in;
-    }
-  }
-  return in;
+  /* midpoint strictly inside */
+  return tt_test_midpoint_inside(h->nq, h->x, h->y, i, j);
 }
 
 typedef struct oracle {

@@ -9,6 +9,7 @@
  * seed is printed (TT_SEED=<n> replays a run). */
 #include "polygon_dp.h"
 #include "tt_test.h"
+#include "tt_test_geom.h"
 
 #include <stdbool.h>
 
@@ -24,34 +25,13 @@ typedef struct poly {
 static int64_t cross(int64_t ax, int64_t ay, int64_t bx, int64_t by,
                      int64_t cx, int64_t cy)
 {
-  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-}
-
-static int sgn(int64_t v) { return (v > 0) - (v < 0); }
-
-static bool on_segment(int64_t ax, int64_t ay, int64_t bx, int64_t by,
-                       int64_t px, int64_t py)
-{
-  return cross(ax, ay, bx, by, px, py) == 0 &&
-         px >= (ax < bx ? ax : bx) && px <= (ax < bx ? bx : ax) &&
-         py >= (ay < by ? ay : by) && py <= (ay < by ? by : ay);
+  return tt_test_cross(ax, ay, bx, by, cx, cy);
 }
 
 /* closed segments meet */
 static bool seg_meet(const poly *p, int a, int b, int c, int d)
 {
-  int64_t ax = p->x[a], ay = p->y[a], bx = p->x[b], by = p->y[b];
-  int64_t cx = p->x[c], cy = p->y[c], dx = p->x[d], dy = p->y[d];
-  int o1 = sgn(cross(ax, ay, bx, by, cx, cy));
-  int o2 = sgn(cross(ax, ay, bx, by, dx, dy));
-  int o3 = sgn(cross(cx, cy, dx, dy, ax, ay));
-  int o4 = sgn(cross(cx, cy, dx, dy, bx, by));
-  if (o1 * o2 < 0 && o3 * o4 < 0)
-    return true;
-  return on_segment(ax, ay, bx, by, cx, cy) ||
-         on_segment(ax, ay, bx, by, dx, dy) ||
-         on_segment(cx, cy, dx, dy, ax, ay) ||
-         on_segment(cx, cy, dx, dy, bx, by);
+  return tt_test_segments_meet(p->x, p->y, a, b, c, d);
 }
 
 static bool simple(const poly *p)
@@ -81,22 +61,7 @@ static bool simple(const poly *p)
  * half-open rule on y */
 static bool midpoint_inside(const poly *p, int i, int j)
 {
-  int64_t mx = p->x[i] + p->x[j], my = p->y[i] + p->y[j];
-  bool in = false;
-  for (int k = 0; k < p->n; k++) {
-    int k1 = (k + 1) % p->n;
-    int64_t ax = 2 * p->x[k], ay = 2 * p->y[k], bx = 2 * p->x[k1],
-            by = 2 * p->y[k1];
-    if (on_segment(ax, ay, bx, by, mx, my))
-      return false;
-    if ((ay > my) != (by > my)) {
-      /* x of the crossing > mx ? */
-      int64_t c = cross(ax, ay, bx, by, mx, my);
-      if ((by > ay) ? c > 0 : c < 0)
-        in = !in;
-    }
-  }
-  return in;
+  return tt_test_midpoint_inside(p->n, p->x, p->y, i, j);
 }
 
 static bool chord_inside(const poly *p, int i, int j)
@@ -111,7 +76,8 @@ static bool chord_inside(const poly *p, int i, int j)
   /* no other vertex on the chord */
   for (int k = 0; k < p->n; k++)
     if (k != i && k != j &&
-        on_segment(p->x[i], p->y[i], p->x[j], p->y[j], p->x[k], p->y[k]))
+        tt_test_on_segment(p->x[i], p->y[i], p->x[j], p->y[j], p->x[k],
+                           p->y[k]))
       return false;
   return midpoint_inside(p, i, j);
 }
@@ -325,8 +291,8 @@ static void check_case(const poly *p, bool sum, uint64_t seed, int round)
   for (int t = 0; t < p->n - 2; t++) {
     int a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
     CHECK(a < b && b < c);
-    CHECK(p->s * sgn(cross(p->x[a], p->y[a], p->x[b], p->y[b], p->x[c],
-                           p->y[c])) > 0);
+    CHECK(p->s * tt_test_sgn(cross(p->x[a], p->y[a], p->x[b], p->y[b],
+                                   p->x[c], p->y[c])) > 0);
     double m = sum ? area3(p, a, b, c) : max_angle(p, a, b, c);
     v = sum ? v + m : fmax(v, m);
     int e[3][2] = {{a, b}, {b, c}, {a, c}};
