@@ -29,6 +29,18 @@
 static const char *const optimize_names[] = {"auto", "none", "local",
                                              "lookahead"};
 #define NOPT (sizeof optimize_names / sizeof optimize_names[0])
+static const char *const repair_names[] = {"auto", "flip", "local",
+                                           "lookahead", "delaunay"};
+#define NREP (sizeof repair_names / sizeof repair_names[0])
+
+/* The index of name in names[0..n), or -1. */
+static int name_index(const char *const *names, size_t n, const char *name)
+{
+  for (size_t i = 0; name && i < n; i++)
+    if (strcmp(names[i], name) == 0)
+      return (int)i;
+  return -1;
+}
 
 const char *tt_optimize_name(tt_optimize optimize)
 {
@@ -38,19 +50,14 @@ const char *tt_optimize_name(tt_optimize optimize)
 tt_status tt_optimize_parse(tt_context *ctx, const char *name,
                             tt_optimize *out_optimize)
 {
-  if (name && out_optimize)
-    for (size_t i = 0; i < NOPT; i++)
-      if (strcmp(optimize_names[i], name) == 0) {
-        *out_optimize = (tt_optimize)i;
-        return TT_OK;
-      }
+  int i = name_index(optimize_names, NOPT, name);
+  if (i >= 0 && out_optimize) {
+    *out_optimize = (tt_optimize)i;
+    return TT_OK;
+  }
   return tt__error(ctx, TT_ERR_ARG, "unknown optimisation '%s' (known: auto, "
                    "none, local, lookahead)", name ? name : "(null)");
 }
-
-static const char *const repair_names[] = {"auto", "flip", "local",
-                                           "lookahead", "delaunay"};
-#define NREP (sizeof repair_names / sizeof repair_names[0])
 
 const char *tt_repair_name(tt_repair repair)
 {
@@ -60,12 +67,11 @@ const char *tt_repair_name(tt_repair repair)
 tt_status tt_repair_parse(tt_context *ctx, const char *name,
                           tt_repair *out_repair)
 {
-  if (name && out_repair)
-    for (size_t i = 0; i < NREP; i++)
-      if (strcmp(repair_names[i], name) == 0) {
-        *out_repair = (tt_repair)i;
-        return TT_OK;
-      }
+  int i = name_index(repair_names, NREP, name);
+  if (i >= 0 && out_repair) {
+    *out_repair = (tt_repair)i;
+    return TT_OK;
+  }
   return tt__error(ctx, TT_ERR_ARG, "unknown repair '%s' (known: auto, "
                    "flip, local, lookahead, delaunay)",
                    name ? name : "(null)");
