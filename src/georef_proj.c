@@ -60,14 +60,6 @@
  * this relative tolerance (UTM's own scale varies by 0.1% across a zone). */
 #define TT_METRIC_TOLERANCE 0.01
 
-TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
-                                            OGRSpatialReferenceH srs,
-                                            const char *work_srs,
-                                            const double gt[6], size_t nx,
-                                            size_t ny, double out_frame[4],
-                                            char *out_name,
-                                            size_t name_size);
-
 /* Sets out_frame to the geotransform's linear part scaled to metres at the
  * centre latitude of an nx x ny grid: column and row steps in the CRS's
  * angular unit become (m per unit of longitude, m per unit of latitude)

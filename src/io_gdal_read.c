@@ -30,14 +30,6 @@
 #include <strings.h>
 #include <unistd.h>
 
-TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
-                                            OGRSpatialReferenceH srs,
-                                            const char *work_srs,
-                                            const double gt[6], size_t nx,
-                                            size_t ny, double out_frame[4],
-                                            char *out_name,
-                                            size_t name_size);
-
 /* Largest mask buffer used at once; taller blocks are read in bands of rows
  * (the block itself then stays in GDAL's cache between the bands). */
 #define TT_READ_MASK_BYTES ((size_t)1 << 20)
