@@ -182,8 +182,9 @@ typedef enum tt_repair {
   TT_REPAIR_FLIP,          /* Lawson flips outward from the new vertex: an
                               edge opposite it is swapped while its swap
                               value is positive (exact incircle flips for
-                              Delaunay); min_area first re-triangulates the
-                              hole around the vertex by exact dynamic
+                              Delaunay). With flip, local and lookahead,
+                              min_area first re-triangulates the hole
+                              around the vertex by exact dynamic
                               programming */
   TT_REPAIR_LOCAL,         /* maximal-reduction local swap over the edges
                               around the new vertex and every edge a swap
