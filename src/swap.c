@@ -28,12 +28,7 @@ static bool should_flip(const tt__mesh *m, const tt__criterion_vt *crit,
 {
   if (m->twin[e] < 0 || (m->eflag[e] & TT__EDGE_CONSTRAINED))
     return false;
-  /* the cheaper test first: Delaunay's incircle is cheaper than the two
-   * orientations of the flippability test and mostly says no; every other
-   * swap value costs more than they do */
-  if (crit->id == TT_CRITERION_DELAUNAY)
-    return crit->swap_value(env, e) > 0 && tt__mesh_flippable(m, e);
-  return tt__mesh_flippable(m, e) && crit->swap_value(env, e) > 0;
+  return crit->swap_value(env, e) > 0 && tt__mesh_flippable(m, e);
 }
 
 long tt__swap_repair(tt__mesh *m, const tt__criterion_vt *crit,
