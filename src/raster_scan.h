@@ -19,6 +19,7 @@
 
 #include "internal.h"
 #include "mesh.h"
+#include "parallel.h"
 
 typedef struct tt__scan_tri {
   int64_t x[3], y[3];   /* pixel coordinates of the corners */
@@ -50,10 +51,45 @@ TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t,
 TT_HIDDEN void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
                                   double *out_err, int64_t *out_index);
 
-/* The same, restricted to rows [ylo, yhi] of the triangle (for splitting a
- * large triangle into jobs: the candidate of the whole is the largest of
- * the parts, the earliest part winning ties). */
+/* Error bounds per tile of TT__TILE x TT__TILE samples (tile (i, j) holds
+ * columns TT__TILE i .. TT__TILE i + TT__TILE - 1, rows likewise): a plane
+ * fitted to the tile's samples, L(x, y) = c + bx (x - xc) + by (y - yc)
+ * about the tile's centre (xc, yc), and h, the largest |z - L| of a valid
+ * sample (h < 0: the tile has none). For any triangle's plane P, every
+ * valid sample of the tile has
+ *   |z - P| <= |L - P|(xc, yc) + |bx - gx| hw + |by - gy| hh + h,
+ * (hw, hh the tile's half extents), since L - P is linear: so a scan for
+ * the largest error may skip the tiles whose bound is below the best error
+ * found so far, and still finds exactly the same sample. The floats are
+ * the stored plane itself (h is measured from them, rounded up), so their
+ * rounding costs tightness, never validity. Memory: 16 bytes per tile,
+ * 0.25 bytes per sample. */
+#define TT__TILE_SHIFT 3
+#define TT__TILE (1 << TT__TILE_SHIFT)
+
+typedef struct tt__scan_tiles {
+  size_t ntx, nty;     /* tiles per row and per column */
+  float *t;            /* 4 per tile, row-major: c, bx, by, h */
+} tt__scan_tiles;
+
+/* Builds the bounds of g into *out (its own array); false when out of
+ * memory (then *out is empty). pool may be NULL. The caller frees *out with
+ * tt__scan_tiles_free(). */
+TT_HIDDEN bool tt__scan_tiles_build(const tt_grid *g, tt__pool *pool,
+                                    tt__scan_tiles *out);
+TT_HIDDEN void tt__scan_tiles_free(tt__scan_tiles *tiles);
+
+/* Whether tt__scan_candidate_rows uses the tiles for this triangle: only
+ * for triangles large enough that skipping tiles pays for their bounds. */
+TT_HIDDEN bool tt__scan_tiled(const tt__scan_tri *st);
+
+/* The same as tt__scan_candidate, restricted to rows [ylo, yhi] of the
+ * triangle (for splitting a large triangle into jobs: the candidate of the
+ * whole is the largest of the parts, the earliest part winning ties).
+ * With tiles (may be NULL) large triangles skip the tiles that cannot hold
+ * an error as large as the best found; the result is the same. */
 TT_HIDDEN void tt__scan_candidate_rows(const tt_grid *g,
+                                       const tt__scan_tiles *tiles,
                                        const tt__scan_tri *st, int64_t ylo,
                                        int64_t yhi, double *out_err,
                                        int64_t *out_index);

@@ -21,7 +21,8 @@
  * TIN covers exactly the valid samples that a valid cell part holds (the
  * others, lone samples amid nodata, are counted as uncovered).
  *
- * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 20.
+ * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 20;
+ * per sample, while inserting: the scans' tile bounds, 0.25 bytes.
  * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
  */
 #include "criteria/criterion.h"
@@ -63,6 +64,7 @@ typedef struct refine {
   size_t inscap;
   tt__edge_stack stack;
   tt__pool *pool;      /* NULL: single-threaded */
+  tt__scan_tiles tiles; /* error bounds per tile (empty: none) */
   struct scan_job_t *jobs; /* scans of this round */
   size_t jobcap;
   size_t max_points, max_tris;
@@ -131,7 +133,8 @@ static void scan_job(void *arg, size_t i)
   refine *r = arg;
   scan_job_t *j = &r->jobs[i];
   const tt__scan_tri st = j->st;
-  tt__scan_candidate_rows(r->g, &st, j->ylo, j->yhi, &j->err, &j->index);
+  tt__scan_candidate_rows(r->g, &r->tiles, &st, j->ylo, j->yhi, &j->err,
+                          &j->index);
 }
 
 /* Appends the jobs of live triangle t. */
@@ -205,7 +208,8 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
     /* small triangles, cold in cache: ask for all their rows first, so
      * the misses overlap instead of queueing one row at a time */
     for (size_t i = 0; i < njobs; i++)
-      tt__scan_prefetch(r->g, &r->jobs[i].st, INT64_MIN, INT64_MAX);
+      if (!tt__scan_tiled(&r->jobs[i].st))
+        tt__scan_prefetch(r->g, &r->jobs[i].st, INT64_MIN, INT64_MAX);
   }
   tt__pool_run(samples >= PARALLEL_MIN_SAMPLES ? r->pool : NULL, njobs,
                scan_job, r);
@@ -530,6 +534,9 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   if (nthreads == 0 && grid->nx * grid->ny < ((size_t)1 << 20))
     nthreads = 1; /* small grids: handing jobs over costs more than it saves */
   r.pool = tt__pool_create(tt__pool_threads(nthreads));
+  /* the scans' error bounds per tile: without them (out of memory) large
+   * triangles are scanned row by row, with the same results */
+  (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
   r.max_error = opt->max_error;
   r.max_points = opt->max_points;
   r.max_tris = opt->max_triangles;
@@ -635,6 +642,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   /* The insertion state is no longer needed: free it before the TIN's
    * arrays are made, to keep the peak low. */
   tt__heap_free(&r.heap);
+  tt__scan_tiles_free(&r.tiles);
   free(r.cand);
   free(r.cerr);
   r.cand = NULL;
@@ -658,6 +666,7 @@ done:
   if (r.env.cache)
     r.crit->cache_free(r.env.cache);
   tt__pool_destroy(r.pool);
+  tt__scan_tiles_free(&r.tiles);
   free(r.jobs);
   tt__heap_free(&r.heap);
   free(r.cand);
