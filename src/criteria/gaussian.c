@@ -26,10 +26,15 @@
  * of each other the double products are exact and the bound is 0: no
  * exact sums at all. The common factor det(frame) does not change which
  * side the rays are on, so it is never needed.
- * The hull cone: from a ray of a supporting pair (a hull ray), gift
- * wrapping in the star's cyclic order (the hull rays keep that order)
- * with the same exact signs; O(d h) for degree d and h hull rays.
- *
+ * Classification in O(d) (star_curvature): with t_i the exact sign of
+ * (e_i x e_{i+1}) . e_{i+2}, the star is convex iff all t_i >= 0 or all
+ * <= 0; only pairs whose t_{i-1}, t_i agree can support, so only those
+ * are tested against every ray, in index order up to the first that does
+ * (none: a saddle). The hull cone of a mixed star: Graham's scan from that
+ * pair in the star's cyclic order with an O(d) proof of its result, else
+ * gift wrapping (hull_wrap). Classes, hull rays and so the bits of |K| are
+ * those of testing every pair against every ray and gift wrapping
+ * (tests/core/test_gaussian_speed.c checks it against that reference).
  * Swap value: sum |K| over the quad's four vertices before minus after
  * (the stars of those four change: a and b lose the diagonal, c and d gain
  * the new one); positive when the swap lowers the sum. Differences below
@@ -49,18 +54,27 @@
  * Its only allocation is its growth with the mesh.
  *
  * Cost: per star d square roots, one atan2 (angle sums as arguments of
- * complex products, below), d(d-2) triple products without a branch each
- * (two atan2 and the hull for mixed vertices); eight stars per swap value.
- * Without the cache: 1.1 us per value on test_criteria's mesh (float
- * heights; 1.3 us before the branch-free tests), 1.1 us with integer
- * heights (1.6 us before: exact products, no exact sums). In greedy
- * insertion with Lawson flips from the new vertex the star in the mesh is
- * found in the cache three times in four, but the edited star of the
- * other configuration never is (it only comes back when the swap is
- * taken): about three stars computed per value, 1.15 us per value on
- * Crater Lake at 10 % (1.8 us before), two thirds of it computing stars,
- * the rest walking the mesh and the cache. Gaussian then runs 5 times
- * Delaunay's insertion time (7 to 9 before).
+ * complex products, below), d triple products for the t_i, d - 2 more per
+ * candidate pair tested, about 3d for a mixed star's hull (and a second
+ * atan2); eight stars per swap value. In greedy insertion with Lawson
+ * flips from the new vertex (Crater Lake, 10 %: 66,000 values, 4.3 per
+ * insertion) the star in the mesh is found in the cache about three times
+ * in four, the edited star of the other configuration never (it only
+ * comes back when the swap is taken): five stars computed per value, of
+ * mean degree 6.8; 65 % of them mixed, 17 % convex, 17 % saddle.
+ * Measured (callgrind, instructions; wall clock on this shared machine
+ * varies 2x): a star cost 3,090 instructions with its atan2 calls under
+ * the O(d^2) tests and gift wrapping, 2,690 now (high degrees gain most);
+ * a swap value 18,500 before, 16,500 now. In time that is within noise of
+ * before (the same meshes, bit for bit): a value
+ * costs about 1.8 us in wall clock, of which the stars are about two
+ * thirds and the rest is waiting for memory (star_gather, the rays' vertex
+ * loads) -- the serial turn products, the two atan2 of a mixed star and
+ * the cache misses, not the sign tests, are now what a star costs.
+ * Gaussian greedy insertion runs 4.5 to 5.5 times Delaunay's on Crater
+ * Lake (3.6 to 4.5 on a 1025^2 fractal); the 3x goal needs fewer stars
+ * computed per value (a sign-only swap test for the flip repair, or stars
+ * shared between a value's two configurations), not cheaper signs.
  */
 #include "geometry.h"
 
@@ -187,35 +201,37 @@ static bool star_with(const star *s, int32_t x, int32_t y, star *o)
 
 /* --- exact sign of a triple product in pixel space -------------------- */
 
-/* The rays of a star in pixel space (exact column and row steps, the
- * heights as floats) and on the ground. */
-typedef struct pray {
-  double x, y, z;                       /* column and row steps (exact),
-                                           z_k - z_v (rounded) */
-} pray;
+/* x mod n for 0 <= x < 2n, without a division */
+static inline int wrap(int x, int n) { return x >= n ? x - n : x; }
 
 /* A pair's cross product and its error bound. */
 typedef struct pair {
   double nx, ny, nz, bound;
 } pair;
 
+/* The rays of a star as arrays, each stored twice over (x[n + k] = x[k]),
+ * so that loops over consecutive rays run without wrapping: in pixel space
+ * (exact column and row steps, z_k - z_v rounded) for the signs, on the
+ * ground for the angles, and the exact inputs of exact_sign. */
+#define TT__RAYS (2 * TT__STAR_MAX + 2)
 typedef struct rays {
-  pray p[TT__STAR_MAX + 1];             /* for the filter, contiguous */
+  double x[TT__RAYS], y[TT__RAYS], z[TT__RAYS]; /* pixel space */
+  double gx[TT__RAYS], gy[TT__RAYS];            /* ground (its z is z[]) */
+  double nx[TT__STAR_MAX + 1], ny[TT__STAR_MAX + 1], nz[TT__STAR_MAX + 1],
+      nb[TT__STAR_MAX + 1];             /* pair (i, i+1): e_i x e_i+1 and
+                                           its bound (pair_make) */
+  double c[TT__STAR_MAX + 1], d[TT__STAR_MAX + 1]; /* |g_i x g_i+1|,
+                                                      g_i . g_i+1 */
   int64_t dc[TT__STAR_MAX + 1], dr[TT__STAR_MAX + 1];
   float zk[TT__STAR_MAX + 1];
   float zv;
-  double maxc;                          /* largest |x|, |y|, |z| of p[] */
-  bool ints;                            /* p[] are integers of at most
+  double maxc;                          /* largest |x|, |y|, |z| */
+  bool ints;                            /* x, y, z are integers of at most
                                            2^16: every triple product is
                                            exact in doubles (below) */
-  unsigned char sides[TT__STAR_MAX + 1];/* pair (i, i+1): 1 when a ray lies
-                                           on its positive side, 2 on its
-                                           negative side (both: stopped) */
-  tt__gvec g[TT__STAR_MAX + 1];         /* ground vectors */
-  pair pr[TT__STAR_MAX + 1];            /* consecutive pairs (i, i+1) */
-  double x[2 * TT__STAR_MAX + 2], y[2 * TT__STAR_MAX + 2],
-      z[2 * TT__STAR_MAX + 2];          /* p[] again, column by column,
-                                           twice over (x[n + k] = x[k]) */
+  signed char t[TT__STAR_MAX + 1];      /* sign of (e_i x e_i+1) . e_i+2 */
+  int hull[TT__STAR_MAX + 1];           /* the hull rays of a mixed star */
+  pair top[TT__STAR_MAX + 1];           /* their faces (hull_graham) */
 } rays;
 
 static inline void two_sum(double a, double b, double *x, double *y)
@@ -242,6 +258,7 @@ static int add_products(double *h, int len, float z, int64_t m)
   return len;
 }
 
+/* i, j, k < n */
 static int exact_sign(const rays *r, int i, int j, int k)
 {
   int64_t mi = r->dc[j] * r->dr[k] - r->dr[j] * r->dc[k];
@@ -259,36 +276,42 @@ static int exact_sign(const rays *r, int i, int j, int k)
   return 0;
 }
 
+/* Shewchuk's orient3d bound is (7 + 56 eps) eps times the permanent
+ * sum_k |x_k| (|yi zj| + |zi yj|) + ...; bounding every |x_k| by the
+ * star's largest coordinate gives one bound per pair, valid for every
+ * third ray, so a test costs a dot product and two comparisons. With
+ * integers up to 2^16 the products are below 2^32, n below 2^33, n . e_k
+ * below 3 2^49 < 2^53: the double result is exact, and a zero bound lets
+ * side() take its sign as it is (integer heights, the common case, meet
+ * many exact zeros on flats, which a bound would send to the exact sum). */
+static inline double pair_bound(const rays *r, double xi, double yi,
+                                double zi, double xj, double yj, double zj)
+{
+  double per = fabs(yi * zj) + fabs(zi * yj) + fabs(zi * xj) +
+               fabs(xi * zj) + fabs(xi * yj) + fabs(yi * xj);
+  return 1e-15 * per * r->maxc;
+}
 
 static inline void pair_make(const rays *r, int i, int j, pair *p)
 {
-  double xi = r->p[i].x, yi = r->p[i].y, zi = r->p[i].z;
-  double xj = r->p[j].x, yj = r->p[j].y, zj = r->p[j].z;
+  double xi = r->x[i], yi = r->y[i], zi = r->z[i];
+  double xj = r->x[j], yj = r->y[j], zj = r->z[j];
   p->nx = yi * zj - zi * yj;
   p->ny = zi * xj - xi * zj;
   p->nz = xi * yj - yi * xj;
-  /* Shewchuk's orient3d bound is (7 + 56 eps) eps times the permanent
-   * sum_k |x_k| (|yi zj| + |zi yj|) + ...; bounding every |x_k| by the
-   * star's largest coordinate gives one bound per pair, valid for every
-   * third ray, so a test costs a dot product and two comparisons. */
-  if (r->ints) {
-    /* integers up to 2^16: the products are below 2^32, n below 2^33,
-     * n . e_k below 3 2^49 < 2^53, so the double result is exact and a
-     * zero bound lets side() take its sign as it is (integer heights,
-     * the common case, meet many exact zeros on flats, which the bound
-     * below would send to the exact sum) */
-    p->bound = 0;
-    return;
-  }
-  double per = fabs(yi * zj) + fabs(zi * yj) + fabs(zi * xj) +
-               fabs(xi * zj) + fabs(xi * yj) + fabs(yi * xj);
-  p->bound = 1e-15 * per * r->maxc;
+  p->bound = r->ints ? 0 : pair_bound(r, xi, yi, zi, xj, yj, zj);
 }
 
-/* sign of (e_i x e_j) . e_k, exact */
+static inline pair pair_at(const rays *r, int i)
+{
+  pair p = {r->nx[i], r->ny[i], r->nz[i], r->nb[i]};
+  return p;
+}
+
+/* sign of (e_i x e_j) . e_k, exact (i, j, k < n) */
 static inline int side(const rays *r, const pair *p, int i, int j, int k)
 {
-  double det = p->nx * r->p[k].x + p->ny * r->p[k].y + p->nz * r->p[k].z;
+  double det = p->nx * r->x[k] + p->ny * r->y[k] + p->nz * r->z[k];
   if (det > p->bound)
     return 1;
   if (det < -p->bound)
@@ -296,27 +319,6 @@ static inline int side(const rays *r, const pair *p, int i, int j, int k)
   if (p->bound == 0)
     return 0; /* exact (r->ints) or the cross product is exactly zero */
   return exact_sign(r, i, j, k);
-}
-
-static void rays_finish(rays *r, int n);
-
-int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
-                        const float z[3], float zv)
-{
-  rays r;
-  r.zv = zv;
-  for (int i = 0; i < 3; i++) {
-    r.dc[i] = dc[i];
-    r.dr[i] = dr[i];
-    r.zk[i] = z[i];
-    r.p[i].x = (double)dc[i];
-    r.p[i].y = (double)dr[i];
-    r.p[i].z = (double)z[i] - (double)zv;
-  }
-  rays_finish(&r, 3);
-  pair p;
-  pair_make(&r, 0, 1, &p);
-  return side(&r, &p, 0, 1, 2);
 }
 
 static inline double max3abs(double m, double x, double y, double z)
@@ -337,43 +339,57 @@ static inline int small_int(double z)
   return (fabs(z) <= 65536.0) & ((z + 0x1.8p52) - 0x1.8p52 == z);
 }
 
-/* Sets maxc and ints from the n rays in p[] (x, y are integers). */
-static void rays_finish(rays *r, int n)
+int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
+                        const float z[3], float zv)
 {
+  rays r;
   double mx = 0;
   int ints = 1;
-  for (int i = 0; i < n; i++) {
-    mx = max3abs(mx, r->p[i].x, r->p[i].y, r->p[i].z);
-    ints &= small_int(r->p[i].z);
+  r.zv = zv;
+  for (int i = 0; i < 3; i++) {
+    r.dc[i] = dc[i];
+    r.dr[i] = dr[i];
+    r.zk[i] = z[i];
+    r.x[i] = (double)dc[i];
+    r.y[i] = (double)dr[i];
+    r.z[i] = (double)z[i] - (double)zv;
+    mx = max3abs(mx, r.x[i], r.y[i], r.z[i]);
+    ints &= small_int(r.z[i]);
   }
-  r->maxc = mx;
-  r->ints = ints && mx <= 65536.0;
+  r.maxc = mx;
+  r.ints = ints && mx <= 65536.0;
+  pair p;
+  pair_make(&r, 0, 1, &p);
+  return side(&r, &p, 0, 1, 2);
 }
 
 static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
                       const star *s, rays *r)
 {
   const tt__mesh_vertex *o = &m->v[v];
+  int n = s->n;
   r->zv = o->z;
   double mx = 0;
   int ints = 1;
-  for (int i = 0; i < s->n; i++) {
+  for (int i = 0; i < n; i++) {
     const tt__mesh_vertex *w = &m->v[s->nb[i]];
-    r->dc[i] = (int64_t)w->c - o->c;
-    r->dr[i] = (int64_t)w->r - o->r;
+    int64_t dci = (int64_t)w->c - o->c, dri = (int64_t)w->r - o->r;
+    r->dc[i] = dci;
+    r->dr[i] = dri;
     r->zk[i] = w->z;
-    double dc = (double)r->dc[i], dr = (double)r->dr[i];
+    double dc = (double)dci, dr = (double)dri;
     double dz = (double)w->z - (double)r->zv;
-    r->p[i].x = r->x[i] = r->x[i + s->n] = dc;
-    r->p[i].y = r->y[i] = r->y[i + s->n] = dr;
-    r->p[i].z = r->z[i] = r->z[i + s->n] = dz;
-    tt__gvec g = {fr[0] * dc + fr[1] * dr, fr[2] * dc + fr[3] * dr, dz};
-    r->g[i] = g;
+    double gx = fr[0] * dc + fr[1] * dr, gy = fr[2] * dc + fr[3] * dr;
+    r->x[i] = r->x[i + n] = dc;
+    r->y[i] = r->y[i + n] = dr;
+    r->z[i] = r->z[i + n] = dz;
+    r->gx[i] = r->gx[i + n] = gx;
+    r->gy[i] = r->gy[i + n] = gy;
     mx = max3abs(mx, dc, dr, dz);
     ints &= small_int(dz);
   }
   r->maxc = mx;
-  r->ints = ints && mx <= 65536.0; /* as rays_finish, in the same loop */
+  r->ints = ints && mx <= 65536.0;
 }
 
 /* Sums of angles without an atan2 per angle: angle theta = atan2(c, d)
@@ -395,9 +411,9 @@ static inline bool upper(double x, double y)
   return y > 0 || (y == 0 && x > 0);
 }
 
-static inline void turn_add(turn *t, tt__gvec u, tt__gvec v)
+/* the angle atan2(c, d) of c = |u x v|, d = u . v */
+static inline void turn_step(turn *t, double c, double d)
 {
-  double c = tt__glen(tt__gcross(u, v)), d = tt__gdot(u, v);
   if (c == 0 && d >= 0)
     return; /* angle 0 (or a zero vector: atan2(0, 0) = 0) */
   double x = t->x * d - t->y * c, y = t->x * c + t->y * d;
@@ -415,6 +431,18 @@ static inline void turn_add(turn *t, tt__gvec u, tt__gvec v)
   t->y = y;
 }
 
+/* |g_i x g_j| and g_i . g_j, as tt__glen(tt__gcross()) and tt__gdot() */
+static inline void ground_cd(const rays *r, int i, int j, double *out_c,
+                             double *out_d)
+{
+  double ux = r->gx[i], uy = r->gy[i], uz = r->z[i];
+  double vx = r->gx[j], vy = r->gy[j], vz = r->z[j];
+  double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz,
+         cz = ux * vy - uy * vx;
+  *out_c = sqrt(cx * cx + cy * cy + cz * cz);
+  *out_d = ux * vx + uy * vy + uz * vz;
+}
+
 static inline double turn_angle(const turn *t)
 {
   double a = atan2(t->y, t->x);
@@ -423,102 +451,57 @@ static inline double turn_angle(const turn *t)
   return 2 * TT__PI * t->k + a;
 }
 
-/* x mod n for 0 <= x < 2n, without a division */
-static inline int wrap(int x, int n) { return x >= n ? x - n : x; }
-
-/* |K| of v with star s; the class in *out_class. */
-static double star_curvature(const tt__mesh *m, const double fr[4],
-                             int32_t v, const star *s, rays *r,
-                             int *out_class)
+/* The sides of pair (i, i+1) against every other ray, without early
+ * exits: 1 when some ray lies strictly on its positive side, 2 on its
+ * negative side (3: both, the pair does not support). The n - 2 rays after
+ * the pair are x[i+2 .. i+n-1], in order and without wrapping; a branch
+ * per test that the processor cannot predict costs more than the tests it
+ * would save. A product within the pair's bound is undecided: that pair is
+ * redone with the exact signs (never with integer heights, where the bound
+ * is 0). */
+static int pair_sides(const rays *r, int n, int i)
 {
-  int n = s->n;
-  rays_load(m, fr, v, s, r);
-  turn tsum = {1, 0, 0, true};
-  int nang = s->boundary ? n - 1 : n;
-  for (int i = 0; i < nang; i++)
-    turn_add(&tsum, r->g[i], r->g[wrap(i + 1, n)]);
-  double sum = turn_angle(&tsum);
-  if (s->boundary) {
-    *out_class = TT__VERTEX_BOUNDARY;
-    return fabs(TT__PI - sum);
-  }
-  int nsupport = 0, start = -1, sgn = 0;
-  /* Every consecutive pair against every other ray, without early exits:
-   * on a terrain the signs are a coin toss, and a branch per test that the
-   * processor cannot predict cost more than the tests it saved. The rays
-   * are stored twice over (x[n + k] = x[k]), so the n - 2 rays after pair
-   * (i, i+1) are x[i+2 .. i+n-1], in order and without wrapping. A product
-   * within the pair's bound is undecided: that pair is redone with the
-   * exact signs (never with integer heights, where the bound is 0). */
-  pair *pr = r->pr;
-  for (int i = 0; i < n; i++)
-    pair_make(r, i, wrap(i + 1, n), &pr[i]);
-  for (int i = 0; i < n; i++) {
-    const pair *p = &pr[i];
-    double nx = p->nx, ny = p->ny, nz = p->nz, b = p->bound;
-    const double *x = r->x + i + 2, *y = r->y + i + 2, *z = r->z + i + 2;
-    int fp = 0, fn = 0, near = 0;
-    if (r->ints) {
-      for (int t = 0; t < n - 2; t++) {
-        double det = nx * x[t] + ny * y[t] + nz * z[t];
-        fp |= det > 0;
-        fn |= det < 0;
-      }
-    } else {
-      for (int t = 0; t < n - 2; t++) {
-        double det = nx * x[t] + ny * y[t] + nz * z[t];
-        fp |= det > b;
-        fn |= det < -b;
-        near |= fabs(det) <= b;
-      }
+  double nx = r->nx[i], ny = r->ny[i], nz = r->nz[i], b = r->nb[i];
+  const double *x = r->x + i + 2, *y = r->y + i + 2, *z = r->z + i + 2;
+  int fp = 0, fn = 0, near = 0;
+  if (r->ints) {
+    for (int t = 0; t < n - 2; t++) {
+      double det = nx * x[t] + ny * y[t] + nz * z[t];
+      fp |= det > 0;
+      fn |= det < 0;
     }
-    if (near && b > 0) {
-      int j = wrap(i + 1, n);
-      fp = fn = 0;
-      for (int t = 2; t < n; t++) {
-        int sd = side(r, p, i, j, wrap(i + t, n));
-        fp |= sd > 0;
-        fn |= sd < 0;
-      }
-    }
-    r->sides[i] = (unsigned char)(fp | fn << 1);
-  }
-  for (int i = 0; i < n; i++) {
-    int sd = r->sides[i];
-    if (sd == 3)
-      continue;
-    nsupport++;
-    if (start < 0 && sd != 0) {
-      start = i;
-      sgn = sd == 1 ? 1 : -1;
+  } else {
+    for (int t = 0; t < n - 2; t++) {
+      double det = nx * x[t] + ny * y[t] + nz * z[t];
+      fp |= det > b;
+      fn |= det < -b;
+      near |= fabs(det) <= b;
     }
   }
-  if (nsupport == n) {
-    *out_class = TT__VERTEX_CONVEX;
-    return 2 * TT__PI - sum;
+  if (near && b > 0) {
+    int j = wrap(i + 1, n);
+    pair p = pair_at(r, i);
+    fp = fn = 0;
+    for (int t = 2; t < n; t++) {
+      int sd = side(r, &p, i, j, wrap(i + t, n));
+      fp |= sd > 0;
+      fn |= sd < 0;
+    }
   }
-  if (nsupport == 0 || start < 0) {
-    /* start < 0 with some support: every supporting pair has all rays in
-     * its plane, impossible unless the star is flat (then convex above) */
-    *out_class = TT__VERTEX_SADDLE;
-    return sum - 2 * TT__PI;
-  }
-  *out_class = TT__VERTEX_MIXED;
-  /* gift wrapping over positions t = 0..n (t = n is the start again);
-   * a consecutive pair that supports on the hull's side is a hull face, so
-   * runs of those are walked without a test */
-  turn thull = {1, 0, 0, true};
-  int tp = 0;
-  unsigned char wrong = sgn > 0 ? 2 : 1;
+  return fp | fn << 1;
+}
+
+/* The hull of a mixed star by gift wrapping, from hull ray `start` on the
+ * side sgn: out_h[] receives the hull rays in order from start, their
+ * count is returned. O(d h); the reference that hull_graham must match,
+ * and its fallback. */
+static int hull_wrap(const rays *r, int n, int start, int sgn, int *out_h)
+{
+  int tp = 0, m = 0;
   while (tp < n) {
     int p = wrap(start + tp, n);
     int tq = tp + 1, q = wrap(start + tq, n);
-    if (!(r->sides[p] & wrong)) {
-      turn_add(&thull, r->g[p], r->g[q]);
-      tp = tq;
-      continue;
-    }
-    pair pq = r->pr[p]; /* q = p + 1 */
+    pair pq = pair_at(r, p); /* q = p + 1 */
     for (int tr = tp + 2; tr <= n; tr++) {
       int x = wrap(start + tr, n);
       if (x == p)
@@ -529,8 +512,160 @@ static double star_curvature(const tt__mesh *m, const double fr[4],
         pair_make(r, p, q, &pq);
       }
     }
-    turn_add(&thull, r->g[p], r->g[q]);
+    out_h[m++] = p;
     tp = tq;
+  }
+  return m;
+}
+
+/* sign of (c_i x c_j)_z in pixel space, exact (|dc|, |dr| < 2^28) */
+static inline int cross2_sign(const rays *r, int i, int j)
+{
+  int64_t c = r->dc[i] * r->dr[j] - r->dr[i] * r->dc[j];
+  return (c > 0) - (c < 0);
+}
+
+/* The same hull by Graham's scan in the star's cyclic order, O(d), then
+ * proved in O(d): consecutive hull rays less than pi apart in plan, a
+ * strictly convex turn at every hull ray and every other ray strictly
+ * inside the face over its sector. Then the hull's faces are the convex
+ * envelope of the star on side sgn, its rays are exactly the envelope's
+ * kinks, and gift wrapping from start finds the same rays in the same
+ * order (so the same bits). Returns the count, or 0 when the proof fails
+ * (coplanar rays, a face spanning pi or more, ...): the caller then wraps.
+ * Every sign is exact. The scan itself proves the turns at every hull ray
+ * but the start (a ray stays on the stack only after a strict turn
+ * towards the next one), and leaves each face's cross product on the
+ * stack; what is left is the start's turn, the plan gaps and the rays
+ * inside each face. */
+static int hull_graham(rays *r, int n, int start, int sgn, int *out_h)
+{
+  int *h = out_h;
+  pair *top = r->top; /* top[k]: pair (h[k-1], h[k]); top[0]: closing */
+  int m = 1;
+  h[0] = start;
+  for (int t = 1; t <= n; t++) {
+    int x = wrap(start + t, n);
+    while (m >= 2 &&
+           sgn * side(r, &top[m - 1], h[m - 2], h[m - 1], x) <= 0)
+      m--;
+    if (t == n)
+      break;
+    pair_make(r, h[m - 1], x, &top[m]);
+    h[m++] = x;
+  }
+  if (m < 3)
+    return 0;
+  pair_make(r, h[m - 1], start, &top[0]);
+  if (sgn * side(r, &top[0], h[m - 1], start, h[1]) <= 0)
+    return 0;
+  int o = cross2_sign(r, 0, 1); /* the plan orientation of the fan */
+  for (int k = 0; k < m; k++) {
+    int a = h[k], b = k + 1 < m ? h[k + 1] : start;
+    const pair *f = &top[k + 1 < m ? k + 1 : 0];
+    if (cross2_sign(r, a, b) != o)
+      return 0;
+    int e = b > a ? b : b + n; /* rays a+1 .. e-1, from the doubled arrays */
+    for (int x = a + 1; x < e; x++) {
+      double det = f->nx * r->x[x] + f->ny * r->y[x] + f->nz * r->z[x];
+      if (sgn * det > f->bound)
+        continue;
+      if (f->bound == 0 || sgn * side(r, f, a, b, wrap(x, n)) <= 0)
+        return 0;
+    }
+  }
+  return m;
+}
+
+/* |K| of v with star s; the class in *out_class.
+ * Classification in O(d) but for the hull's proof: with t_i the exact
+ * sign of (e_i x e_{i+1}) . e_{i+2} (consecutive rays), the star is
+ * convex iff every t_i >= 0 or every t_i <= 0 -- the star's height
+ * function is then convex (or concave) across every ray, hence
+ * everywhere, and each of its faces supports it; conversely a supporting
+ * pair (i, i+1) has t_{i-1} and t_i (its tests against rays i-1 and i+2)
+ * of its own sign, and supporting pairs of opposite signs force a flat
+ * star. So only pairs with t_{i-1}, t_i of one sign are tested in full,
+ * in index order, up to the first that supports: no such pair, a saddle;
+ * else a mixed star, whose hull (its convex envelope on that side) starts
+ * at that pair. These are the same classes and the same start as testing
+ * every pair against every ray. */
+static double star_curvature(const tt__mesh *m, const double fr[4],
+                             int32_t v, const star *s, rays *r,
+                             int *out_class)
+{
+  int n = s->n;
+  rays_load(m, fr, v, s, r);
+  int nang = s->boundary ? n - 1 : n;
+  for (int i = 0; i < nang; i++)
+    ground_cd(r, i, i + 1, &r->c[i], &r->d[i]);
+  turn tsum = {1, 0, 0, true};
+  for (int i = 0; i < nang; i++)
+    turn_step(&tsum, r->c[i], r->d[i]);
+  double sum = turn_angle(&tsum);
+  if (s->boundary) {
+    *out_class = TT__VERTEX_BOUNDARY;
+    return fabs(TT__PI - sum);
+  }
+  /* the consecutive pairs, and t_i = their sides against the next ray */
+  const double *x = r->x, *y = r->y, *z = r->z;
+  for (int i = 0; i < n; i++) {
+    r->nx[i] = y[i] * z[i + 1] - z[i] * y[i + 1];
+    r->ny[i] = z[i] * x[i + 1] - x[i] * z[i + 1];
+    r->nz[i] = x[i] * y[i + 1] - y[i] * x[i + 1];
+  }
+  int anyp = 0, anyn = 0;
+  signed char *t = r->t;
+  if (r->ints) {
+    for (int i = 0; i < n; i++) {
+      r->nb[i] = 0;
+      double det = r->nx[i] * x[i + 2] + r->ny[i] * y[i + 2] +
+                   r->nz[i] * z[i + 2];
+      int sd = (det > 0) - (det < 0);
+      t[i] = (signed char)sd;
+      anyp |= sd > 0;
+      anyn |= sd < 0;
+    }
+  } else {
+    for (int i = 0; i < n; i++) {
+      r->nb[i] = pair_bound(r, x[i], y[i], z[i], x[i + 1], y[i + 1],
+                            z[i + 1]);
+      pair p = pair_at(r, i);
+      int sd = side(r, &p, i, wrap(i + 1, n), wrap(i + 2, n));
+      t[i] = (signed char)sd;
+      anyp |= sd > 0;
+      anyn |= sd < 0;
+    }
+  }
+  if (!(anyp && anyn)) {
+    *out_class = TT__VERTEX_CONVEX;
+    return 2 * TT__PI - sum;
+  }
+  int start = -1, sgn = 0;
+  for (int i = 0; i < n && start < 0; i++) {
+    int tl = t[i == 0 ? n - 1 : i - 1], tr = t[i];
+    if ((tl < 0 || tr < 0) && (tl > 0 || tr > 0))
+      continue; /* t_{i-1} and t_i of opposite signs */
+    int sd = pair_sides(r, n, i);
+    if (sd == 1 || sd == 2) {
+      start = i;
+      sgn = sd == 1 ? 1 : -1;
+    }
+  }
+  if (start < 0) {
+    *out_class = TT__VERTEX_SADDLE;
+    return sum - 2 * TT__PI;
+  }
+  *out_class = TT__VERTEX_MIXED;
+  int *hr = r->hull;
+  int nh = hull_graham(r, n, start, sgn, hr);
+  if (nh == 0)
+    nh = hull_wrap(r, n, start, sgn, hr);
+  turn thull = {1, 0, 0, true};
+  for (int k = 0; k < nh; k++) {
+    double c, d;
+    ground_cd(r, hr[k], hr[k + 1 < nh ? k + 1 : 0], &c, &d);
+    turn_step(&thull, c, d);
   }
   return 2 * TT__PI - 2 * turn_angle(&thull) + sum;
 }
