@@ -15,6 +15,12 @@
 
 #include <math.h>
 #include <stdlib.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#if defined(__SSE2__) && defined(__GNUC__)
+#define TT_NARROW 1 /* the lane test of narrow triangles (rows_init) */
+#endif
 
 void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t, tt__scan_tri *st)
 {
@@ -85,7 +91,24 @@ typedef struct rows {
   edge_dda hi[3];      /* edges bounding x from above (a < 0) */
   edge_flat flat[3];   /* horizontal edges (a == 0) */
   int nlo, nhi, nflat;
+#if defined(TT_NARROW)
+  /* Narrow triangles (at most NARROW_W columns): no divisions, no steps
+   * per edge. Each row's span comes from the three edge functions on the
+   * columns bx0 .. bx0 + 7 at once, as 32-bit lanes E_k + a_k i (small:
+   * |E| <= 2 W H about bx0), compared with -own_k (E > 0, or E >= 0 on an
+   * owned edge). */
+  bool narrow;
+  int64_t bx0;
+  int64_t nb[3], ney[3];   /* E_k(bx0, y) and its step per row */
+  __m128i noff[3][2];      /* a_k i for lanes i = 0..3 and 4..7 */
+  __m128i nthr[3];         /* -own_k in every lane */
+  __m128i nlive[2];        /* lanes i < box width */
+#endif
 } rows;
+
+/* The widest triangle (in columns of its bounding box) whose rows are
+ * found by the lane test above. */
+#define NARROW_W 8
 
 /* Floor division with remainder in [0, d), d > 0. A double division
  * (|n| < 2^57, d < 2^29 here), truncated, is within two of the floor, and
@@ -126,6 +149,32 @@ static void rows_init(const tt__scan_tri *st, int64_t nx, int64_t from,
   if (from > r->ymin)
     r->ymin = from;
   r->nlo = r->nhi = r->nflat = 0;
+#if defined(TT_NARROW)
+  int64_t bx0 = st->x[0], bx1 = st->x[0];
+  for (int k = 1; k < 3; k++) {
+    bx0 = st->x[k] < bx0 ? st->x[k] : bx0;
+    bx1 = st->x[k] > bx1 ? st->x[k] : bx1;
+  }
+  r->narrow = bx1 - bx0 < NARROW_W && r->ymax - r->ymin < (1 << 20);
+  if (r->narrow) {
+    r->bx0 = bx0;
+    for (int k = 0; k < 3; k++) {
+      int k1 = (k + 1) % 3;
+      int32_t a = (int32_t)(-s * (st->y[k1] - st->y[k]));
+      r->ney[k] = s * (st->x[k1] - st->x[k]);
+      r->nb[k] = r->ney[k] * (r->ymin - st->y[k]) + a * (bx0 - st->x[k]);
+      r->noff[k][0] = _mm_set_epi32(3 * a, 2 * a, a, 0);
+      r->noff[k][1] = _mm_set_epi32(7 * a, 6 * a, 5 * a, 4 * a);
+      r->nthr[k] = _mm_set1_epi32(st->own[k] ? -1 : 0);
+    }
+    int32_t w = (int32_t)(bx1 - bx0);
+    r->nlive[0] = _mm_cmplt_epi32(_mm_set_epi32(3, 2, 1, 0),
+                                  _mm_set1_epi32(w + 1));
+    r->nlive[1] = _mm_cmplt_epi32(_mm_set_epi32(7, 6, 5, 4),
+                                  _mm_set1_epi32(w + 1));
+    return;
+  }
+#endif
   for (int k = 0; k < 3; k++) {
     int k1 = (k + 1) % 3;
     int64_t a = -s * (st->y[k1] - st->y[k]);
@@ -169,6 +218,27 @@ static inline void dda_step(edge_dda *d)
  * row; false when the span is empty. */
 static inline bool row_span_step(rows *r, int64_t *out_xl, int64_t *out_xr)
 {
+#if defined(TT_NARROW)
+  if (r->narrow) {
+    /* |E| <= 2 W H fits 32 bits (W <= 8, H < 2^20) */
+    __m128i in0 = r->nlive[0], in1 = r->nlive[1];
+    for (int k = 0; k < 3; k++) {
+      __m128i b = _mm_set1_epi32((int32_t)r->nb[k]);
+      in0 = _mm_and_si128(in0, _mm_cmpgt_epi32(_mm_add_epi32(b, r->noff[k][0]),
+                                               r->nthr[k]));
+      in1 = _mm_and_si128(in1, _mm_cmpgt_epi32(_mm_add_epi32(b, r->noff[k][1]),
+                                               r->nthr[k]));
+      r->nb[k] += r->ney[k];
+    }
+    unsigned mask = (unsigned)_mm_movemask_ps(_mm_castsi128_ps(in0)) |
+                    (unsigned)_mm_movemask_ps(_mm_castsi128_ps(in1)) << 4;
+    if (!mask)
+      return false;
+    *out_xl = r->bx0 + __builtin_ctz(mask);
+    *out_xr = r->bx0 + (31 - __builtin_clz(mask));
+    return true;
+  }
+#endif
   int64_t xl = 0, xr = r->xmax;
   bool empty = false;
   for (int k = 0; k < r->nlo; k++) {
@@ -289,8 +359,6 @@ typedef struct row_acc {
 } row_acc;
 
 #if defined(__SSE2__)
-#include <emmintrin.h>
-
 typedef struct kern {
   __m128d absmask, gx, two, four;
 } kern;

@@ -11,7 +11,10 @@
  * triangles are random, from slivers to the whole grid, each also scanned
  * in random bands of rows (as the parallel jobs of refine.c do).
  * The brute force evaluates every owned sample with the kernels' own plane
- * expression and takes the largest error, the first in row-major order.
+ * expression and takes the largest error, the first in row-major order;
+ * the statistics (count, max, sums) are checked against it too. Narrow
+ * triangles (raster_scan.c finds their rows by a lane test, not by
+ * stepping the edges) are most of the small ones here.
  */
 #include "raster_scan.h"
 #include "tt_test.h"
@@ -141,6 +144,29 @@ static void brute(const tt_grid *g, const tt__scan_tri *st, int64_t ylo,
   *out_index = bi;
 }
 
+static void brute_stats(const tt_grid *g, const tt__scan_tri *st,
+                        size_t *out_n, double *out_max, double *out_abs,
+                        double *out_sq)
+{
+  plane p;
+  plane_of(st, &p);
+  const float *z = tt_grid_heights_const(g);
+  size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
+  for (int64_t y = 0; y < (int64_t)ny; y++) {
+    double rowbase = p.z0 + p.gy * (double)(y - p.y0);
+    for (int64_t x = 0; x < (int64_t)nx; x++) {
+      float h = z[(size_t)y * nx + (size_t)x];
+      if (h != h || !owned(st, x, y))
+        continue;
+      double e = fabs((double)h - (rowbase + p.gx * (double)(x - p.x0)));
+      (*out_n)++;
+      *out_max = e > *out_max ? e : *out_max;
+      *out_abs += e;
+      *out_sq += e * e;
+    }
+  }
+}
+
 static bool random_tri(const tt_grid *g, int64_t span, tt__scan_tri *st)
 {
   int64_t nx = (int64_t)tt_grid_width(g), ny = (int64_t)tt_grid_height(g);
@@ -202,6 +228,17 @@ static void test_grid(tt_context *ctx, int kind, size_t nx, size_t ny,
       bad++;
     }
     if (i % 8 == 0) {
+      /* the statistics walk the same rows: count and max exactly, the
+       * sums to rounding */
+      size_t n = 0;
+      double mx = 0, sa = 0, sq = 0;
+      brute_stats(g, &st, &n, &mx, &sa, &sq);
+      tt__scan_stats ss;
+      tt__scan_stats_run(g, &st, &ss);
+      CHECK_INT_EQ(ss.count, n);
+      CHECK(memcmp(&ss.max_err, &mx, sizeof mx) == 0);
+      CHECK(fabs(ss.sum_abs - sa) <= 1e-12 * (sa + 1));
+      CHECK(fabs(ss.sum_sq - sq) <= 1e-12 * (sq + 1));
       brute(g, &st, INT64_MIN, INT64_MAX, &e2, &i2);
       if (memcmp(&e0, &e2, sizeof e0) != 0 || i0 != i2) {
         TT_FAIL_("%s grid: row scan %.17g at %lld, brute force %.17g at "
