@@ -21,6 +21,10 @@
 #if defined(__SSE2__) && defined(__GNUC__)
 #define TT_NARROW 1 /* the lane test of narrow triangles (rows_init) */
 #endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#include <immintrin.h>
+#define TT_WIDE 1 /* AVX-512 row search, chosen at run time */
+#endif
 
 void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t, tt__scan_tri *st)
 {
@@ -931,6 +935,120 @@ done:
   return ok;
 }
 
+/* --- the row-by-row search, in two instruction sets --------------------
+ * plain_rows is written once and instantiated per kernel: with SSE2 (two
+ * doubles a step) and, where the processor has AVX-512, with eight doubles
+ * a step and a masked last step, so that the short rows of small triangles
+ * take one step. The kernels evaluate the same expression in the same
+ * double operations (no fused multiply-add: -ffp-contract=off), so both
+ * find the same maximum bit for bit; a maximum does not depend on the
+ * order it is taken in. */
+typedef double (*row_max_fn)(const kern *kn, const float *zr, int64_t xl,
+                             int64_t xr, double rowbase, double gx,
+                             int64_t x0);
+
+static inline __attribute__((always_inline)) void
+plain_rows(const tt_grid *g, const tt__scan_tri *st, const plane *p,
+           const kern *kn, int64_t ylo, int64_t yhi, best_t *b,
+           row_max_fn kernel)
+{
+  rows r;
+  rows_init(st, (int64_t)g->nx, ylo, &r);
+  if (yhi < r.ymax)
+    r.ymax = yhi;
+  tt__scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
+  for (int64_t y = r.ymin; y <= r.ymax; y++) {
+    int64_t xl, xr;
+    if (!row_span_step(&r, &xl, &xr))
+      continue;
+    const float *zr = g->z + (size_t)y * g->nx;
+    prefetch_row(zr, g->nx, y, r.ymax, xl, xr);
+    double rowbase = p->z0 + p->gy * (double)(y - p->y0);
+    double m;
+    if (!vertex_row(st, y)) {
+      m = kernel(kn, zr, xl, xr, rowbase, p->gx, p->x0);
+    } else {
+      int64_t sp[8];
+      int n = split_span(st, y, xl, xr, sp);
+      m = 0;
+      for (int i = 0; i < n; i++) {
+        double mi = kernel(kn, zr, sp[2 * i], sp[2 * i + 1], rowbase, p->gx,
+                           p->x0);
+        m = mi > m ? mi : m;
+      }
+    }
+    if (m > b->err) {
+      b->err = m;
+      b->y = y;
+      b->xl = xl;
+      b->xr = xr;
+    }
+  }
+}
+
+static void plain_rows_sse(const tt_grid *g, const tt__scan_tri *st,
+                           const plane *p, const kern *kn, int64_t ylo,
+                           int64_t yhi, best_t *b)
+{
+  plain_rows(g, st, p, kn, ylo, yhi, b, row_max);
+}
+
+#if defined(TT_WIDE)
+#define TT_WIDE_TARGET __attribute__((target("avx512f,avx512vl")))
+
+/* row_max with eight lanes: columns x .. x + 7 as k = x - x0 + lane (exact
+ * doubles), the last step masked to the columns left. NaN errors keep the
+ * running maximum (max(e, m) returns m when e is NaN), as in row_max. */
+static inline __attribute__((always_inline)) TT_WIDE_TARGET double
+row_max_wide(const kern *kn, const float *zr, int64_t xl, int64_t xr,
+             double rowbase, double gx, int64_t x0)
+{
+  (void)kn;
+  const __m512d vbase = _mm512_set1_pd(rowbase), vgx = _mm512_set1_pd(gx);
+  const __m512d eight = _mm512_set1_pd(8.0);
+  __m512d k = _mm512_add_pd(_mm512_set1_pd((double)(xl - x0)),
+                            _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
+  __m512d m = _mm512_setzero_pd();
+  int64_t x = xl;
+  for (; x + 7 <= xr; x += 8) {
+    __m512d z = _mm512_cvtps_pd(_mm256_loadu_ps(zr + x));
+    __m512d e = _mm512_abs_pd(
+        _mm512_sub_pd(z, _mm512_add_pd(vbase, _mm512_mul_pd(vgx, k))));
+    m = _mm512_max_pd(e, m);
+    k = _mm512_add_pd(k, eight);
+  }
+  if (x <= xr) {
+    __mmask8 live = (__mmask8)((1u << (xr - x + 1)) - 1u);
+    __m512d z = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(live, zr + x));
+    __m512d e = _mm512_abs_pd(
+        _mm512_sub_pd(z, _mm512_add_pd(vbase, _mm512_mul_pd(vgx, k))));
+    m = _mm512_mask_max_pd(m, live, e, m);
+  }
+  return _mm512_reduce_max_pd(m);
+}
+
+static TT_WIDE_TARGET void plain_rows_wide(const tt_grid *g,
+                                           const tt__scan_tri *st,
+                                           const plane *p, const kern *kn,
+                                           int64_t ylo, int64_t yhi,
+                                           best_t *b)
+{
+  plain_rows(g, st, p, kn, ylo, yhi, b, row_max_wide);
+}
+
+static bool wide_on = true;
+
+void tt__scan_allow_wide(bool allow) { wide_on = allow; }
+
+static inline bool wide_ok(void)
+{
+  return wide_on && __builtin_cpu_supports("avx512f") &&
+         __builtin_cpu_supports("avx512vl");
+}
+#else
+void tt__scan_allow_wide(bool allow) { (void)allow; }
+#endif
+
 void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
                         double *out_err, int64_t *out_index)
 {
@@ -950,38 +1068,12 @@ void tt__scan_candidate_rows(const tt_grid *g, const tt__scan_tiles *tiles,
   best_t b = {0, -1, 0, -1, -1};
   if (!(tiles && tiles->t && tt__scan_tiled(st) &&
         candidate_tiled(g, tiles, st, &p, &kn, ylo, yhi, &b))) {
-    rows r;
-    rows_init(st, (int64_t)g->nx, ylo, &r);
-    if (yhi < r.ymax)
-      r.ymax = yhi;
-    tt__scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
-    for (int64_t y = r.ymin; y <= r.ymax; y++) {
-      int64_t xl, xr;
-      if (!row_span_step(&r, &xl, &xr))
-        continue;
-      const float *zr = g->z + (size_t)y * g->nx;
-      prefetch_row(zr, g->nx, y, r.ymax, xl, xr);
-      double rowbase = p.z0 + p.gy * (double)(y - p.y0);
-      double m;
-      if (!vertex_row(st, y)) {
-        m = row_max(&kn, zr, xl, xr, rowbase, p.gx, p.x0);
-      } else {
-        int64_t sp[8];
-        int n = split_span(st, y, xl, xr, sp);
-        m = 0;
-        for (int i = 0; i < n; i++) {
-          double mi = row_max(&kn, zr, sp[2 * i], sp[2 * i + 1], rowbase,
-                              p.gx, p.x0);
-          m = mi > m ? mi : m;
-        }
-      }
-      if (m > b.err) {
-        b.err = m;
-        b.y = y;
-        b.xl = xl;
-        b.xr = xr;
-      }
-    }
+#if defined(TT_WIDE)
+    if (wide_ok())
+      plain_rows_wide(g, st, &p, &kn, ylo, yhi, &b);
+    else
+#endif
+      plain_rows_sse(g, st, &p, &kn, ylo, yhi, &b);
   }
   *out_err = b.err;
   *out_index = b.y >= 0 ? best_index(g, st, &p, &b) : -1;

@@ -94,6 +94,11 @@ TT_HIDDEN void tt__scan_candidate_rows(const tt_grid *g,
                                        int64_t yhi, double *out_err,
                                        int64_t *out_index);
 
+/* Lets the row search use AVX-512 where the processor has it (the
+ * default) or keeps it to SSE2 (for tests: both must find the same
+ * samples). Process-wide; not for use while scans run. */
+TT_HIDDEN void tt__scan_allow_wide(bool allow);
+
 /* Asks the memory system for the bounding-box rows [ylo, yhi] of the
  * triangle (all of them: ylo = INT64_MIN, yhi = INT64_MAX), so that the
  * misses of several small triangles overlap. Only a hint. */

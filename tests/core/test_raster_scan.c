@@ -14,7 +14,9 @@
  * expression and takes the largest error, the first in row-major order;
  * the statistics (count, max, sums) are checked against it too. Narrow
  * triangles (raster_scan.c finds their rows by a lane test, not by
- * stepping the edges) are most of the small ones here.
+ * stepping the edges) are most of the small ones here. Everything runs
+ * twice: with the SSE2 row search and with the AVX-512 one (where the
+ * processor has it; else SSE2 again).
  */
 #include "raster_scan.h"
 #include "tt_test.h"
@@ -272,9 +274,13 @@ int main(void)
   tt_context *ctx = tt_context_create();
   size_t tiled = 0;
   const size_t sizes[][2] = {{403, 297}, {64, 64}, {9, 300}, {1030, 61}};
-  for (int kind = 0; kind < G_COUNT; kind++)
-    for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++)
-      test_grid(ctx, kind, sizes[s][0], sizes[s][1], 1200, &tiled);
+  /* the row search with SSE2 only, then with AVX-512 where there is one */
+  for (int wide = 0; wide < 2; wide++) {
+    tt__scan_allow_wide(wide);
+    for (int kind = 0; kind < G_COUNT; kind++)
+      for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++)
+        test_grid(ctx, kind, sizes[s][0], sizes[s][1], 600, &tiled);
+  }
   /* the tiled path must really have run */
   CHECK(tiled > 3000);
   printf("%zu of the triangles took the tiled path\n", tiled);
