@@ -763,26 +763,39 @@ static int64_t best_index(const tt_grid *g, const tt__scan_tri *st,
   return b->index;
 }
 
+/* A row kernel: the largest error in columns [xl, xr] (row_max, or its
+ * wide twin below). */
+typedef double (*row_max_fn)(const kern *kn, const float *zr, int64_t xl,
+                             int64_t xr, double rowbase, double gx,
+                             int64_t x0);
+
+/* The largest error in columns [xl, xr] of row y, vertex columns cut out. */
+static inline __attribute__((always_inline)) double
+segment_max(const tt_grid *g, const tt__scan_tri *st, const plane *p,
+            const kern *kn, int64_t y, int64_t xl, int64_t xr,
+            row_max_fn kernel)
+{
+  const float *zr = g->z + (size_t)y * g->nx;
+  double rowbase = p->z0 + p->gy * (double)(y - p->y0);
+  if (!vertex_row(st, y))
+    return kernel(kn, zr, xl, xr, rowbase, p->gx, p->x0);
+  int64_t sp[8];
+  int n = split_span(st, y, xl, xr, sp);
+  double m = 0;
+  for (int i = 0; i < n; i++) {
+    double mi = kernel(kn, zr, sp[2 * i], sp[2 * i + 1], rowbase, p->gx,
+                       p->x0);
+    m = mi > m ? mi : m;
+  }
+  return m;
+}
+
 /* Scans columns [xl, xr] of row y into b (vertex columns cut out). */
 static inline void scan_segment(const tt_grid *g, const tt__scan_tri *st,
                                 const plane *p, const kern *kn, int64_t y,
                                 int64_t xl, int64_t xr, best_t *b)
 {
-  const float *zr = g->z + (size_t)y * g->nx;
-  double rowbase = p->z0 + p->gy * (double)(y - p->y0);
-  double m;
-  if (!vertex_row(st, y)) {
-    m = row_max(kn, zr, xl, xr, rowbase, p->gx, p->x0);
-  } else {
-    int64_t sp[8];
-    int n = split_span(st, y, xl, xr, sp);
-    m = 0;
-    for (int i = 0; i < n; i++) {
-      double mi = row_max(kn, zr, sp[2 * i], sp[2 * i + 1], rowbase, p->gx,
-                          p->x0);
-      m = mi > m ? mi : m;
-    }
-  }
+  double m = segment_max(g, st, p, kn, y, xl, xr, row_max);
   if (m > b->err) {
     b->err = m;
     b->y = y;
@@ -943,10 +956,6 @@ done:
  * double operations (no fused multiply-add: -ffp-contract=off), so both
  * find the same maximum bit for bit; a maximum does not depend on the
  * order it is taken in. */
-typedef double (*row_max_fn)(const kern *kn, const float *zr, int64_t xl,
-                             int64_t xr, double rowbase, double gx,
-                             int64_t x0);
-
 static inline __attribute__((always_inline)) void
 plain_rows(const tt_grid *g, const tt__scan_tri *st, const plane *p,
            const kern *kn, int64_t ylo, int64_t yhi, best_t *b,
@@ -961,22 +970,8 @@ plain_rows(const tt_grid *g, const tt__scan_tri *st, const plane *p,
     int64_t xl, xr;
     if (!row_span_step(&r, &xl, &xr))
       continue;
-    const float *zr = g->z + (size_t)y * g->nx;
-    prefetch_row(zr, g->nx, y, r.ymax, xl, xr);
-    double rowbase = p->z0 + p->gy * (double)(y - p->y0);
-    double m;
-    if (!vertex_row(st, y)) {
-      m = kernel(kn, zr, xl, xr, rowbase, p->gx, p->x0);
-    } else {
-      int64_t sp[8];
-      int n = split_span(st, y, xl, xr, sp);
-      m = 0;
-      for (int i = 0; i < n; i++) {
-        double mi = kernel(kn, zr, sp[2 * i], sp[2 * i + 1], rowbase, p->gx,
-                           p->x0);
-        m = mi > m ? mi : m;
-      }
-    }
+    prefetch_row(g->z + (size_t)y * g->nx, g->nx, y, r.ymax, xl, xr);
+    double m = segment_max(g, st, p, kn, y, xl, xr, kernel);
     if (m > b->err) {
       b->err = m;
       b->y = y;
