@@ -68,9 +68,11 @@ static bool owns_seg(const tt__mesh *m, int32_t p, int32_t q)
 
 typedef struct l2_entry {
   int32_t v[3];        /* rotated triple; v[0] = -1: empty */
-  uint32_t own;        /* ownership bits */
+  uint32_t own;        /* ownership bits (0-2); bit 3: no valid sample */
   double sse;
 } l2_entry;
+
+#define L2_NO_SAMPLE 8u
 
 typedef struct l2_cache {
   l2_entry *e;
@@ -128,9 +130,9 @@ static void l2_cache_free(void *cache)
 
 /* Sum of squared residuals of triangle (p0, p1, p2) with edge ownership
  * o0 (p0->p1), o1, o2: scanned from its smallest vertex, or read from the
- * cache. */
+ * cache; *out_none tells whether it owns no valid sample at all. */
 static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
-                      int32_t p2, bool o0, bool o1, bool o2)
+                      int32_t p2, bool o0, bool o1, bool o2, bool *out_none)
 {
   const tt__mesh *m = env->mesh;
   int32_t p[3] = {p0, p1, p2};
@@ -156,8 +158,10 @@ static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
     h ^= h >> 29;
     slot = &c->e[h & c->mask];
     if (slot->v[0] == v[0] && slot->v[1] == v[1] && slot->v[2] == v[2] &&
-        slot->own == own)
+        (slot->own & ~L2_NO_SAMPLE) == own) {
+      *out_none = slot->own & L2_NO_SAMPLE;
       return slot->sse;
+    }
   }
   tt__scan_tri st;
   for (int k = 0; k < 3; k++) {
@@ -168,9 +172,10 @@ static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
   }
   tt__scan_stats s;
   tt__scan_stats_run(env->grid, &st, &s);
+  *out_none = s.count == 0;
   if (slot) {
     memcpy(slot->v, v, sizeof v);
-    slot->own = own;
+    slot->own = own | (s.count == 0 ? L2_NO_SAMPLE : 0u);
     slot->sse = s.sum_sq;
   }
   return s.sum_sq;
@@ -189,10 +194,16 @@ static double l2_swap_value(const tt__crit_env *env, int32_t e)
   bool o_bc = owns(m, q.in[0]), o_ca = owns(m, q.in[1]);
   bool o_ad = owns(m, q.in[2]), o_db = owns(m, q.in[3]);
   bool o_ab = owns_seg(m, q.a, q.b), o_cd = owns_seg(m, q.c, q.d);
-  double before = tri_sse(env, q.a, q.b, q.c, o_ab, o_bc, o_ca) +
-                  tri_sse(env, q.b, q.a, q.d, !o_ab, o_ad, o_db);
-  double after = tri_sse(env, q.c, q.a, q.d, o_ca, o_ad, !o_cd) +
-                 tri_sse(env, q.d, q.b, q.c, o_db, o_bc, o_cd);
+  bool none1, none2;
+  double before = tri_sse(env, q.a, q.b, q.c, o_ab, o_bc, o_ca, &none1) +
+                  tri_sse(env, q.b, q.a, q.d, !o_ab, o_ad, o_db, &none2);
+  if (none1 && none2) {
+    /* the two triangles after the swap own the same samples as the two
+     * before (see the ownership note above): none, so both sums are 0 */
+    return q.sign * tt__snap(0.0, 0.0);
+  }
+  double after = tri_sse(env, q.c, q.a, q.d, o_ca, o_ad, !o_cd, &none1) +
+                 tri_sse(env, q.d, q.b, q.c, o_db, o_bc, o_cd, &none2);
   return q.sign * tt__snap(before - after, before + after);
 }
 
