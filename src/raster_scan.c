@@ -752,6 +752,16 @@ typedef struct best_t {
   int64_t index;
 } best_t;
 
+static inline void best_set(best_t *b, double err, int64_t y, int64_t xl,
+                            int64_t xr, int64_t index)
+{
+  b->err = err;
+  b->y = y;
+  b->xl = xl;
+  b->xr = xr;
+  b->index = index;
+}
+
 static int64_t best_index(const tt_grid *g, const tt__scan_tri *st,
                           const plane *p, best_t *b)
 {
@@ -797,21 +807,13 @@ static inline void scan_segment(const tt_grid *g, const tt__scan_tri *st,
 {
   double m = segment_max(g, st, p, kn, y, xl, xr, row_max);
   if (m > b->err) {
-    b->err = m;
-    b->y = y;
-    b->xl = xl;
-    b->xr = xr;
-    b->index = -1;
+    best_set(b, m, y, xl, xr, -1);
   } else if (m == b->err && m > 0) {
     /* a tie in a later tile may still come earlier in row-major order */
     int64_t x = find_in_row(g, st, p, y, xl, xr, m);
     int64_t i = (int64_t)((size_t)y * g->nx) + x;
-    if (x >= 0 && i < best_index(g, st, p, b)) {
-      b->y = y;
-      b->xl = xl;
-      b->xr = xr;
-      b->index = i;
-    }
+    if (x >= 0 && i < best_index(g, st, p, b))
+      best_set(b, m, y, xl, xr, i);
   }
 }
 
@@ -972,12 +974,8 @@ plain_rows(const tt_grid *g, const tt__scan_tri *st, const plane *p,
       continue;
     prefetch_row(g->z + (size_t)y * g->nx, g->nx, y, r.ymax, xl, xr);
     double m = segment_max(g, st, p, kn, y, xl, xr, kernel);
-    if (m > b->err) {
-      b->err = m;
-      b->y = y;
-      b->xl = xl;
-      b->xr = xr;
-    }
+    if (m > b->err)
+      best_set(b, m, y, xl, xr, -1);
   }
 }
 
