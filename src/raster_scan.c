@@ -3,13 +3,20 @@
  * raster_scan.h for the ownership rule and the plane expression).
  *
  * Per row the owned span [xl, xr] comes from the three edge functions in
- * exact 64-bit integer arithmetic, stepped row to row without division;
- * vertex samples on the row are cut out. The per-sample loop is a max
- * reduction over |z - plane|, written with SSE2 where the machine has it
- * (GCC does not vectorise a NaN-aware max by itself) and portably
- * otherwise; NaN nodata compares false and drops out. Workload: in
- * greedy refinement every sample is rescanned each time the triangle
- * holding it changes, O(log n) times on average.
+ * exact 64-bit integer arithmetic, stepped row to row without division
+ * (triangles at most 8 columns wide test their box's columns in 32-bit
+ * lanes instead); vertex samples on the row are cut out. The per-sample
+ * loop is a max reduction over |z - plane|, written with SSE2 where the
+ * machine has it (GCC does not vectorise a NaN-aware max by itself), with
+ * AVX-512 chosen at run time for the row-by-row search, and portably
+ * otherwise; NaN nodata compares false and drops out. Large triangles
+ * search tile by tile, skipping the tiles whose error bound (raster_scan.h)
+ * is below the best error found. Every path finds the same sample.
+ * Workload: in greedy refinement every sample is rescanned each time the
+ * triangle holding it changes, O(log n) times on average; the per-row and
+ * per-triangle set-up costs as much as the samples on small triangles, and
+ * the rows' cache misses (one a row, on a grid larger than the caches) as
+ * much as both on large grids.
  */
 #include "raster_scan.h"
 
@@ -150,6 +157,9 @@ static void rows_init(const tt__scan_tri *st, int64_t nx, int64_t from,
       r->ymax = st->y[k];
   }
   r->xmax = nx - 1;
+#if defined(TT_NARROW)
+  int64_t height = r->ymax - r->ymin; /* of the whole triangle */
+#endif
   if (from > r->ymin)
     r->ymin = from;
   r->nlo = r->nhi = r->nflat = 0;
@@ -159,7 +169,7 @@ static void rows_init(const tt__scan_tri *st, int64_t nx, int64_t from,
     bx0 = st->x[k] < bx0 ? st->x[k] : bx0;
     bx1 = st->x[k] > bx1 ? st->x[k] : bx1;
   }
-  r->narrow = bx1 - bx0 < NARROW_W && r->ymax - r->ymin < (1 << 20);
+  r->narrow = bx1 - bx0 < NARROW_W && height < (1 << 20);
   if (r->narrow) {
     r->bx0 = bx0;
     for (int k = 0; k < 3; k++) {
@@ -224,7 +234,7 @@ static inline bool row_span_step(rows *r, int64_t *out_xl, int64_t *out_xr)
 {
 #if defined(TT_NARROW)
   if (r->narrow) {
-    /* |E| <= 2 W H fits 32 bits (W <= 8, H < 2^20) */
+    /* |E| <= 2 W H < 2^24 fits 32 bits (W <= 8, H < 2^20) */
     __m128i in0 = r->nlive[0], in1 = r->nlive[1];
     for (int k = 0; k < 3; k++) {
       __m128i b = _mm_set1_epi32((int32_t)r->nb[k]);
