@@ -12,14 +12,45 @@
 
 #include "predicates.h"
 
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 void tt__mesh_init(tt__mesh *m, const tt__metric *metric)
 {
+  static atomic_uint_fast64_t serials = 1;
   memset(m, 0, sizeof *m);
   m->metric = *metric;
+  m->serial = (uint64_t)atomic_fetch_add(&serials, 1);
+}
+
+/* One more version of v's star (when tracked). */
+static inline void bump(tt__mesh *m, int32_t v)
+{
+  if (m->vver)
+    m->vver[v]++;
+}
+
+static void bump_slot(tt__mesh *m, int32_t t)
+{
+  if (m->vver && m->hv[3 * t] >= 0)
+    for (int k = 0; k < 3; k++)
+      m->vver[m->hv[3 * t + k]]++;
+}
+
+bool tt__mesh_track_stars(tt__mesh *m)
+{
+  if (m->vver)
+    return true;
+  size_t cap = 0;
+  uint32_t *p = NULL;
+  if (!tt__grow((void **)&p, &cap, m->vcap > 16 ? m->vcap : 16, sizeof *p))
+    return false;
+  memset(p, 0, cap * sizeof *p);
+  m->vver = p;
+  m->vvercap = cap;
+  return true;
 }
 
 void tt__mesh_free(tt__mesh *m)
@@ -30,11 +61,18 @@ void tt__mesh_free(tt__mesh *m)
   free(m->eflag);
   free(m->freelist);
   free(m->touched);
+  free(m->vver);
   memset(m, 0, sizeof *m);
 }
 
 static bool grow_vertices(tt__mesh *m, size_t need)
 {
+  if (m->vver && need > m->vvercap) {
+    size_t old = m->vvercap;
+    if (!tt__grow((void **)&m->vver, &m->vvercap, need, sizeof(uint32_t)))
+      return false;
+    memset(m->vver + old, 0, (m->vvercap - old) * sizeof(uint32_t));
+  }
   return tt__grow((void **)&m->v, &m->vcap, need, sizeof(tt__mesh_vertex));
 }
 
@@ -147,6 +185,7 @@ int32_t tt__mesh_add_triangle(tt__mesh *m, int32_t a, int32_t b, int32_t c)
   if (t < 0)
     return -1;
   set_triangle(m, t, a, b, c);
+  bump_slot(m, t);
   return t;
 }
 
@@ -210,8 +249,11 @@ bool tt__mesh_link_all(tt__mesh *m)
     }
     if (lo < n && keys[idx[lo]] == want) {
       int32_t f = edges[idx[lo]];
-      if (m->twin[f] < 0)
+      if (m->twin[f] < 0) {
         link(m, e, f, 0);
+        bump(m, (int32_t)a);
+        bump(m, (int32_t)b);
+      }
     }
   }
   free(idx);
@@ -261,6 +303,8 @@ bool tt__mesh_split_triangle(tt__mesh *m, int32_t t, int32_t p,
   set_triangle(m, t, a, b, p);
   set_triangle(m, t1, b, c, p);
   set_triangle(m, t2, c, a, p);
+  bump_slot(m, t1);
+  bump(m, a);
   link(m, 3 * t, o_ab, f_ab);
   link(m, 3 * t1, o_bc, f_bc);
   link(m, 3 * t2, o_ca, f_ca);
@@ -313,6 +357,10 @@ bool tt__mesh_split_edge(tt__mesh *m, int32_t e, int32_t p,
    */
   set_triangle(m, t, c, a, p);
   set_triangle(m, t1, c, p, b);
+  bump_slot(m, t);
+  bump(m, b);
+  if (d >= 0)
+    bump(m, d);
   link(m, 3 * t, o_ca, f_ca);
   link(m, 3 * t1 + 2, o_bc, f_bc);
   link(m, 3 * t + 2, 3 * t1, 0); /* p->c with c->p */
@@ -366,6 +414,10 @@ int32_t tt__mesh_flip(tt__mesh *m, int32_t e)
   m->hv[3 * u] = -1;
   set_triangle(m, t, c, a, d);
   set_triangle(m, u, d, b, c);
+  bump(m, a);
+  bump(m, b);
+  bump(m, c);
+  bump(m, d);
   link(m, 3 * t, o_ca, f_ca);
   link(m, 3 * t + 1, o_ad, f_ad);
   link(m, 3 * u, o_db, f_db);
@@ -379,6 +431,7 @@ bool tt__mesh_delete_triangle(tt__mesh *m, int32_t t)
   if (!tt__grow((void **)&m->freelist, &m->freecap, m->nfree + 1,
                 sizeof(int32_t)))
     return false;
+  bump_slot(m, t);
   for (int k = 0; k < 3; k++) {
     int32_t f = m->twin[3 * t + k];
     if (f >= 0) {
@@ -678,8 +731,10 @@ void tt__mesh_flip_revert(tt__mesh *m, const tt__mesh_flip_undo *undo)
         m->eflag[o] = m->eflag[h];
       }
     }
-  for (int k = 0; k < 4; k++)
+  for (int k = 0; k < 4; k++) {
     m->v[undo->vert[k]].edge = undo->vedge[k];
+    bump(m, undo->vert[k]);
+  }
   m->ntouched = undo->ntouched;
 }
 
@@ -802,14 +857,18 @@ bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots, int nold,
    * back to every corner of a new triangle (the outline's vertices among
    * them), so only a vertex no triangle uses any more keeps -1. */
   for (int i = 0; i < nold; i++)
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
       m->v[m->hv[3 * old_slots[i] + k]].edge = -1;
+      bump(m, m->hv[3 * old_slots[i] + k]);
+    }
   for (int i = 0; i < nold; i++) {
     m->hv[3 * old_slots[i]] = -1;
     m->nlive--;
   }
-  for (int t = 0; t < ntri; t++)
+  for (int t = 0; t < ntri; t++) {
     set_triangle(m, slot[t], tris[t][0], tris[t][1], tris[t][2]);
+    bump_slot(m, slot[t]);
+  }
   for (int i = ntri; i < nold; i++)
     m->freelist[m->nfree++] = old_slots[i];
   for (int h = 0; h < nhalf; h++) {

@@ -54,6 +54,13 @@ typedef struct tt__mesh {
   /* slots written since the caller last drained the log */
   int32_t *touched;
   size_t ntouched, touchedcap;
+  /* star versions (tt__mesh_track_stars), NULL when not tracked: vver[v]
+   * changes whenever the triangles around v change, so a value computed
+   * from v's star stays true while vver[v] (and serial) are what they were
+   * then */
+  uint32_t *vver;
+  size_t vvercap;
+  uint64_t serial;       /* unique per tt__mesh_init in the process */
 } tt__mesh;
 
 static inline int32_t tt__next(int32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
@@ -64,6 +71,15 @@ static inline bool tt__mesh_live(const tt__mesh *m, int32_t t)
 }
 
 TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
+/* Starts tracking star versions (vver above); call before the first
+ * triangle. False when out of memory (nothing tracked). Every operation
+ * below then adds at least one to the version of each vertex whose star
+ * (the triangles around it, their order, their twins) it may change: the
+ * corners of every triangle it writes or frees, and the ends of every
+ * edge it links. tt__mesh_flip adds exactly one to each of its quad's
+ * four vertices (a criterion's cache may rely on it, criterion.h). A
+ * version wraps after 2^32 changes of one star. */
+TT_HIDDEN bool tt__mesh_track_stars(tt__mesh *m);
 TT_HIDDEN void tt__mesh_free(tt__mesh *m);
 /* Reserves room for about nv vertices and nt triangles (a hint). */
 TT_HIDDEN bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt);

@@ -528,6 +528,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   tt__heap_init(&r.heap);
   r.env.mesh = &r.m;
   r.env.grid = grid;
+  /* a criterion's cache may key its values by star versions (mesh.h);
+   * without them (out of memory) it proves its entries by other means */
+  if (r.crit->cache_new)
+    (void)tt__mesh_track_stars(&r.m);
   r.env.cache = r.crit->cache_new ? r.crit->cache_new(&r.env) : NULL;
 
   int nthreads = opt->threads;

@@ -72,6 +72,8 @@ long tt__swap_repair(tt__mesh *m, const tt__criterion_vt *crit,
     int32_t h = tt__mesh_flip(m, e);
     if (h < 0)
       return -1;
+    if (crit->flipped)
+      crit->flipped(env, h);
     flips++;
     if (!push(stack, tt__next(m->twin[h])) || !push(stack, tt__prev(h)))
       return -1;
@@ -95,6 +97,8 @@ long tt__swap_all(tt__mesh *m, const tt__criterion_vt *crit,
     int32_t h = tt__mesh_flip(m, e);
     if (h < 0)
       return -1;
+    if (crit->flipped)
+      crit->flipped(env, h);
     flips++;
     /* the four outer edges of the quadrilateral may have become illegal */
     int32_t g = m->twin[h];

@@ -47,6 +47,13 @@ typedef struct tt__criterion_vt {
    * NULL: no state. */
   void *(*cache_new)(const tt__crit_env *env);
   void (*cache_free)(void *cache);
+  /* Optional (NULL: nothing to do): told by a flip loop right after it
+   * flipped an edge, h the new diagonal as tt__mesh_flip returned it, so
+   * that a cache can keep what it computed for the configuration just
+   * taken. Not every flip is reported; like the cache itself it may never
+   * change a swap value. A refinement run tracks star versions (mesh.h)
+   * for every criterion with a cache. */
+  void (*flipped)(const tt__crit_env *env, int32_t h);
 } tt__criterion_vt;
 
 /* The criterion of an id, or NULL for an unknown id. */

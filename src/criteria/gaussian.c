@@ -708,20 +708,35 @@ double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)
  * stars again and again: the new vertex's in every quad, each neighbour's
  * in two, and after a flip the three stars it changed are the ones just
  * computed as "other". The cache grows with the mesh (vertex ids are
- * dense); when it cannot, values are computed as without it. */
-#define GC_KEY 13
+ * dense); when it cannot, values are computed as without it.
+ *
+ * When the mesh tracks star versions (mesh.h; a refinement run turns it on
+ * for every criterion with a cache), entry [0] also keeps the version of
+ * v's star it was stored under, and while the mesh still shows that
+ * version the star is the entry's list: neither |K| nor the star itself is
+ * read from the mesh again. That skips walking the star (a chain of
+ * dependent loads) for three stars in four of a swap value. */
+#define GC_KEY 12
 
 typedef struct gentry {
   double k;              /* |K| */
   int32_t tag;           /* 2 * degree + boundary; 0: empty */
+  uint32_t ver;          /* [0] of a versioned cache: the star's version */
   int32_t nb[GC_KEY];    /* the canonical neighbour list */
 } gentry;                /* 64 bytes: one cache line */
 
 typedef struct gcache {
   const tt__mesh *mesh;  /* the mesh and frame it was made for; another */
-  double fr[4];          /* environment is served without it */
+  uint64_t serial;       /* environment is served without it */
+  double fr[4];
+  bool versioned;        /* the mesh tracked star versions from the start */
   gentry (*e)[2];        /* per vertex */
   size_t cap;            /* vertices covered */
+  /* the last swap value's quad (versioned only): its vertices, their star
+   * versions then, and whether entry [1] holds each one's other star */
+  int32_t last_vs[4];
+  uint32_t last_ver[4];
+  bool last_has[4];
 } gcache;
 
 static void *gaussian_cache_new(const tt__crit_env *env)
@@ -730,6 +745,9 @@ static void *gaussian_cache_new(const tt__crit_env *env)
   if (!c)
     return NULL;
   c->mesh = env->mesh;
+  c->serial = env->mesh->serial;
+  c->versioned = env->mesh->vver != NULL;
+  c->last_vs[0] = -1;
   tt__geo_frame(env, c->fr);
   return c;
 }
@@ -743,27 +761,23 @@ static void gaussian_cache_free(void *cache)
   free(c);
 }
 
-/* The cache of env when it serves env's mesh and frame, else NULL. */
+/* The cache of env when it serves env's mesh and frame, grown to cover
+ * every vertex of the mesh; else NULL (another mesh or frame, or out of
+ * memory). */
 static gcache *cache_of(const tt__crit_env *env, const double fr[4])
 {
   gcache *c = env->cache;
-  if (!c || c->mesh != env->mesh || c->fr[0] != fr[0] || c->fr[1] != fr[1] ||
-      c->fr[2] != fr[2] || c->fr[3] != fr[3])
+  const tt__mesh *m = env->mesh;
+  if (!c || c->mesh != m || c->serial != m->serial || c->fr[0] != fr[0] ||
+      c->fr[1] != fr[1] || c->fr[2] != fr[2] || c->fr[3] != fr[3])
     return NULL;
-  return c;
-}
-
-/* v's two entries, the cache grown to the mesh first; NULL when out of
- * memory. */
-static gentry *cache_slots(gcache *c, const tt__mesh *m, int32_t v)
-{
-  if ((size_t)v >= c->cap) {
-    size_t old = c->cap, need = m->nv > (size_t)v ? m->nv : (size_t)v + 1;
-    if (!tt__grow((void **)&c->e, &c->cap, need, sizeof c->e[0]))
+  if (m->nv > c->cap) {
+    size_t old = c->cap;
+    if (!tt__grow((void **)&c->e, &c->cap, m->nv, sizeof c->e[0]))
       return NULL;
     memset(c->e + old, 0, (c->cap - old) * sizeof c->e[0]);
   }
-  return c->e[v];
+  return c;
 }
 
 static bool entry_is(const gentry *x, int32_t tag, const star *s)
@@ -776,23 +790,29 @@ static bool entry_is(const gentry *x, int32_t tag, const star *s)
   return true;
 }
 
-/* |K| of v with canonical star s, through the cache c (may be NULL);
- * mine: s is v's star in the mesh (else an edited one). */
-static double star_k(const tt__mesh *m, const double fr[4], gcache *c,
-                     int32_t v, const star *s, bool mine, rays *r)
+/* |K| of v with canonical star s, through v's entries x (NULL: no cache);
+ * mine: s is v's star in the mesh (else an edited one), and ver its
+ * version (stored with a mine value). */
+static double star_k(const tt__mesh *m, const double fr[4], gentry *x,
+                     int32_t v, const star *s, bool mine, uint32_t ver,
+                     rays *r, bool *in_other)
 {
   gentry *slot = NULL;
   int32_t tag = 2 * s->n + (s->boundary ? 1 : 0);
-  gentry *x = c && s->n <= GC_KEY ? cache_slots(c, m, v) : NULL;
-  if (x) {
-    if (entry_is(&x[0], tag, s))
+  *in_other = false;
+  if (x && s->n <= GC_KEY) {
+    if (entry_is(&x[0], tag, s)) {
+      x[0].ver = mine ? ver : x[0].ver;
       return x[0].k;
+    }
     if (entry_is(&x[1], tag, s)) {
+      *in_other = !mine;
       if (!mine)
         return x[1].k;
       gentry t = x[0]; /* the mesh took the other configuration */
       x[0] = x[1];
       x[1] = t;
+      x[0].ver = ver;
       return x[0].k;
     }
     slot = &x[mine ? 0 : 1];
@@ -802,7 +822,9 @@ static double star_k(const tt__mesh *m, const double fr[4], gcache *c,
   if (slot) {
     slot->k = k;
     slot->tag = tag;
+    slot->ver = ver;
     memcpy(slot->nb, s->nb, (size_t)s->n * sizeof s->nb[0]);
+    *in_other = !mine;
   }
   return k;
 }
@@ -824,23 +846,51 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
   int32_t vs[4] = {q.a, q.b, q.c, q.d};
   double sa = 0, sb = 0; /* sum |K| with diagonal a-b, with c-d */
   star st[4], o;
-  bool got[4];
+  bool got[4], known[4] = {false, false, false, false};
+  bool has[4] = {false, false, false, false};
+  double kmine[4] = {0, 0, 0, 0};
+  uint32_t ver[4] = {0, 0, 0, 0};
+  gentry *x[4] = {NULL, NULL, NULL, NULL};
   rays r;
-  /* Most of a cached value's cost is waiting for memory (the mesh around
-   * four scattered vertices, their cache entries): ask for the entries
-   * first and walk the four stars back to back, so the waits overlap. */
-  for (int i = 0; i < 4 && c; i++)
-    if ((size_t)vs[i] < c->cap) {
-      tt__prefetch(&c->e[vs[i]][0]);
-      tt__prefetch(&c->e[vs[i]][1]);
+  /* Most of a value's cost is waiting for memory (the mesh around four
+   * scattered vertices, their cache entries): ask for the entries first,
+   * take the stars whose version still matches from them, walk the
+   * others back to back, then ask for every ray's vertex at once, so that
+   * the waits overlap. */
+  if (c)
+    for (int i = 0; i < 4; i++) {
+      x[i] = c->e[vs[i]];
+      tt__prefetch(&x[i][0]);
+      tt__prefetch(&x[i][1]);
+      if (c->versioned)
+        tt__prefetch(&m->vver[vs[i]]);
     }
+  for (int i = 0; i < 4; i++) {
+    star *s = &st[i];
+    if (c && c->versioned) {
+      ver[i] = m->vver[vs[i]];
+      const gentry *y = &x[i][0];
+      if (y->tag != 0 && y->ver == ver[i]) {
+        s->n = y->tag >> 1;
+        s->boundary = (y->tag & 1) != 0;
+        memcpy(s->nb, y->nb, (size_t)s->n * sizeof s->nb[0]);
+        kmine[i] = y->k;
+        known[i] = got[i] = true;
+        continue;
+      }
+    }
+    got[i] = star_gather(m, vs[i], s);
+    if (got[i])
+      star_canon(s);
+  }
   for (int i = 0; i < 4; i++)
-    got[i] = star_gather(m, vs[i], &st[i]);
+    if (got[i])
+      for (int j = 0; j < st[i].n; j++)
+        tt__prefetch(&m->v[st[i].nb[j]]);
   for (int i = 0; i < 4; i++) {
     star *s = &st[i];
     if (!got[i])
       continue;
-    star_canon(s);
     bool ok = true;
     switch (i) {
     case 0: ok = ab ? (star_without(s, q.b, &o), true)
@@ -854,12 +904,58 @@ static double gaussian_swap_value(const tt__crit_env *env, int32_t e)
     }
     if (!ok)
       continue; /* a star past the cap: the vertex counts 0 both ways */
-    double kmine = star_k(m, fr, c, vs[i], s, true, &r);
-    double kother = star_k(m, fr, c, vs[i], &o, false, &r);
-    sa += ab ? kmine : kother;
-    sb += ab ? kother : kmine;
+    bool unused;
+    double km = known[i] ? kmine[i]
+                         : star_k(m, fr, x[i], vs[i], s, true, ver[i], &r,
+                                  &unused);
+    double ko = star_k(m, fr, x[i], vs[i], &o, false, 0, &r, &has[i]);
+    sa += ab ? km : ko;
+    sb += ab ? ko : km;
   }
+  if (c && c->versioned)
+    for (int i = 0; i < 4; i++) {
+      c->last_vs[i] = vs[i];
+      c->last_ver[i] = ver[i];
+      c->last_has[i] = has[i];
+    }
   return q.sign * tt__snap(sa - sb, fabs(sa) + fabs(sb));
+}
+
+/* After the flip of the last quad valued: its four stars are now the
+ * other configuration's, each in entry [1], so they become entry [0]
+ * under their new versions -- no walk around them to prove it. Sound
+ * because a flip adds exactly one to each of its four versions (mesh.h):
+ * a vertex whose version is one past the value's changed only by this
+ * flip, and the four vertices, their triangles unchanged until the flip,
+ * make only the one quad, whose diagonal was the edge valued. */
+static void gaussian_flipped(const tt__crit_env *env, int32_t h)
+{
+  double fr[4];
+  tt__geo_frame(env, fr);
+  gcache *c = cache_of(env, fr);
+  const tt__mesh *m = env->mesh;
+  int32_t g = m->twin[h];
+  if (!c || !c->versioned || c->last_vs[0] < 0 || g < 0)
+    return;
+  int32_t now[4] = {m->hv[h], m->hv[g], tt__mesh_apex(m, h),
+                    tt__mesh_apex(m, g)};
+  for (int i = 0; i < 4; i++) {
+    bool in = false;
+    for (int j = 0; j < 4; j++)
+      in |= now[j] == c->last_vs[i];
+    if (!in)
+      return;
+  }
+  for (int i = 0; i < 4; i++) {
+    int32_t v = c->last_vs[i];
+    if (!c->last_has[i] || m->vver[v] != c->last_ver[i] + 1)
+      continue;
+    gentry *x = c->e[v], t = x[0];
+    x[0] = x[1];
+    x[1] = t;
+    x[0].ver = m->vver[v];
+  }
+  c->last_vs[0] = -1;
 }
 
 /* Adds the three edges of the triangle of half-edge x, one half-edge per
@@ -928,4 +1024,4 @@ static int gaussian_affected(const tt__crit_env *env, int32_t h,
 const tt__criterion_vt tt__criterion_gaussian = {
     TT_CRITERION_GAUSSIAN_CURVATURE, "gaussian_curvature", true,
     gaussian_swap_value, gaussian_affected, gaussian_cache_new,
-    gaussian_cache_free};
+    gaussian_cache_free, gaussian_flipped};

@@ -920,8 +920,10 @@ static void gaussian_paraboloid(tt_context *ctx)
  * and the uncached swap value are identical (==, not close), and a swap
  * and its swap back have exactly opposite values both ways. Heights:
  * integers (the exact-in-doubles sign path), terraces (flats: coplanar
- * rays), floats, and integers past that path's 2^16 limit. A cache made
- * for one mesh and handed another is not used. */
+ * rays), floats, and integers past that path's 2^16 limit. Half the
+ * meshes track star versions, flips are mostly reported to the cache
+ * (flipped) and some are tried and reverted. A cache made for one mesh and
+ * handed another is not used. */
 static void gaussian_cache(tt_context *ctx, uint64_t seed)
 {
   const tt__criterion_vt *vt =
@@ -957,11 +959,67 @@ static void gaussian_cache(tt_context *ctx, uint64_t seed)
         tt_grid_destroy(g);
         continue;
       }
+      /* half the meshes track star versions (what refinement does), so
+       * the cache takes stars from its entries and keeps the other
+       * configuration after reported flips; the rest prove every star */
+      if (fi % 2 == 0)
+        CHECK(tt__mesh_track_stars(&m));
       tt__crit_env plain = {&m, g, NULL}, cached = {&m, g, NULL};
       cached.cache = vt->cache_new(&cached);
       CHECK(cached.cache != NULL);
       tt__edge_stack stack = {0};
       for (int it = 0; it < 3000; it++) {
+        if (tt_test_rand(&rng) % 16 == 1) {
+          /* a value, then a flip elsewhere that may change one of its
+           * stars (unreported), then that edge flipped and reported */
+          int32_t e = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
+          int32_t f = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
+          if (!tt__mesh_live(&m, e / 3) || !tt__mesh_flippable(&m, e) ||
+              !tt__mesh_live(&m, f / 3) || !tt__mesh_flippable(&m, f) ||
+              f / 3 == e / 3 || f / 3 == m.twin[e] / 3)
+            continue;
+          int32_t quad[4] = {m.hv[e], m.hv[m.twin[e]], tt__mesh_apex(&m, e),
+                             tt__mesh_apex(&m, m.twin[e])};
+          (void)vt->swap_value(&cached, e);
+          CHECK(tt__mesh_flip(&m, f) >= 0);
+          int32_t x = tt__mesh_find_edge(&m, quad[0], quad[1]);
+          if (x < 0 || m.twin[x] < 0 || tt__mesh_apex(&m, x) != quad[2] ||
+              tt__mesh_apex(&m, m.twin[x]) != quad[3] ||
+              !tt__mesh_flippable(&m, x))
+            continue;
+          vt->flipped(&cached, tt__mesh_flip(&m, x));
+          for (int k = 0; k < 4; k++) {
+            int32_t y = m.v[quad[k]].edge;
+            if (y >= 0 && m.twin[y] >= 0 &&
+                vt->swap_value(&cached, y) != vt->swap_value(&plain, y))
+              TT_FAIL_("seed %#llx: a flip after another: cached value of "
+                       "%d differs", (unsigned long long)s0, y);
+            y = y >= 0 ? tt__prev(y) : -1;
+            if (y >= 0 && m.twin[y] >= 0 &&
+                vt->swap_value(&cached, y) != vt->swap_value(&plain, y))
+              TT_FAIL_("seed %#llx: a flip after another: cached value of "
+                       "%d differs", (unsigned long long)s0, y);
+          }
+          continue;
+        }
+        if (tt_test_rand(&rng) % 16 == 0) {
+          /* a tried and reverted flip (the look-ahead optimiser's) */
+          int32_t e = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
+          if (!tt__mesh_live(&m, e / 3) || !tt__mesh_flippable(&m, e))
+            continue;
+          (void)vt->swap_value(&cached, e);
+          tt__mesh_flip_undo u;
+          int32_t h = tt__mesh_flip_undoable(&m, e, &u);
+          CHECK(h >= 0);
+          if (h < 0)
+            break;
+          double a = vt->swap_value(&cached, h);
+          if (a != vt->swap_value(&plain, h))
+            TT_FAIL_("seed %#llx: tried edge %d: cached %.17g differs",
+                     (unsigned long long)s0, h, a);
+          tt__mesh_flip_revert(&m, &u);
+          continue;
+        }
         if (tt_test_rand(&rng) % 8 == 0) {
           int c = (int)(tt_test_rand(&rng) % (uint64_t)nx);
           int r = (int)(tt_test_rand(&rng) % (uint64_t)ny);
@@ -992,12 +1050,16 @@ static void gaussian_cache(tt_context *ctx, uint64_t seed)
             !(a > 0 || tt_test_rand(&rng) % 3 == 0))
           continue;
         int32_t h = tt__mesh_flip(&m, e);
+        if (vt->flipped && tt_test_rand(&rng) % 4 != 0)
+          vt->flipped(&cached, h); /* as a flip loop reports it, mostly */
         double bc = vt->swap_value(&cached, h), bp = vt->swap_value(&plain, h);
         if (bc != -a || bp != -a)
           TT_FAIL_("seed %#llx: edge %d value %.17g, back %.17g (cached) "
                    "%.17g (uncached)", (unsigned long long)s0, e, a, bc, bp);
         if (tt_test_rand(&rng) % 2) {
           int32_t h2 = tt__mesh_flip(&m, h);
+          if (vt->flipped && tt_test_rand(&rng) % 2)
+            vt->flipped(&cached, h2);
           double again = vt->swap_value(&cached, h2);
           if (again != a)
             TT_FAIL_("seed %#llx: edge %d value %.17g, after swap and "
