@@ -20,8 +20,9 @@
 # vertices): `terratin simplify -percent P -criterion C -json`, and the
 # figure is its seconds.simplify (meshing only, not reading or writing).
 # The criteria are the ones the binary knows (read from its own error
-# message). A run that passes BENCH_TIMEOUT seconds (default 900) prints
-# ">T". Everything lands in bench/out/criteria/ (git-ignored).
+# message), or those listed in CRITERIA (e.g. CRITERIA="delaunay l2").
+# A run that passes BENCH_TIMEOUT seconds (default 900) prints ">T".
+# Everything lands in bench/out/criteria/ (git-ignored).
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -41,8 +42,8 @@ if [ ! -x "$TT" ]; then
 fi
 mkdir -p "$OUT"
 
-criteria=$({ "$TT" simplify -criterion '?' x.tif y.gpkg 2>&1 || true; } \
-             | sed -n 's/.*known: //p' | tr -d ',')
+criteria=${CRITERIA:-$({ "$TT" simplify -criterion '?' x.tif y.gpkg 2>&1 \
+                           || true; } | sed -n 's/.*known: //p' | tr -d ',')}
 if [ -z "$criteria" ]; then
   echo "criteria.sh: could not read the criteria from $TT" >&2
   exit 1

@@ -75,7 +75,8 @@ static double abn_sumsq_swap_value(const tt__crit_env *env, int32_t e)
 }
 
 const tt__criterion_vt tt__criterion_abn = {
-    TT_CRITERION_ABN, "abn", true, abn_swap_value, tt__affected_quad_ring, NULL, NULL, NULL};
+    TT_CRITERION_ABN, "abn", true, abn_swap_value, tt__affected_quad_ring,
+    NULL, NULL, NULL};
 const tt__criterion_vt tt__criterion_abn_sum = {
     TT_CRITERION_ABN_SUM, "abn_sum", true, abn_sum_swap_value,
     tt__affected_quad_ring, NULL, NULL, NULL};

@@ -57,24 +57,26 @@
  * complex products, below), d triple products for the t_i, d - 2 more per
  * candidate pair tested, about 3d for a mixed star's hull (and a second
  * atan2); eight stars per swap value. In greedy insertion with Lawson
- * flips from the new vertex (Crater Lake, 10 %: 66,000 values, 4.3 per
- * insertion) the star in the mesh is found in the cache about three times
- * in four, the edited star of the other configuration never (it only
+ * flips from the new vertex (Crater Lake, 25 %: 166,000 values, about 4.3
+ * per insertion) the star in the mesh is found in the cache about three
+ * times in four, the edited star of the other configuration never (it only
  * comes back when the swap is taken): five stars computed per value, of
- * mean degree 6.8; 65 % of them mixed, 17 % convex, 17 % saddle.
- * Measured (callgrind, instructions; wall clock on this shared machine
- * varies 2x): a star cost 3,090 instructions with its atan2 calls under
- * the O(d^2) tests and gift wrapping, 2,690 now (high degrees gain most);
- * a swap value 18,500 before, 16,500 now. In time that is within noise of
- * before (the same meshes, bit for bit): a value
- * costs about 1.8 us in wall clock, of which the stars are about two
- * thirds and the rest is waiting for memory (star_gather, the rays' vertex
- * loads) -- the serial turn products, the two atan2 of a mixed star and
- * the cache misses, not the sign tests, are now what a star costs.
- * Gaussian greedy insertion runs 4.5 to 5.5 times Delaunay's on Crater
- * Lake (3.6 to 4.5 on a 1025^2 fractal); the 3x goal needs fewer stars
- * computed per value (a sign-only swap test for the flip repair, or stars
- * shared between a value's two configurations), not cheaper signs.
+ * mean degree 6.8; 65 % of them mixed, 17 % convex, 17 % saddle. A star
+ * costs about 2,700 instructions (callgrind; 3,090 under the O(d^2) tests
+ * and gift wrapping this replaced), spread over its parts: loading the
+ * rays and the angles' cross products and roots, the serial turn products
+ * and atan2, the sign tests, the hull: none dominates (measured in wall
+ * clock by doing work twice: the other configuration's four stars, 27 %
+ * of the run; only their rays and angle terms, 5 %).
+ * The star versions (cache, below) took the walks around the stars from
+ * four per value to one (662,000 to 175,000 at 25 %), 6 % of the run's
+ * time with the same meshes. Gaussian greedy insertion runs 3.9 to 4.8
+ * times Delaunay's (Crater Lake and a 1025^2 fractal, 10 to 50 %); the 3x
+ * goal needs fewer full stars per value, not cheaper parts: the other
+ * configuration's four stars derived from the cached ones (an angle sum
+ * changed by three corner angles in fixed point, so that sums stay exact;
+ * the class and hull kept when the edited ray is inside the hull), which
+ * is a redesign of this file's definitions, not a patch.
  */
 #include "geometry.h"
 
