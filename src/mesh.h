@@ -73,11 +73,10 @@ static inline bool tt__mesh_live(const tt__mesh *m, int32_t t)
 TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
 /* Starts tracking star versions (vver above, all 0 from here on); call it
  * before making a cache that relies on them. False when out of memory
- * (nothing tracked). Every operation
- * below then adds at least one to the version of each vertex whose star
- * (the triangles around it, their order, their twins) it may change: the
- * corners of every triangle it writes or frees, and the ends of every
- * edge it links. tt__mesh_flip adds exactly one to each of its quad's
+ * (nothing tracked). Every operation below then adds at least one to the
+ * version of each vertex whose star (the triangles around it, their order,
+ * their twins) it may change: the corners of every triangle it writes or
+ * frees, and the ends of every edge it links. tt__mesh_flip adds exactly one to each of its quad's
  * four vertices (a criterion's cache may rely on it, criterion.h). A
  * version wraps after 2^32 changes of one star. */
 TT_HIDDEN bool tt__mesh_track_stars(tt__mesh *m);
