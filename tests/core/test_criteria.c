@@ -973,13 +973,22 @@ static void gaussian_cache(tt_context *ctx, uint64_t seed)
           /* a value, then a flip elsewhere that may change one of its
            * stars (unreported), then that edge flipped and reported */
           int32_t e = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
-          int32_t f = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
-          if (!tt__mesh_live(&m, e / 3) || !tt__mesh_flippable(&m, e) ||
-              !tt__mesh_live(&m, f / 3) || !tt__mesh_flippable(&m, f) ||
-              f / 3 == e / 3 || f / 3 == m.twin[e] / 3)
+          if (!tt__mesh_live(&m, e / 3) || !tt__mesh_flippable(&m, e))
             continue;
           int32_t quad[4] = {m.hv[e], m.hv[m.twin[e]], tt__mesh_apex(&m, e),
                              tt__mesh_apex(&m, m.twin[e])};
+          /* f: mostly the far side of a triangle around a quad corner,
+           * whose flip gives that corner a new neighbour */
+          int32_t f = (int32_t)(tt_test_rand(&rng) % (3 * m.nslots));
+          if (tt_test_rand(&rng) % 4 != 0) {
+            int32_t y = m.v[quad[tt_test_rand(&rng) % 4]].edge;
+            for (int k = (int)(tt_test_rand(&rng) % 8); k > 0 && y >= 0; k--)
+              y = m.twin[tt__prev(y)] >= 0 ? m.twin[tt__prev(y)] : y;
+            f = y >= 0 ? tt__next(y) : f;
+          }
+          if (!tt__mesh_live(&m, f / 3) || !tt__mesh_flippable(&m, f) ||
+              f / 3 == e / 3 || f / 3 == m.twin[e] / 3)
+            continue;
           (void)vt->swap_value(&cached, e);
           CHECK(tt__mesh_flip(&m, f) >= 0);
           int32_t x = tt__mesh_find_edge(&m, quad[0], quad[1]);
@@ -987,7 +996,11 @@ static void gaussian_cache(tt_context *ctx, uint64_t seed)
               tt__mesh_apex(&m, m.twin[x]) != quad[3] ||
               !tt__mesh_flippable(&m, x))
             continue;
-          vt->flipped(&cached, tt__mesh_flip(&m, x));
+          int32_t hx = tt__mesh_flip(&m, x);
+          CHECK(hx >= 0);
+          if (hx < 0)
+            break;
+          vt->flipped(&cached, hx);
           for (int k = 0; k < 4; k++) {
             int32_t y = m.v[quad[k]].edge;
             if (y >= 0 && m.twin[y] >= 0 &&
