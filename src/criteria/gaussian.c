@@ -71,12 +71,17 @@
  * The star versions (cache, below) took the walks around the stars from
  * four per value to one (662,000 to 175,000 at 25 %), 6 % of the run's
  * time with the same meshes. Gaussian greedy insertion runs 3.9 to 4.8
- * times Delaunay's (Crater Lake and a 1025^2 fractal, 10 to 50 %); the 3x
- * goal needs fewer full stars per value, not cheaper parts: the other
- * configuration's four stars derived from the cached ones (an angle sum
- * changed by three corner angles in fixed point, so that sums stay exact;
- * the class and hull kept when the edited ray is inside the hull), which
- * is a redesign of this file's definitions, not a patch.
+ * times Delaunay's (Crater Lake and a 1025^2 fractal, 10 to 50 %). The
+ * other configuration's four stars are the part that could go: replayed
+ * from a recording of a full run (the same flips, so the same work
+ * otherwise, thread CPU time in one process), the run takes 2.6 / 2.9 /
+ * 2.9 times Delaunay's on Crater Lake at 10 / 25 / 50 % and 2.6 / 2.5 on
+ * the fractal at 10 / 25 %, against 3.6 / 4.7 / 4.5 and 4.1 / 4.0 computed.
+ * So the 3x goal needs those stars nearly free -- derived from the cached
+ * ones (an angle sum changed by three corner angles in fixed point, so
+ * that sums stay exact; the class and hull kept when the edited ray is
+ * inside the hull), a redesign of this file's definitions -- and the rest
+ * of a value (the walks after splits, the entries) cheaper as well.
  */
 #include "geometry.h"
 
