@@ -76,9 +76,9 @@ TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
  * (nothing tracked). Every operation below then adds at least one to the
  * version of each vertex whose star (the triangles around it, their order,
  * their twins) it may change: the corners of every triangle it writes or
- * frees, and the ends of every edge it links. tt__mesh_flip adds exactly one to each of its quad's
- * four vertices (a criterion's cache may rely on it, criterion.h). A
- * version wraps after 2^32 changes of one star. */
+ * frees, and the ends of every edge it links. tt__mesh_flip adds exactly
+ * one to each of its quad's four vertices (a criterion's cache may rely on
+ * it, criterion.h). A version wraps after 2^32 changes of one star. */
 TT_HIDDEN bool tt__mesh_track_stars(tt__mesh *m);
 TT_HIDDEN void tt__mesh_free(tt__mesh *m);
 /* Reserves room for about nv vertices and nt triangles (a hint). */
