@@ -81,7 +81,10 @@
  * ones (an angle sum changed by three corner angles in fixed point, so
  * that sums stay exact; the class and hull kept when the edited ray is
  * inside the hull), a redesign of this file's definitions -- and the rest
- * of a value (the walks after splits, the entries) cheaper as well.
+ * of a value cheaper as well. (Not the walks left: deriving the stars
+ * around a new vertex from their entries at the split took them from
+ * 175,000 to 25,000 and saved no time -- those stars lie around the
+ * triangles just written, already in cache.)
  */
 #include "geometry.h"
 
