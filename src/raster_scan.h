@@ -41,6 +41,27 @@ static inline void tt__scan_tri_bbox(const tt__scan_tri *st, int64_t *x0,
   }
 }
 
+/* The plane through the corners, as every scan evaluates it (above):
+ * z0 + gx (x - x0) + gy (y - y0). */
+typedef struct tt__scan_plane {
+  double z0, gx, gy;
+  int64_t x0, y0;
+} tt__scan_plane;
+
+static inline void tt__scan_plane_of(const tt__scan_tri *st,
+                                     tt__scan_plane *p)
+{
+  int64_t dx1 = st->x[1] - st->x[0], dy1 = st->y[1] - st->y[0];
+  int64_t dx2 = st->x[2] - st->x[0], dy2 = st->y[2] - st->y[0];
+  double det = (double)(dx1 * dy2 - dx2 * dy1);
+  double dz1 = st->z[1] - st->z[0], dz2 = st->z[2] - st->z[0];
+  p->gx = (dz1 * (double)dy2 - dz2 * (double)dy1) / det;
+  p->gy = ((double)dx1 * dz2 - (double)dx2 * dz1) / det;
+  p->z0 = st->z[0];
+  p->x0 = st->x[0];
+  p->y0 = st->y[0];
+}
+
 /* Fills st for live triangle t of the mesh. */
 TT_HIDDEN void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t,
                                       tt__scan_tri *st);

@@ -81,24 +81,11 @@ static tt_grid *make_grid(tt_context *ctx, int kind, size_t nx, size_t ny)
   return g;
 }
 
-/* The kernels' plane, as raster_scan.c evaluates it. */
-typedef struct plane {
-  double z0, gx, gy;
-  int64_t x0, y0;
-} plane;
-
-static void plane_of(const tt__scan_tri *st, plane *p)
-{
-  int64_t dx1 = st->x[1] - st->x[0], dy1 = st->y[1] - st->y[0];
-  int64_t dx2 = st->x[2] - st->x[0], dy2 = st->y[2] - st->y[0];
-  double det = (double)(dx1 * dy2 - dx2 * dy1);
-  double dz1 = st->z[1] - st->z[0], dz2 = st->z[2] - st->z[0];
-  p->gx = (dz1 * (double)dy2 - dz2 * (double)dy1) / det;
-  p->gy = ((double)dx1 * dz2 - (double)dx2 * dz1) / det;
-  p->z0 = st->z[0];
-  p->x0 = st->x[0];
-  p->y0 = st->y[0];
-}
+/* The oracles take the kernels' own plane (raster_scan.h), so that their
+ * errors are the same bits; what they check is which samples are scanned
+ * and which one wins. */
+typedef tt__scan_plane plane;
+#define plane_of tt__scan_plane_of
 
 /* Whether (x, y) is owned: strictly inside, or on an owned edge, and not a
  * corner (exact integer edge functions). */
