@@ -1782,6 +1782,8 @@ static void print_simplify_json(app_run *r, const simplify_report *p)
   json_open(&j, "seconds");
   json_num(&j, "read", p->t_read);
   json_num(&j, "simplify", p->t_simplify);
+  json_num(&j, "mesh", p->sum.seconds_mesh);
+  json_num(&j, "statistics", p->sum.seconds_statistics);
   json_num(&j, "write", p->t_write);
   json_num(&j, "total", p->t_total);
   json_close(&j);
@@ -2030,6 +2032,8 @@ static tt_status run_simplify(app_run *r)
       {"version", TT_FIELD_STRING, tt_version(), 0, 0},
       {"t_read", TT_FIELD_REAL, NULL, 0, rep.t_read},
       {"t_simplify", TT_FIELD_REAL, NULL, 0, rep.t_simplify},
+      {"t_mesh", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_mesh},
+      {"t_stats", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_statistics},
       {"created", TT_FIELD_STRING, created, 0, 0},
   };
   /* Shapefile outputs name their files "<name>_<layer>": the planned

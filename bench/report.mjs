@@ -63,7 +63,10 @@ for (const c of cases) {
   const E = cs.max_error;
 
   const t = {
-    mesh: pick(tt, 'seconds.simplify'),
+    // meshing as delatin's run() does it: up to the finished mesh; then
+    // the error statistics (a pass over every sample) that delatin lacks
+    mesh: pick(tt, 'seconds.mesh'),
+    simplify: pick(tt, 'seconds.simplify'),
     e2e: num(`${c}.terratin.ns`) / 1e9,
     rss: num(`${c}.terratin.rss`) * KiB,
     v: pick(tt, 'vertices'),
@@ -93,6 +96,7 @@ for (const c of cases) {
     `${int(samples)} samples, max error E = ${E}`);
   out.push(row('', 'terratin', 'delatin', 'delatin/terr.'));
   out.push(row('meshing s', fmt(t.mesh), fmt(d.mesh), fmt(d.mesh / t.mesh, 2) + 'x'));
+  out.push(row('  + error statistics s', fmt(t.simplify), '-', fmt(d.mesh / t.simplify, 2) + 'x'));
   out.push(row('end-to-end s', fmt(t.e2e), fmt(d.e2e), fmt(d.e2e / t.e2e, 2) + 'x'));
   out.push(row('peak MiB', fmt(t.rss / MiB, 1), fmt(d.rss / MiB, 1), fmt(d.rss / t.rss, 2) + 'x'));
   out.push(row('peak MiB net of baseline', fmt((t.rss - baseTT) / MiB, 1), fmt((d.rss - baseNode) / MiB, 1), ''));
@@ -115,7 +119,8 @@ for (const c of cases) {
   const goals = [
     [`max error <= E (${E}) for both`, t.max <= E && d.max <= E],
     [`triangles <= delatin + 1 % (${fmt(t.tri / d.tri, 3)} x delatin)`, t.tri <= 1.01 * d.tri],
-    [`meshing >= 5x faster (${fmt(d.mesh / t.mesh, 2)}x)`, d.mesh / t.mesh >= 5],
+    [`meshing >= 5x faster (${fmt(d.mesh / t.mesh, 2)}x; ` +
+      `${fmt(d.mesh / t.simplify, 2)}x with the error statistics)`, d.mesh / t.mesh >= 5],
     [`net peak ${fmt(net / MiB, 1)} MiB <= budget ${fmt(budget / MiB, 1)} MiB`, net <= budget],
   ];
   out.push(`  terratin memory: ${fmt(net / samples, 2)} B/sample net of the ` +

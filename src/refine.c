@@ -500,6 +500,7 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
 tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
                         const tt_refine_options *opt, tt_tin **out_tin)
 {
+  double t_start = tt__now();
   if (!grid || !opt || !out_tin)
     return tt__error(ctx, TT_ERR_ARG, "grid, options and out_tin must not be "
                      "NULL");
@@ -652,10 +653,13 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.cand = NULL;
   r.cerr = NULL;
   tt__edge_stack_free(&r.stack);
+  double t_meshed = tt__now();
   status = tt__tin_build(ctx, &r.m, grid, r.ins_err, r.pool, out_tin);
   r.ins_err = NULL; /* taken over by the tin, or freed on failure */
   if (status != TT_OK)
     goto done;
+  (*out_tin)->summary.seconds_mesh = t_meshed - t_start;
+  (*out_tin)->summary.seconds_statistics = tt__now() - t_meshed;
   (*out_tin)->summary.criterion = opt->criterion;
   (*out_tin)->summary.stop_reason = reason;
   (*out_tin)->summary.valid_samples = valid;

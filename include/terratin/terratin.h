@@ -307,6 +307,12 @@ typedef struct tt_tin_summary {
   size_t components;      /* separate pieces of the TIN (islands) */
   size_t forced_vertices; /* inserted to follow nodata outlines, whatever
                              their error */
+  /* Wall-clock seconds tt_refine_run spent building the mesh (from the
+   * call to the end of the final optimisation pass) and then measuring it
+   * (`errors` above and the per-triangle and per-vertex statistics: one
+   * more pass over every sample). */
+  double seconds_mesh;
+  double seconds_statistics;
 } tt_tin_summary;
 
 void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary);

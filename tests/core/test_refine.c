@@ -146,7 +146,9 @@ static void check_run(tt_grid *g, const double frame[4], double max_error,
   tt_refine_options_init(&opt);
   opt.max_error = max_error;
   tt_tin *tin = NULL, *again = NULL;
+  double t0 = tt__now();
   CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
+  double wall = tt__now() - t0;
   if (!tin)
     return;
   oracle o;
@@ -163,6 +165,9 @@ static void check_run(tt_grid *g, const double frame[4], double max_error,
   CHECK_DBL_NEAR(s.errors.rmse, sqrt(o.sum_sq / (double)o.valid), 1e-9);
   CHECK_DBL_NEAR(s.errors.mean_abs, o.sum_abs / (double)o.valid, 1e-9);
   CHECK_INT_EQ(s.stop_reason, TT_STOP_MAX_ERROR);
+  /* the two phases were timed, within the call */
+  CHECK(s.seconds_mesh > 0 && s.seconds_statistics > 0);
+  CHECK_DBL_LE(s.seconds_mesh + s.seconds_statistics, wall);
   /* the triangles' owned samples partition the valid samples */
   size_t owned = 0;
   for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {

@@ -200,9 +200,13 @@ need = ["vertices", "triangles", "max_error", "rmse", "mean_abs_error",
         "seconds", "input", "output", "format", "valid_samples", "cells",
         "stop_reason", "criterion", "limits", "z_unit", "crs"]
 missing = [k for k in need if k not in d]
-missing += ["seconds." + k for k in ["read", "simplify", "write", "total"]
+missing += ["seconds." + k for k in ["read", "simplify", "mesh",
+                                     "statistics", "write", "total"]
             if k not in d["seconds"]]
 assert not missing, missing
+t = d["seconds"]
+assert t["mesh"] > 0 and t["statistics"] > 0, t
+assert t["mesh"] + t["statistics"] <= t["simplify"] <= t["total"], t
 assert d["format"] == "GPKG" and d["criterion"] == "delaunay"
 assert d["limits"]["max_error"] == 2 and d["cells"] == 12000
 assert d["valid_samples"] == 12000 and d["max_error"] <= 2
@@ -226,7 +230,8 @@ check "run_parameters holds the limit and the results" bash -c '
 ogrinfo -q out/tin.gpkg run_parameters >rp.txt 2>&1
 grep -q "max_error (Real) = 2$" rp.txt && grep -q "stop (String) = max_error" rp.txt &&
 grep -q "vertices (Integer64) = $(python3 -c "import json;print(json.load(open(\"tin.json\"))[\"vertices\"])")" rp.txt &&
-grep -q "created (String) = 20[0-9-]*T[0-9:]*Z" rp.txt'
+grep -q "created (String) = 20[0-9-]*T[0-9:]*Z" rp.txt &&
+grep -q "t_mesh (Real) = [0-9]" rp.txt && grep -q "t_stats (Real) = [0-9]" rp.txt'
 check "the layers carry the raster's CRS" \
   grep -q 'ID\["EPSG",32633\]' <(ogrinfo -so out/tin.gpkg triangles 2>&1)
 check "only the output in the folder" [ "$(ls -A out)" = "tin.gpkg" ]
