@@ -5,7 +5,10 @@
  * convex hull of the valid samples), made to satisfy the criterion. Each
  * live triangle keeps its candidate: the sample it owns with the largest
  * |H - H'| (raster_scan.c); candidates sit in an indexed max-heap keyed by
- * that error. Repeat: take the worst candidate, check the stop conditions,
+ * that error -- those above max_error only: one within it can never be
+ * taken, and at the end most triangles are such (keeping them out makes
+ * the heap small and its misses fewer: 8-9 % of the run on fractal DEMs of
+ * 1025^2 and 4097^2, same meshes). Repeat: take the worst candidate, check the stop conditions,
  * insert it (split its triangle, or the edge it lies on), restore the
  * criterion around it by flips (swap.c), and rescan only the triangles the
  * mesh logged as written.
@@ -21,7 +24,8 @@
  * TIN covers exactly the valid samples that a valid cell part holds (the
  * others, lone samples amid nodata, are counted as uncovered).
  *
- * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 20;
+ * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 4
+ * (+ 16 per triangle above max_error);
  * per sample, while inserting: the scans' tile bounds, 0.25 bytes.
  * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
  */
@@ -226,7 +230,8 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
       }
     r->cand[t] = index;
     r->cerr[t] = err;
-    if (index < 0)
+    /* (max_error < 0, none: every candidate enters) */
+    if (index < 0 || err <= r->max_error)
       tt__heap_remove(&r->heap, t);
     else if (!tt__heap_set(&r->heap, t, err))
       return false;
