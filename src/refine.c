@@ -8,10 +8,10 @@
  * that error -- those above max_error only: one within it can never be
  * taken, and at the end most triangles are such (keeping them out makes
  * the heap small and its misses fewer: 8-9 % of the run on fractal DEMs of
- * 1025^2 and 4097^2, same meshes). Repeat: take the worst candidate, check the stop conditions,
- * insert it (split its triangle, or the edge it lies on), restore the
- * criterion around it by flips (swap.c), and rescan only the triangles the
- * mesh logged as written.
+ * 1025^2 and 4097^2, same meshes). Repeat: take the worst candidate, check
+ * the stop conditions, insert it (split its triangle, or the edge it lies
+ * on), restore the criterion around it by flips (swap.c), and rescan only
+ * the triangles the mesh logged as written.
  *
  * Stop conditions (the first reached wins, and each is exact): the worst
  * error is <= max_error; one more vertex would pass max_points (or the
@@ -413,8 +413,8 @@ static int32_t locate_in(const refine *r, int32_t t, int64_t col, int64_t row)
   int s = m->metric.det_sign; /* pixel-space orientation of live triangles */
   for (int k = 0; k < 3; k++) {
     int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3];
-    if (s * tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, col, row) ==
-        0)
+    if (s * tt__orient_i(m->v[a].c, m->v[a].r, m->v[b].c, m->v[b].r, col,
+                         row) == 0)
       return 3 * t + k;
   }
   return -1;
@@ -426,7 +426,8 @@ static int32_t locate_in(const refine *r, int32_t t, int64_t col, int64_t row)
  * insertion's work instead of stalling the next one. Stage 2 (for the
  * triangle named last time, whose slot words are now near): its corners,
  * its neighbours' slots and the samples around its candidate. Stage 1:
- * the slot words and the candidate of the current second entry. Only hints: nothing here changes what is computed. */
+ * the slot words and the candidate of the current second entry. Only
+ * hints: nothing here changes what is computed. */
 static void prefetch_next(const refine *r, int32_t *ahead)
 {
 #if defined(__GNUC__)
