@@ -537,7 +537,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.env.grid = grid;
   /* a criterion's cache may key its values by star versions (mesh.h);
    * without them (out of memory) it proves its entries by other means */
-  if (r.crit->cache_new)
+  if (r.crit->star_versions)
     (void)tt__mesh_track_stars(&r.m);
   r.env.cache = r.crit->cache_new ? r.crit->cache_new(&r.env) : NULL;
 

@@ -76,10 +76,10 @@ static double abn_sumsq_swap_value(const tt__crit_env *env, int32_t e)
 
 const tt__criterion_vt tt__criterion_abn = {
     TT_CRITERION_ABN, "abn", true, abn_swap_value, tt__affected_quad_ring,
-    NULL, NULL, NULL};
+    NULL, NULL, NULL, false};
 const tt__criterion_vt tt__criterion_abn_sum = {
     TT_CRITERION_ABN_SUM, "abn_sum", true, abn_sum_swap_value,
-    tt__affected_quad_ring, NULL, NULL, NULL};
+    tt__affected_quad_ring, NULL, NULL, NULL, false};
 const tt__criterion_vt tt__criterion_abn_sumsq = {
     TT_CRITERION_ABN_SUMSQ, "abn_sumsq", true, abn_sumsq_swap_value,
-    tt__affected_quad_ring, NULL, NULL, NULL};
+    tt__affected_quad_ring, NULL, NULL, NULL, false};

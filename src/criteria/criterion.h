@@ -51,9 +51,11 @@ typedef struct tt__criterion_vt {
    * flipped an edge, h the new diagonal as tt__mesh_flip returned it, so
    * that a cache can keep what it computed for the configuration just
    * taken. Not every flip is reported; like the cache itself it may never
-   * change a swap value. A refinement run tracks star versions (mesh.h)
-   * for every criterion with a cache. */
+   * change a swap value. */
   void (*flipped)(const tt__crit_env *env, int32_t h);
+  /* The cache reads star versions (mesh.h): a refinement run then tracks
+   * them (a cost on every mesh operation, so only then). */
+  bool star_versions;
 } tt__criterion_vt;
 
 /* The criterion of an id, or NULL for an unknown id. */

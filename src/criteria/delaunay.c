@@ -20,4 +20,4 @@ static double delaunay_swap_value(const tt__crit_env *env, int32_t e)
 
 const tt__criterion_vt tt__criterion_delaunay = {
     TT_CRITERION_DELAUNAY, "delaunay", false, delaunay_swap_value, NULL, NULL,
-    NULL, NULL};
+    NULL, NULL, false};

@@ -721,11 +721,11 @@ double tt__gaussian_vertex(const tt__crit_env *env, int32_t v, int *out_class)
  * dense); when it cannot, values are computed as without it.
  *
  * When the mesh tracks star versions (mesh.h; a refinement run turns it on
- * for every criterion with a cache), entry [0] also keeps the version of
- * v's star it was stored under, and while the mesh still shows that
- * version the star is the entry's list: neither |K| nor the star itself is
- * read from the mesh again. That skips walking the star (a chain of
- * dependent loads) for three stars in four of a swap value. */
+ * for this criterion, star_versions in its vtable), entry [0] also keeps
+ * the version of v's star it was stored under, and while the mesh still
+ * shows that version the star is the entry's list: neither |K| nor the
+ * star itself is read from the mesh again. That skips walking the star (a
+ * chain of dependent loads) for three stars in four of a swap value. */
 #define GC_KEY 12
 
 typedef struct gentry {
@@ -1034,4 +1034,4 @@ static int gaussian_affected(const tt__crit_env *env, int32_t h,
 const tt__criterion_vt tt__criterion_gaussian = {
     TT_CRITERION_GAUSSIAN_CURVATURE, "gaussian_curvature", true,
     gaussian_swap_value, gaussian_affected, gaussian_cache_new,
-    gaussian_cache_free, gaussian_flipped};
+    gaussian_cache_free, gaussian_flipped, true};

@@ -209,4 +209,4 @@ static double l2_swap_value(const tt__crit_env *env, int32_t e)
 
 const tt__criterion_vt tt__criterion_l2 = {
     TT_CRITERION_L2, "l2", true, l2_swap_value, NULL, l2_cache_new,
-    l2_cache_free, NULL};
+    l2_cache_free, NULL, false};

@@ -75,4 +75,4 @@ int tt__affected_quad_ring(const tt__crit_env *env, int32_t h, int32_t *out,
 
 const tt__criterion_vt tt__criterion_mean_curvature = {
     TT_CRITERION_MEAN_CURVATURE, "mean_curvature", true,
-    mean_curvature_swap_value, tt__affected_quad_ring, NULL, NULL, NULL};
+    mean_curvature_swap_value, tt__affected_quad_ring, NULL, NULL, NULL, false};

@@ -29,4 +29,4 @@ static double min_area_swap_value(const tt__crit_env *env, int32_t e)
 
 const tt__criterion_vt tt__criterion_min_area = {
     TT_CRITERION_MIN_AREA, "min_area", true, min_area_swap_value, NULL, NULL,
-    NULL, NULL};
+    NULL, NULL, false};

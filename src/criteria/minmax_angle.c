@@ -120,8 +120,8 @@ static double minmax_lex_swap_value(const tt__crit_env *env, int32_t e)
 
 const tt__criterion_vt tt__criterion_minmax_angle = {
     TT_CRITERION_MINMAX_ANGLE, "minmax_angle", false, minmax_swap_value,
-    NULL, NULL, NULL, NULL};
+    NULL, NULL, NULL, NULL, false};
 
 const tt__criterion_vt tt__criterion_minmax_angle_lex = {
     TT_CRITERION_MINMAX_ANGLE_LEX, "minmax_angle_lex", false,
-    minmax_lex_swap_value, NULL, NULL, NULL, NULL};
+    minmax_lex_swap_value, NULL, NULL, NULL, NULL, false};

@@ -75,7 +75,7 @@ static double area_swap_value(const tt__crit_env *env, int32_t e)
 
 static const tt__criterion_vt area_crit = {
     (tt_criterion)1000, "test_area", true, area_swap_value, NULL, NULL, NULL,
-    NULL};
+    NULL, false};
 
 static double total_area(const tt__mesh *m)
 {
