@@ -706,7 +706,6 @@ void tt__scan_tiles_free(tt__scan_tiles *tiles)
  * the rows they skip. */
 #define TILED_MIN_AREA 4096
 
-
 bool tt__scan_tiled(const tt__scan_tri *st)
 {
   int64_t area2 = (st->x[1] - st->x[0]) * (st->y[2] - st->y[0]) -
