@@ -21,7 +21,7 @@
  * The quad is read in geometry.h's canonical form, so a swap and the swap
  * back have exactly opposite values. Cost: 8 cross products and 10 atan2.
  */
-#include "geometry.h"
+#include "criteria/geometry.h"
 
 /* The five alphas before and after in the quad's canonical form; *sign
  * as in tt__quad. */

@@ -13,8 +13,8 @@
 #ifndef TT_CRITERION_H
 #define TT_CRITERION_H
 
-#include "../internal.h"
-#include "../mesh.h"
+#include "base/internal.h"
+#include "mesh/mesh.h"
 
 typedef struct tt__crit_env {
   const tt__mesh *mesh;

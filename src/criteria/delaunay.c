@@ -7,7 +7,7 @@
  * so ties are the normal case, and a tie is legal: the edge stays. Flipping
  * illegal edges reaches the global Delaunay triangulation.
  */
-#include "criterion.h"
+#include "criteria/criterion.h"
 
 static double delaunay_swap_value(const tt__crit_env *env, int32_t e)
 {

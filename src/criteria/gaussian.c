@@ -86,7 +86,7 @@
  * 175,000 to 25,000 and saved no time -- those stars lie around the
  * triangles just written, already in cache.)
  */
-#include "geometry.h"
+#include "criteria/geometry.h"
 
 #include <stdlib.h>
 #include <string.h>

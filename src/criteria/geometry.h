@@ -23,7 +23,7 @@
 #ifndef TT_CRITERIA_GEOMETRY_H
 #define TT_CRITERIA_GEOMETRY_H
 
-#include "criterion.h"
+#include "criteria/criterion.h"
 
 #include <math.h>
 

@@ -42,8 +42,8 @@
  * degenerate triangle. Cost: a scan of the quad's samples twice -- the
  * price of a data-dependent criterion, linear in the quad's area.
  */
-#include "geometry.h"
-#include "../raster_scan.h"
+#include "criteria/geometry.h"
+#include "mesh/raster_scan.h"
 
 #include <stdlib.h>
 #include <string.h>

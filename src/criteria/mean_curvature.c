@@ -19,7 +19,7 @@
  * back have exactly opposite values. Cost: 8 cross products and 5 + 5
  * atan2.
  */
-#include "geometry.h"
+#include "criteria/geometry.h"
 
 static double mean_curvature_swap_value(const tt__crit_env *env, int32_t e)
 {

@@ -13,7 +13,7 @@
  * have exactly opposite values.
  * Cost: four cross products and four square roots.
  */
-#include "geometry.h"
+#include "criteria/geometry.h"
 
 static double min_area_swap_value(const tt__crit_env *env, int32_t e)
 {

@@ -20,7 +20,7 @@
  * The quad is read in geometry.h's canonical form, so a swap and the swap
  * back have exactly opposite values.
  */
-#include "geometry.h"
+#include "criteria/geometry.h"
 
 /* An angle in [0, pi] as the point (d, c) = (u . v, |u x v|) of the upper
  * half-plane (2-D, heights ignored): its argument. Comparing two angles

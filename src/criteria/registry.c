@@ -2,7 +2,7 @@
  * registry.c -- the table of criteria: id <-> name <-> vtable. Adding a
  * criterion means one file in src/criteria/ and one row here.
  */
-#include "geometry.h"
+#include "criteria/geometry.h"
 
 #include <string.h>
 

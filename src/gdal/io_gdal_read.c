@@ -1,0 +1,675 @@
+/*
+ * io_gdal_read.c -- reading one raster band into a tt_grid.
+ *
+ * The band is read block by block in its natural block size, one row of
+ * blocks at a time, with RasterIO converting straight to Float32 into the
+ * grid's own array (no full-size temporary). Validity comes from GDAL's mask
+ * band (nodata value, NaN nodata, alpha, .msk) unless SRCNODATA overrides it;
+ * masked samples become NaN. Then scale/offset and Z_FACTOR are applied, and
+ * every valid sample must be finite. The heights' memory is checked against
+ * MAX_MEMORY before anything is allocated.
+ *
+ * Memory: the grid (4 bytes per sample) plus one block of mask bytes plus
+ * GDAL's block cache, which is held to a few blocks for the duration of the
+ * read unless the user set GDAL_CACHEMAX (the cache limit is process-wide
+ * state of GDAL's: it is restored afterwards).
+ */
+#include "gdal/georef.h"
+#include "base/internal.h"
+#include "terratin/terratin_gdal.h"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <cpl_string.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+/* Largest mask buffer used at once; taller blocks are read in bands of rows
+ * (the block itself then stays in GDAL's cache between the bands). */
+#define TT_READ_MASK_BYTES ((size_t)1 << 20)
+/* Block-cache limit during the read when the user has not chosen one. */
+#define TT_READ_CACHE_BYTES ((GIntBig)2 << 20)
+
+typedef struct read_options {
+  double z_factor;
+  int has_z_factor;      /* Z_FACTOR was given */
+  int z_unit_m;          /* Z_UNIT=m: convert ft and us-ft to metres */
+  const char *work_srs;  /* WORK_SRS, NULL: chosen here (points into the
+                            options list) */
+  int has_srcnodata;
+  int srcnodata_is_nan;
+  float srcnodata;       /* compared with the raw value read as Float32 */
+  size_t max_memory;     /* bytes */
+  int max_memory_default; /* not given: 3/4 of physical memory */
+} read_options;
+
+static char *dup_str(const char *s)
+{
+  if (!s)
+    s = "";
+  size_t n = strlen(s) + 1;
+  char *d = malloc(n);
+  if (d)
+    memcpy(d, s, n);
+  return d;
+}
+
+void tt_raster_info_destroy(tt_raster_info *info)
+{
+  if (!info)
+    return;
+  free(info->path);
+  free(info->driver);
+  free(info->crs_wkt);
+  free(info->crs_name);
+  free(info->z_unit);
+  free(info->z_unit_declared);
+  free(info->z_unit_source);
+  free(info->area_or_point);
+  free(info->datatype);
+  free(info->frame_name);
+  free(info);
+}
+
+/* Three quarters of physical memory; SIZE_MAX when the system cannot say. */
+static size_t default_max_memory(void)
+{
+  long pages = sysconf(_SC_PHYS_PAGES);
+  long page_size = sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page_size <= 0)
+    return SIZE_MAX;
+  double bytes = (double)pages * (double)page_size * 0.75;
+  return bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)bytes;
+}
+
+/* Parses a whole string as a finite double. */
+static int parse_double(const char *s, double *out)
+{
+  char *end = NULL;
+  errno = 0;
+  double v = strtod(s, &end);
+  if (end == s || errno == ERANGE)
+    return 0;
+  while (*end == ' ')
+    end++;
+  if (*end != '\0' || !isfinite(v))
+    return 0;
+  *out = v;
+  return 1;
+}
+
+static tt_status parse_options(tt_context *ctx, char **options,
+                               read_options *opt)
+{
+  opt->z_factor = 1.0;
+  opt->has_z_factor = 0;
+  opt->z_unit_m = 0;
+  opt->work_srs = NULL;
+  opt->has_srcnodata = 0;
+  opt->srcnodata_is_nan = 0;
+  opt->srcnodata = 0.0f;
+  opt->max_memory = 0;
+  int has_max_memory = 0;
+  for (char **o = options; o && *o; o++) {
+    char *key = NULL;
+    const char *value = CPLParseNameValue(*o, &key);
+    if (!key || !value) {
+      CPLFree(key);
+      return tt__error(ctx, TT_ERR_ARG, "read option \"%s\" is not "
+                       "NAME=VALUE", *o);
+    }
+    tt_status s = TT_OK;
+    double v = 0;
+    if (strcasecmp(key, "Z_FACTOR") == 0) {
+      if (!parse_double(value, &v) || v == 0)
+        s = tt__error(ctx, TT_ERR_ARG, "Z_FACTOR must be a non-zero number, "
+                      "got \"%s\"", value);
+      else {
+        opt->z_factor = v;
+        opt->has_z_factor = 1;
+      }
+    } else if (strcasecmp(key, "Z_UNIT") == 0) {
+      if (strcasecmp(value, "m") != 0)
+        s = tt__error(ctx, TT_ERR_ARG, "Z_UNIT must be m (heights in ft or "
+                      "us-ft converted to metres), got \"%s\"", value);
+      else
+        opt->z_unit_m = 1;
+    } else if (strcasecmp(key, "WORK_SRS") == 0) {
+      if (!*value)
+        s = tt__error(ctx, TT_ERR_ARG, "WORK_SRS needs a CRS");
+      else
+        opt->work_srs = value;
+    } else if (strcasecmp(key, "SRCNODATA") == 0) {
+      opt->has_srcnodata = 1;
+      if (strcasecmp(value, "nan") == 0) {
+        opt->srcnodata_is_nan = 1;
+      } else if (!parse_double(value, &v)) {
+        s = tt__error(ctx, TT_ERR_ARG, "SRCNODATA must be a number or nan, "
+                      "got \"%s\"", value);
+      } else {
+        opt->srcnodata = (float)v;
+      }
+    } else if (strcasecmp(key, "MAX_MEMORY") == 0) {
+      if (!parse_double(value, &v) || v <= 0)
+        s = tt__error(ctx, TT_ERR_ARG, "MAX_MEMORY must be a positive number "
+                      "of bytes, got \"%s\"", value);
+      else {
+        opt->max_memory = v >= (double)SIZE_MAX ? SIZE_MAX : (size_t)v;
+        has_max_memory = 1;
+      }
+    } else {
+      s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
+                    "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS)",
+                    key);
+    }
+    CPLFree(key);
+    if (s != TT_OK)
+      return s;
+  }
+  opt->max_memory_default = !has_max_memory;
+  if (!has_max_memory)
+    opt->max_memory = default_max_memory();
+  return TT_OK;
+}
+
+/* "31.2 KiB", "1.5 GiB": sizes for messages. */
+static const char *fmt_bytes(char *buf, size_t size, size_t bytes)
+{
+  static const char *const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB",
+                                      "PiB", "EiB"};
+  double v = (double)bytes;
+  int u = 0;
+  while (v >= 1024.0 && u < 6) {
+    v /= 1024.0;
+    u++;
+  }
+  if (u == 0)
+    snprintf(buf, size, "%zu bytes", bytes);
+  else
+    snprintf(buf, size, "%.1f %s", v, units[u]);
+  return buf;
+}
+
+/* Prefixes the context's current message with "path: ". */
+static tt_status with_path(tt_context *ctx, tt_status s, const char *path)
+{
+  if (!ctx || s == TT_OK)
+    return s;
+  char msg[TT_ERRMSG_MAX];
+  snprintf(msg, sizeof msg, "%s", ctx->errmsg);
+  return tt__error(ctx, s, "%s: %s", path, msg);
+}
+
+/* Fills the CRS fields of info from srs (may be NULL). */
+static tt_status describe_crs(tt_context *ctx, OGRSpatialReferenceH srs,
+                              tt_raster_info *info)
+{
+  char *wkt = NULL;
+  char name[512] = "";
+  if (srs) {
+    const char *const wkt_options[] = {"FORMAT=WKT2_2019", NULL};
+    if (OSRExportToWktEx(srs, &wkt, wkt_options) != OGRERR_NONE) {
+      CPLFree(wkt);
+      wkt = NULL;
+      OSRExportToWkt(srs, &wkt);
+    }
+    const char *crs = OSRGetName(srs);
+    const char *auth = OSRGetAuthorityName(srs, NULL);
+    const char *code = OSRGetAuthorityCode(srs, NULL);
+    if (auth && code) {
+      snprintf(name, sizeof name, "%s (%s:%s)", crs ? crs : "unnamed", auth,
+               code);
+    } else {
+      /* No code of its own (USGS DEM, .prj files): say what it looks like,
+       * which helps more than "unnamed". Only the name is affected. */
+      OGRSpatialReferenceH guess = OSRClone(srs);
+      CPLPushErrorHandler(CPLQuietErrorHandler);
+      int found = guess && OSRAutoIdentifyEPSG(guess) == OGRERR_NONE;
+      CPLPopErrorHandler();
+      const char *gcode = found ? OSRGetAuthorityCode(guess, NULL) : NULL;
+      if (gcode)
+        snprintf(name, sizeof name, "%s (like EPSG:%s)",
+                 crs ? crs : "unnamed", gcode);
+      else
+        snprintf(name, sizeof name, "%s", crs ? crs : "unnamed");
+      OSRDestroySpatialReference(guess);
+    }
+    info->crs_is_geographic = OSRIsGeographic(srs) ? 1 : 0;
+  }
+  info->crs_wkt = dup_str(wkt);
+  info->crs_name = dup_str(name);
+  CPLFree(wkt);
+  if (!info->crs_wkt || !info->crs_name)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  return TT_OK;
+}
+
+/* The short name of a height unit: "m", "ft" (international foot) or
+ * "us-ft" (US survey foot); NULL for anything else. */
+static const char *unit_short_name(const char *u)
+{
+  static const char *const m[] = {"m", "metre", "meter", "metres", "meters",
+                                  NULL};
+  static const char *const ft[] = {"ft", "foot", "feet", "international "
+                                   "foot", "foot (international)", "intl ft",
+                                   NULL};
+  static const char *const usft[] = {"us-ft", "us_ft", "ftus", "us-foot",
+                                     "us survey foot", "foot_us",
+                                     "us foot", "survey foot",
+                                     "foot (us survey)", NULL};
+  if (!u)
+    return NULL;
+  for (int i = 0; m[i]; i++)
+    if (strcasecmp(u, m[i]) == 0)
+      return "m";
+  for (int i = 0; ft[i]; i++)
+    if (strcasecmp(u, ft[i]) == 0)
+      return "ft";
+  for (int i = 0; usft[i]; i++)
+    if (strcasecmp(u, usft[i]) == 0)
+      return "us-ft";
+  return NULL;
+}
+
+/* Metres per unit of a short unit name (unit_short_name). */
+static double unit_metres(const char *short_name)
+{
+  if (strcmp(short_name, "ft") == 0)
+    return 0.3048;
+  if (strcmp(short_name, "us-ft") == 0)
+    return 1200.0 / 3937.0;
+  return 1.0;
+}
+
+/* The unit the heights are declared in: the band's unit type, else the
+ * linear unit of the vertical part of a compound CRS (or of a vertical
+ * CRS). Writes the name as declared to buf ("" when nothing says) and
+ * returns where it came from. */
+static const char *declared_z_unit(GDALRasterBandH band,
+                                   OGRSpatialReferenceH srs, char *buf,
+                                   size_t size)
+{
+  const char *u = GDALGetRasterUnitType(band);
+  buf[0] = '\0';
+  if (u && *u) {
+    snprintf(buf, size, "%s", u);
+    return "band unit";
+  }
+  if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
+    char *name = NULL;
+    double to_m = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
+    if (to_m > 0 && name && *name) {
+      const char *sn = unit_short_name(name);
+      /* A unit PROJ names oddly but whose size is known still counts. */
+      if (!sn && fabs(to_m - 1.0) < 1e-12)
+        sn = "m";
+      else if (!sn && fabs(to_m - 0.3048) < 1e-12)
+        sn = "ft";
+      else if (!sn && fabs(to_m - 1200.0 / 3937.0) < 1e-12)
+        sn = "us-ft";
+      snprintf(buf, size, "%s", sn ? sn : name);
+      return "vertical CRS";
+    }
+  }
+  return "";
+}
+
+/* Converts a band of rows [r0, r0+nrows) in place: mask, scale/offset,
+ * Z_FACTOR, finiteness. mask (nx*nrows bytes, 0 = invalid) may be NULL. */
+static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
+                              size_t nx, size_t r0, size_t nrows,
+                              const unsigned char *mask,
+                              const read_options *opt, double scale,
+                              double offset, size_t *valid_count)
+{
+  const double zf = opt->z_factor;
+  const int identity = scale == 1.0 && offset == 0.0 && zf == 1.0;
+  for (size_t r = 0; r < nrows; r++) {
+    float *row = z + (r0 + r) * nx;
+    const unsigned char *mrow = mask ? mask + r * nx : NULL;
+    for (size_t c = 0; c < nx; c++) {
+      float raw = row[c];
+      int ok;
+      if (opt->has_srcnodata)
+        ok = opt->srcnodata_is_nan ? !isnan(raw) : raw != opt->srcnodata;
+      else
+        ok = mrow ? mrow[c] != 0 : 1;
+      if (!ok) {
+        row[c] = NAN;
+        continue;
+      }
+      /* Scale and offset first, then Z_FACTOR, as documented. */
+      double hd = ((double)raw * scale + offset) * zf;
+      float h = identity ? raw : (float)hd;
+      if (!isfinite(h)) {
+        if (isnan(raw) && opt->has_srcnodata)
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is NaN, which SRCNODATA %g does not cover "
+                           "(use -srcnodata nan)", path, r0 + r, c,
+                           (double)opt->srcnodata);
+        if (isnan(raw))
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is NaN but not marked nodata (use "
+                           "-srcnodata nan)", path, r0 + r, c);
+        if (isinf(raw))
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is infinite but not marked nodata", path,
+                           r0 + r, c);
+        return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                         "%zu is %g after scale %g, offset %g and Z_FACTOR "
+                         "%g: too large for a 32-bit float", path, r0 + r, c,
+                         hd, scale, offset, zf);
+      }
+      row[c] = h;
+      (*valid_count)++;
+    }
+  }
+  return TT_OK;
+}
+
+tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
+                            char **options, tt_progress_fn progress,
+                            void *progress_arg, tt_grid **out_grid,
+                            tt_raster_info **out_info)
+{
+  if (!out_grid)
+    return tt__error(ctx, TT_ERR_ARG, "out_grid must not be NULL");
+  *out_grid = NULL;
+  if (out_info)
+    *out_info = NULL;
+  if (!band)
+    return tt__error(ctx, TT_ERR_ARG, "band must not be NULL");
+
+  tt_status s = TT_OK;
+  tt_grid *grid = NULL;
+  tt_raster_info *info = NULL;
+  unsigned char *mask = NULL;
+  GDALRasterBandH mask_band = NULL;
+  int cache_changed = 0;
+  GIntBig old_cache_max = 0;
+
+  GDALDatasetH ds = GDALGetBandDataset(band);
+  const char *path = ds ? GDALGetDescription(ds) : "";
+  if (!path || !*path)
+    path = "(unnamed raster)";
+
+  read_options opt;
+  s = parse_options(ctx, options, &opt);
+  if (s != TT_OK)
+    goto done;
+
+  const GDALDataType dtype = GDALGetRasterDataType(band);
+  if (GDALDataTypeIsComplex(dtype)) {
+    s = tt__error(ctx, TT_ERR_FORMAT, "%s: band %d holds complex numbers "
+                  "(%s), not heights", path, GDALGetBandNumber(band),
+                  GDALGetDataTypeName(dtype));
+    goto done;
+  }
+
+  const int xsize = GDALGetRasterBandXSize(band);
+  const int ysize = GDALGetRasterBandYSize(band);
+  if (xsize < 2 || ysize < 2) {
+    s = tt__error(ctx, TT_ERR_DATA, "%s: raster is %d x %d pixels: at least "
+                  "2 x 2 are needed to make a triangle", path, xsize, ysize);
+    goto done;
+  }
+  const size_t nx = (size_t)xsize, ny = (size_t)ysize;
+  if (nx > SIZE_MAX / sizeof(float) / ny) {
+    s = tt__error(ctx, TT_ERR_LIMIT, "%s: %zu x %zu heights do not fit in "
+                  "this machine's address space", path, nx, ny);
+    goto done;
+  }
+  const size_t need = nx * ny * sizeof(float);
+  if (need > opt.max_memory) {
+    char need_s[32], max_s[32];
+    s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %s, "
+                  "more than %s (%s); refused before reading", path, nx, ny,
+                  fmt_bytes(need_s, sizeof need_s, need),
+                  opt.max_memory_default ? "3/4 of this machine's physical "
+                                           "memory"
+                                         : "MAX_MEMORY",
+                  fmt_bytes(max_s, sizeof max_s, opt.max_memory));
+    goto done;
+  }
+
+  /* Georeferencing, before the big allocation: a GCP-only raster fails
+   * here. */
+  double gt[6] = {0, 1, 0, 0, 0, 1};
+  int has_gt = 0;
+  if (ds) {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    has_gt = GDALGetGeoTransform(ds, gt) == CE_None;
+    CPLPopErrorHandler();
+    if (!has_gt) {
+      const double unit_gt[6] = {0, 1, 0, 0, 0, 1};
+      memcpy(gt, unit_gt, sizeof gt);
+      if (GDALGetGCPCount(ds) > 0) {
+        s = tt__error(ctx, TT_ERR_FORMAT, "%s: georeferenced by %d ground "
+                      "control points only, not by a geotransform: warp it "
+                      "first (gdalwarp)", path, GDALGetGCPCount(ds));
+        goto done;
+      }
+    }
+  }
+
+  info = calloc(1, sizeof *info);
+  if (!info) {
+    s = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+    goto done;
+  }
+  OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+  s = describe_crs(ctx, srs, info);
+  if (s != TT_OK)
+    goto done;
+
+  int has_scale = 0, has_offset = 0;
+  double scale = GDALGetRasterScale(band, &has_scale);
+  double offset = GDALGetRasterOffset(band, &has_offset);
+  if (!has_scale)
+    scale = 1.0;
+  if (!has_offset)
+    offset = 0.0;
+  if (!isfinite(scale) || scale == 0 || !isfinite(offset)) {
+    s = tt__error(ctx, TT_ERR_FORMAT, "%s: band %d has an unusable scale %g "
+                  "or offset %g", path, GDALGetBandNumber(band), scale,
+                  offset);
+    goto done;
+  }
+
+  /* The height unit, and Z_UNIT=m's conversion (before Z_FACTOR). */
+  char unit_declared[128];
+  const char *unit_source = declared_z_unit(band, srs, unit_declared,
+                                            sizeof unit_declared);
+  const char *unit_short = unit_short_name(unit_declared);
+  double unit_factor = 1.0;
+  const char *unit_out = unit_short ? unit_short : unit_declared;
+  if (opt.z_unit_m) {
+    if (unit_short) {
+      unit_factor = unit_metres(unit_short);
+    } else if (!opt.has_z_factor) {
+      s = tt__error(ctx, TT_ERR_DATA, "%s: heights cannot be converted to "
+                    "metres (Z_UNIT=m, -z_unit m): the height unit is %s%s%s"
+                    "; give the factor to metres as Z_FACTOR (-z_factor)",
+                    path, unit_declared[0] ? "\"" : "unknown (no band unit, no "
+                    "vertical CRS)", unit_declared,
+                    unit_declared[0] ? "\", which is not m, ft or us-ft" : "");
+      goto done;
+    }
+    unit_out = "m";
+  }
+  read_options conv = opt; /* what convert_rows() multiplies by */
+  conv.z_factor = opt.z_factor * unit_factor;
+
+  s = tt_grid_create(ctx, nx, ny, &grid);
+  if (s != TT_OK) {
+    s = with_path(ctx, s, path);
+    goto done;
+  }
+  s = tt_grid_set_geotransform(ctx, grid, gt);
+  if (s != TT_OK) {
+    s = with_path(ctx, s, path);
+    goto done;
+  }
+  char frame_name[512] = "geotransform";
+  if (srs || opt.work_srs) {
+    double frame[4];
+    s = tt__georef_ground_frame(ctx, srs, opt.work_srs, gt, nx, ny, frame,
+                                frame_name, sizeof frame_name);
+    if (s == TT_ERR_DATA) {
+      /* A CRS that says geographic over coordinates that cannot be (a
+       * mislabelled projected grid) or a grid centred on a pole: measure
+       * in the geotransform's units rather than refuse the DEM. */
+      tt__warn(ctx, "%s: %s; angles and areas are measured in the "
+               "geotransform's units instead", path, ctx ? ctx->errmsg : "");
+      tt_context_clear_error(ctx);
+      snprintf(frame_name, sizeof frame_name, "geotransform (the CRS is "
+               "geographic but no local frame fits)");
+      s = TT_OK;
+    } else if (s == TT_OK) {
+      s = tt_grid_set_ground_frame(ctx, grid, frame);
+    }
+    if (s != TT_OK) {
+      s = with_path(ctx, s, path);
+      goto done;
+    }
+  }
+
+  /* Validity: SRCNODATA overrides the mask; GMF_ALL_VALID needs none. */
+  if (!opt.has_srcnodata && !(GDALGetMaskFlags(band) & GMF_ALL_VALID))
+    mask_band = GDALGetMaskBand(band);
+
+  int bw = 0, bh = 0;
+  GDALGetBlockSize(band, &bw, &bh);
+  if (bw <= 0 || bw > xsize)
+    bw = xsize;
+  if (bh <= 0 || bh > ysize)
+    bh = ysize;
+  /* Rows per step: a block's height, fewer if the mask buffer of a row of
+   * blocks would be large (single-strip files). */
+  size_t step = (size_t)bh;
+  if (mask_band && step * nx > TT_READ_MASK_BYTES)
+    step = TT_READ_MASK_BYTES / nx > 0 ? TT_READ_MASK_BYTES / nx : 1;
+  if (mask_band) {
+    mask = malloc(step * nx);
+    if (!mask) {
+      s = tt__error(ctx, TT_ERR_NOMEM, "out of memory for a mask buffer");
+      goto done;
+    }
+  }
+
+  /* Hold GDAL's block cache to a few blocks unless the user chose a size. */
+  if (!CPLGetConfigOption("GDAL_CACHEMAX", NULL)) {
+    GIntBig block_bytes = (GIntBig)bw * bh *
+                          (GIntBig)(GDALGetDataTypeSizeBytes(dtype) + 1);
+    GIntBig want = TT_READ_CACHE_BYTES;
+    if (want < 3 * block_bytes)
+      want = 3 * block_bytes;
+    old_cache_max = GDALGetCacheMax64();
+    if (want < old_cache_max) {
+      GDALSetCacheMax64(want);
+      cache_changed = 1;
+    }
+  }
+
+  float *z = tt_grid_heights(grid);
+  size_t valid = 0;
+  if (progress && !progress(0.0, "reading", progress_arg)) {
+    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: read interrupted",
+                  path);
+    goto done;
+  }
+  for (size_t r0 = 0; r0 < ny; r0 += step) {
+    const size_t nrows = ny - r0 < step ? ny - r0 : step;
+    for (size_t c0 = 0; c0 < nx; c0 += (size_t)bw) {
+      const size_t ncols = nx - c0 < (size_t)bw ? nx - c0 : (size_t)bw;
+      CPLErrorReset();
+      CPLErr err = GDALRasterIOEx(band, GF_Read, (int)c0, (int)r0,
+                                  (int)ncols, (int)nrows, z + r0 * nx + c0,
+                                  (int)ncols, (int)nrows, GDT_Float32,
+                                  (GSpacing)sizeof(float),
+                                  (GSpacing)(nx * sizeof(float)), NULL);
+      if (err == CE_None && mask_band)
+        err = GDALRasterIOEx(mask_band, GF_Read, (int)c0, (int)r0,
+                             (int)ncols, (int)nrows, mask + c0, (int)ncols,
+                             (int)nrows, GDT_Byte, 1, (GSpacing)nx, NULL);
+      if (err != CE_None) {
+        s = tt__error(ctx, TT_ERR_IO, "%s: reading band %d at row %zu, "
+                      "column %zu failed: %s", path, GDALGetBandNumber(band),
+                      r0, c0, CPLGetLastErrorMsg());
+        goto done;
+      }
+    }
+    s = convert_rows(ctx, path, z, nx, r0, nrows, mask, &conv, scale,
+                     offset, &valid);
+    if (s != TT_OK)
+      goto done;
+    if (progress &&
+        !progress((double)(r0 + nrows) / (double)ny, "reading",
+                  progress_arg)) {
+      s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: read interrupted at row "
+                    "%zu of %zu", path, r0 + nrows, ny);
+      goto done;
+    }
+  }
+  if (valid == 0) {
+    s = tt__error(ctx, TT_ERR_DATA, "%s: all nodata: band %d has no valid "
+                  "sample", path, GDALGetBandNumber(band));
+    goto done;
+  }
+
+  info->path = dup_str(path);
+  GDALDriverH drv = ds ? GDALGetDatasetDriver(ds) : NULL;
+  info->driver = dup_str(drv ? GDALGetDriverShortName(drv) : "");
+  info->band = GDALGetBandNumber(band);
+  info->width = nx;
+  info->height = ny;
+  info->valid_samples = valid;
+  info->nodata_samples = nx * ny - valid;
+  memcpy(info->gt, gt, sizeof gt);
+  info->has_geotransform = has_gt;
+  info->z_unit = dup_str(unit_out);
+  info->z_unit_declared = dup_str(unit_declared);
+  info->z_unit_source = dup_str(unit_source);
+  info->z_unit_factor = unit_factor;
+  info->scale = scale;
+  info->offset = offset;
+  info->z_factor = opt.z_factor;
+  info->area_or_point =
+      dup_str(ds ? GDALGetMetadataItem(ds, GDALMD_AREA_OR_POINT, NULL) : "");
+  info->datatype = dup_str(GDALGetDataTypeName(dtype));
+  tt_grid_get_ground_frame(grid, info->frame);
+  info->frame_name = dup_str(frame_name);
+  if (!info->path || !info->driver || !info->z_unit ||
+      !info->z_unit_declared || !info->z_unit_source ||
+      !info->area_or_point || !info->datatype || !info->frame_name) {
+    s = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+    goto done;
+  }
+
+done:
+  if (cache_changed) {
+    /* Drop this read's blocks, then give the user their cache size back. */
+    GDALFlushRasterCache(band);
+    if (mask_band)
+      GDALFlushRasterCache(mask_band);
+    GDALSetCacheMax64(old_cache_max);
+  }
+  free(mask);
+  if (s != TT_OK) {
+    tt_grid_destroy(grid);
+    tt_raster_info_destroy(info);
+    return s;
+  }
+  *out_grid = grid;
+  if (out_info)
+    *out_info = info;
+  else
+    tt_raster_info_destroy(info);
+  return TT_OK;
+}

@@ -1,0 +1,1006 @@
+/*
+ * io_gpkg_rtree.c -- bulk-loading the R-tree spatial index of a GeoPackage
+ * feature table, on the closed file, with the sqlite3 C API.
+ *
+ * GDAL 3.6 fills a GPKG R-tree by inserting the features one by one through
+ * SQLite's R*Tree module (about 11 us each). Here the tree is packed in
+ * memory instead and its nodes are written straight into the shadow tables
+ * the module keeps:
+ *   rtree_<t>_<c>_node    (nodeno, data): one blob per node, all of the size
+ *                         the module chose when the table was created (read
+ *                         back from node 1). Blob layout, big-endian: 2 bytes
+ *                         tree depth (root only; 0 elsewhere), 2 bytes cell
+ *                         count, then cells of an 8-byte rowid (leaves) or
+ *                         child node number (inner nodes) and minx maxx miny
+ *                         maxy as 32-bit floats.
+ *   rtree_<t>_<c>_rowid   (rowid, nodeno): the leaf holding each feature.
+ *   rtree_<t>_<c>_parent  (nodeno, parentnode): every node but the root.
+ * The root is node 1. Boxes come from the GeoPackage geometry blobs: the
+ * header envelope when there is one, else the WKB (GDAL writes no envelope
+ * for points). NULL and empty geometries are not indexed, as the triggers of
+ * the standard do. Doubles become floats rounded outward exactly as the
+ * module rounds the values it is given, so a row written here equals the
+ * row an INSERT or a trigger would write.
+ *
+ * Packing is Sort-Tile-Recursive, level by level: a level of k items makes
+ * ceil(k / capacity) nodes whose sizes differ by at most one (so every node
+ * but a lone root is at least half full), cut from ceil(sqrt(nodes))
+ * vertical slices sorted by x centre, each slice sorted by y centre. Ties
+ * break on the rowid: the same table gives the same file.
+ *
+ * Everything happens in one IMMEDIATE transaction: the virtual table, its
+ * nodes, the triggers of the standard (the seven of GeoPackage 1.4 in a 1.4
+ * file, the six of 1.2.1-1.3 otherwise; see trigger_sql()), the
+ * gpkg_extensions row, then SQLite's rtreecheck() on the result; only then
+ * COMMIT. Any failure or interruption rolls back and leaves the file as it
+ * was.
+ *
+ * Workload: one sequential scan of the table, an O(n log n) sort, one blob
+ * per 51 features and one %_rowid row per feature; memory about 40 bytes per
+ * feature.
+ */
+#include "base/internal.h"
+#include "terratin/terratin_gdal.h"
+
+#include <sqlite3.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define RT_CELL_BYTES 24 /* 8-byte id + 4 floats */
+#define RT_MAX_DEPTH 40  /* far beyond any table SQLite can hold */
+#define WKB_MAX_NESTING 32
+
+/* One cell: a feature (leaves) or a child node (inner levels). */
+typedef struct rt_item {
+  int64_t id;
+  float box[4]; /* minx, maxx, miny, maxy */
+} rt_item;
+
+typedef struct rt_link {
+  int64_t rowid, nodeno;
+} rt_link;
+
+typedef struct rt_build {
+  tt_context *ctx;
+  sqlite3 *db;
+  const char *path;
+  char *table, *column, *fid; /* as stored in the file */
+  char *rtree;                /* rtree_<t>_<c> */
+  tt_progress_fn progress;
+  void *progress_arg;
+  rt_item *items;
+  size_t nitems, cap_items;
+  rt_link *links; /* %_rowid rows */
+  size_t nlinks;
+  size_t node_size, node_cap; /* bytes per node blob, cells per node */
+  int64_t next_nodeno;
+  unsigned char *blob;
+  sqlite3_stmt *ins_node, *ins_parent, *ins_rowid;
+  size_t nodes_written, nodes_total;
+  int gpkg_version; /* PRAGMA user_version: 10400 for 1.4.0 */
+} rt_build;
+
+/* --- small helpers -------------------------------------------------------- */
+
+static tt_status db_error(rt_build *b, tt_status s, const char *what)
+{
+  return tt__error(b->ctx, s, "%s: table %s: %s: %s", b->path,
+                   b->table ? b->table : "?", what,
+                   b->db ? sqlite3_errmsg(b->db) : "no database");
+}
+
+/* Runs sql (owned by sqlite3_malloc, freed here). */
+static tt_status exec_owned(rt_build *b, char *sql, const char *what)
+{
+  if (!sql)
+    return tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
+  int rc = sqlite3_exec(b->db, sql, NULL, NULL, NULL);
+  sqlite3_free(sql);
+  return rc == SQLITE_OK ? TT_OK : db_error(b, TT_ERR_IO, what);
+}
+
+static tt_status prepare_owned(rt_build *b, char *sql, sqlite3_stmt **out,
+                               const char *what)
+{
+  if (!sql)
+    return tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
+  int rc = sqlite3_prepare_v2(b->db, sql, -1, out, NULL);
+  sqlite3_free(sql);
+  return rc == SQLITE_OK ? TT_OK : db_error(b, TT_ERR_IO, what);
+}
+
+static char *dup_text(const unsigned char *s)
+{
+  size_t n = strlen((const char *)s);
+  char *d = malloc(n + 1);
+  if (d)
+    memcpy(d, s, n + 1);
+  return d;
+}
+
+static tt_status report(rt_build *b, double complete)
+{
+  if (b->progress && !b->progress(complete, "indexing", b->progress_arg))
+    return tt__error(b->ctx, TT_ERR_INTERRUPTED, "%s: table %s: building "
+                     "the spatial index was interrupted", b->path, b->table);
+  return TT_OK;
+}
+
+/* The module's rounding of a double to the float it stores: a min never
+ * above the value, a max never below it (SQLite's rtreeValueDown/Up rule:
+ * when the nearest float lies on the wrong side, scale by 1 -/+ 2^-23). */
+static float round_down(double d)
+{
+  float f = (float)d;
+  if ((double)f > d)
+    f = (float)(d * (d < 0 ? 1.0 + 1.0 / 8388608.0 : 1.0 - 1.0 / 8388608.0));
+  return f;
+}
+
+static float round_up(double d)
+{
+  float f = (float)d;
+  if ((double)f < d)
+    f = (float)(d * (d < 0 ? 1.0 - 1.0 / 8388608.0 : 1.0 + 1.0 / 8388608.0));
+  return f;
+}
+
+/* --- GeoPackage geometry blobs -------------------------------------------- */
+
+typedef struct wkb_reader {
+  const unsigned char *p;
+  size_t len, pos;
+} wkb_reader;
+
+static int rd_u32(wkb_reader *r, int little, uint32_t *out)
+{
+  if (r->len - r->pos < 4)
+    return 0;
+  const unsigned char *q = r->p + r->pos;
+  *out = little ? (uint32_t)q[0] | (uint32_t)q[1] << 8 |
+                      (uint32_t)q[2] << 16 | (uint32_t)q[3] << 24
+                : (uint32_t)q[3] | (uint32_t)q[2] << 8 |
+                      (uint32_t)q[1] << 16 | (uint32_t)q[0] << 24;
+  r->pos += 4;
+  return 1;
+}
+
+static int rd_f64(wkb_reader *r, int little, double *out)
+{
+  if (r->len - r->pos < 8)
+    return 0;
+  uint64_t u = 0;
+  const unsigned char *q = r->p + r->pos;
+  for (int i = 0; i < 8; i++)
+    u |= (uint64_t)q[little ? i : 7 - i] << (8 * i);
+  memcpy(out, &u, sizeof *out);
+  r->pos += 8;
+  return 1;
+}
+
+typedef struct bounds {
+  double minx, maxx, miny, maxy;
+  int any; /* a non-empty point was seen */
+} bounds;
+
+static void extend(bounds *bx, double x, double y)
+{
+  if (!bx->any) {
+    bx->minx = bx->maxx = x;
+    bx->miny = bx->maxy = y;
+    bx->any = 1;
+    return;
+  }
+  if (x < bx->minx) bx->minx = x;
+  if (x > bx->maxx) bx->maxx = x;
+  if (y < bx->miny) bx->miny = y;
+  if (y > bx->maxy) bx->maxy = y;
+}
+
+/* n points of dims coordinates; a point whose x or y is NaN is empty. */
+static int wkb_points(wkb_reader *r, int little, uint32_t n, int dims,
+                      bounds *bx)
+{
+  if ((r->len - r->pos) / (size_t)(8 * dims) < n)
+    return 0;
+  for (uint32_t i = 0; i < n; i++) {
+    double c[4];
+    for (int k = 0; k < dims; k++)
+      if (!rd_f64(r, little, &c[k]))
+        return 0;
+    if (!isnan(c[0]) && !isnan(c[1])) {
+      if (!isfinite(c[0]) || !isfinite(c[1]))
+        return 0;
+      extend(bx, c[0], c[1]);
+    }
+  }
+  return 1;
+}
+
+/* One WKB geometry (ISO or 0x80000000/0x40000000-flagged types): points,
+ * curves of straight segments, polygons, triangles and their collections.
+ * Returns 0 when malformed or of a type without straight edges. */
+static int wkb_geometry(wkb_reader *r, int nesting, bounds *bx)
+{
+  if (nesting > WKB_MAX_NESTING || r->pos >= r->len)
+    return 0;
+  unsigned char order = r->p[r->pos++];
+  if (order > 1)
+    return 0;
+  int little = order == 1;
+  uint32_t type;
+  if (!rd_u32(r, little, &type))
+    return 0;
+  int dims = 2;
+  if (type & 0x80000000u)
+    dims++;
+  if (type & 0x40000000u)
+    dims++;
+  if (type & 0x20000000u) /* EWKB SRID: not GeoPackage */
+    return 0;
+  type &= 0x0fffffffu;
+  if (type >= 1000 && type < 4000) {
+    dims += type / 1000 == 3 ? 2 : 1;
+    type %= 1000;
+  }
+  if (dims > 4)
+    return 0;
+  uint32_t n;
+  switch (type) {
+  case 1: /* point */
+    return wkb_points(r, little, 1, dims, bx);
+  case 2: /* linestring */
+    return rd_u32(r, little, &n) && wkb_points(r, little, n, dims, bx);
+  case 3:  /* polygon */
+  case 17: /* triangle */
+    if (!rd_u32(r, little, &n) || (r->len - r->pos) / 4 < n)
+      return 0;
+    for (uint32_t i = 0; i < n; i++) {
+      uint32_t np;
+      if (!rd_u32(r, little, &np) || !wkb_points(r, little, np, dims, bx))
+        return 0;
+    }
+    return 1;
+  case 4: case 5: case 6: case 7: /* multi*, geometry collection */
+  case 15: case 16:               /* polyhedral surface, TIN */
+    if (!rd_u32(r, little, &n) || (r->len - r->pos) / 5 < n)
+      return 0;
+    for (uint32_t i = 0; i < n; i++)
+      if (!wkb_geometry(r, nesting + 1, bx))
+        return 0;
+    return 1;
+  default:
+    return 0;
+  }
+}
+
+/* Box of a GeoPackage geometry blob: 1 with *bx set, 0 when the geometry is
+ * empty, -1 when the blob is not a GeoPackage geometry this file reads. */
+static int gpkg_box(const unsigned char *g, size_t len, bounds *bx)
+{
+  memset(bx, 0, sizeof *bx);
+  if (len < 8 || g[0] != 'G' || g[1] != 'P' || g[2] != 0)
+    return -1;
+  unsigned flags = g[3];
+  int little = flags & 1;
+  unsigned env = (flags >> 1) & 7;
+  if (env > 4)
+    return -1;
+  if (flags & 0x10) /* the empty flag */
+    return 0;
+  static const size_t env_doubles[5] = {0, 4, 6, 6, 8};
+  wkb_reader r = {g, len, 8};
+  if (env) {
+    double e[4];
+    for (int k = 0; k < 4; k++)
+      if (!rd_f64(&r, little, &e[k]))
+        return -1;
+    if (len - 8 < env_doubles[env] * 8)
+      return -1;
+    if (isnan(e[0]) || isnan(e[1]) || isnan(e[2]) || isnan(e[3]))
+      return 0;
+    if (!(e[0] <= e[1]) || !(e[2] <= e[3]) || !isfinite(e[0]) ||
+        !isfinite(e[1]) || !isfinite(e[2]) || !isfinite(e[3]))
+      return -1;
+    bx->minx = e[0];
+    bx->maxx = e[1];
+    bx->miny = e[2];
+    bx->maxy = e[3];
+    bx->any = 1;
+    return 1;
+  }
+  if (flags & 0x20) /* extended (non-standard) geometry type */
+    return -1;
+  if (!wkb_geometry(&r, 0, bx))
+    return -1;
+  return bx->any ? 1 : 0;
+}
+
+/* --- reading the table ---------------------------------------------------- */
+
+/* Finds the table and column as stored (case-insensitive match), the
+ * integer primary key, and checks that no index exists yet. */
+static tt_status describe(rt_build *b, const char *table, const char *column)
+{
+  sqlite3_stmt *st = NULL;
+  tt_status s = prepare_owned(
+      b,
+      sqlite3_mprintf("SELECT table_name, column_name FROM "
+                      "gpkg_geometry_columns WHERE lower(table_name) = "
+                      "lower(%Q) AND lower(column_name) = lower(%Q)",
+                      table, column),
+      &st, "not a GeoPackage (no gpkg_geometry_columns)");
+  if (s != TT_OK)
+    goto done;
+  if (sqlite3_step(st) != SQLITE_ROW) {
+    s = tt__error(b->ctx, TT_ERR_ARG, "%s: table %s: no geometry column %s "
+                  "in gpkg_geometry_columns", b->path, table, column);
+    goto done;
+  }
+  free(b->table);
+  b->table = dup_text(sqlite3_column_text(st, 0));
+  b->column = dup_text(sqlite3_column_text(st, 1));
+  sqlite3_finalize(st);
+  st = NULL;
+  if (!b->table || !b->column) {
+    s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
+    goto done;
+  }
+  b->rtree = sqlite3_mprintf("rtree_%s_%s", b->table, b->column);
+  if (!b->rtree) {
+    s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
+    goto done;
+  }
+
+  /* The integer primary key: exactly one INTEGER column with pk = 1. */
+  s = prepare_owned(b, sqlite3_mprintf("PRAGMA table_info(\"%w\")",
+                                       b->table),
+                    &st, "cannot read the table's columns");
+  if (s != TT_OK)
+    goto done;
+  int npk = 0;
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    if (sqlite3_column_int(st, 5) == 0)
+      continue;
+    npk++;
+    const unsigned char *type = sqlite3_column_text(st, 2);
+    if (type && sqlite3_stricmp((const char *)type, "INTEGER") == 0) {
+      free(b->fid);
+      b->fid = dup_text(sqlite3_column_text(st, 1));
+    }
+  }
+  if (npk != 1 || !b->fid) {
+    s = tt__error(b->ctx, TT_ERR_FORMAT, "%s: table %s has no INTEGER "
+                  "PRIMARY KEY column", b->path, b->table);
+    goto done;
+  }
+  sqlite3_finalize(st);
+  st = NULL;
+
+  /* No index yet: none of the names the virtual table, its shadow tables
+   * or its triggers (any generation) would take, no gpkg_extensions row. */
+  static const char *const suffixes[] = {
+      "", "_node", "_parent", "_rowid", "_insert", "_update1", "_update2",
+      "_update3", "_update4", "_update5", "_update6", "_update7", "_delete"};
+  s = prepare_owned(b,
+                    sqlite3_mprintf("SELECT name FROM sqlite_master WHERE "
+                                    "lower(name) = lower(?1 || ?2)"),
+                    &st, "cannot read the schema");
+  if (s != TT_OK)
+    goto done;
+  for (size_t k = 0; k < sizeof suffixes / sizeof suffixes[0]; k++) {
+    sqlite3_bind_text(st, 1, b->rtree, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 2, suffixes[k], -1, SQLITE_STATIC);
+    if (sqlite3_step(st) == SQLITE_ROW) {
+      s = tt__error(b->ctx, TT_ERR_EXISTS, "%s: table %s already has a "
+                    "spatial index (%s exists)", b->path, b->table,
+                    (const char *)sqlite3_column_text(st, 0));
+      goto done;
+    }
+    sqlite3_reset(st);
+  }
+  sqlite3_finalize(st);
+  st = NULL;
+  if (sqlite3_table_column_metadata(b->db, NULL, "gpkg_extensions",
+                                    "extension_name", NULL, NULL, NULL, NULL,
+                                    NULL) == SQLITE_OK) {
+    s = prepare_owned(
+        b,
+        sqlite3_mprintf("SELECT 1 FROM gpkg_extensions WHERE "
+                        "lower(table_name) = lower(%Q) AND "
+                        "lower(column_name) = lower(%Q) AND extension_name "
+                        "= 'gpkg_rtree_index'",
+                        b->table, b->column),
+        &st, "cannot read gpkg_extensions");
+    if (s != TT_OK)
+      goto done;
+    if (sqlite3_step(st) == SQLITE_ROW)
+      s = tt__error(b->ctx, TT_ERR_EXISTS, "%s: table %s already has a "
+                    "gpkg_rtree_index row in gpkg_extensions", b->path,
+                    b->table);
+  }
+done:
+  sqlite3_finalize(st);
+  return s;
+}
+
+static tt_status read_boxes(rt_build *b)
+{
+  sqlite3_stmt *st = NULL;
+  int64_t maxfid = 0;
+  tt_status s = prepare_owned(
+      b, sqlite3_mprintf("SELECT max(\"%w\") FROM \"%w\"", b->fid, b->table),
+      &st, "cannot read the table");
+  if (s != TT_OK)
+    goto done;
+  if (sqlite3_step(st) == SQLITE_ROW)
+    maxfid = sqlite3_column_int64(st, 0);
+  sqlite3_finalize(st);
+  st = NULL;
+
+  s = prepare_owned(b,
+                    sqlite3_mprintf("SELECT \"%w\", \"%w\" FROM \"%w\"",
+                                    b->fid, b->column, b->table),
+                    &st, "cannot read the table");
+  if (s != TT_OK)
+    goto done;
+  int64_t next_report = maxfid / 100;
+  int rc;
+  while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+    int64_t fid = sqlite3_column_int64(st, 0);
+    if (b->progress && fid >= next_report && maxfid > 0) {
+      next_report = fid + maxfid / 100 + 1;
+      s = report(b, 0.6 * (double)fid / (double)maxfid);
+      if (s != TT_OK)
+        goto done;
+    }
+    int type = sqlite3_column_type(st, 1);
+    if (type == SQLITE_NULL)
+      continue;
+    bounds bx;
+    int got = -1;
+    if (type == SQLITE_BLOB) {
+      const void *g = sqlite3_column_blob(st, 1);
+      got = gpkg_box(g, (size_t)sqlite3_column_bytes(st, 1), &bx);
+    }
+    if (got < 0) {
+      s = tt__error(b->ctx, TT_ERR_FORMAT, "%s: table %s: feature %lld: "
+                    "column %s is not a GeoPackage geometry this indexer "
+                    "reads", b->path, b->table, (long long)fid, b->column);
+      goto done;
+    }
+    if (got == 0)
+      continue;
+    if (!tt__grow((void **)&b->items, &b->cap_items, b->nitems + 1,
+                  sizeof *b->items)) {
+      s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory for "
+                    "%zu index entries", b->path, b->table, b->nitems + 1);
+      goto done;
+    }
+    rt_item *it = &b->items[b->nitems++];
+    it->id = fid;
+    it->box[0] = round_down(bx.minx);
+    it->box[1] = round_up(bx.maxx);
+    it->box[2] = round_down(bx.miny);
+    it->box[3] = round_up(bx.maxy);
+  }
+  if (rc != SQLITE_DONE)
+    s = db_error(b, TT_ERR_IO, "cannot read the table");
+done:
+  sqlite3_finalize(st);
+  return s;
+}
+
+/* --- packing -------------------------------------------------------------- */
+
+static int cmp_x(const void *pa, const void *pb)
+{
+  const rt_item *a = pa, *b = pb;
+  double ca = (double)a->box[0] + (double)a->box[1];
+  double cb = (double)b->box[0] + (double)b->box[1];
+  if (ca != cb)
+    return ca < cb ? -1 : 1;
+  return (a->id > b->id) - (a->id < b->id);
+}
+
+static int cmp_y(const void *pa, const void *pb)
+{
+  const rt_item *a = pa, *b = pb;
+  double ca = (double)a->box[2] + (double)a->box[3];
+  double cb = (double)b->box[2] + (double)b->box[3];
+  if (ca != cb)
+    return ca < cb ? -1 : 1;
+  return (a->id > b->id) - (a->id < b->id);
+}
+
+static int cmp_link(const void *pa, const void *pb)
+{
+  const rt_link *a = pa, *b = pb;
+  return (a->rowid > b->rowid) - (a->rowid < b->rowid);
+}
+
+/* First item of group g when n items make ngroups groups of near-equal
+ * size. */
+static size_t group_start(size_t g, size_t n, size_t ngroups)
+{
+  return (size_t)((uint64_t)g * n / ngroups);
+}
+
+/* Orders items for ngroups consecutive groups: STR slices by x, then y. */
+static void str_order(rt_item *items, size_t n, size_t ngroups)
+{
+  size_t nslices = (size_t)ceil(sqrt((double)ngroups));
+  if (nslices < 1)
+    nslices = 1;
+  qsort(items, n, sizeof *items, cmp_x);
+  for (size_t sl = 0; sl < nslices; sl++) {
+    size_t g0 = sl * ngroups / nslices, g1 = (sl + 1) * ngroups / nslices;
+    size_t e0 = group_start(g0, n, ngroups), e1 = group_start(g1, n, ngroups);
+    if (e1 > e0)
+      qsort(items + e0, e1 - e0, sizeof *items, cmp_y);
+  }
+}
+
+static void put_be16(unsigned char *p, unsigned v)
+{
+  p[0] = (unsigned char)(v >> 8);
+  p[1] = (unsigned char)v;
+}
+
+static void put_be64(unsigned char *p, uint64_t v)
+{
+  for (int i = 0; i < 8; i++)
+    p[i] = (unsigned char)(v >> (56 - 8 * i));
+}
+
+static void put_bef32(unsigned char *p, float f)
+{
+  uint32_t u;
+  memcpy(&u, &f, sizeof u);
+  for (int i = 0; i < 4; i++)
+    p[i] = (unsigned char)(u >> (24 - 8 * i));
+}
+
+static tt_status step_reset(rt_build *b, sqlite3_stmt *st, const char *what)
+{
+  int rc = sqlite3_step(st);
+  sqlite3_reset(st);
+  return rc == SQLITE_DONE ? TT_OK : db_error(b, TT_ERR_IO, what);
+}
+
+/* Writes node nodeno holding items[0..n) (depth written for the root) and
+ * links its cells: %_rowid rows for a leaf, %_parent rows for children. */
+static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
+                            size_t n, int leaf, int depth)
+{
+  memset(b->blob, 0, b->node_size);
+  put_be16(b->blob, nodeno == 1 ? (unsigned)depth : 0u);
+  put_be16(b->blob + 2, (unsigned)n);
+  for (size_t i = 0; i < n; i++) {
+    unsigned char *c = b->blob + 4 + i * RT_CELL_BYTES;
+    put_be64(c, (uint64_t)items[i].id);
+    for (int k = 0; k < 4; k++)
+      put_bef32(c + 8 + 4 * k, items[i].box[k]);
+  }
+  sqlite3_bind_int64(b->ins_node, 1, nodeno);
+  sqlite3_bind_blob(b->ins_node, 2, b->blob, (int)b->node_size,
+                    SQLITE_STATIC);
+  tt_status s = step_reset(b, b->ins_node, "cannot write an index node");
+  for (size_t i = 0; i < n && s == TT_OK; i++) {
+    if (leaf) {
+      b->links[b->nlinks].rowid = items[i].id;
+      b->links[b->nlinks++].nodeno = nodeno;
+    } else {
+      sqlite3_bind_int64(b->ins_parent, 1, items[i].id);
+      sqlite3_bind_int64(b->ins_parent, 2, nodeno);
+      s = step_reset(b, b->ins_parent, "cannot write an index node parent");
+    }
+  }
+  b->nodes_written++;
+  if (s == TT_OK && b->nodes_written % 256 == 0)
+    s = report(b, 0.6 + 0.3 * (double)b->nodes_written /
+                            (double)b->nodes_total);
+  return s;
+}
+
+/* Packs b->items level by level into nodes and writes them. */
+static tt_status pack_and_write(rt_build *b)
+{
+  rt_item *level = b->items, *next = NULL;
+  size_t n = b->nitems;
+  tt_status s = TT_OK;
+  b->links = n ? malloc(n * sizeof *b->links) : NULL;
+  if (n && !b->links)
+    return tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
+                     b->path, b->table);
+  /* Node count, for progress. */
+  b->nodes_total = 1;
+  for (size_t k = n; k > b->node_cap; k = (k + b->node_cap - 1) / b->node_cap)
+    b->nodes_total += (k + b->node_cap - 1) / b->node_cap;
+
+  b->next_nodeno = 2;
+  for (int depth = 0;; depth++) {
+    if (depth > RT_MAX_DEPTH) {
+      s = tt__error(b->ctx, TT_ERR_INTERNAL, "%s: table %s: index deeper "
+                    "than %d levels", b->path, b->table, RT_MAX_DEPTH);
+      goto done;
+    }
+    if (n <= b->node_cap) {
+      s = write_node(b, 1, level, n, depth == 0, depth);
+      goto done;
+    }
+    size_t ngroups = (n + b->node_cap - 1) / b->node_cap;
+    str_order(level, n, ngroups);
+    next = malloc(ngroups * sizeof *next);
+    if (!next) {
+      s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
+                    b->path, b->table);
+      goto done;
+    }
+    for (size_t g = 0; g < ngroups; g++) {
+      size_t e0 = group_start(g, n, ngroups);
+      size_t e1 = group_start(g + 1, n, ngroups);
+      rt_item *up = &next[g];
+      up->id = b->next_nodeno++;
+      memcpy(up->box, level[e0].box, sizeof up->box);
+      for (size_t i = e0 + 1; i < e1; i++) {
+        const float *bx = level[i].box;
+        if (bx[0] < up->box[0]) up->box[0] = bx[0];
+        if (bx[1] > up->box[1]) up->box[1] = bx[1];
+        if (bx[2] < up->box[2]) up->box[2] = bx[2];
+        if (bx[3] > up->box[3]) up->box[3] = bx[3];
+      }
+      s = write_node(b, up->id, level + e0, e1 - e0, depth == 0, depth);
+      if (s != TT_OK)
+        goto done;
+    }
+    if (level != b->items)
+      free(level);
+    level = next;
+    next = NULL;
+    n = ngroups;
+  }
+done:
+  if (level != b->items)
+    free(level);
+  free(next);
+  if (s != TT_OK)
+    return s;
+  /* %_rowid rows in rowid order: appends to its B-tree. */
+  if (b->nlinks)
+    qsort(b->links, b->nlinks, sizeof *b->links, cmp_link);
+  for (size_t i = 0; i < b->nlinks && s == TT_OK; i++) {
+    sqlite3_bind_int64(b->ins_rowid, 1, b->links[i].rowid);
+    sqlite3_bind_int64(b->ins_rowid, 2, b->links[i].nodeno);
+    s = step_reset(b, b->ins_rowid, "cannot write the index rowid map");
+  }
+  return s;
+}
+
+/* --- schema --------------------------------------------------------------- */
+
+/* The triggers of the RTree Spatial Indexes extension, laid out line for
+ * line as the standard prints its templates, identifiers double-quoted.
+ * t: table, c: geometry column, i: integer primary key, r: rtree table.
+ *   GeoPackage 1.4:       insert update2 update4 update5 update6 update7
+ *                         delete (seven; update1 and update3 deprecated)
+ *   GeoPackage 1.2.1-1.3: insert update1 update2 update3 update4 delete
+ *                         (update3 as corrected in 1.2.1, the body of 1.4's
+ *                         update5)
+ * A file gets the set of the version it declares (PRAGMA user_version), as
+ * GDAL does: GDAL before 3.7 knows only the older names, drops them by name
+ * when it renames a layer or disables its index (and fails on the others),
+ * and writes 1.2 files itself. */
+enum { TR_INSERT, TR_UPDATE1, TR_UPDATE2, TR_UPDATE3, TR_UPDATE4, TR_UPDATE5,
+       TR_UPDATE6, TR_UPDATE7, TR_DELETE };
+static const int triggers_v14[] = {TR_INSERT, TR_UPDATE2, TR_UPDATE4,
+                                   TR_UPDATE5, TR_UPDATE6, TR_UPDATE7,
+                                   TR_DELETE};
+static const int triggers_v13[] = {TR_INSERT, TR_UPDATE1, TR_UPDATE2,
+                                   TR_UPDATE3, TR_UPDATE4, TR_DELETE};
+
+#define NEW_BOX_END "  );\n"
+#define NEW_BOX(c)                                                           \
+  "    ST_MinX(NEW.\"" c "\"), ST_MaxX(NEW.\"" c "\"),\n"                   \
+  "    ST_MinY(NEW.\"" c "\"), ST_MaxY(NEW.\"" c "\")\n"
+static char *trigger_sql(int which, const char *t, const char *c,
+                         const char *i, const char *r)
+{
+  switch (which) {
+  case TR_INSERT:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_insert\" AFTER INSERT ON \"%w\"\n"
+        "  WHEN (new.\"%w\" NOT NULL AND NOT ST_IsEmpty(NEW.\"%w\"))\n"
+        "BEGIN\n"
+        "  INSERT OR REPLACE INTO \"%w\" VALUES (\n"
+        "    NEW.\"%w\",\n" NEW_BOX("%w") NEW_BOX_END
+        "END",
+        r, t, c, c, r, i, c, c, c, c);
+  case TR_UPDATE1:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_update1\" AFTER UPDATE OF \"%w\" ON \"%w\"\n"
+        "  WHEN OLD.\"%w\" = NEW.\"%w\" AND\n"
+        "       (NEW.\"%w\" NOTNULL AND NOT ST_IsEmpty(NEW.\"%w\"))\n"
+        "BEGIN\n"
+        "  INSERT OR REPLACE INTO \"%w\" VALUES (\n"
+        "    NEW.\"%w\",\n" NEW_BOX("%w") NEW_BOX_END
+        "END",
+        r, c, t, i, i, c, c, r, i, c, c, c, c);
+  case TR_UPDATE2:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_update2\" AFTER UPDATE OF \"%w\" ON \"%w\"\n"
+        "  WHEN OLD.\"%w\" = NEW.\"%w\" AND\n"
+        "       (NEW.\"%w\" ISNULL OR ST_IsEmpty(NEW.\"%w\"))\n"
+        "BEGIN\n"
+        "  DELETE FROM \"%w\" WHERE id = OLD.\"%w\";\n"
+        "END",
+        r, c, t, i, i, c, c, r, i);
+  case TR_UPDATE4:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_update4\" AFTER UPDATE ON \"%w\"\n"
+        "  WHEN OLD.\"%w\" != NEW.\"%w\" AND\n"
+        "       (NEW.\"%w\" ISNULL OR ST_IsEmpty(NEW.\"%w\"))\n"
+        "BEGIN\n"
+        "  DELETE FROM \"%w\" WHERE id IN (OLD.\"%w\", NEW.\"%w\");\n"
+        "END",
+        r, t, i, i, c, c, r, i, i);
+  case TR_UPDATE3:
+  case TR_UPDATE5:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_%s\" AFTER UPDATE ON \"%w\"\n"
+        "  WHEN OLD.\"%w\" != NEW.\"%w\" AND\n"
+        "       (NEW.\"%w\" NOTNULL AND NOT ST_IsEmpty(NEW.\"%w\"))\n"
+        "BEGIN\n"
+        "  DELETE FROM \"%w\" WHERE id = OLD.\"%w\";\n"
+        "  INSERT OR REPLACE INTO \"%w\" VALUES (\n"
+        "    NEW.\"%w\",\n" NEW_BOX("%w") NEW_BOX_END
+        "END",
+        r, which == TR_UPDATE3 ? "update3" : "update5", t, i, i, c, c, r, i,
+        r, i, c, c, c, c);
+  case TR_UPDATE6:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_update6\" AFTER UPDATE OF \"%w\" ON \"%w\"\n"
+        "  WHEN OLD.\"%w\" = NEW.\"%w\" AND\n"
+        "       (NEW.\"%w\" NOTNULL AND NOT ST_IsEmpty(NEW.\"%w\")) AND\n"
+        "       (OLD.\"%w\" NOTNULL AND NOT ST_IsEmpty(OLD.\"%w\"))\n"
+        "BEGIN\n"
+        "  UPDATE \"%w\" SET\n"
+        "    minx = ST_MinX(NEW.\"%w\"),\n"
+        "    maxx = ST_MaxX(NEW.\"%w\"),\n"
+        "    miny = ST_MinY(NEW.\"%w\"),\n"
+        "    maxy = ST_MaxY(NEW.\"%w\")\n"
+        "  WHERE id = NEW.\"%w\";\n"
+        "END",
+        r, c, t, i, i, c, c, c, c, r, c, c, c, c, i);
+  case TR_UPDATE7:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_update7\" AFTER UPDATE OF \"%w\" ON \"%w\"\n"
+        "  WHEN OLD.\"%w\" = NEW.\"%w\" AND\n"
+        "       (NEW.\"%w\" NOTNULL AND NOT ST_IsEmpty(NEW.\"%w\")) AND\n"
+        "       (OLD.\"%w\" ISNULL OR ST_IsEmpty(OLD.\"%w\"))\n"
+        "BEGIN\n"
+        "  INSERT INTO \"%w\" VALUES (\n"
+        "    NEW.\"%w\",\n" NEW_BOX("%w") NEW_BOX_END
+        "END",
+        r, c, t, i, i, c, c, c, c, r, i, c, c, c, c);
+  default:
+    return sqlite3_mprintf(
+        "CREATE TRIGGER \"%w_delete\" AFTER DELETE ON \"%w\"\n"
+        "  WHEN old.\"%w\" NOT NULL\n"
+        "BEGIN\n"
+        "  DELETE FROM \"%w\" WHERE id = OLD.\"%w\";\n"
+        "END",
+        r, t, c, r, i);
+  }
+}
+#undef NEW_BOX
+#undef NEW_BOX_END
+
+static tt_status create_schema(rt_build *b)
+{
+  tt_status s = exec_owned(
+      b,
+      sqlite3_mprintf("CREATE VIRTUAL TABLE \"%w\" USING rtree(id, minx, "
+                      "maxx, miny, maxy)",
+                      b->rtree),
+      "cannot create the R-tree (is SQLite's R*Tree module there?)");
+  int v14 = b->gpkg_version >= 10400;
+  const int *set = v14 ? triggers_v14 : triggers_v13;
+  size_t nset = v14 ? sizeof triggers_v14 / sizeof triggers_v14[0]
+                    : sizeof triggers_v13 / sizeof triggers_v13[0];
+  for (size_t k = 0; k < nset && s == TT_OK; k++)
+    s = exec_owned(b, trigger_sql(set[k], b->table, b->column, b->fid,
+                                  b->rtree),
+                   "cannot create the R-tree triggers");
+  if (s != TT_OK)
+    return s;
+  if (sqlite3_table_column_metadata(b->db, NULL, "gpkg_extensions",
+                                    "extension_name", NULL, NULL, NULL, NULL,
+                                    NULL) != SQLITE_OK) {
+    s = exec_owned(b,
+                   sqlite3_mprintf(
+                       "CREATE TABLE gpkg_extensions (table_name TEXT, "
+                       "column_name TEXT, extension_name TEXT NOT NULL, "
+                       "definition TEXT NOT NULL, scope TEXT NOT NULL, "
+                       "CONSTRAINT ge_tce UNIQUE (table_name, column_name, "
+                       "extension_name))"),
+                   "cannot create gpkg_extensions");
+    if (s != TT_OK)
+      return s;
+  }
+  s = exec_owned(
+      b,
+      sqlite3_mprintf("INSERT INTO gpkg_extensions (table_name, column_name, "
+                      "extension_name, definition, scope) VALUES (%Q, %Q, "
+                      "'gpkg_rtree_index', "
+                      "'http://www.geopackage.org/spec/#extension_rtree', "
+                      "'write-only')",
+                      b->table, b->column),
+      "cannot register the index in gpkg_extensions");
+  if (s != TT_OK)
+    return s;
+
+  /* The node size SQLite chose (from the page size) and the capacity. */
+  sqlite3_stmt *st = NULL;
+  s = prepare_owned(b,
+                    sqlite3_mprintf("SELECT length(data) FROM \"%w_node\" "
+                                    "WHERE nodeno = 1",
+                                    b->rtree),
+                    &st, "cannot read the R-tree root");
+  if (s != TT_OK)
+    return s;
+  int size = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int(st, 0) : 0;
+  sqlite3_finalize(st);
+  if (size < 4 + 2 * RT_CELL_BYTES || size > 65536)
+    return tt__error(b->ctx, TT_ERR_INTERNAL, "%s: table %s: unexpected "
+                     "R-tree node size %d", b->path, b->table, size);
+  b->node_size = (size_t)size;
+  b->node_cap = (b->node_size - 4) / RT_CELL_BYTES;
+  b->blob = malloc(b->node_size);
+  if (!b->blob)
+    return tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
+
+  s = exec_owned(b,
+                 sqlite3_mprintf("DELETE FROM \"%w_node\"; DELETE FROM "
+                                 "\"%w_parent\"; DELETE FROM \"%w_rowid\"",
+                                 b->rtree, b->rtree, b->rtree),
+                 "cannot clear the R-tree");
+  if (s == TT_OK)
+    s = prepare_owned(b,
+                      sqlite3_mprintf("INSERT INTO \"%w_node\" (nodeno, data) "
+                                      "VALUES (?, ?)",
+                                      b->rtree),
+                      &b->ins_node, "cannot write the R-tree");
+  if (s == TT_OK)
+    s = prepare_owned(b,
+                      sqlite3_mprintf("INSERT INTO \"%w_parent\" (nodeno, "
+                                      "parentnode) VALUES (?, ?)",
+                                      b->rtree),
+                      &b->ins_parent, "cannot write the R-tree");
+  if (s == TT_OK)
+    s = prepare_owned(b,
+                      sqlite3_mprintf("INSERT INTO \"%w_rowid\" (rowid, "
+                                      "nodeno) VALUES (?, ?)",
+                                      b->rtree),
+                      &b->ins_rowid, "cannot write the R-tree");
+  return s;
+}
+
+/* SQLite's own consistency check of the tree, inside the transaction. */
+static tt_status check_tree(rt_build *b)
+{
+  sqlite3_stmt *st = NULL;
+  tt_status s = prepare_owned(b, sqlite3_mprintf("SELECT rtreecheck(%Q)",
+                                                 b->rtree),
+                              &st, "cannot run rtreecheck()");
+  if (s != TT_OK)
+    return s;
+  if (sqlite3_step(st) != SQLITE_ROW) {
+    s = db_error(b, TT_ERR_INTERNAL, "rtreecheck() failed");
+  } else {
+    const char *msg = (const char *)sqlite3_column_text(st, 0);
+    if (!msg || strcmp(msg, "ok") != 0) {
+      /* One line: the first finding (the check prints one per line). */
+      const char *nl = msg ? strchr(msg, '\n') : NULL;
+      int len = nl ? (int)(nl - msg) : msg ? (int)strlen(msg) : 0;
+      s = tt__error(b->ctx, TT_ERR_INTERNAL, "%s: table %s: the R-tree "
+                    "built fails rtreecheck(): %.*s%s", b->path, b->table,
+                    len > 300 ? 300 : len, msg ? msg : "",
+                    nl && nl[1] ? " (and more)" : "");
+    }
+  }
+  sqlite3_finalize(st);
+  return s;
+}
+
+tt_status tt_gpkg_build_rtree(tt_context *ctx, const char *gpkg_path,
+                              const char *table, const char *geom_column,
+                              tt_progress_fn progress, void *progress_arg)
+{
+  if (!gpkg_path || !table || !geom_column || !*table || !*geom_column)
+    return tt__error(ctx, TT_ERR_ARG, "GeoPackage path, table and geometry "
+                     "column must be given");
+  rt_build b;
+  memset(&b, 0, sizeof b);
+  b.ctx = ctx;
+  b.path = gpkg_path;
+  b.progress = progress;
+  b.progress_arg = progress_arg;
+  b.table = malloc(strlen(table) + 1);
+  if (!b.table)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  memcpy(b.table, table, strlen(table) + 1);
+  int in_transaction = 0;
+  tt_status s = report(&b, 0.0);
+  if (s != TT_OK)
+    goto done;
+
+  /* No SQLITE_OPEN_CREATE: a missing file is an error, not a new file. */
+  if (sqlite3_open_v2(gpkg_path, &b.db, SQLITE_OPEN_READWRITE, NULL) !=
+      SQLITE_OK) {
+    s = db_error(&b, TT_ERR_IO, "cannot open");
+    goto done;
+  }
+  sqlite3_extended_result_codes(b.db, 1);
+  sqlite3_busy_timeout(b.db, 5000);
+  if (sqlite3_exec(b.db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
+    s = db_error(&b, TT_ERR_IO, "cannot start a transaction");
+    goto done;
+  }
+  in_transaction = 1;
+
+  sqlite3_stmt *uv = NULL;
+  if (sqlite3_prepare_v2(b.db, "PRAGMA user_version", -1, &uv, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(uv) == SQLITE_ROW)
+    b.gpkg_version = sqlite3_column_int(uv, 0);
+  sqlite3_finalize(uv);
+  s = describe(&b, table, geom_column);
+  if (s == TT_OK)
+    s = read_boxes(&b);
+  if (s == TT_OK)
+    s = report(&b, 0.6);
+  if (s == TT_OK)
+    s = create_schema(&b);
+  if (s == TT_OK)
+    s = pack_and_write(&b);
+  if (s == TT_OK)
+    s = report(&b, 0.9);
+  if (s == TT_OK)
+    s = check_tree(&b);
+  if (s == TT_OK)
+    s = report(&b, 0.99);
+  if (s != TT_OK)
+    goto done;
+  sqlite3_finalize(b.ins_node);
+  sqlite3_finalize(b.ins_parent);
+  sqlite3_finalize(b.ins_rowid);
+  b.ins_node = b.ins_parent = b.ins_rowid = NULL;
+  if (sqlite3_exec(b.db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) {
+    s = db_error(&b, TT_ERR_IO, "cannot commit the spatial index");
+    goto done;
+  }
+  in_transaction = 0;
+  if (progress)
+    progress(1.0, "indexing", progress_arg); /* done: too late to stop */
+
+done:
+  sqlite3_finalize(b.ins_node);
+  sqlite3_finalize(b.ins_parent);
+  sqlite3_finalize(b.ins_rowid);
+  if (in_transaction)
+    sqlite3_exec(b.db, "ROLLBACK", NULL, NULL, NULL);
+  if (b.db && sqlite3_close(b.db) != SQLITE_OK && s == TT_OK)
+    s = db_error(&b, TT_ERR_IO, "cannot close");
+  free(b.table);
+  free(b.column);
+  free(b.fid);
+  sqlite3_free(b.rtree);
+  free(b.items);
+  free(b.links);
+  free(b.blob);
+  return s;
+}

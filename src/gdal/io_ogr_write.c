@@ -1,0 +1,742 @@
+/*
+ * io_ogr_write.c -- writing a TIN into an open OGR dataset.
+ *
+ * Three layers, named with an optional prefix (NLN_PREFIX, which the
+ * shapefile output uses to make `<name>_triangles.shp` etc.):
+ *   <prefix>triangles       POLYGON Z, one feature per triangle; the ring is
+ *                           v0 v1 v2 v0 (closed, 4 points), counter-clockwise
+ *                           in map space as tt_tin_triangle() gives it.
+ *                           (The Shapefile driver rewinds outer rings to the
+ *                           clockwise order its format prescribes.)
+ *   <prefix>vertices        POINT Z, one feature per vertex.
+ *   <prefix>run_parameters  no geometry, one feature of typed fields.
+ * Field names have at most 10 characters so they survive DBF. Real values
+ * that are NaN (aspect of a flat triangle, insertion error of a starting
+ * vertex) are written as NULL.
+ *
+ * The rows are written in one transaction when the driver has them (GPKG,
+ * SQLite, PostgreSQL): nothing is visible until the commit, and an error or
+ * an interruption rolls it back. The layers themselves are created just
+ * before it and deleted again on failure: GDAL 3.6's GPKG driver keeps the
+ * layer objects of a rolled-back CREATE TABLE and then writes triggers for
+ * tables that do not exist when the dataset closes. Drivers without
+ * transactions (Shapefile) get their layers deleted on failure too; the
+ * temporary names of tt_output guard the final files either way.
+ *
+ * Spatial index: GPKG layers are created with SPATIAL_INDEX=NO (its R-tree
+ * triggers would update the index per insert) and the R-tree is built once,
+ * in bulk, by the driver's CreateSpatialIndex() SQL function after the
+ * inserts and inside the transaction; LCO=SPATIAL_INDEX=NO skips it, and
+ * RTREE=DEFERRED leaves it to the caller (tt_gpkg_build_rtree() on the
+ * closed file, several times faster than GDAL 3.6's one-by-one inserts). Other
+ * drivers index as their own options say (Shapefile: .qix at close with
+ * LCO=SPATIAL_INDEX=YES). Shapefile layers default to ENCODING=UTF-8 (.cpg).
+ *
+ * Output CRS: the layers get srs (the input CRS) unless T_SRS names
+ * another; then every vertex is transformed once, up front, from srs to
+ * T_SRS with OGR/PROJ (traditional GIS axis order on both sides, so x is
+ * easting or longitude) and the triangles' rings are made of the
+ * transformed vertices: the triangles themselves (which vertices, which
+ * order) do not change.
+ *
+ * Areas: per-triangle area_2d and area_3d come from the TIN (the ground
+ * frame, metres) when the output CRS is projected or absent. When it is
+ * geographic, area_2d is the geodesic area of the triangle whose corners
+ * are the output longitudes and latitudes, on the output CRS's ellipsoid
+ * (GeographicLib's geod_polygonarea, shipped with PROJ), and area_3d keeps
+ * the TIN's ratio area_3d / area_2d, which is 1 / cos(slope) of the
+ * triangle's plane: area_3d = geodesic area_2d * (frame area_3d / frame
+ * area_2d). Slope, aspect and angles stay those of the ground frame.
+ *
+ * Each layer's feature and geometry are made once and reused: per feature
+ * only field values and coordinates change. Progress is reported about
+ * every 1% of the features.
+ *
+ * Workload: O(vertices + triangles) feature inserts (about 16 us each into
+ * GPKG, R-tree included); memory O(1) beyond what the driver buffers.
+ */
+#include "base/internal.h"
+#include "terratin/terratin_gdal.h"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <cpl_string.h>
+
+#include <geodesic.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#define TT_SHP_FIELD_NAME_MAX 10
+#define TT_DBF_STRING_MAX 254
+
+typedef struct field_spec {
+  const char *name;
+  OGRFieldType type;
+} field_spec;
+
+/* Column order of the two geometry layers; the writers below index these
+ * tables by the enum values. */
+enum { TF_V0, TF_V1, TF_V2, TF_MAX_ERR, TF_RMSE, TF_N_SAMPLES, TF_AREA_2D,
+       TF_AREA_3D, TF_SLOPE, TF_ASPECT, TF_MIN_ANGLE, TF_MAX_ANGLE,
+       TF_COUNT };
+static const field_spec triangle_fields[TF_COUNT] = {
+    {"v0", OFTInteger},         {"v1", OFTInteger},
+    {"v2", OFTInteger},         {"max_err", OFTReal},
+    {"rmse", OFTReal},          {"n_samples", OFTInteger64},
+    {"area_2d", OFTReal},       {"area_3d", OFTReal},
+    {"slope", OFTReal},         {"aspect", OFTReal},
+    {"min_angle", OFTReal},     {"max_angle", OFTReal}};
+
+enum { VF_ID, VF_COL, VF_ROW, VF_INS_ERR, VF_INS_RANK, VF_STAR_MAX,
+       VF_STAR_RMSE, VF_STAR_N, VF_COUNT };
+static const field_spec vertex_fields[VF_COUNT] = {
+    {"vertex_id", OFTInteger},  {"col", OFTInteger},
+    {"row", OFTInteger},        {"ins_err", OFTReal},
+    {"ins_rank", OFTInteger64}, {"star_max", OFTReal},
+    {"star_rmse", OFTReal},     {"star_n", OFTInteger64}};
+
+typedef struct write_state {
+  tt_context *ctx;
+  GDALDatasetH dst;
+  int shapefile;
+  char *prefix;
+  char **lco;              /* layer creation options */
+  char *created[3];        /* names of the layers made, for cleanup */
+  int ncreated;
+  int gpkg;
+  int build_rtree;         /* GPKG: bulk-build the R-trees before commit */
+  int rtree_deferred;      /* RTREE=DEFERRED: the caller builds them */
+  OGRLayerH tri_layer, vtx_layer, run_layer;
+  int tri_idx[TF_COUNT], vtx_idx[VF_COUNT];
+  int *run_idx;
+  tt_progress_fn progress;
+  void *progress_arg;
+  char *t_srs;             /* T_SRS as given, NULL: none */
+  OGRSpatialReferenceH out_srs; /* the layers' CRS (owned), NULL: none */
+  double *xy;              /* T_SRS: the transformed vertices, 2 per vertex */
+  int geodesic;            /* the output CRS is geographic */
+  struct geod_geodesic geod;
+  double deg_per_unit;     /* output angular unit in degrees */
+  size_t done, total, next_report, step;
+  double scale;            /* share of the progress range the rows take */
+} write_state;
+
+/* The driver's last message, or a generic one. */
+static const char *ogr_msg(void)
+{
+  const char *m = CPLGetLastErrorMsg();
+  return m && *m ? m : "no details from GDAL";
+}
+
+static tt_status parse_options(write_state *w, char **options)
+{
+  for (char **o = options; o && *o; o++) {
+    char *key = NULL;
+    const char *value = CPLParseNameValue(*o, &key);
+    if (!key || !value) {
+      CPLFree(key);
+      return tt__error(w->ctx, TT_ERR_ARG, "write option \"%s\" is not "
+                       "NAME=VALUE", *o);
+    }
+    tt_status s = TT_OK;
+    if (strcasecmp(key, "NLN_PREFIX") == 0) {
+      CPLFree(w->prefix);
+      w->prefix = CPLStrdup(value);
+    } else if (strcasecmp(key, "LCO") == 0) {
+      char *lkey = NULL;
+      const char *lvalue = CPLParseNameValue(value, &lkey);
+      if (!lkey || !lvalue)
+        s = tt__error(w->ctx, TT_ERR_ARG, "LCO=%s is not LCO=NAME=VALUE",
+                      value);
+      else
+        w->lco = CSLSetNameValue(w->lco, lkey, lvalue);
+      CPLFree(lkey);
+    } else if (strcasecmp(key, "T_SRS") == 0) {
+      CPLFree(w->t_srs);
+      w->t_srs = *value ? CPLStrdup(value) : NULL;
+    } else if (strcasecmp(key, "RTREE") == 0) {
+      if (strcasecmp(value, "DEFERRED") == 0)
+        w->rtree_deferred = 1;
+      else if (strcasecmp(value, "NOW") == 0)
+        w->rtree_deferred = 0;
+      else
+        s = tt__error(w->ctx, TT_ERR_ARG, "RTREE=%s: expected NOW or "
+                      "DEFERRED", value);
+    } else {
+      s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
+                    "(known: NLN_PREFIX, LCO, RTREE, T_SRS)", key);
+    }
+    CPLFree(key);
+    if (s != TT_OK)
+      return s;
+  }
+  if (!w->prefix)
+    w->prefix = CPLStrdup("");
+  /* GPKG: no R-tree at creation (its triggers would update it per insert);
+   * it is built in bulk after the inserts, inside the transaction, unless
+   * the user asked for none. */
+  if (w->gpkg) {
+    const char *si = CSLFetchNameValue(w->lco, "SPATIAL_INDEX");
+    /* RTREE=DEFERRED: tt_gpkg_build_rtree() on the closed file instead. */
+    w->build_rtree = (!si || CPLTestBool(si)) && !w->rtree_deferred;
+    w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "NO");
+  }
+  /* DBF strings are Latin-1 unless told otherwise; CRS names and paths may
+   * not be. A .cpg file tells QGIS. */
+  if (w->shapefile && !CSLFetchNameValue(w->lco, "ENCODING"))
+    w->lco = CSLSetNameValue(w->lco, "ENCODING", "UTF-8");
+  return TT_OK;
+}
+
+static tt_status report(write_state *w)
+{
+  w->done++;
+  if (!w->progress || w->done < w->next_report)
+    return TT_OK;
+  w->next_report = w->done + w->step;
+  if (!w->progress(w->scale * (double)w->done / (double)w->total,
+                   "writing", w->progress_arg))
+    return tt__error(w->ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
+                     "interrupted after %zu of %zu features", w->done,
+                     w->total);
+  return TT_OK;
+}
+
+static tt_status create_layer(write_state *w, const char *suffix,
+                              OGRSpatialReferenceH srs,
+                              OGRwkbGeometryType type, OGRLayerH *out_layer)
+{
+  char *name = CPLStrdup(CPLSPrintf("%s%s", w->prefix, suffix));
+  CPLErrorReset();
+  OGRLayerH layer = GDALDatasetCreateLayer(w->dst, name,
+                                           type == wkbNone ? NULL : srs,
+                                           type, w->lco);
+  if (!layer) {
+    tt_status s = tt__error(w->ctx, TT_ERR_IO, "cannot create layer %s: %s",
+                            name, ogr_msg());
+    CPLFree(name);
+    return s;
+  }
+  w->created[w->ncreated++] = name;
+  *out_layer = layer;
+  return TT_OK;
+}
+
+/* Creates the fields and returns their indices in the layer definition. */
+static tt_status create_fields(write_state *w, OGRLayerH layer,
+                               const field_spec *spec, int n, int *out_index)
+{
+  for (int i = 0; i < n; i++) {
+    OGRFieldDefnH fd = OGR_Fld_Create(spec[i].name, spec[i].type);
+    CPLErrorReset();
+    OGRErr err = OGR_L_CreateField(layer, fd, TRUE);
+    OGR_Fld_Destroy(fd);
+    int idx = err == OGRERR_NONE
+                  ? OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer),
+                                         spec[i].name)
+                  : -1;
+    if (idx < 0)
+      return tt__error(w->ctx, TT_ERR_IO, "cannot create field %s in layer "
+                       "%s: %s", spec[i].name, OGR_L_GetName(layer),
+                       ogr_msg());
+    out_index[i] = idx;
+  }
+  return TT_OK;
+}
+
+static void set_real(OGRFeatureH f, int idx, double v)
+{
+  if (isfinite(v))
+    OGR_F_SetFieldDouble(f, idx, v);
+  else
+    OGR_F_SetFieldNull(f, idx);
+}
+
+static tt_status insert(write_state *w, OGRLayerH layer, OGRFeatureH f,
+                        size_t index)
+{
+  OGR_F_SetFID(f, OGRNullFID);
+  CPLErrorReset();
+  if (OGR_L_CreateFeature(layer, f) != OGRERR_NONE)
+    return tt__error(w->ctx, TT_ERR_IO, "cannot write feature %zu of layer "
+                     "%s: %s", index, OGR_L_GetName(layer), ogr_msg());
+  return report(w);
+}
+
+static tt_status write_triangles(write_state *w, const tt_tin *tin)
+{
+  OGRLayerH layer = w->tri_layer;
+  const int *idx = w->tri_idx;
+  tt_status s = TT_OK;
+  OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+  OGRGeometryH poly = OGR_G_CreateGeometry(wkbPolygon25D);
+  OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing);
+  OGR_G_AddGeometryDirectly(poly, ring); /* poly owns ring; ring stays ours
+                                            to edit through poly */
+  OGR_G_Set3D(poly, TRUE); /* CreateGeometry(wkbPolygon25D) makes it 2D */
+  const size_t nt = tt_tin_triangle_count(tin);
+  for (size_t i = 0; i < nt && s == TT_OK; i++) {
+    tt_triangle_info t;
+    tt_vertex_info v[3];
+    if (tt_tin_triangle(tin, i, &t) != TT_OK ||
+        tt_tin_vertex(tin, (size_t)t.v[0], &v[0]) != TT_OK ||
+        tt_tin_vertex(tin, (size_t)t.v[1], &v[1]) != TT_OK ||
+        tt_tin_vertex(tin, (size_t)t.v[2], &v[2]) != TT_OK) {
+      s = tt__error(w->ctx, TT_ERR_INTERNAL, "triangle %zu of %zu could not "
+                    "be read from the TIN", i, nt);
+      break;
+    }
+    double px[3], py[3];
+    for (int k = 0; k < 3; k++) {
+      px[k] = w->xy ? w->xy[2 * (size_t)t.v[k]] : v[k].x;
+      py[k] = w->xy ? w->xy[2 * (size_t)t.v[k] + 1] : v[k].y;
+    }
+    if (w->geodesic) {
+      double lats[3], lons[3], area = 0, perimeter = 0;
+      for (int k = 0; k < 3; k++) {
+        lons[k] = px[k] * w->deg_per_unit;
+        lats[k] = py[k] * w->deg_per_unit;
+      }
+      geod_polygonarea(&w->geod, lats, lons, 3, &area, &perimeter);
+      area = fabs(area);
+      t.area_3d = t.area_2d > 0 ? t.area_3d * (area / t.area_2d) : area;
+      t.area_2d = area;
+    }
+    ring = OGR_G_GetGeometryRef(poly, 0);
+    for (int k = 0; k < 4; k++)
+      OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], v[k % 3].z);
+    OGR_F_SetGeometry(f, poly);
+    OGR_F_SetFieldInteger(f, idx[TF_V0], t.v[0]);
+    OGR_F_SetFieldInteger(f, idx[TF_V1], t.v[1]);
+    OGR_F_SetFieldInteger(f, idx[TF_V2], t.v[2]);
+    set_real(f, idx[TF_MAX_ERR], t.max_error);
+    set_real(f, idx[TF_RMSE], t.rmse);
+    OGR_F_SetFieldInteger64(f, idx[TF_N_SAMPLES], (GIntBig)t.samples);
+    set_real(f, idx[TF_AREA_2D], t.area_2d);
+    set_real(f, idx[TF_AREA_3D], t.area_3d);
+    set_real(f, idx[TF_SLOPE], t.slope_deg);
+    set_real(f, idx[TF_ASPECT], t.aspect_deg);
+    set_real(f, idx[TF_MIN_ANGLE], t.min_angle_deg);
+    set_real(f, idx[TF_MAX_ANGLE], t.max_angle_deg);
+    s = insert(w, layer, f, i);
+  }
+  OGR_G_DestroyGeometry(poly);
+  OGR_F_Destroy(f);
+  return s;
+}
+
+static tt_status write_vertices(write_state *w, const tt_tin *tin)
+{
+  OGRLayerH layer = w->vtx_layer;
+  const int *idx = w->vtx_idx;
+  tt_status s = TT_OK;
+  OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+  OGRGeometryH pt = OGR_G_CreateGeometry(wkbPoint25D);
+  OGR_G_Set3D(pt, TRUE);
+  const size_t nv = tt_tin_vertex_count(tin);
+  for (size_t i = 0; i < nv && s == TT_OK; i++) {
+    tt_vertex_info v;
+    if (tt_tin_vertex(tin, i, &v) != TT_OK) {
+      s = tt__error(w->ctx, TT_ERR_INTERNAL, "vertex %zu of %zu could not "
+                    "be read from the TIN", i, nv);
+      break;
+    }
+    OGR_G_SetPoint(pt, 0, w->xy ? w->xy[2 * i] : v.x,
+                   w->xy ? w->xy[2 * i + 1] : v.y, v.z);
+    OGR_F_SetGeometry(f, pt);
+    OGR_F_SetFieldInteger(f, idx[VF_ID], (int)i);
+    OGR_F_SetFieldInteger(f, idx[VF_COL], v.col);
+    OGR_F_SetFieldInteger(f, idx[VF_ROW], v.row);
+    set_real(f, idx[VF_INS_ERR], v.insert_error);
+    OGR_F_SetFieldInteger64(f, idx[VF_INS_RANK], (GIntBig)v.rank);
+    set_real(f, idx[VF_STAR_MAX], v.star_max_error);
+    set_real(f, idx[VF_STAR_RMSE], v.star_rmse);
+    OGR_F_SetFieldInteger64(f, idx[VF_STAR_N], (GIntBig)v.star_samples);
+    s = insert(w, layer, f, i);
+  }
+  OGR_G_DestroyGeometry(pt);
+  OGR_F_Destroy(f);
+  return s;
+}
+
+static tt_status create_run_fields(write_state *w,
+                                   const tt_run_field *fields,
+                                   size_t nfields)
+{
+  OGRLayerH layer = w->run_layer;
+  w->run_idx = nfields ? malloc(nfields * sizeof *w->run_idx) : NULL;
+  if (nfields && !w->run_idx)
+    return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
+  for (size_t i = 0; i < nfields; i++) {
+    const tt_run_field *rf = &fields[i];
+    OGRFieldType type = rf->type == TT_FIELD_STRING    ? OFTString
+                        : rf->type == TT_FIELD_INTEGER ? OFTInteger64
+                                                       : OFTReal;
+    OGRFieldDefnH fd = OGR_Fld_Create(rf->name, type);
+    if (w->shapefile && type == OFTString) {
+      /* DBF strings are fixed-width: as wide as the value, at most 254. */
+      size_t n = rf->s ? strlen(rf->s) : 0;
+      if (n > TT_DBF_STRING_MAX)
+        tt__warn(w->ctx, "run parameter %s is %zu characters long; a "
+                 "shapefile keeps only the first %d", rf->name, n,
+                 TT_DBF_STRING_MAX);
+      OGR_Fld_SetWidth(fd, n == 0 ? 1 : n > TT_DBF_STRING_MAX
+                                            ? TT_DBF_STRING_MAX
+                                            : (int)n);
+    }
+    CPLErrorReset();
+    OGRErr err = OGR_L_CreateField(layer, fd, TRUE);
+    OGR_Fld_Destroy(fd);
+    w->run_idx[i] =
+        err == OGRERR_NONE
+            ? OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer), rf->name)
+            : -1;
+    if (w->run_idx[i] < 0)
+      return tt__error(w->ctx, TT_ERR_IO, "cannot create field %s in layer "
+                       "%s: %s", rf->name, OGR_L_GetName(layer), ogr_msg());
+  }
+  return TT_OK;
+}
+
+static tt_status write_run_parameters(write_state *w,
+                                      const tt_run_field *fields,
+                                      size_t nfields)
+{
+  OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(w->run_layer));
+  for (size_t i = 0; i < nfields; i++) {
+    const tt_run_field *rf = &fields[i];
+    int idx = w->run_idx[i];
+    if (rf->type == TT_FIELD_STRING) {
+      if (rf->s)
+        OGR_F_SetFieldString(f, idx, rf->s);
+      else
+        OGR_F_SetFieldNull(f, idx);
+    } else if (rf->type == TT_FIELD_INTEGER) {
+      OGR_F_SetFieldInteger64(f, idx, (GIntBig)rf->i);
+    } else {
+      set_real(f, idx, rf->r);
+    }
+  }
+  tt_status s = insert(w, w->run_layer, f, 0);
+  OGR_F_Destroy(f);
+  return s;
+}
+
+/* A copy of s with single quotes doubled, for an SQL string literal. */
+static char *sql_quote(const char *s)
+{
+  size_t n = 0;
+  for (const char *p = s; *p; p++)
+    n += *p == '\'' ? 2 : 1;
+  char *q = CPLMalloc(n + 1), *o = q;
+  for (const char *p = s; *p; p++) {
+    *o++ = *p;
+    if (*p == '\'')
+      *o++ = '\'';
+  }
+  *o = '\0';
+  return q;
+}
+
+/* GPKG: builds a layer's R-tree in one pass over its rows (the driver's
+ * CreateSpatialIndex() SQL function), inside the open transaction. */
+static tt_status build_rtree(write_state *w, OGRLayerH layer)
+{
+  char *name = sql_quote(OGR_L_GetName(layer));
+  char *geom = sql_quote(OGR_L_GetGeometryColumn(layer));
+  char *sql = CPLStrdup(
+      CPLSPrintf("SELECT CreateSpatialIndex('%s', '%s')", name, geom));
+  CPLErrorReset();
+  OGRLayerH rs = GDALDatasetExecuteSQL(w->dst, sql, NULL, NULL);
+  if (rs)
+    GDALDatasetReleaseResultSet(w->dst, rs);
+  tt_status s = TT_OK;
+  if (CPLGetLastErrorType() >= CE_Failure)
+    s = tt__error(w->ctx, TT_ERR_IO, "cannot build the spatial index of "
+                  "layer %s: %s", OGR_L_GetName(layer), ogr_msg());
+  CPLFree(sql);
+  CPLFree(geom);
+  CPLFree(name);
+  return s;
+}
+
+static tt_status check_run_fields(write_state *w, const tt_run_field *fields,
+                                  size_t nfields)
+{
+  for (size_t i = 0; i < nfields; i++) {
+    const tt_run_field *rf = &fields[i];
+    if (!rf->name || !*rf->name)
+      return tt__error(w->ctx, TT_ERR_ARG, "run parameter %zu has no name",
+                       i);
+    if (rf->type != TT_FIELD_STRING && rf->type != TT_FIELD_INTEGER &&
+        rf->type != TT_FIELD_REAL)
+      return tt__error(w->ctx, TT_ERR_ARG, "run parameter %s has an unknown "
+                       "type %d", rf->name, (int)rf->type);
+    if (w->shapefile && strlen(rf->name) > TT_SHP_FIELD_NAME_MAX)
+      return tt__error(w->ctx, TT_ERR_ARG, "run parameter name \"%s\" is "
+                       "longer than the %d characters a shapefile allows",
+                       rf->name, TT_SHP_FIELD_NAME_MAX);
+    for (size_t k = 0; k < i; k++)
+      if (strcasecmp(fields[k].name, rf->name) == 0)
+        return tt__error(w->ctx, TT_ERR_ARG, "run parameter \"%s\" is given "
+                         "twice", rf->name);
+  }
+  return TT_OK;
+}
+
+/* The layers' CRS: srs, or T_SRS with every vertex transformed to it; and
+ * the ellipsoid for geodesic areas when that CRS is geographic. */
+static tt_status prepare_crs(write_state *w, const tt_tin *tin,
+                             OGRSpatialReferenceH srs)
+{
+  tt_status s = TT_OK;
+  OGRSpatialReferenceH src = NULL;
+  OGRCoordinateTransformationH ct = NULL;
+  if (w->t_srs) {
+    if (!srs)
+      return tt__error(w->ctx, TT_ERR_ARG, "T_SRS=%s: the TIN has no CRS "
+                       "to transform from", w->t_srs);
+    w->out_srs = OSRNewSpatialReference(NULL);
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRErr e = w->out_srs ? OSRSetFromUserInput(w->out_srs, w->t_srs)
+                          : OGRERR_FAILURE;
+    CPLPopErrorHandler();
+    if (e != OGRERR_NONE)
+      return tt__error(w->ctx, TT_ERR_ARG, "T_SRS '%s' is not a CRS GDAL "
+                       "understands", w->t_srs);
+    OSRSetAxisMappingStrategy(w->out_srs, OAMS_TRADITIONAL_GIS_ORDER);
+    src = OSRClone(srs);
+    if (src)
+      OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+    CPLErrorReset();
+    ct = src ? OCTNewCoordinateTransformation(src, w->out_srs) : NULL;
+    if (!ct) {
+      s = tt__error(w->ctx, TT_ERR_ARG, "PROJ cannot transform the TIN's "
+                    "CRS to T_SRS '%s': %s", w->t_srs, ogr_msg());
+      goto done;
+    }
+    const size_t nv = tt_tin_vertex_count(tin);
+    w->xy = malloc((nv ? nv : 1) * 2 * sizeof *w->xy);
+    double *bx = malloc(4096 * sizeof *bx), *by = malloc(4096 * sizeof *by);
+    int *ok = malloc(4096 * sizeof *ok);
+    if (!w->xy || !bx || !by || !ok) {
+      s = tt__error(w->ctx, TT_ERR_NOMEM, "out of memory for %zu "
+                    "transformed vertices", nv);
+    }
+    for (size_t i0 = 0; s == TT_OK && i0 < nv; i0 += 4096) {
+      size_t n = nv - i0 < 4096 ? nv - i0 : 4096;
+      for (size_t k = 0; k < n; k++) {
+        tt_vertex_info v;
+        tt_tin_vertex(tin, i0 + k, &v);
+        bx[k] = v.x;
+        by[k] = v.y;
+      }
+      if (!OCTTransformEx(ct, (int)n, bx, by, NULL, ok)) {
+        for (size_t k = 0; k < n; k++)
+          if (!ok[k]) {
+            s = tt__error(w->ctx, TT_ERR_DATA, "vertex %zu cannot be "
+                          "transformed to T_SRS '%s': %s", i0 + k, w->t_srs,
+                          ogr_msg());
+            break;
+          }
+        if (s == TT_OK)
+          s = tt__error(w->ctx, TT_ERR_DATA, "the vertices cannot be "
+                        "transformed to T_SRS '%s': %s", w->t_srs,
+                        ogr_msg());
+      }
+      for (size_t k = 0; s == TT_OK && k < n; k++) {
+        if (!isfinite(bx[k]) || !isfinite(by[k])) {
+          s = tt__error(w->ctx, TT_ERR_DATA, "vertex %zu has no finite "
+                        "coordinates in T_SRS '%s'", i0 + k, w->t_srs);
+          break;
+        }
+        w->xy[2 * (i0 + k)] = bx[k];
+        w->xy[2 * (i0 + k) + 1] = by[k];
+      }
+    }
+    free(bx);
+    free(by);
+    free(ok);
+    if (s != TT_OK)
+      goto done;
+  } else if (srs) {
+    w->out_srs = OSRClone(srs);
+    if (!w->out_srs)
+      return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
+  }
+  if (w->out_srs && OSRIsGeographic(w->out_srs)) {
+    OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
+    double a = OSRGetSemiMajor(w->out_srs, &e1);
+    double invf = OSRGetInvFlattening(w->out_srs, &e2);
+    double deg = OSRGetAngularUnits(w->out_srs, NULL) * 180.0 /
+                 3.14159265358979323846;
+    if (e1 == OGRERR_NONE && e2 == OGRERR_NONE && a > 0 && isfinite(a) &&
+        invf >= 0 && isfinite(invf) && deg > 0 && isfinite(deg)) {
+      geod_init(&w->geod, a, invf > 0 ? 1.0 / invf : 0.0);
+      w->deg_per_unit = deg;
+      w->geodesic = 1;
+    } else {
+      tt__warn(w->ctx, "the output CRS is geographic but has no usable "
+               "ellipsoid: triangle areas are those of the ground frame");
+    }
+  }
+done:
+  if (ct)
+    OCTDestroyCoordinateTransformation(ct);
+  OSRDestroySpatialReference(src);
+  return s;
+}
+
+/* After a failure without a transaction: drop the layers this call made. */
+static void delete_created_layers(write_state *w)
+{
+  for (int k = w->ncreated - 1; k >= 0; k--) {
+    int n = GDALDatasetGetLayerCount(w->dst);
+    for (int i = 0; i < n; i++) {
+      OGRLayerH l = GDALDatasetGetLayer(w->dst, i);
+      if (l && strcmp(OGR_L_GetName(l), w->created[k]) == 0) {
+        GDALDatasetDeleteLayer(w->dst, i);
+        break;
+      }
+    }
+  }
+}
+
+tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
+                           const tt_tin *tin, OGRSpatialReferenceH srs,
+                           const tt_run_field *fields, size_t nfields,
+                           char **options, tt_progress_fn progress,
+                           void *progress_arg)
+{
+  if (!dst || !tin)
+    return tt__error(ctx, TT_ERR_ARG, "dataset and TIN must not be NULL");
+  if (nfields && !fields)
+    return tt__error(ctx, TT_ERR_ARG, "run parameters must not be NULL");
+
+  write_state w;
+  memset(&w, 0, sizeof w);
+  w.ctx = ctx;
+  w.dst = dst;
+  GDALDriverH drv = GDALGetDatasetDriver(dst);
+  const char *drv_name = drv ? GDALGetDriverShortName(drv) : "";
+  w.shapefile = strcasecmp(drv_name, "ESRI Shapefile") == 0;
+  w.gpkg = strcasecmp(drv_name, "GPKG") == 0;
+  w.progress = progress;
+  w.progress_arg = progress_arg;
+  int in_transaction = 0;
+
+  tt_status s = parse_options(&w, options);
+  if (s == TT_OK)
+    s = check_run_fields(&w, fields, nfields);
+  if (s != TT_OK)
+    goto done;
+
+  const size_t nv = tt_tin_vertex_count(tin);
+  const size_t nt = tt_tin_triangle_count(tin);
+  if (nv > (size_t)INT32_MAX || nt > (size_t)INT32_MAX) {
+    s = tt__error(ctx, TT_ERR_LIMIT, "TIN of %zu vertices and %zu triangles "
+                  "is too large for 32-bit feature fields", nv, nt);
+    goto done;
+  }
+  s = prepare_crs(&w, tin, srs);
+  if (s != TT_OK)
+    goto done;
+  w.total = nv + nt + 1;
+  w.step = (w.total + 99) / 100; /* at most 100 reports for the rows */
+  w.next_report = w.step;
+  w.scale = w.build_rtree ? 0.75 : 1.0; /* the R-trees take about a quarter */
+  if (progress && !progress(0.0, "writing", progress_arg)) {
+    s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
+                  "interrupted before the first feature");
+    goto done;
+  }
+
+  /* The layers and their fields first, outside the transaction: GDAL 3.6's
+   * GPKG driver keeps the layer objects of a rolled-back CREATE TABLE and
+   * then breaks the file at close. On failure they are deleted instead. */
+  s = create_layer(&w, "triangles", w.out_srs, wkbPolygon25D, &w.tri_layer);
+  if (s == TT_OK)
+    s = create_layer(&w, "vertices", w.out_srs, wkbPoint25D, &w.vtx_layer);
+  if (s == TT_OK)
+    s = create_layer(&w, "run_parameters", NULL, wkbNone, &w.run_layer);
+  if (s == TT_OK)
+    s = create_fields(&w, w.tri_layer, triangle_fields, TF_COUNT, w.tri_idx);
+  if (s == TT_OK)
+    s = create_fields(&w, w.vtx_layer, vertex_fields, VF_COUNT, w.vtx_idx);
+  if (s == TT_OK)
+    s = create_run_fields(&w, fields, nfields);
+  if (s != TT_OK)
+    goto done;
+
+  if (GDALDatasetTestCapability(dst, ODsCTransactions)) {
+    /* Drivers that create tables lazily (GPKG) make them now, so that the
+     * transaction holds only rows (and the R-trees). */
+    CPLErrorReset();
+    GDALFlushCache(dst);
+    if (CPLGetLastErrorType() >= CE_Failure) {
+      s = tt__error(ctx, TT_ERR_IO, "cannot create the layers: %s",
+                    ogr_msg());
+      goto done;
+    }
+    if (GDALDatasetStartTransaction(dst, FALSE) != OGRERR_NONE) {
+      s = tt__error(ctx, TT_ERR_IO, "cannot start a transaction: %s",
+                    ogr_msg());
+      goto done;
+    }
+    in_transaction = 1;
+  }
+
+  s = write_triangles(&w, tin);
+  if (s == TT_OK)
+    s = write_vertices(&w, tin);
+  if (s == TT_OK)
+    s = write_run_parameters(&w, fields, nfields);
+  if (s == TT_OK && w.build_rtree) {
+    s = build_rtree(&w, w.tri_layer);
+    if (s == TT_OK && progress && !progress(0.95, "indexing", progress_arg))
+      s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
+                    "interrupted while indexing");
+    if (s == TT_OK)
+      s = build_rtree(&w, w.vtx_layer);
+  }
+  if (s != TT_OK)
+    goto done;
+
+  if (in_transaction) {
+    CPLErrorReset();
+    in_transaction = 0; /* a failed commit leaves nothing to roll back */
+    if (GDALDatasetCommitTransaction(dst) != OGRERR_NONE) {
+      s = tt__error(ctx, TT_ERR_IO, "cannot commit the TIN: %s", ogr_msg());
+      goto done;
+    }
+  }
+  /* Flush now so that write errors (disk full) surface here rather than
+   * unreported at close. */
+  CPLErrorReset();
+  GDALFlushCache(dst);
+  if (CPLGetLastErrorType() >= CE_Failure)
+    s = tt__error(ctx, TT_ERR_IO, "cannot write the TIN: %s", ogr_msg());
+  if (s == TT_OK && progress)
+    progress(1.0, "writing", progress_arg); /* done: too late to stop */
+
+done:
+  if (s != TT_OK) {
+    if (in_transaction)
+      GDALDatasetRollbackTransaction(dst);
+    delete_created_layers(&w);
+  }
+  for (int k = 0; k < w.ncreated; k++)
+    CPLFree(w.created[k]);
+  free(w.run_idx);
+  free(w.xy);
+  CPLFree(w.t_srs);
+  if (w.out_srs)
+    OSRDestroySpatialReference(w.out_srs);
+  CPLFree(w.prefix);
+  CSLDestroy(w.lco);
+  return s;
+}

@@ -1,0 +1,29 @@
+/*
+ * domain.h -- the valid domain of a grid with nodata as the constrained
+ * outline of the starting triangulation (see domain.c).
+ */
+#ifndef TT_DOMAIN_H
+#define TT_DOMAIN_H
+
+#include "criteria/criterion.h"
+#include "mesh/mesh.h"
+#include "optimize/swap.h"
+
+/* Adds a vertex for sample (col, row) to the caller's bookkeeping and the
+ * mesh; false when out of memory. */
+typedef bool (*tt__domain_add_vertex)(void *arg, int32_t col, int32_t row,
+                                      int32_t *out_v);
+
+/* m holds a triangulation of the valid samples' convex hull. Inserts the
+ * corners of the domain's outline, recovers its straight runs as
+ * constrained edges, restores the criterion elsewhere, and deletes the
+ * triangles outside the domain. */
+TT_HIDDEN tt_status tt__domain_build(tt_context *ctx, tt__mesh *m,
+                                     const tt_grid *g,
+                                     const tt__criterion_vt *crit,
+                                     const tt__crit_env *env,
+                                     tt__edge_stack *stack,
+                                     tt__domain_add_vertex add_vertex,
+                                     void *add_arg);
+
+#endif /* TT_DOMAIN_H */

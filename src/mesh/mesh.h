@@ -1,0 +1,216 @@
+/*
+ * mesh.h -- the triangle mesh: flat arrays of half-edges.
+ *
+ * Triangle t owns half-edges 3t, 3t+1, 3t+2. Half-edge e starts at vertex
+ * hv[e] and ends at hv[tt__next(e)]; twin[e] is the opposite half-edge in
+ * the neighbouring triangle, or -1 on the boundary. Every live triangle is
+ * counter-clockwise in the ground frame (see predicates.h for the sign
+ * convention and mesh->metric.det_sign for how pixel space maps to it).
+ * A free triangle slot has hv[3t] == -1 and sits on the free list, so flips,
+ * splits and (later) vertex removals make no garbage.
+ *
+ * Vertices are grid samples: integer pixel coordinates (col, row). v[i].edge
+ * is one half-edge leaving vertex i (hv[v[i].edge] == i), or -1 for a
+ * vertex in no triangle. eflag[e] holds TT__EDGE_CONSTRAINED for edges that flips must
+ * keep (domain boundaries; both half-edges carry it).
+ *
+ * Only mesh.c writes these arrays. Each operation appends the slots of the
+ * triangles it wrote to the touched log, which the caller drains (to rescan
+ * candidates); a logged slot may have been freed since, or logged twice.
+ *
+ * Limits: at most TT_MAX_VERTICES vertices and INT32_MAX/3 triangle slots.
+ */
+#ifndef TT_MESH_H
+#define TT_MESH_H
+
+#include "base/internal.h"
+
+#define TT__EDGE_CONSTRAINED 1u
+
+/* A vertex: one 16-byte record, so a triangle's corners cost three cache
+ * lines, not twelve. */
+typedef struct tt__mesh_vertex {
+  int32_t c, r;          /* pixel column, row */
+  float z;               /* height (kept here so scans need not fetch it
+                            from the grid at a random place) */
+  int32_t edge;          /* a half-edge leaving the vertex, or -1 */
+} tt__mesh_vertex;
+
+typedef struct tt__mesh {
+  /* vertices */
+  tt__mesh_vertex *v;
+  size_t nv, vcap;
+  /* triangles (3 half-edges each) */
+  int32_t *hv;           /* start vertex; hv[3t] == -1: free slot */
+  int32_t *twin;         /* opposite half-edge or -1 */
+  uint8_t *eflag;
+  size_t nslots;         /* triangle slots in use or free */
+  size_t tcap;           /* triangle slots allocated */
+  size_t nlive;          /* live triangles */
+  int32_t *freelist;
+  size_t nfree, freecap;
+  /* the ground frame */
+  tt__metric metric;
+  /* slots written since the caller last drained the log */
+  int32_t *touched;
+  size_t ntouched, touchedcap;
+  /* star versions (tt__mesh_track_stars), NULL when not tracked: vver[v]
+   * changes whenever the triangles around v change, so a value computed
+   * from v's star stays true while vver[v] (and serial) are what they were
+   * then */
+  uint32_t *vver;
+  size_t vvercap;
+  uint64_t serial;       /* unique per tt__mesh_init in the process */
+} tt__mesh;
+
+static inline int32_t tt__next(int32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+static inline int32_t tt__prev(int32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
+static inline bool tt__mesh_live(const tt__mesh *m, int32_t t)
+{
+  return m->hv[3 * (size_t)t] >= 0;
+}
+
+TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
+/* Starts tracking star versions (vver above, all 0 from here on); call it
+ * before making a cache that relies on them. False when out of memory
+ * (nothing tracked). Every operation below then adds at least one to the
+ * version of each vertex whose star (the triangles around it, their order,
+ * their twins) it may change: the corners of every triangle it writes or
+ * frees, and the ends of every edge it links. tt__mesh_flip adds exactly
+ * one to each of its quad's four vertices (a criterion's cache may rely on
+ * it, criterion.h). A version wraps after 2^32 changes of one star. */
+TT_HIDDEN bool tt__mesh_track_stars(tt__mesh *m);
+TT_HIDDEN void tt__mesh_free(tt__mesh *m);
+/* Reserves room for about nv vertices and nt triangles (a hint). */
+TT_HIDDEN bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt);
+
+/* Adds an unconnected vertex; returns its index, or -1 when out of memory
+ * or past TT_MAX_VERTICES. */
+TT_HIDDEN int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row,
+                                      float z);
+
+/* Adds triangle (a, b, c), which must be counter-clockwise in the ground
+ * frame, with no twins; returns its slot or -1 when out of memory. */
+TT_HIDDEN int32_t tt__mesh_add_triangle(tt__mesh *m, int32_t a, int32_t b,
+                                        int32_t c);
+/* Links every boundary half-edge with its reverse, if present, among the
+ * live triangles (used once after building a starting triangulation). */
+TT_HIDDEN bool tt__mesh_link_all(tt__mesh *m);
+
+/* Ground-frame orientation of three vertices / incircle of four (d inside
+ * the circle through a, b, c given counter-clockwise: > 0). Exact. */
+TT_HIDDEN int tt__mesh_orient(const tt__mesh *m, int32_t a, int32_t b,
+                              int32_t c);
+TT_HIDDEN int tt__mesh_incircle(const tt__mesh *m, int32_t a, int32_t b,
+                                int32_t c, int32_t d);
+
+/* Inserts vertex p strictly inside live triangle t: t becomes three
+ * triangles around p. out_opposite receives the three half-edges opposite
+ * p (for the criterion's repair). False when out of memory (mesh unchanged). */
+TT_HIDDEN bool tt__mesh_split_triangle(tt__mesh *m, int32_t t, int32_t p,
+                                       int32_t out_opposite[3]);
+/* Inserts vertex p strictly inside the edge of half-edge e: its two
+ * triangles (one on the boundary) become four (two). out_opposite receives
+ * the half-edges opposite p (4, or 2 on the boundary; unused slots -1).
+ * A constrained edge stays constrained in both halves. False when out of
+ * memory (mesh unchanged). */
+TT_HIDDEN bool tt__mesh_split_edge(tt__mesh *m, int32_t e, int32_t p,
+                                   int32_t out_opposite[4]);
+
+/* True when the edge of e has two triangles, is not constrained, and its
+ * quadrilateral is strictly convex. */
+TT_HIDDEN bool tt__mesh_flippable(const tt__mesh *m, int32_t e);
+/* Flips the edge of e (which must be flippable). With e = a->b in
+ * (a, b, c) and its twin b->a in (b, a, d), the two triangles become
+ * (c, a, d) in e's slot and (d, b, c) in the twin's; the returned half-edge
+ * is the new diagonal d->c, in e's slot:
+ *
+ *          c                       c
+ *         / \                     /|\
+ *        /   \                   / | \
+ *       a-----b        ==>      a  |  b
+ *        \   /                   \ | /
+ *         \ /                     \|/
+ *          d                       d
+ *
+ * Afterwards tt__prev(h) is a->d and tt__next(twin[h]) is d->b: the two
+ * edges opposite c, for the next round of a repair that started at c.
+ * Returns -1 (mesh unchanged) when out of memory. */
+TT_HIDDEN int32_t tt__mesh_flip(tt__mesh *m, int32_t e);
+
+/* Undoable flips (optimize.c's look-ahead): tt__mesh_flip_undoable flips
+ * the flippable edge of e like tt__mesh_flip and saves what it overwrote;
+ * tt__mesh_flip_revert restores the two slots word for word (half-edge
+ * indices included), the vertex edges and the touched log. Reverts must
+ * come in the reverse order of the flips, with no other write between. */
+typedef struct tt__mesh_flip_undo {
+  int32_t slot[2];
+  int32_t hv[6], twin[6];
+  uint8_t eflag[6];
+  int32_t vert[4], vedge[4];
+  size_t ntouched;
+} tt__mesh_flip_undo;
+
+TT_HIDDEN int32_t tt__mesh_flip_undoable(tt__mesh *m, int32_t e,
+                                         tt__mesh_flip_undo *out_undo);
+TT_HIDDEN void tt__mesh_flip_revert(tt__mesh *m,
+                                    const tt__mesh_flip_undo *undo);
+
+/* Removes live triangle t: its neighbours' edges across it become
+ * boundary edges (a hole or a new outline). Vertex edges that pointed into
+ * t are left stale: call tt__mesh_fix_vertex_edges() after a batch of
+ * deletions. False (mesh unchanged) when out of memory. */
+TT_HIDDEN bool tt__mesh_delete_triangle(tt__mesh *m, int32_t t);
+/* Points every vertex at a live half-edge leaving it, or -1 when it is in
+ * no triangle any more. O(V + T). */
+TT_HIDDEN void tt__mesh_fix_vertex_edges(tt__mesh *m);
+
+/* The half-edge from vertex a to vertex b, or -1 when there is none.
+ * O(degree of a). */
+TT_HIDDEN int32_t tt__mesh_find_edge(const tt__mesh *m, int32_t a, int32_t b);
+
+/* Locates pixel point (col, row) by a walk from live triangle `start`
+ * (any live triangle when -1). Returns the triangle holding it (closed)
+ * and sets *out_on to -1 (strictly inside), to the half-edge it lies on,
+ * or to -2 - v when it is vertex v. Returns -1 when the point is outside
+ * the mesh. Meant for Delaunay-like meshes (walks terminate there); gives
+ * up after a linear number of steps and falls back to a scan. */
+TT_HIDDEN int32_t tt__mesh_locate(const tt__mesh *m, int32_t start,
+                                  int64_t col, int64_t row,
+                                  int32_t *out_on);
+
+/* Vertex opposite half-edge e in its triangle. */
+static inline int32_t tt__mesh_apex(const tt__mesh *m, int32_t e)
+{
+  return m->hv[tt__prev(e)];
+}
+
+/* Checks every invariant: live triangles counter-clockwise and
+ * non-degenerate, twins symmetric and reversed, constraint flags symmetric,
+ * vertex edges leaving their vertex, free list consistent, Euler's formula
+ * V - E + F = 2C - L (C components, L boundary loops). On failure writes a
+ * reason into why and returns false. */
+TT_HIDDEN bool tt__mesh_validate(const tt__mesh *m, char *why, size_t whylen);
+
+/* Empties the touched log. */
+static inline void tt__mesh_clear_touched(tt__mesh *m) { m->ntouched = 0; }
+
+/* Replaces the nold live triangles in old_slots (distinct, one connected
+ * region) by the ntri triangles tris (vertex triples, counter-clockwise in
+ * the ground frame) triangulating the same outline: every edge of tris is
+ * either shared by two of them or is an outline edge of the region, and
+ * every outline edge is used once. The old slots are reused (then slots
+ * from the free list or new ones; unused old slots go to the free list);
+ * twins are set inside and to the outside neighbours, outline edges keep
+ * their constraint flags, a constrained edge inside the region stays
+ * constrained (tris must contain it), other inner edges are not
+ * constrained, vertex edges point into the new triangles (-1 for a vertex
+ * left in no triangle), and the written slots are logged as touched.
+ * False, with the mesh unchanged, when tris does not fit the outline that
+ * way, drops an inner constrained edge, has a triangle that is not
+ * strictly counter-clockwise, or when out of memory. O((nold + ntri)^2). */
+TT_HIDDEN bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots,
+                                       int nold, const int32_t (*tris)[3],
+                                       int ntri);
+
+#endif /* TT_MESH_H */

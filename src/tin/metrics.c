@@ -1,0 +1,280 @@
+/*
+ * metrics.c -- error measures of a finished mesh against its grid (SPEC
+ * section 6) and the per-triangle and per-vertex bookkeeping of the output.
+ *
+ * One pass over the triangles scans the samples each owns (raster_scan.c),
+ * so every valid sample is measured exactly once; a vertex's own sample has
+ * error zero and is counted with the triangle its vertex edge belongs to.
+ * A vertex's star statistics gather the samples owned by the triangles
+ * around it. Cost: O(samples + triangles); memory: the compact tin arrays
+ * plus 12 bytes per vertex and 4 per triangle slot while building.
+ */
+#include "mesh/raster_scan.h"
+#include "tin/tin.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static tt_status alloc_tin(tt_context *ctx, size_t nv, size_t nt,
+                           tt_tin **out)
+{
+  tt_tin *tin = calloc(1, sizeof *tin);
+  if (!tin)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+  size_t v1 = nv ? nv : 1, t1 = nt ? nt : 1;
+  tin->vc = malloc(v1 * sizeof *tin->vc);
+  tin->vr = malloc(v1 * sizeof *tin->vr);
+  tin->vz = malloc(v1 * sizeof *tin->vz);
+  tin->v_star_max = calloc(v1, sizeof *tin->v_star_max);
+  tin->v_star_rmse = calloc(v1, sizeof *tin->v_star_rmse);
+  tin->v_star_n = calloc(v1, sizeof *tin->v_star_n);
+  tin->tv = malloc(3 * t1 * sizeof *tin->tv);
+  tin->t_max = malloc(t1 * sizeof *tin->t_max);
+  tin->t_rmse = malloc(t1 * sizeof *tin->t_rmse);
+  tin->t_n = malloc(t1 * sizeof *tin->t_n);
+  if (!tin->vc || !tin->vr || !tin->vz || !tin->v_star_max ||
+      !tin->v_star_rmse || !tin->v_star_n || !tin->tv || !tin->t_max ||
+      !tin->t_rmse || !tin->t_n) {
+    tt_tin_destroy(tin);
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for a TIN of %zu "
+                     "vertices and %zu triangles", nv, nt);
+  }
+  tin->nv = nv;
+  tin->nt = nt;
+  *out = tin;
+  return TT_OK;
+}
+
+#define CHUNK 1024 /* triangles per job of the final scan */
+
+typedef struct chunk_acc {
+  size_t count;
+  double max_err, sum_abs, sum_sq;
+  int64_t max_index;
+} chunk_acc;
+
+typedef struct stats_job_arg {
+  const tt__mesh *m;
+  const tt_grid *g;
+  const int32_t *order;
+  tt_tin *tin;
+  double *t_sq;
+  chunk_acc *chunks;
+  size_t nt;
+} stats_job_arg;
+
+/* Scans the triangles of one chunk: writes their own entries of the tin and
+ * the chunk's partial sums. */
+static void stats_job(void *arg, size_t c)
+{
+  const stats_job_arg *a = arg;
+  chunk_acc acc = {0, 0, 0, 0, -1};
+  size_t end = (c + 1) * CHUNK < a->nt ? (c + 1) * CHUNK : a->nt;
+  for (size_t i = c * CHUNK; i < end; i++) {
+    tt__scan_tri st;
+    tt__scan_stats ss;
+    tt__scan_tri_from_mesh(a->m, a->order[i], &st);
+    tt__scan_stats_run(a->g, &st, &ss);
+    a->tin->t_max[i] = ss.max_err;
+    a->tin->t_n[i] = ss.count;
+    a->t_sq[i] = ss.sum_sq;
+    if (ss.count && (acc.max_index < 0 || ss.max_err > acc.max_err ||
+                     (ss.max_err == acc.max_err &&
+                      ss.max_index < acc.max_index))) {
+      acc.max_err = ss.max_err;
+      acc.max_index = ss.max_index;
+    }
+    acc.sum_abs += ss.sum_abs;
+    acc.sum_sq += ss.sum_sq;
+    acc.count += ss.count;
+  }
+  a->chunks[c] = acc;
+}
+
+static int32_t uf_find(int32_t *p, int32_t x)
+{
+  while (p[x] != x) {
+    p[x] = p[p[x]];
+    x = p[x];
+  }
+  return x;
+}
+
+/* Pieces of the mesh: triangles joined through shared edges. */
+static size_t count_components(const tt__mesh *m)
+{
+  int32_t *p = malloc((m->nslots ? m->nslots : 1) * sizeof *p);
+  if (!p)
+    return 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    p[t] = (int32_t)t;
+  for (size_t e = 0; e < 3 * m->nslots; e++)
+    if (m->hv[e - e % 3] >= 0 && m->twin[e] >= 0) {
+      int32_t a = uf_find(p, (int32_t)(e / 3)), b = uf_find(p, m->twin[e] / 3);
+      if (a != b)
+        p[a] = b;
+    }
+  size_t n = 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    if (m->hv[3 * t] >= 0 && uf_find(p, (int32_t)t) == (int32_t)t)
+      n++;
+  free(p);
+  return n;
+}
+
+static size_t top_row(const tt__mesh *m, int32_t t)
+{
+  int32_t r0 = m->v[m->hv[3 * t]].r, r1 = m->v[m->hv[3 * t + 1]].r,
+          r2 = m->v[m->hv[3 * t + 2]].r;
+  int32_t r = r0 < r1 ? r0 : r1;
+  return (size_t)(r < r2 ? r : r2);
+}
+
+tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
+                        double *ins_err, tt__pool *pool, tt_tin **out_tin)
+{
+  tt_status status;
+  tt_tin *tin = NULL;
+  int32_t *slot_to_tri = NULL, *order = NULL;
+  chunk_acc *chunks = NULL;
+  size_t *first = NULL;
+  double *t_sq = NULL;
+  *out_tin = NULL;
+
+  status = alloc_tin(ctx, m->nv, m->nlive, &tin);
+  if (status != TT_OK) {
+    free(ins_err);
+    return status;
+  }
+  tin->v_ins_err = ins_err;
+  slot_to_tri = malloc((m->nslots ? m->nslots : 1) * sizeof *slot_to_tri);
+  t_sq = malloc((m->nlive ? m->nlive : 1) * sizeof *t_sq);
+  if (!slot_to_tri || !t_sq) {
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    goto done;
+  }
+  memcpy(tin->gt, g->gt, sizeof tin->gt);
+  memcpy(tin->frame, g->frame, sizeof tin->frame);
+  for (size_t v = 0; v < m->nv; v++) {
+    tin->vc[v] = m->v[v].c;
+    tin->vr[v] = m->v[v].r;
+    tin->vz[v] = m->v[v].z;
+  }
+
+  tt_error_stats *es = &tin->summary.errors;
+  memset(es, 0, sizeof *es);
+  es->max_col = es->max_row = -1;
+  double sum_abs = 0, sum_sq = 0;
+  size_t count = 0;
+  int64_t max_index = -1;
+  /* Triangles go out in spatial order: by the row of their top corner,
+   * then by slot (a counting sort, O(T + rows)). The scan below then walks
+   * the grid band by band, which keeps the rows it reads in cache (10x
+   * faster than slot order on a 4097^2 grid), and the output layers get
+   * the locality that R-trees and map renderers like. */
+  order = malloc((m->nlive ? m->nlive : 1) * sizeof *order);
+  first = calloc(g->ny + 1, sizeof *first);
+  if (!order || !first) {
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    goto done;
+  }
+  /* slot_to_tri holds each live slot's top row for the two passes of the
+   * sort, then the slot's triangle index */
+  for (size_t s = 0; s < m->nslots; s++) {
+    slot_to_tri[s] = -1;
+    if (tt__mesh_live(m, (int32_t)s)) {
+      slot_to_tri[s] = (int32_t)top_row(m, (int32_t)s);
+      first[slot_to_tri[s] + 1]++;
+    }
+  }
+  for (size_t y = 0; y < g->ny; y++)
+    first[y + 1] += first[y];
+  for (size_t s = 0; s < m->nslots; s++)
+    if (slot_to_tri[s] >= 0)
+      order[first[slot_to_tri[s]]++] = (int32_t)s;
+  size_t nt = m->nlive;
+  for (size_t i = 0; i < nt; i++) {
+    int32_t s = order[i];
+    slot_to_tri[s] = (int32_t)i;
+    for (int k = 0; k < 3; k++)
+      tin->tv[3 * i + k] = m->hv[3 * (size_t)s + k];
+  }
+  /* the scans, in fixed chunks reduced in chunk order: the sums do not
+   * depend on the number of threads */
+  size_t nchunks = (nt + CHUNK - 1) / CHUNK;
+  chunks = calloc(nchunks ? nchunks : 1, sizeof *chunks);
+  if (!chunks) {
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    goto done;
+  }
+  stats_job_arg ja = {m, g, order, tin, t_sq, chunks, nt};
+  tt__pool_run(pool, nchunks, stats_job, &ja);
+  for (size_t c = 0; c < nchunks; c++) {
+    const chunk_acc *ca = &chunks[c];
+    if (ca->count && (max_index < 0 || ca->max_err > es->max_error ||
+                      (ca->max_err == es->max_error &&
+                       ca->max_index < max_index))) {
+      es->max_error = ca->max_err;
+      max_index = ca->max_index;
+    }
+    sum_abs += ca->sum_abs;
+    sum_sq += ca->sum_sq;
+    count += ca->count;
+  }
+  /* vertex samples: error zero, owned by the triangle of the vertex edge */
+  for (size_t v = 0; v < m->nv; v++) {
+    int32_t e = m->v[v].edge;
+    if (e < 0)
+      continue;
+    int32_t t = slot_to_tri[e / 3];
+    tin->t_n[t]++;
+    count++;
+    if (max_index < 0) {
+      max_index = (int64_t)m->v[v].r * (int64_t)g->nx + m->v[v].c;
+      es->max_error = 0;
+    }
+  }
+  for (size_t t = 0; t < nt; t++) {
+    tin->t_rmse[t] = tin->t_n[t] ? (float)sqrt(t_sq[t] / (double)tin->t_n[t])
+                                 : 0.0f;
+    for (int k = 0; k < 3; k++) {
+      int32_t v = tin->tv[3 * t + k];
+      if (tin->t_max[t] > tin->v_star_max[v])
+        tin->v_star_max[v] = tin->t_max[t];
+      tin->v_star_rmse[v] += t_sq[t]; /* sum of squares for now */
+      tin->v_star_n[v] += tin->t_n[t];
+    }
+  }
+  for (size_t v = 0; v < m->nv; v++)
+    tin->v_star_rmse[v] = tin->v_star_n[v]
+                              ? sqrt(tin->v_star_rmse[v] /
+                                     (double)tin->v_star_n[v])
+                              : 0.0;
+  es->samples = count; /* the caller sets the valid count */
+  es->covered = count;
+  tin->summary.components = count_components(m);
+  es->total_abs = sum_abs;
+  es->l2 = sqrt(sum_sq);
+  es->rmse = count ? sqrt(sum_sq / (double)count) : 0;
+  es->mean_abs = count ? sum_abs / (double)count : 0;
+  if (max_index >= 0) {
+    es->max_col = max_index % (int64_t)g->nx;
+    es->max_row = max_index / (int64_t)g->nx;
+  }
+  tin->summary.vertices = m->nv;
+  tin->summary.triangles = nt;
+  tin->summary.grid_width = g->nx;
+  tin->summary.grid_height = g->ny;
+  *out_tin = tin;
+  tin = NULL;
+  status = TT_OK;
+done:
+  free(chunks);
+  free(order);
+  free(first);
+  free(slot_to_tri);
+  free(t_sq);
+  tt_tin_destroy(tin);
+  return status;
+}

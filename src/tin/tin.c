@@ -1,0 +1,132 @@
+/*
+ * tin.c -- reading a finished TIN: counts, the run summary, and per-vertex
+ * and per-triangle records. Geometry attributes (areas, slope, aspect,
+ * angles) are derived on demand in the ground frame from the stored
+ * corners, so the TIN holds only what cannot be recomputed cheaply.
+ */
+#include "tin/tin.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+static const double RAD2DEG = 57.29577951308232;
+
+void tt_tin_destroy(tt_tin *tin)
+{
+  if (!tin)
+    return;
+  free(tin->vc);
+  free(tin->vr);
+  free(tin->vz);
+  free(tin->v_ins_err);
+  free(tin->v_star_max);
+  free(tin->v_star_rmse);
+  free(tin->v_star_n);
+  free(tin->tv);
+  free(tin->t_max);
+  free(tin->t_rmse);
+  free(tin->t_n);
+  free(tin);
+}
+
+const char *tt_stop_reason_name(tt_stop_reason reason)
+{
+  switch (reason) {
+  case TT_STOP_NONE: return "none";
+  case TT_STOP_MAX_ERROR: return "max_error";
+  case TT_STOP_MAX_POINTS: return "max_points";
+  case TT_STOP_MAX_TRIANGLES: return "max_triangles";
+  case TT_STOP_EXHAUSTED: return "exhausted";
+  }
+  return "unknown";
+}
+
+void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary)
+{
+  *out_summary = tin->summary;
+}
+
+size_t tt_tin_vertex_count(const tt_tin *tin) { return tin->nv; }
+size_t tt_tin_triangle_count(const tt_tin *tin) { return tin->nt; }
+
+tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
+                        tt_vertex_info *out_vertex)
+{
+  if (!tin || !out_vertex || index >= tin->nv)
+    return TT_ERR_ARG;
+  tt_vertex_info *o = out_vertex;
+  const double *gt = tin->gt;
+  double px = tin->vc[index] + 0.5, py = tin->vr[index] + 0.5;
+  o->col = tin->vc[index];
+  o->row = tin->vr[index];
+  o->x = gt[0] + px * gt[1] + py * gt[2];
+  o->y = gt[3] + px * gt[4] + py * gt[5];
+  o->z = tin->vz[index];
+  o->insert_error = tin->v_ins_err[index];
+  o->rank = index;
+  o->star_max_error = tin->v_star_max[index];
+  o->star_rmse = tin->v_star_rmse[index];
+  o->star_samples = (size_t)tin->v_star_n[index];
+  return TT_OK;
+}
+
+/* Angle at p between the directions to q and r, radians. */
+static double angle_at(const double p[2], const double q[2], const double r[2])
+{
+  double ux = q[0] - p[0], uy = q[1] - p[1];
+  double vx = r[0] - p[0], vy = r[1] - p[1];
+  return atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy);
+}
+
+tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
+                          tt_triangle_info *out_triangle)
+{
+  if (!tin || !out_triangle || index >= tin->nt)
+    return TT_ERR_ARG;
+  tt_triangle_info *o = out_triangle;
+  const double *a = tin->frame;
+  double p[3][2], z[3];
+  for (int k = 0; k < 3; k++) {
+    int32_t v = tin->tv[3 * index + k];
+    o->v[k] = v;
+    /* ground frame, relative to the first corner for precision */
+    double dc = (double)(tin->vc[v] - tin->vc[tin->tv[3 * index]]);
+    double dr = (double)(tin->vr[v] - tin->vr[tin->tv[3 * index]]);
+    p[k][0] = a[0] * dc + a[1] * dr;
+    p[k][1] = a[2] * dc + a[3] * dr;
+    z[k] = tin->vz[v];
+  }
+  o->max_error = tin->t_max[index];
+  o->rmse = tin->t_rmse[index];
+  o->samples = (size_t)tin->t_n[index];
+  double ux = p[1][0] - p[0][0], uy = p[1][1] - p[0][1];
+  double vx = p[2][0] - p[0][0], vy = p[2][1] - p[0][1];
+  double uz = z[1] - z[0], vz = z[2] - z[0];
+  double cross2 = ux * vy - uy * vx; /* > 0: counter-clockwise */
+  o->area_2d = 0.5 * fabs(cross2);
+  double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = cross2;
+  o->area_3d = 0.5 * sqrt(nx * nx + ny * ny + nz * nz);
+  /* plane z = gx X + gy Y + c: gradient (gx, gy) = -(nx, ny) / nz */
+  double gx = -nx / nz, gy = -ny / nz;
+  double grad = hypot(gx, gy);
+  o->slope_deg = atan(grad) * RAD2DEG;
+  if (grad == 0) {
+    o->aspect_deg = NAN;
+  } else {
+    /* downslope direction (-gx, -gy), azimuth clockwise from +y */
+    double az = atan2(-gx, -gy) * RAD2DEG;
+    o->aspect_deg = az < 0 ? az + 360.0 : az;
+    if (o->aspect_deg >= 360.0)
+      o->aspect_deg = 0.0;
+  }
+  double ang[3] = {angle_at(p[0], p[1], p[2]), angle_at(p[1], p[2], p[0]),
+                   angle_at(p[2], p[0], p[1])};
+  double mn = ang[0], mx = ang[0];
+  for (int k = 1; k < 3; k++) {
+    mn = fmin(mn, ang[k]);
+    mx = fmax(mx, ang[k]);
+  }
+  o->min_angle_deg = mn * RAD2DEG;
+  o->max_angle_deg = mx * RAD2DEG;
+  return TT_OK;
+}

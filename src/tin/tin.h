@@ -1,0 +1,42 @@
+/*
+ * tin.h -- the finished TIN (struct tt_tin): compact vertex and triangle
+ * arrays with the bookkeeping of the run, built from a mesh by metrics.c
+ * and read through the accessors of tin.c. Vertex index = insertion rank.
+ * Triangles are counter-clockwise in map space (the ground frame keeps the
+ * geotransform's orientation, grid.c).
+ */
+#ifndef TT_TIN_H
+#define TT_TIN_H
+
+#include "base/internal.h"
+#include "mesh/mesh.h"
+#include "base/parallel.h"
+
+struct tt_tin {
+  size_t nv, nt;
+  /* vertices */
+  int32_t *vc, *vr;
+  float *vz;
+  double *v_ins_err;     /* NaN for starting vertices */
+  double *v_star_max, *v_star_rmse;
+  uint64_t *v_star_n;
+  /* triangles */
+  int32_t *tv;           /* 3 per triangle */
+  double *t_max;
+  float *t_rmse;
+  uint64_t *t_n;
+  /* georeference */
+  double gt[6];
+  double frame[4];
+  tt_tin_summary summary;
+};
+
+/* Builds a tin from the mesh's live triangles (in spatial order) with the
+ * error statistics of every sample (metrics.c). ins_err: per mesh vertex
+ * (taken over, freed by the tin). Frees nothing of the mesh. The scans
+ * run on pool (may be NULL); the result does not depend on it. */
+TT_HIDDEN tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m,
+                                  const tt_grid *g, double *ins_err,
+                                  tt__pool *pool, tt_tin **out_tin);
+
+#endif /* TT_TIN_H */
