@@ -126,6 +126,21 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            char **options, tt_progress_fn progress,
                            void *progress_arg);
 
+/* Writes the rows of the <prefix>triangles and <prefix>vertices layers of
+ * tin straight into the closed GeoPackage gpkg_path, whose two layers
+ * tt_ogr_write_tin() made with ROWS=DEFERRED (empty, with their fields),
+ * in one SQLite transaction: the same features, values and geometry blobs
+ * as tt_ogr_write_tin() without ROWS=DEFERRED writes through OGR, and the
+ * layers' extents and feature counts. srs and the options NLN_PREFIX and
+ * T_SRS must be those given to tt_ogr_write_tin() (LCO, ROWS and RTREE are
+ * accepted and ignored, so the same list can be passed). Any failure or an
+ * interruption (progress returns 0: TT_ERR_INTERRUPTED) rolls back and
+ * leaves the layers empty. */
+tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
+                             const tt_tin *tin, OGRSpatialReferenceH srs,
+                             char **options, tt_progress_fn progress,
+                             void *progress_arg);
+
 /* Builds the GeoPackage R-tree spatial index (extension gpkg_rtree_index)
  * of geom_column in table, on a closed GeoPackage file whose table has no
  * index yet, in one SQLite transaction: the boxes are read from the
