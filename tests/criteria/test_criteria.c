@@ -833,7 +833,8 @@ static void gaussian_exact_orient(uint64_t seed)
     for (int i = 0; i < 3; i++)
       det += (__int128)(int64_t)ldexp(z[i] - (double)zv, 20) * m[i];
     int want = det > 0 ? 1 : det < 0 ? -1 : 0;
-    int got = tt__gaussian_orient(dc, dr, z, zv);
+    const double zd[3] = {z[0], z[1], z[2]};
+    int got = tt__gaussian_orient(dc, dr, zd, zv);
     seen[want + 1]++;
     if (got != want) {
       TT_FAIL_("seed %#llx case %d: sign %d, exact %d",
