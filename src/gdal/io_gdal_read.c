@@ -62,6 +62,9 @@ typedef struct read_options {
   int srcnodata_is_nan;
   float srcnodata;       /* compared with raw values that are floats */
   double srcnodata_d;    /* compared with the other raw values */
+  int srcnodata_is_int;  /* an integer literal, kept exactly for 64-bit */
+  int srcnodata_neg;     /* integer bands: sign and magnitude */
+  uint64_t srcnodata_mag;
   size_t max_memory;     /* bytes */
   int max_memory_default; /* not given: 3/4 of physical memory */
 } read_options;
@@ -121,6 +124,31 @@ static int parse_double(const char *s, double *out)
   return 1;
 }
 
+/* Parses a whole string as an integer of magnitude below 2^64 (sign and
+ * magnitude, so that every Int64 and UInt64 value is one). */
+static int parse_integer(const char *s, int *out_neg, uint64_t *out_mag)
+{
+  while (*s == ' ')
+    s++;
+  int neg = *s == '-';
+  if (*s == '-' || *s == '+')
+    s++;
+  if (*s < '0' || *s > '9')
+    return 0;
+  char *end = NULL;
+  errno = 0;
+  unsigned long long m = strtoull(s, &end, 10);
+  if (errno == ERANGE)
+    return 0;
+  while (*end == ' ')
+    end++;
+  if (*end != '\0')
+    return 0;
+  *out_neg = neg && m != 0;
+  *out_mag = (uint64_t)m;
+  return 1;
+}
+
 static tt_status parse_options(tt_context *ctx, char **options,
                                read_options *opt)
 {
@@ -132,6 +160,9 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->srcnodata_is_nan = 0;
   opt->srcnodata = 0.0f;
   opt->srcnodata_d = 0.0;
+  opt->srcnodata_is_int = 0;
+  opt->srcnodata_neg = 0;
+  opt->srcnodata_mag = 0;
   opt->max_memory = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
@@ -173,6 +204,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
       } else {
         opt->srcnodata = (float)v;
         opt->srcnodata_d = v;
+        opt->srcnodata_is_int = parse_integer(value, &opt->srcnodata_neg,
+                                              &opt->srcnodata_mag);
       }
     } else if (strcasecmp(key, "MAX_MEMORY") == 0) {
       if (!parse_double(value, &v) || v <= 0)
@@ -424,17 +457,16 @@ static tt_status widen_grid(tt_context *ctx, const char *path, tt_grid *g,
   return TT_OK;
 }
 
-/* Whether v, an integer raw value, equals SRCNODATA exactly (compared as
- * integers: a double near 2^63 would match its neighbours too). */
+/* Whether a 64-bit integer raw value (sign and magnitude) equals SRCNODATA
+ * exactly: compared as integers when SRCNODATA is an integer literal (a
+ * double near 2^63 would match its neighbours too), else as doubles. */
 static int int_is_srcnodata(const read_options *opt, int neg, uint64_t mag)
 {
-  double d = opt->srcnodata_d;
-  if (opt->srcnodata_is_nan || d != floor(d) ||
-      fabs(d) >= 18446744073709551616.0) /* 2^64 */
+  if (opt->srcnodata_is_nan)
     return 0;
-  if ((d < 0) != neg && d != 0)
-    return 0;
-  return (uint64_t)fabs(d) == mag;
+  if (opt->srcnodata_is_int)
+    return neg == opt->srcnodata_neg && mag == opt->srcnodata_mag;
+  return (neg ? -(double)mag : (double)mag) == opt->srcnodata_d;
 }
 
 /* Converts a band of rows [r0, r0+nrows) into the grid, in every case but
