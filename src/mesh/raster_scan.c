@@ -454,7 +454,6 @@ void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
                           out_index);
 }
 
-
 void tt__scan_candidate_rows(const tt_grid *g, const tt__scan_tiles *tiles,
                              const tt__scan_tri *st, int64_t ylo,
                              int64_t yhi, double *out_err,
