@@ -297,6 +297,33 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
                         const tt_refine_options *opt, tt_tin **out_tin);
 void tt_tin_destroy(tt_tin *tin);
 
+/* Optimising a TIN the caller already has (tt_optimize_run). */
+typedef struct tt_optimize_options {
+  tt_criterion criterion;
+  tt_optimize optimize;    /* TT_OPTIMIZE_AUTO: local */
+  /* A move is refused when one of the triangles it makes has a sample
+   * with |H - H'| > max_error (z units). Negative: no bound. */
+  double max_error;
+  tt_anneal_options anneal;
+} tt_optimize_options;
+
+/* Default: Delaunay, local swap, no bound, the default schedule. */
+void tt_optimize_options_init(tt_optimize_options *opt);
+
+/* Rebuilds the mesh of ntriangles triangles given as tt_eval_triangles
+ * takes them (9 doubles each, pixel-centre space; corners within 1e-6
+ * pixel of a sample are put on it, the z given is ignored: heights come
+ * from the grid), optimises it for the criterion with opt->optimize, and
+ * returns it as a TIN (vertex ranks in order of first appearance, no
+ * insertion errors). TT_ERR_DATA with a message naming the triangle when
+ * a corner is not a valid sample of the grid, a triangle has no area, an
+ * edge is used twice the same way, the triangles overlap (around a vertex,
+ * or over a sample), or they do not form a surface. The caller owns
+ * *out_tin and frees it with tt_tin_destroy(). */
+tt_status tt_optimize_run(tt_context *ctx, const tt_grid *grid,
+                          size_t ntriangles, const double *pix_xyz,
+                          const tt_optimize_options *opt, tt_tin **out_tin);
+
 typedef enum tt_stop_reason {
   TT_STOP_NONE = 0,        /* not stopped */
   TT_STOP_MAX_ERROR,       /* every sample within max_error */

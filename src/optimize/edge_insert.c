@@ -52,6 +52,7 @@ typedef struct ei {
   size_t nw, wcap;
   tt__opt_accept_fn accept;
   void *accept_arg;
+  int max_depth;    /* TT__EI_MAX_DEPTH, TT__EI_MORE_DEPTH past the optimum */
   tt__edge_insert_stats st;
 } ei;
 
@@ -258,7 +259,7 @@ static bool improve(ei *s, int32_t t, double mu, bool *out_done,
       continue;
     int32_t x = m->hv[tt__prev(tw)];
     int o_r = tt__mesh_orient(m, p, w.rb, x), o_l = tt__mesh_orient(m, p, x, w.lb);
-    bool deeper = w.depth + 1 < TT__EI_MAX_DEPTH;
+    bool deeper = w.depth + 1 < s->max_depth;
     if (o_r > 0 && o_l > 0) {
       if (!try_edge(s, i, p, x, mu, out_done, out_refused))
         return false;
@@ -290,6 +291,7 @@ bool tt__edge_insert_run(tt__mesh *m, const tt__crit_env *env,
   s.env = env;
   s.accept = accept;
   s.accept_arg = accept_arg;
+  s.max_depth = TT__EI_MAX_DEPTH;
   tt__geo_frame(env, s.fr);
   tt__heap_init(&s.heap);
   bool ok = tt__heap_reserve_items(&s.heap, m->nslots ? m->nslots : 1);
@@ -306,16 +308,20 @@ bool tt__edge_insert_run(tt__mesh *m, const tt__crit_env *env,
     tt__heap_entry top = tt__heap_top(&s.heap);
     bool done, refused;
     ok = improve(&s, top.item, top.key, &done, &refused);
-    if (ok && refused) {
-      ok = tt__grow((void **)&aside, &asidecap, naside + 1, sizeof *aside);
-      if (ok) {
-        aside[naside++] = top.item;
-        tt__heap_remove(&s.heap, top.item);
-      }
+    if (!ok || done)
       continue;
+    /* stuck: the first time with no refusal, the largest angle is the
+     * optimum; set the triangle aside and go on with the next worst */
+    if (!refused && !s.st.optimum_reached) {
+      s.st.optimum_reached = true;
+      s.st.optimum_max = top.key;
+      s.max_depth = TT__EI_MORE_DEPTH;
     }
-    if (!done)
-      break;
+    ok = tt__grow((void **)&aside, &asidecap, naside + 1, sizeof *aside);
+    if (ok) {
+      aside[naside++] = top.item;
+      tt__heap_remove(&s.heap, top.item);
+    }
   }
   for (size_t i = 0; i < naside; i++)
     if (tt__mesh_live(m, aside[i]) && !heap_put(&s, aside[i]))

@@ -11,7 +11,15 @@
  * whose new triangles all have angles below mu - 1e-12. Stop when no edge
  * from the anchor improves: by the theorem of Bern et al. the largest
  * angle is then the least any triangulation of those vertices (with those
- * constrained edges) can have.
+ * constrained edges) can have. Past that point the run goes on with the
+ * next worst triangle, the stuck ones set aside: each insertion still
+ * replaces a triangle of angle mu and makes none of mu or more, so the
+ * vector of the triangles' largest angles, sorted in decreasing order,
+ * gets lexicographically smaller every time, and the triangles below the
+ * forced largest angle improve too (a TIN's largest angle is often forced
+ * by its outline); that phase tries edges crossing at most
+ * TT__EI_MORE_DEPTH edges. The run ends when every triangle is set
+ * aside.
  *
  * Exact: which vertex p sees, which edges p-q crosses and whether a
  * polygon's diagonal lies inside it are integer orientation tests
@@ -19,9 +27,7 @@
  * and boundary edges are never crossed; the outline and every constrained
  * edge stay.
  *
- * Cost: each insertion removes one triangle with the largest angle and
- * makes none as large, so a run makes at most as many insertions as there
- * are triangles above the final angle (ties included); the search of one
+ * Cost: every triangle is the worst once or more; the search of one
  * anchor visits the visible triangles within TT__EI_MAX_DEPTH crossed
  * edges (the depth bound keeps a failed search local on a mesh of 100k
  * vertices; the optimum is exact when every improving edge crosses fewer,
@@ -35,6 +41,7 @@
 #include "optimize/optimize.h"
 
 #define TT__EI_MAX_DEPTH 32
+#define TT__EI_MORE_DEPTH 8
 
 typedef struct tt__edge_insert_stats {
   long insertions;   /* edges inserted */
@@ -42,6 +49,8 @@ typedef struct tt__edge_insert_stats {
   long refused;      /* improving insertions the accept callback refused */
   double start_max;  /* the largest angle before and after, radians */
   double end_max;
+  bool optimum_reached; /* a worst triangle was stuck with no refusal: */
+  double optimum_max;   /* its angle, the least largest angle there is */
 } tt__edge_insert_stats;
 
 /* Runs edge insertion over the whole mesh (2-D angles in env's ground

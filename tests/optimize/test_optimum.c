@@ -614,6 +614,21 @@ static bool build_random(tt__mesh *m, const tt_grid *g, uint64_t *rng, int n)
   return ok;
 }
 
+/* The largest angle of every triangle, sorted in decreasing order, into
+ * *out (malloc'd); the count. */
+static int largest_angles(const tt__mesh *m, const tt_grid *g, double **out)
+{
+  tt__crit_env env = {m, g, NULL};
+  double *v = malloc((m->nslots + 1) * sizeof *v);
+  int n = 0;
+  for (size_t t = 0; t < m->nslots; t++)
+    if (tt__mesh_live(m, (int32_t)t))
+      v[n++] = tt__edge_insert_tri_angle(m, &env, (int32_t)t);
+  qsort(v, (size_t)n, sizeof *v, cmp_desc);
+  *out = v;
+  return n;
+}
+
 static bool same_mesh(const tt__mesh *a, const tt__mesh *b)
 {
   return a->nslots == b->nslots &&
@@ -673,10 +688,21 @@ static void test_medium(uint64_t seed)
              "swaps), edge insertion %.6f (%ld insertions, %ld edges "
              "tried)\n", n + 4, del, loc, sl.swaps, ins, es.insertions,
              es.candidates);
-    /* edge insertion again from its own result: nothing left to do */
+    CHECK(es.optimum_reached);
+    CHECK_DBL_NEAR(es.optimum_max, ins, TOL);
+    /* again from its own result (triangles set aside may have become
+     * improvable): the largest angle stays, the sorted vector of the
+     * triangles' largest angles never gets worse */
+    double *v1 = NULL, *v2 = NULL;
+    int n1 = largest_angles(&b, g, &v1);
     tt__edge_insert_stats es2;
     CHECK(tt__edge_insert_run(&b, &eb, NULL, NULL, &es2));
-    CHECK_INT_EQ(es2.insertions, 0);
+    int n2 = largest_angles(&b, g, &v2);
+    CHECK_INT_EQ(n1, n2);
+    CHECK(lex_cmp(v2, v1, n1) <= 0);
+    CHECK_DBL_NEAR(es2.end_max, ins, TOL);
+    free(v1);
+    free(v2);
     tt__mesh_free(&a);
     tt__mesh_free(&b);
 
