@@ -345,6 +345,15 @@ bool tt__anneal_run(tt__mesh *m, const tt__criterion_vt *crit,
                     tt__opt_accept_fn accept, void *accept_arg,
                     tt__anneal_stats *out_stats)
 {
+  return tt__anneal_run_log(m, crit, env, opt, accept, accept_arg, 0,
+                            out_stats);
+}
+
+bool tt__anneal_run_log(tt__mesh *m, const tt__criterion_vt *crit,
+                        const tt__crit_env *env, const tt_anneal_options *opt,
+                        tt__opt_accept_fn accept, void *accept_arg,
+                        size_t log_records, tt__anneal_stats *out_stats)
+{
   ann a;
   memset(&a, 0, sizeof a);
   a.m = m;
@@ -358,7 +367,8 @@ bool tt__anneal_run(tt__mesh *m, const tt__criterion_vt *crit,
                    crit->id == TT_CRITERION_MINMAX_ANGLE_LEX
                ? KIND_TRI_ANGLE
                : crit->id == TT_CRITERION_ABN ? KIND_EDGE_ALPHA : KIND_SUM;
-  a.logmax = m->nslots < LOG_MIN ? LOG_MIN
+  a.logmax = log_records     ? log_records
+             : m->nslots < LOG_MIN ? LOG_MIN
              : m->nslots > LOG_MAX ? LOG_MAX
                                    : m->nslots;
   bool ok = true;

@@ -67,4 +67,14 @@ TT_HIDDEN bool tt__anneal_run(tt__mesh *m, const tt__criterion_vt *crit,
                               tt__opt_accept_fn accept, void *accept_arg,
                               tt__anneal_stats *out_stats);
 
+/* The same with an undo log of log_records records (0: the default, the
+ * slot count within [65536, 2^20]); the result does not depend on it
+ * (test_optimum checks a log of 8 against the default). */
+TT_HIDDEN bool tt__anneal_run_log(tt__mesh *m, const tt__criterion_vt *crit,
+                                  const tt__crit_env *env,
+                                  const tt_anneal_options *opt,
+                                  tt__opt_accept_fn accept, void *accept_arg,
+                                  size_t log_records,
+                                  tt__anneal_stats *out_stats);
+
 #endif /* TT_ANNEAL_H */

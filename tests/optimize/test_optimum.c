@@ -724,6 +724,19 @@ static void test_medium(uint64_t seed)
     check_valid(&c, "anneal, medium");
     CHECK(same_mesh(&c, &d));
     CHECK_INT_EQ(s1.swaps, s2.swaps);
+    /* a log of 8 records: the best is saved whole again and again and the
+     * log replayed; the same mesh word for word */
+    tt__mesh f;
+    rng = r0;
+    CHECK(build_random(&f, g, &rng, n));
+    tt__crit_env ef = {&f, g, NULL};
+    tt__anneal_stats s4;
+    CHECK(tt__anneal_run_log(&f, l2, &ef, &ao, NULL, NULL, 8, &s4));
+    check_valid(&f, "anneal, a log of 8");
+    CHECK(s4.saves > 0 && s1.saves == 0);
+    CHECK(same_mesh(&c, &f));
+    CHECK_INT_EQ(s4.swaps, s1.swaps);
+    tt__mesh_free(&f);
     CHECK(s1.gain >= 0);
     CHECK(s1.worse > 0); /* it did wander uphill */
     tt__mesh_free(&d);
