@@ -101,7 +101,7 @@ static double dp_measure(void *arg, int i, int j, int k)
  * the new edge) into tris (mesh vertex triples); false when it has none
  * with every angle below mu - EI_EPS. */
 static bool fill_polygon(ei *s, const int32_t *v, int n, double mu,
-                         int32_t (*tris)[3], bool *out_oom)
+                         int32_t (*tris)[3])
 {
   const tt__mesh *m = s->m;
   /* cheap test first: some apex j must make (v0, v1, vj) good enough */
@@ -119,13 +119,12 @@ static bool fill_polygon(ei *s, const int32_t *v, int n, double mu,
   }
   dp_arg a = {s, v};
   double val;
+  /* false: no triangulation (a degenerate polygon), or out of memory --
+   * the DP does not tell them apart, and its buffers are a few kilobytes:
+   * the candidate is passed over either way */
   if (!tt__polygon_dp(n, x, y, m->metric.det_sign, TT__DP_MAX, dp_measure,
-                      &a, idx, &val)) {
-    /* no triangulation: a degenerate polygon (or out of memory; the DP
-     * does not tell, and its buffers are a few kilobytes) */
-    (void)out_oom;
+                      &a, idx, &val))
     return false;
-  }
   if (!(val < mu - EI_EPS))
     return false;
   for (int t = 0; t < n - 2; t++)
@@ -168,10 +167,9 @@ static bool try_edge(ei *s, size_t wi, int32_t p, int32_t q, double mu,
   for (int i = nlr - 1; i >= 0; i--)
     left[nl++] = lrev[i];
   int32_t tris[2 * POLY_MAX][3];
-  bool oom = false;
-  if (!fill_polygon(s, left, nl, mu, tris, &oom) ||
-      !fill_polygon(s, right, nr, mu, tris + (nl - 2), &oom))
-    return !oom;
+  if (!fill_polygon(s, left, nl, mu, tris) ||
+      !fill_polygon(s, right, nr, mu, tris + (nl - 2)))
+    return true; /* not better than mu: the next candidate */
   int ntri = nl - 2 + nr - 2;
   /* the old triangles: the near triangle of every crossed edge, and the
    * last one */
@@ -258,7 +256,8 @@ static bool improve(ei *s, int32_t t, double mu, bool *out_done,
     if (tw < 0 || (m->eflag[w.he] & TT__EDGE_CONSTRAINED))
       continue;
     int32_t x = m->hv[tt__prev(tw)];
-    int o_r = tt__mesh_orient(m, p, w.rb, x), o_l = tt__mesh_orient(m, p, x, w.lb);
+    int o_r = tt__mesh_orient(m, p, w.rb, x);
+    int o_l = tt__mesh_orient(m, p, x, w.lb);
     bool deeper = w.depth + 1 < s->max_depth;
     if (o_r > 0 && o_l > 0) {
       if (!try_edge(s, i, p, x, mu, out_done, out_refused))

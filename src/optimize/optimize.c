@@ -60,7 +60,8 @@ tt_status tt_optimize_parse(tt_context *ctx, const char *name,
     return TT_OK;
   }
   return tt__error(ctx, TT_ERR_ARG, "unknown optimisation '%s' (known: auto, "
-                   "none, local, lookahead, anneal, edge_insertion)", name ? name : "(null)");
+                   "none, local, lookahead, anneal, edge_insertion)",
+                   name ? name : "(null)");
 }
 
 tt_status tt_optimize_check(tt_context *ctx, tt_optimize optimize,
