@@ -10,7 +10,7 @@
  *               the DEM, choosing the output driver
  *   progress.c  the text progress bar and the phase scaling
  *   report.c    the JSON writer and simplify's summary and JSON
- *   simplify.c, generate.c, eval.c   one file per subcommand
+ *   simplify.c, generate.c, eval.c, optimize.c   one file per subcommand
  *
  * Invariants: a run reports at most one failure (the first), as one line;
  * every run either commits its output or leaves nothing behind; GDAL never
@@ -185,5 +185,12 @@ void tt__app_print_simplify_summary(app_run *r,
 tt_status tt__app_simplify(app_run *r);  /* simplify.c */
 tt_status tt__app_generate(app_run *r);  /* generate.c */
 tt_status tt__app_eval(app_run *r);      /* eval.c */
+tt_status tt__app_optimize(app_run *r);  /* optimize.c */
+/* eval.c, for optimize too: opens r->s->tin's kind of dataset (a vector
+ * dataset, explaining in one line why not), and picks its triangle layer
+ * (-layer, else "triangles" or "*_triangles", else the first polygon
+ * layer); NULL with the failure recorded. */
+GDALDatasetH tt__app_open_vector(app_run *r, const char *path);
+OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds);
 
 #endif /* TERRATIN_APP_H */

@@ -30,8 +30,9 @@ static int ends_with(const char *s, const char *suffix)
   return n >= m && strcasecmp(s + n - m, suffix) == 0;
 }
 
-/* -layer, else "triangles" or "*_triangles", else the first polygon layer. */
-static OGRLayerH eval_layer(app_run *r, GDALDatasetH ds)
+/* -layer, else "triangles" or "*_triangles", else the first polygon layer
+ * (eval, optimize). */
+OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds)
 {
   const char *path = r->s->tin;
   int n = GDALDatasetGetLayerCount(ds);
@@ -60,7 +61,7 @@ static OGRLayerH eval_layer(app_run *r, GDALDatasetH ds)
   return NULL;
 }
 
-static GDALDatasetH open_vector(app_run *r, const char *path)
+GDALDatasetH tt__app_open_vector(app_run *r, const char *path)
 {
   VSIStatBufL sb;
   r->msg.last[0] = '\0';
@@ -125,12 +126,12 @@ tt_status tt__app_eval(app_run *r)
     goto done;
   }
 
-  tds = open_vector(r, s->tin);
+  tds = tt__app_open_vector(r, s->tin);
   if (!tds) {
     st = r->res->status;
     goto done;
   }
-  OGRLayerH layer = eval_layer(r, tds);
+  OGRLayerH layer = tt__app_tin_layer(r, tds);
   if (!layer) {
     st = r->res->status;
     goto done;

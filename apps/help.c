@@ -16,6 +16,7 @@ static const char help_top[] =
     "  simplify   DEM -> TIN layers (GeoPackage, Shapefile, other formats)\n"
     "  generate   write a synthetic test terrain as a GeoTIFF\n"
     "  eval       measure the error of a triangle layer against a DEM\n"
+    "  optimize   re-triangulate a TIN's vertices for a criterion\n"
     "\n"
     "Options of every command:\n"
     "  --help              this help, or the help of COMMAND\n"
@@ -33,11 +34,25 @@ static const char help_top[] =
     "\n"
     "Run 'terratin COMMAND --help' for the options of a command.\n";
 
+/* The annealing options, shared by simplify and optimize. */
+#define ANNEAL_HELP                                                           \
+  "  -anneal_t0 T      -optimize anneal: start temperature, in swap value\n" \
+  "                    units (default: 2 x the largest |swap value|)\n"     \
+  "  -anneal_stages K  stages, the temperature times R each (default 100)\n"\
+  "  -anneal_swaps S   random edges tried per stage, per edge (default 5)\n"\
+  "  -anneal_good G    a stage ends after G x edges improving swaps\n"      \
+  "                    (default 5); a stage with no swap ends the run\n"    \
+  "  -anneal_r R       cooling factor, 0 < R < 1 (default 0.95)\n"         \
+  "  -seed N           the random sequence (default 0): the same seed, the\n"\
+  "                    same TIN; the best triangulation seen is returned\n"
+
 static const char help_simplify[] =
     "Usage: terratin simplify [-b BAND] [-max_error E] [-max_points N]\n"
     "           [-max_triangles N] [-percent P] [-criterion NAME]\n"
     "           [-repair flip|local|lookahead|delaunay]\n"
-    "           [-optimize local|lookahead|none]\n"
+    "           [-optimize local|lookahead|anneal|edge_insertion|none]\n"
+    "           [-anneal_t0 T] [-anneal_stages K] [-anneal_swaps S]\n"
+    "           [-anneal_good G] [-anneal_r R] [-seed N]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
     "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
@@ -92,10 +107,13 @@ static const char help_simplify[] =
     "                    the criterion in the final pass only; the default\n"
     "                    for l2). Except with delaunay, min_area first\n"
     "                    re-triangulates the hole around it exactly\n"
-    "  -optimize MODE    final swap pass over the whole mesh: local,\n"
-    "                    lookahead or none (default: local after -repair\n"
-    "                    delaunay with another criterion, else none); it\n"
-    "                    never lifts an error past the bound\n"
+    "  -optimize MODE    final pass over the whole mesh: local, lookahead,\n"
+    "                    anneal (simulated annealing), edge_insertion (the\n"
+    "                    global Min-Max angle optimum; -criterion\n"
+    "                    minmax_angle only) or none (default: local after\n"
+    "                    -repair delaunay with another criterion, else\n"
+    "                    none); it never lifts an error past the bound\n"
+    ANNEAL_HELP
     "  -of FORMAT        OGR vector driver that can create datasets: GPKG,\n"
     "                    \"ESRI Shapefile\", ... (default: guessed from\n"
     "                    OUTPUT's extension, else GPKG)\n"
@@ -188,12 +206,49 @@ static const char help_eval[] =
     "Example:\n"
     "  terratin eval dem.tif tin.gpkg -max_error 0.5 -q || echo too coarse\n";
 
+static const char help_optimize[] =
+    "Usage: terratin optimize DEM IN_TIN OUTPUT [-b BAND] [-layer NAME]\n"
+    "           [-criterion NAME]\n"
+    "           [-optimize local|lookahead|anneal|edge_insertion]\n"
+    "           [-max_error E] [-anneal_t0 T] [-anneal_stages K]\n"
+    "           [-anneal_swaps S] [-anneal_good G] [-anneal_r R] [-seed N]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
+    "           [-nln PREFIX] [-overwrite] [-q] [-json]\n"
+    "\n"
+    "Reads a layer of triangles (from terratin or another tool, as eval\n"
+    "reads it) whose corners are samples of band BAND of DEM, keeps its\n"
+    "vertices and its outline, re-triangulates it for the criterion, and\n"
+    "writes OUTPUT with the layers simplify writes (PREFIXtriangles,\n"
+    "PREFIXvertices, PREFIXrun_parameters). A corner that is not a valid\n"
+    "DEM sample, a triangle with no area, or triangles that overlap are\n"
+    "refused with a message naming them.\n"
+    "\n"
+    "Options:\n"
+    "  -layer NAME       layer of IN_TIN (default as eval: 'triangles' or\n"
+    "                    '*_triangles', else the first polygon layer)\n"
+    "  -criterion NAME   as simplify (default delaunay)\n"
+    "  -optimize MODE    local (default), lookahead, anneal or\n"
+    "                    edge_insertion (-criterion minmax_angle only)\n"
+    "  -max_error E      refuse every move that makes a triangle with a\n"
+    "                    sample farther than E from it (z units)\n"
+    ANNEAL_HELP
+    "  -b, -srcnodata, -z_factor, -z_unit   as simplify\n"
+    "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
+    "\n"
+    "Exit codes: 0 success, 1 processing failure, 2 usage error.\n"
+    "\n"
+    "Example:\n"
+    "  terratin optimize dem.tif tin.gpkg l2.gpkg -criterion l2 "
+    "-optimize anneal\n";
+
 const char *tt_app_help(tt_app_command topic)
 {
   switch (topic) {
   case TT_APP_SIMPLIFY: return help_simplify;
   case TT_APP_GENERATE: return help_generate;
   case TT_APP_EVAL: return help_eval;
+  case TT_APP_OPTIMIZE: return help_optimize;
   default: return help_top;
   }
 }
@@ -204,6 +259,7 @@ const char *tt__app_command_name(tt_app_command c)
   case TT_APP_SIMPLIFY: return "simplify";
   case TT_APP_GENERATE: return "generate";
   case TT_APP_EVAL: return "eval";
+  case TT_APP_OPTIMIZE: return "optimize";
   default: return "";
   }
 }

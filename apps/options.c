@@ -141,12 +141,14 @@ enum opt_id {
   O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_OPTIMIZE, O_REPAIR, O_JSON,
   O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE,
   O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
-  O_Z_UNIT, O_WORK_SRS, O_T_SRS
+  O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
+  O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
 #define FOR_G (1u << TT_APP_GENERATE)
 #define FOR_E (1u << TT_APP_EVAL)
+#define FOR_O (1u << TT_APP_OPTIMIZE)
 
 static const struct opt_def {
   const char *name;
@@ -154,26 +156,26 @@ static const struct opt_def {
   int takes_value;
   unsigned commands;
 } opt_defs[] = {
-    {"-b", O_B, 1, FOR_S | FOR_E},
-    {"-max_error", O_MAX_ERROR, 1, FOR_S | FOR_E},
+    {"-b", O_B, 1, FOR_S | FOR_E | FOR_O},
+    {"-max_error", O_MAX_ERROR, 1, FOR_S | FOR_E | FOR_O},
     {"-max_points", O_MAX_POINTS, 1, FOR_S},
     {"-max_triangles", O_MAX_TRIANGLES, 1, FOR_S},
     {"-percent", O_PERCENT, 1, FOR_S},
-    {"-of", O_OF, 1, FOR_S},
-    {"-f", O_OF, 1, FOR_S}, /* ogr2ogr's spelling */
-    {"-lco", O_LCO, 1, FOR_S},
-    {"-dsco", O_DSCO, 1, FOR_S},
-    {"-nln", O_NLN, 1, FOR_S},
-    {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G},
-    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E},
-    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E},
-    {"-criterion", O_CRITERION, 1, FOR_S},
-    {"-optimize", O_OPTIMIZE, 1, FOR_S},
+    {"-of", O_OF, 1, FOR_S | FOR_O},
+    {"-f", O_OF, 1, FOR_S | FOR_O}, /* ogr2ogr's spelling */
+    {"-lco", O_LCO, 1, FOR_S | FOR_O},
+    {"-dsco", O_DSCO, 1, FOR_S | FOR_O},
+    {"-nln", O_NLN, 1, FOR_S | FOR_O},
+    {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G | FOR_O},
+    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O},
+    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O},
+    {"-criterion", O_CRITERION, 1, FOR_S | FOR_O},
+    {"-optimize", O_OPTIMIZE, 1, FOR_S | FOR_O},
     {"-repair", O_REPAIR, 1, FOR_S},
-    {"-json", O_JSON, 0, FOR_S | FOR_E},
-    {"-layer", O_LAYER, 1, FOR_E},
+    {"-json", O_JSON, 0, FOR_S | FOR_E | FOR_O},
+    {"-layer", O_LAYER, 1, FOR_E | FOR_O},
     {"-size", O_SIZE, 1, FOR_G},
-    {"-seed", O_SEED, 1, FOR_G},
+    {"-seed", O_SEED, 1, FOR_G | FOR_S | FOR_O},
     {"-iterations", O_ITERATIONS, 1, FOR_G},
     {"-displacement", O_DISPLACEMENT, 1, FOR_G},
     {"-wave_size", O_WAVE_SIZE, 1, FOR_G},
@@ -181,11 +183,16 @@ static const struct opt_def {
     {"-amplitude", O_AMPLITUDE, 1, FOR_G},
     {"-seeding", O_SEEDING, 1, FOR_G},
     {"-a_srs", O_A_SRS, 1, FOR_G},
-    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E},
-    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E},
-    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E},
+    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E | FOR_O},
+    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E | FOR_O},
+    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E | FOR_O},
     {"-work_srs", O_WORK_SRS, 1, FOR_S},
     {"-t_srs", O_T_SRS, 1, FOR_S},
+    {"-anneal_t0", O_ANNEAL_T0, 1, FOR_S | FOR_O},
+    {"-anneal_stages", O_ANNEAL_STAGES, 1, FOR_S | FOR_O},
+    {"-anneal_swaps", O_ANNEAL_SWAPS, 1, FOR_S | FOR_O},
+    {"-anneal_good", O_ANNEAL_GOOD, 1, FOR_S | FOR_O},
+    {"-anneal_r", O_ANNEAL_R, 1, FOR_S | FOR_O},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -308,6 +315,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (tt__app_str_ieq(w, "simplify")) first_cmd = TT_APP_SIMPLIFY;
       else if (tt__app_str_ieq(w, "generate")) first_cmd = TT_APP_GENERATE;
       else if (tt__app_str_ieq(w, "eval")) first_cmd = TT_APP_EVAL;
+      else if (tt__app_str_ieq(w, "optimize")) first_cmd = TT_APP_OPTIMIZE;
       else if (tt__app_str_ieq(w, "help")) { want_help = 1; continue; }
       if (first_cmd == TT_APP_NONE)
         break; /* an unknown command: reported below */
@@ -381,13 +389,14 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (o->s.command == TT_APP_NONE) {
       if (w[0] == '-' && w[1] != '\0')
         USAGE("unknown option '%s' before the command; expected simplify, "
-              "generate or eval (see 'terratin --help')", w);
+              "generate, eval or optimize (see 'terratin --help')", w);
       if (tt__app_str_ieq(w, "simplify")) o->s.command = TT_APP_SIMPLIFY;
       else if (tt__app_str_ieq(w, "generate")) o->s.command = TT_APP_GENERATE;
       else if (tt__app_str_ieq(w, "eval")) o->s.command = TT_APP_EVAL;
+      else if (tt__app_str_ieq(w, "optimize")) o->s.command = TT_APP_OPTIMIZE;
       else
-        USAGE("unknown command '%s'; expected simplify, generate or eval "
-              "(see 'terratin --help')", w);
+        USAGE("unknown command '%s'; expected simplify, generate, eval or "
+              "optimize (see 'terratin --help')", w);
       cmdname = tt__app_command_name(o->s.command);
       snprintf(hint, sizeof hint, " (see 'terratin %s --help')", cmdname);
       continue;
@@ -410,7 +419,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         i++;
       }
     } else {
-      if (npos >= 2)
+      if (npos >= (o->s.command == TT_APP_OPTIMIZE ? 3u : 2u))
         USAGE("%s: unexpected argument '%s'%s", cmdname, w, hint);
       pos[npos++] = w;
       continue;
@@ -498,8 +507,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     }
     case O_OPTIMIZE:
       if (tt_optimize_parse(ctx, v, &o->s.optimize) != TT_OK)
-        USAGE("%s: unknown -optimize '%s'; known: local, lookahead, none, "
-              "auto", cmdname, v);
+        USAGE("%s: unknown -optimize '%s'; known: local, lookahead, anneal, "
+              "edge_insertion, none, auto", cmdname, v);
       break;
     case O_REPAIR:
       if (tt_repair_parse(ctx, v, &o->s.repair) != TT_OK)
@@ -528,6 +537,31 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         USAGE("%s: -seed must be an unsigned integer, got '%s'", cmdname, v);
       sf.seed = 1;
       sf.seed_value = u;
+      o->s.anneal.seed = u;
+      break;
+    case O_ANNEAL_T0:
+      if (!parse_double(v, &x) || !(x > 0))
+        USAGE("%s: -anneal_t0 must be a finite number > 0 (the start "
+              "temperature, in swap value units), got '%s'", cmdname, v);
+      o->s.anneal.t0 = x;
+      break;
+    case O_ANNEAL_STAGES:
+      if (!parse_size(v, &z) || z < 1 || z > 1000000)
+        USAGE("%s: -anneal_stages must be an integer in [1, 1000000], got "
+              "'%s'", cmdname, v);
+      o->s.anneal.stages = (int)z;
+      break;
+    case O_ANNEAL_SWAPS:
+    case O_ANNEAL_GOOD:
+      if (!parse_double(v, &x) || !(x > 0 && x <= 1e6))
+        USAGE("%s: %s must be a number in (0, 1e6] (per edge), got '%s'",
+              cmdname, d->name, v);
+      *(d->id == O_ANNEAL_SWAPS ? &o->s.anneal.swaps : &o->s.anneal.good) = x;
+      break;
+    case O_ANNEAL_R:
+      if (!parse_double(v, &x) || !(x > 0 && x < 1))
+        USAGE("%s: -anneal_r must be in (0, 1), got '%s'", cmdname, v);
+      o->s.anneal.r = x;
       break;
     case O_ITERATIONS:
       if (!parse_size(v, &z) || z < 1)
@@ -611,10 +645,15 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     }
   }
 
+  if (o->s.optimize == TT_OPTIMIZE_EDGE_INSERTION &&
+      o->s.criterion != TT_CRITERION_MINMAX_ANGLE)
+    USAGE("%s: -optimize edge_insertion optimises the Min-Max angle only: "
+          "add -criterion minmax_angle, or use local, lookahead or anneal",
+          cmdname);
   switch (o->s.command) {
   case TT_APP_NONE:
-    USAGE("missing command: simplify, generate or eval (see 'terratin "
-          "--help')");
+    USAGE("missing command: simplify, generate, eval or optimize (see "
+          "'terratin --help')");
   case TT_APP_SIMPLIFY:
     if (npos < 1)
       USAGE("simplify: missing INPUT and OUTPUT%s", hint);
@@ -629,6 +668,15 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (npos < 2)
       USAGE("eval: missing TIN after '%s'%s", pos[0], hint);
     if (!(o->s.input = keep(o, pos[0])) || !(o->s.tin = keep(o, pos[1])))
+      NOMEM();
+    break;
+  case TT_APP_OPTIMIZE:
+    if (npos < 3)
+      USAGE("optimize: missing %s%s", npos == 0 ? "DEM, IN_TIN and OUTPUT"
+                                      : npos == 1 ? "IN_TIN and OUTPUT"
+                                                  : "OUTPUT", hint);
+    if (!(o->s.input = keep(o, pos[0])) || !(o->s.tin = keep(o, pos[1])) ||
+        !(o->s.output = keep(o, pos[2])))
       NOMEM();
     break;
   case TT_APP_GENERATE: {

@@ -46,7 +46,8 @@ typedef enum tt_app_command {
   TT_APP_VERSION,            /* print terratin, GDAL and PROJ versions */
   TT_APP_SIMPLIFY,
   TT_APP_GENERATE,
-  TT_APP_EVAL
+  TT_APP_EVAL,
+  TT_APP_OPTIMIZE            /* optimize DEM IN_TIN OUTPUT */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
@@ -95,13 +96,16 @@ typedef struct tt_app_settings {
   tt_criterion criterion;    /* -criterion; default delaunay */
   tt_optimize optimize;      /* -optimize; default auto (tt_optimize_resolve) */
   tt_repair repair;          /* -repair; default auto (tt_repair_resolve) */
+  tt_anneal_options anneal;  /* -anneal_t0, -anneal_stages, -anneal_swaps,
+                                -anneal_good, -anneal_r, -seed (simplify,
+                                optimize); zero: the study's defaults */
   const char *format;        /* -of; NULL: guessed from the output's
                                 extension, else GPKG */
   const char *const *lco;    /* -lco NAME=VALUE, in order */
   const char *const *dsco;   /* -dsco NAME=VALUE, in order */
   const char *nln;           /* -nln layer name prefix; "" by default */
 
-  /* eval */
+  /* eval, optimize (which reads the TIN from tin and writes output) */
   const char *layer;         /* -layer; NULL: the triangles layer */
 
   /* generate */

@@ -248,15 +248,42 @@ typedef enum tt_optimize {
                               a criterion other than Delaunay), else none */
   TT_OPTIMIZE_NONE,
   TT_OPTIMIZE_LOCAL,       /* maximal-reduction local swap */
-  TT_OPTIMIZE_LOOKAHEAD    /* local swap, then two-swap look-ahead moves
+  TT_OPTIMIZE_LOOKAHEAD,   /* local swap, then two-swap look-ahead moves
                               (Dyn, Hormann, Kim, Levin) */
+  TT_OPTIMIZE_ANNEAL,      /* simulated annealing (Schumaker, SPEC 3.3),
+                              tt_anneal_options; the best triangulation
+                              seen is kept */
+  TT_OPTIMIZE_EDGE_INSERTION /* edge insertion, the global Min-Max angle
+                              optimum (SPEC 3.4); minmax_angle only */
 } tt_optimize;
 
-/* "auto", "none", "local", "lookahead"; NULL for an unknown value. */
+/* Simulated annealing's schedule (SPEC 3.3). Zero in any field means the
+ * study's default, so a zeroed struct is the default schedule. Stages
+ * k = 1..stages run at t_k = r^k t0; each tries up to swaps x E random
+ * swappable edges (E: the interior unconstrained edges at the start) and
+ * ends after good x E improving swaps; a stage with no swap ends the run. */
+typedef struct tt_anneal_options {
+  double t0;        /* start temperature; <= 0: 2 x the largest |swap
+                       value| at the start */
+  int stages;       /* K; 0: 100 */
+  double swaps;     /* S per edge; 0: 5 */
+  double good;      /* G per edge; 0: 5 */
+  double r;         /* cooling factor in (0, 1); 0: 0.95 */
+  uint64_t seed;    /* the random sequence; the same seed, the same TIN */
+} tt_anneal_options;
+
+/* "auto", "none", "local", "lookahead", "anneal", "edge_insertion"; NULL
+ * for an unknown value. */
 const char *tt_optimize_name(tt_optimize optimize);
 /* Parses one of those names; TT_ERR_ARG for an unknown one. */
 tt_status tt_optimize_parse(tt_context *ctx, const char *name,
                             tt_optimize *out_optimize);
+/* Checks that an optimisation fits a criterion (edge insertion is for
+ * minmax_angle only) and that an annealing schedule is in range (anneal
+ * may be NULL): TT_ERR_ARG with a message naming the problem. */
+tt_status tt_optimize_check(tt_context *ctx, tt_optimize optimize,
+                            tt_criterion criterion,
+                            const tt_anneal_options *anneal);
 /* What TT_OPTIMIZE_AUTO means for a criterion and a resolved repair
  * (other values are returned as they are). */
 tt_optimize tt_optimize_resolve(tt_optimize optimize, tt_criterion criterion,
@@ -279,6 +306,8 @@ typedef struct tt_refine_options {
   tt_optimize optimize;
   /* The criterion's restoration around each inserted vertex. */
   tt_repair repair;
+  /* The schedule of optimize = TT_OPTIMIZE_ANNEAL. */
+  tt_anneal_options anneal;
   /* Threads for the raster scans: 0 = automatic (all online CPUs for grids
    * of a million samples or more, else 1), 1 = the caller's only, N = N.
    * The result does not depend on it. */
@@ -303,6 +332,33 @@ typedef struct tt_tin tt_tin;
 tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
                         const tt_refine_options *opt, tt_tin **out_tin);
 void tt_tin_destroy(tt_tin *tin);
+
+/* Optimising a TIN the caller already has (tt_optimize_run). */
+typedef struct tt_optimize_options {
+  tt_criterion criterion;
+  tt_optimize optimize;    /* TT_OPTIMIZE_AUTO: local */
+  /* A move is refused when one of the triangles it makes has a sample
+   * with |H - H'| > max_error (z units). Negative: no bound. */
+  double max_error;
+  tt_anneal_options anneal;
+} tt_optimize_options;
+
+/* Default: Delaunay, local swap, no bound, the default schedule. */
+void tt_optimize_options_init(tt_optimize_options *opt);
+
+/* Rebuilds the mesh of ntriangles triangles given as tt_eval_triangles
+ * takes them (9 doubles each, pixel-centre space; corners within 1e-6
+ * pixel of a sample are put on it, the z given is ignored: heights come
+ * from the grid), optimises it for the criterion with opt->optimize, and
+ * returns it as a TIN (vertex ranks in order of first appearance, no
+ * insertion errors). TT_ERR_DATA with a message naming the triangle when
+ * a corner is not a valid sample of the grid, a triangle has no area, an
+ * edge is used twice the same way, the triangles overlap (around a vertex,
+ * or over a sample), or they do not form a surface. The caller owns
+ * *out_tin and frees it with tt_tin_destroy(). */
+tt_status tt_optimize_run(tt_context *ctx, const tt_grid *grid,
+                          size_t ntriangles, const double *pix_xyz,
+                          const tt_optimize_options *opt, tt_tin **out_tin);
 
 typedef enum tt_stop_reason {
   TT_STOP_NONE = 0,        /* not stopped */

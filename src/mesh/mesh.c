@@ -912,3 +912,81 @@ done:
   }
   return ok;
 }
+
+/* --- snapshots (anneal.c) -------------------------------------------------
+ * Simulated annealing keeps the best triangulation seen while it wanders
+ * through worse ones. Its undo log is bounded, so now and then it saves
+ * the best one whole: the triangle and vertex-edge words, which flips (the
+ * only writes between a snapshot and its restore) change in place, never
+ * the slot count or the free list. */
+
+bool tt__mesh_snapshot_take(const tt__mesh *m, tt__mesh_snapshot *s)
+{
+  size_t nh = 3 * m->nslots;
+  if (s->cap_h < nh) {
+    int32_t *hv = realloc(s->hv, (nh ? nh : 1) * sizeof *hv);
+    if (hv)
+      s->hv = hv;
+    int32_t *tw = hv ? realloc(s->twin, (nh ? nh : 1) * sizeof *tw) : NULL;
+    if (tw)
+      s->twin = tw;
+    uint8_t *fl = tw ? realloc(s->eflag, nh ? nh : 1) : NULL;
+    if (!fl)
+      return false;
+    s->eflag = fl;
+    s->cap_h = nh;
+  }
+  if (s->cap_v < m->nv) {
+    int32_t *ve = realloc(s->vedge, m->nv * sizeof *ve);
+    if (!ve)
+      return false;
+    s->vedge = ve;
+    s->cap_v = m->nv;
+  }
+  if (nh) {
+    memcpy(s->hv, m->hv, nh * sizeof *s->hv);
+    memcpy(s->twin, m->twin, nh * sizeof *s->twin);
+    memcpy(s->eflag, m->eflag, nh);
+  }
+  for (size_t i = 0; i < m->nv; i++)
+    s->vedge[i] = m->v[i].edge;
+  s->nslots = m->nslots;
+  s->nv = m->nv;
+  s->nlive = m->nlive;
+  return true;
+}
+
+bool tt__mesh_snapshot_restore(tt__mesh *m, const tt__mesh_snapshot *s)
+{
+  if (s->nslots != m->nslots || s->nv != m->nv)
+    return false;
+  size_t nh = 3 * m->nslots;
+  if (!tt__grow((void **)&m->touched, &m->touchedcap,
+                m->ntouched + m->nslots, sizeof(int32_t)))
+    return false;
+  for (size_t t = 0; t < m->nslots; t++)
+    bump_slot(m, (int32_t)t);
+  if (nh) {
+    memcpy(m->hv, s->hv, nh * sizeof *s->hv);
+    memcpy(m->twin, s->twin, nh * sizeof *s->twin);
+    memcpy(m->eflag, s->eflag, nh);
+  }
+  for (size_t i = 0; i < m->nv; i++)
+    m->v[i].edge = s->vedge[i];
+  m->nlive = s->nlive;
+  for (size_t t = 0; t < m->nslots; t++)
+    if (m->hv[3 * t] >= 0) {
+      bump_slot(m, (int32_t)t);
+      m->touched[m->ntouched++] = (int32_t)t;
+    }
+  return true;
+}
+
+void tt__mesh_snapshot_free(tt__mesh_snapshot *s)
+{
+  free(s->hv);
+  free(s->twin);
+  free(s->eflag);
+  free(s->vedge);
+  memset(s, 0, sizeof *s);
+}

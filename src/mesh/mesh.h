@@ -228,4 +228,22 @@ TT_HIDDEN bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots,
                                        int nold, const int32_t (*tris)[3],
                                        int ntri);
 
+/* A copy of the triangles and vertex edges (anneal.c keeps the best
+ * triangulation seen in one). Zero-initialise it; take may be called
+ * again on the same snapshot. restore writes it back into a mesh that
+ * since changed only by flips (same slots, same free list, same vertices),
+ * logs every live slot as touched and bumps every star version; false
+ * (mesh unchanged) when the mesh does not fit or out of memory. */
+typedef struct tt__mesh_snapshot {
+  int32_t *hv, *twin, *vedge;
+  uint8_t *eflag;
+  size_t nslots, nv, nlive, cap_h, cap_v;
+} tt__mesh_snapshot;
+
+TT_HIDDEN bool tt__mesh_snapshot_take(const tt__mesh *m,
+                                      tt__mesh_snapshot *s);
+TT_HIDDEN bool tt__mesh_snapshot_restore(tt__mesh *m,
+                                         const tt__mesh_snapshot *s);
+TT_HIDDEN void tt__mesh_snapshot_free(tt__mesh_snapshot *s);
+
 #endif /* TT_MESH_H */

@@ -17,6 +17,9 @@
 #include "optimize/optimize.h"
 
 #include "base/heap.h"
+#include "criteria/geometry.h"
+#include "optimize/anneal.h"
+#include "optimize/edge_insert.h"
 #include "optimize/hole_dp.h"
 #include "mesh/raster_scan.h"
 
@@ -26,8 +29,9 @@
 
 /* --- public names -------------------------------------------------------- */
 
-static const char *const optimize_names[] = {"auto", "none", "local",
-                                             "lookahead"};
+static const char *const optimize_names[] = {"auto",      "none",
+                                             "local",     "lookahead",
+                                             "anneal",    "edge_insertion"};
 #define NOPT (sizeof optimize_names / sizeof optimize_names[0])
 static const char *const repair_names[] = {"auto", "flip", "local",
                                            "lookahead", "delaunay"};
@@ -56,7 +60,39 @@ tt_status tt_optimize_parse(tt_context *ctx, const char *name,
     return TT_OK;
   }
   return tt__error(ctx, TT_ERR_ARG, "unknown optimisation '%s' (known: auto, "
-                   "none, local, lookahead)", name ? name : "(null)");
+                   "none, local, lookahead, anneal, edge_insertion)",
+                   name ? name : "(null)");
+}
+
+tt_status tt_optimize_check(tt_context *ctx, tt_optimize optimize,
+                            tt_criterion criterion,
+                            const tt_anneal_options *anneal)
+{
+  if (!tt_optimize_name(optimize))
+    return tt__error(ctx, TT_ERR_ARG, "unknown optimisation %d",
+                     (int)optimize);
+  if (optimize == TT_OPTIMIZE_EDGE_INSERTION &&
+      criterion != TT_CRITERION_MINMAX_ANGLE)
+    return tt__error(ctx, TT_ERR_ARG, "edge insertion optimises the Min-Max "
+                     "angle only: use -criterion minmax_angle, or another "
+                     "-optimize (local, lookahead, anneal)");
+  if (!anneal)
+    return TT_OK;
+  if (!(anneal->t0 >= 0) || isinf(anneal->t0))
+    return tt__error(ctx, TT_ERR_ARG, "anneal t0 must be a finite number "
+                     ">= 0 (0: automatic), got %g", anneal->t0);
+  if (anneal->stages < 0)
+    return tt__error(ctx, TT_ERR_ARG, "anneal stages must be >= 0 (0: 100), "
+                     "got %d", anneal->stages);
+  if (!(anneal->swaps >= 0) || !(anneal->good >= 0) || isinf(anneal->swaps) ||
+      isinf(anneal->good) || anneal->swaps > 1e6 || anneal->good > 1e6)
+    return tt__error(ctx, TT_ERR_ARG, "anneal swaps and good swaps per edge "
+                     "must be in [0, 1e6] (0: 5), got %g and %g",
+                     anneal->swaps, anneal->good);
+  if (!(anneal->r >= 0 && anneal->r < 1))
+    return tt__error(ctx, TT_ERR_ARG, "anneal r must be in (0, 1) (0: 0.95), "
+                     "got %g", anneal->r);
+  return TT_OK;
 }
 
 const char *tt_repair_name(tt_repair repair)
@@ -417,8 +453,86 @@ static bool single_move(opt *o, int32_t id, int32_t e, double v)
   return rescore(o, slots, 2, &h, 1, true);
 }
 
+/* --- pairs under the max-type criteria ----------------------------------
+ * For min-max angle (and its lexicographic form) and lexicographic ABN, the
+ * score v + w of a pair says nothing certain about the global value: a
+ * pair is kept only when the region of its three triangles gets a better
+ * vector -- their angles, or the angles between normals across every edge
+ * of theirs (the edges of the rest of the mesh keep their values) -- so
+ * that look-ahead, too, never ends worse than it started. */
+
+/* 1: min-max angle (the largest entry decides), 2: min-max angle lex, 3:
+ * abn (the sorted vector decides), 0: an additive criterion. */
+static int max_kind(const tt__criterion_vt *c)
+{
+  return c->id == TT_CRITERION_MINMAX_ANGLE       ? 1
+         : c->id == TT_CRITERION_MINMAX_ANGLE_LEX ? 2
+         : c->id == TT_CRITERION_ABN              ? 3
+                                                  : 0;
+}
+
+static tt__gvec slot_normal(const double fr[4], const tt__mesh *m, int32_t t)
+{
+  int32_t p = m->hv[3 * t];
+  return tt__gcross(tt__geo_vec(fr, m, p, m->hv[3 * t + 1]),
+                    tt__geo_vec(fr, m, p, m->hv[3 * t + 2]));
+}
+
+/* The region's vector (at most 9 entries), sorted in decreasing order;
+ * its length. */
+static int region_vector(const opt *o, const int32_t slots[3], int kind,
+                         double *out)
+{
+  const tt__mesh *m = o->m;
+  double fr[4];
+  tt__geo_frame(o->p->env, fr);
+  int n = 0;
+  for (int i = 0; i < 3; i++) {
+    int32_t t = slots[i];
+    if (kind != 3) {
+      for (int k = 0; k < 3; k++) {
+        int32_t a = m->hv[3 * t + k], b = m->hv[3 * t + (k + 1) % 3],
+                c = m->hv[3 * t + (k + 2) % 3];
+        out[n++] = tt__gangle2(tt__geo_vec(fr, m, a, b),
+                               tt__geo_vec(fr, m, a, c));
+      }
+      continue;
+    }
+    tt__gvec nt = slot_normal(fr, m, t);
+    for (int k = 0; k < 3; k++) {
+      int32_t h = 3 * t + k, tw = m->twin[h];
+      if (tw < 0)
+        continue;
+      bool inner = false;
+      for (int j = 0; j < 3; j++)
+        inner |= tw / 3 == slots[j];
+      if (inner && tw < h)
+        continue; /* an inner edge, counted from its other side */
+      out[n++] = tt__gangle(nt, slot_normal(fr, m, tw / 3));
+    }
+  }
+  for (int i = 1; i < n; i++)
+    for (int j = i; j > 0 && out[j - 1] < out[j]; j--) {
+      double x = out[j];
+      out[j] = out[j - 1];
+      out[j - 1] = x;
+    }
+  return n;
+}
+
+/* Whether vector a beats b: smaller at the first of the n entries where
+ * they differ by more than 1e-12 (the criteria's own tie width). */
+static bool region_better(const double *a, const double *b, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (fabs(a[i] - b[i]) > 1e-12)
+      return a[i] < b[i];
+  return false;
+}
+
 /* Swaps e (value v <= tol) and then its best follow-up, when the pair
- * improves by more than the pair threshold and is accepted. */
+ * improves by more than the pair threshold (for the max-type criteria:
+ * when it makes its region's vector better, above) and is accepted. */
 static bool pair_move(opt *o, int32_t id, int32_t e, double v)
 {
   tt__mesh *m = o->m;
@@ -442,12 +556,30 @@ static bool pair_move(opt *o, int32_t id, int32_t e, double v)
     ns = 3;
     if (!unscore_slots(o, &slots[2], 1))
       return false;
+    int kind = max_kind(o->p->crit);
+    double before[9], after[9];
+    int nb = 0;
+    if (kind) {
+      /* the region's vector before the pair: back, measure, and the same
+       * flip again (word for word the same, so f is still f) */
+      tt__mesh_flip_revert(m, &u1);
+      nb = region_vector(o, slots, kind, before);
+      if (tt__mesh_flip_undoable(m, e, &u1) < 0)
+        return false;
+    }
     int32_t h2 = tt__mesh_flip_undoable(m, f, &u2);
     if (h2 < 0) {
       tt__mesh_flip_revert(m, &u1);
       return false;
     }
-    if (accepted(o, slots, 3)) {
+    bool better = true;
+    if (kind) {
+      int na = region_vector(o, slots, kind, after);
+      better = na == nb && region_better(after, before, kind == 1 ? 1 : na);
+      if (!better)
+        o->st.noisy++;
+    }
+    if (better && accepted(o, slots, 3)) {
       o->st.pairs++;
       o->moves++;
       /* the first diagonal c-d survives the second flip: find it */
@@ -460,7 +592,8 @@ static bool pair_move(opt *o, int32_t id, int32_t e, double v)
         }
       return rescore(o, slots, 3, diag, diag[1] >= 0 ? 2 : 1, true);
     }
-    o->st.refused++;
+    if (better)
+      o->st.refused++;
     tt__mesh_flip_revert(m, &u2);
   }
   tt__mesh_flip_revert(m, &u1);
@@ -657,6 +790,7 @@ static bool within_bound(void *arg, const tt__mesh *m, const int32_t *slots,
 bool tt__optimize_final(tt__mesh *m, const tt__criterion_vt *crit,
                         const tt__crit_env *env, tt_optimize mode,
                         tt_repair repair, double bound,
+                        const tt_anneal_options *anneal,
                         tt__opt_stats *out_stats)
 {
   if (out_stats)
@@ -665,6 +799,26 @@ bool tt__optimize_final(tt__mesh *m, const tt__criterion_vt *crit,
   if (mode == TT_OPTIMIZE_NONE)
     return true;
   bound_arg b = {env->grid, bound};
+  if (mode == TT_OPTIMIZE_ANNEAL && crit->id != TT_CRITERION_DELAUNAY) {
+    tt__anneal_stats as;
+    bool ok = tt__anneal_run(m, crit, env, anneal, within_bound, &b, &as);
+    if (out_stats) {
+      out_stats->swaps = as.swaps;
+      out_stats->refused = as.refused;
+    }
+    return ok;
+  }
+  if (mode == TT_OPTIMIZE_EDGE_INSERTION) {
+    tt__edge_insert_stats es;
+    bool ok = tt__edge_insert_run(m, env, within_bound, &b, &es);
+    if (out_stats) {
+      out_stats->swaps = es.insertions;
+      out_stats->refused = es.refused;
+    }
+    return ok;
+  }
+  /* Delaunay's flips reach its global optimum: its annealing is the
+   * local swap */
   tt__opt_params p = {crit, env, mode == TT_OPTIMIZE_LOOKAHEAD, within_bound,
                       &b};
   return tt__optimize_run(m, &p, NULL, 0, out_stats);

@@ -21,7 +21,10 @@
  * total (min area, the curvatures, ABN sum and sum of squares, L2) every
  * move improves that total, so look-ahead never ends worse than plain
  * local swap from the same start. For the max-type criteria (min-max
- * angle, lexicographic ABN) v + w is only a heuristic score of a pair.
+ * angle and its lexicographic form, lexicographic ABN) v + w is only a
+ * heuristic score of a pair: a pair is kept only when the sorted vector of
+ * its three triangles (their angles, or the angles between normals across
+ * their edges) gets better, so no move makes the global value worse.
  * Delaunay skips the look-ahead phase: its swap values are incircle signs,
  * not quality differences, and its local optimum is the global one.
  *
@@ -65,7 +68,9 @@ typedef struct tt__opt_stats {
   long swaps;       /* single swaps kept */
   long pairs;       /* look-ahead pairs kept */
   long refused;     /* moves the accept callback refused */
-  long noisy;       /* swaps taken back: the swap back scored >= 0 too */
+  long noisy;       /* moves taken back: a swap whose swap back scored
+                       >= 0 too, or a max-type pair that did not better
+                       the vector of its three triangles */
   double tol;       /* at the end every swappable edge in scope that is
                        not resting has a swap value <= tol */
   bool budget_hit;  /* stopped by the move budget */
@@ -100,10 +105,15 @@ TT_HIDDEN long tt__optimize_insert(tt__mesh *m, const tt__criterion_vt *crit,
  * TT_OPTIMIZE_AUTO resolved here for the criterion and repair
  * (tt_optimize_resolve). A move is refused when one of the triangles it
  * makes has an owned sample with |H - H'| > bound, so the run's error
- * bound survives the pass. False when out of memory. */
+ * bound survives the pass. anneal: the schedule of TT_OPTIMIZE_ANNEAL
+ * (anneal.h; NULL: the defaults); TT_OPTIMIZE_EDGE_INSERTION is
+ * edge_insert.h's, whatever crit (the caller checks it is minmax_angle).
+ * Only the swaps (insertions) and refusals of out_stats are set for
+ * those two. False when out of memory. */
 TT_HIDDEN bool tt__optimize_final(tt__mesh *m, const tt__criterion_vt *crit,
                                   const tt__crit_env *env, tt_optimize mode,
                                   tt_repair repair, double bound,
+                                  const tt_anneal_options *anneal,
                                   tt__opt_stats *out_stats);
 
 #endif /* TT_OPTIMIZE_H */

@@ -497,9 +497,9 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
   if (!tt__criterion_get(o->criterion))
     return tt__error(ctx, TT_ERR_ARG, "unknown criterion %d",
                      (int)o->criterion);
-  if (!tt_optimize_name(o->optimize))
-    return tt__error(ctx, TT_ERR_ARG, "unknown optimisation %d",
-                     (int)o->optimize);
+  tt_status st = tt_optimize_check(ctx, o->optimize, o->criterion, &o->anneal);
+  if (st != TT_OK)
+    return st;
   if (!tt_repair_name(o->repair))
     return tt__error(ctx, TT_ERR_ARG, "unknown repair %d", (int)o->repair);
   return TT_OK;
@@ -653,7 +653,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
                           fmax(r.max_error, tt__heap_size(&r.heap)
                                                 ? tt__heap_top(&r.heap).key
                                                 : 0.0),
-                          NULL)) {
+                          &opt->anneal, NULL)) {
     status = oom(&r);
     goto done;
   }

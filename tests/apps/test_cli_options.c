@@ -206,7 +206,7 @@ static void test_simplify_usage_errors(void)
   CHECK_USAGE("-srcnodata", "simplify", "-srcnodata", "none", "a", "b");
   CHECK_USAGE("-z_factor", "simplify", "-z_factor", "0", "a", "b");
   CHECK_USAGE("-z_factor", "simplify", "-z_factor", "inf", "a", "b");
-  CHECK_USAGE("does not apply", "simplify", "-seed", "1", "a", "b");
+  CHECK_USAGE("does not apply", "simplify", "-size", "9", "a", "b");
   CHECK_USAGE("does not apply", "simplify", "-layer", "t", "a", "b");
   CHECK_USAGE("--config", "simplify", "a", "b", "--config");
   CHECK_USAGE("--config K needs a VALUE", "simplify", "a", "b", "--config",
@@ -399,6 +399,72 @@ static void test_eval(void)
   CHECK_USAGE("-max_error", "eval", "a", "b", "-max_error", "-0.1");
   CHECK_USAGE("does not apply", "eval", "a", "b", "-overwrite");
   CHECK_USAGE("does not apply", "eval", "a", "b", "-max_points", "5");
+}
+
+/* optimize DEM IN_TIN OUTPUT and the annealing options (issue 14). */
+static void test_optimize(void)
+{
+  tt_app_options *o = NULL;
+  const tt_app_settings *s;
+  PARSE_OK(o, "optimize", "dem.tif", "tin.gpkg", "out.gpkg");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_OPTIMIZE);
+  CHECK(s && strcmp(s->input, "dem.tif") == 0);
+  CHECK(s && strcmp(s->tin, "tin.gpkg") == 0);
+  CHECK(s && strcmp(s->output, "out.gpkg") == 0);
+  CHECK(s && s->optimize == TT_OPTIMIZE_AUTO && s->max_error < 0);
+  CHECK(s && s->anneal.t0 == 0 && s->anneal.stages == 0 &&
+        s->anneal.seed == 0);
+  tt_app_options_destroy(o);
+
+  PARSE_OK(o, "optimize", "-criterion", "l2", "-optimize", "anneal",
+           "-anneal_t0", "0.01", "-anneal_stages", "500", "-anneal_swaps",
+           "15", "-anneal_good", "15", "-anneal_r", "0.9", "-seed", "42",
+           "-max_error", "2", "-layer", "t", "dem.tif", "tin.gpkg",
+           "out.gpkg", "-overwrite", "-json", "-nln", "x_");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->criterion == TT_CRITERION_L2);
+  CHECK(s && s->optimize == TT_OPTIMIZE_ANNEAL && s->max_error == 2);
+  CHECK(s && s->anneal.t0 == 0.01 && s->anneal.stages == 500 &&
+        s->anneal.swaps == 15 && s->anneal.good == 15 &&
+        s->anneal.r == 0.9 && s->anneal.seed == 42);
+  CHECK(s && s->overwrite && s->json && strcmp(s->layer, "t") == 0);
+  tt_app_options_destroy(o);
+
+  /* simplify takes them too */
+  PARSE_OK(o, "simplify", "-optimize", "edge_insertion", "-criterion",
+           "minmax_angle", "-seed", "7", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->optimize == TT_OPTIMIZE_EDGE_INSERTION &&
+        s->anneal.seed == 7);
+  tt_app_options_destroy(o);
+
+  CHECK_USAGE("missing DEM, IN_TIN and OUTPUT", "optimize");
+  CHECK_USAGE("missing IN_TIN and OUTPUT", "optimize", "a");
+  CHECK_USAGE("missing OUTPUT", "optimize", "a", "b");
+  CHECK_USAGE("unexpected argument", "optimize", "a", "b", "c", "d");
+  CHECK_USAGE("Min-Max angle only", "optimize", "-optimize",
+              "edge_insertion", "a", "b", "c");
+  CHECK_USAGE("Min-Max angle only", "simplify", "-optimize",
+              "edge_insertion", "-criterion", "l2", "a", "b");
+  CHECK_USAGE("-anneal_r", "optimize", "-anneal_r", "1", "a", "b", "c");
+  CHECK_USAGE("-anneal_t0", "optimize", "-anneal_t0", "0", "a", "b", "c");
+  CHECK_USAGE("-anneal_stages", "optimize", "-anneal_stages", "0", "a", "b",
+              "c");
+  CHECK_USAGE("-anneal_swaps", "simplify", "-anneal_swaps", "-1", "a", "b");
+  CHECK_USAGE("-anneal_good", "simplify", "-anneal_good", "nan", "a", "b");
+  CHECK_USAGE("does not apply", "optimize", "-percent", "5", "a", "b", "c");
+  CHECK_USAGE("does not apply", "eval", "-anneal_r", "0.5", "a", "b");
+  const char *help = tt_app_help(TT_APP_OPTIMIZE);
+  static const char *const opts[] = {
+      "IN_TIN", "-criterion", "-optimize", "edge_insertion", "-max_error",
+      "-anneal_t0", "-anneal_stages", "-anneal_swaps", "-anneal_good",
+      "-anneal_r", "-seed", "-layer", "Exit codes"};
+  for (size_t i = 0; i < sizeof opts / sizeof *opts; i++)
+    if (!strstr(help, opts[i]))
+      TT_FAIL_("optimize help lacks %s", opts[i]);
+  CHECK(strstr(tt_app_help(TT_APP_NONE), "optimize") != NULL);
+  CHECK(strstr(tt_app_help(TT_APP_SIMPLIFY), "-anneal_t0") != NULL);
 }
 
 static char *slurp(FILE *f)
@@ -613,6 +679,7 @@ int main(void)
   test_help_and_version();
   test_generate();
   test_eval();
+  test_optimize();
   test_progress_bar();
   test_no_argv();
   test_library_runs();

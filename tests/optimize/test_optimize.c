@@ -892,8 +892,7 @@ static void test_final_veto(uint64_t seed)
     tt__opt_stats st;
     double bound = 0.8 * before; /* already passed: nothing may rise */
     CHECK(tt__optimize_final(&m, &area_crit, &env, (tt_optimize)mode,
-                             TT_REPAIR_FLIP, bound,
-                             &st));
+                             TT_REPAIR_FLIP, bound, NULL, &st));
     check_valid(&m, "final pass");
     double after = worst_error(&m, g);
     CHECK_DBL_LE(after, before);
