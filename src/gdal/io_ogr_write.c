@@ -5,7 +5,9 @@
  * shapefile output uses to make `<name>_triangles.shp` etc.):
  *   <prefix>triangles       POLYGON Z, one feature per triangle; the ring is
  *                           v0 v1 v2 v0 (closed, 4 points), counter-clockwise
- *                           in map space as tt_tin_triangle() gives it.
+ *                           in the coordinates written (tt_tin_triangle()'s
+ *                           order, corners 1 and 2 swapped where T_SRS
+ *                           mirrors the plane).
  *                           (The Shapefile driver rewinds outer rings to the
  *                           clockwise order its format prescribes.)
  *   <prefix>vertices        POINT Z, one feature per vertex.
@@ -294,6 +296,18 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
     for (int k = 0; k < 3; k++) {
       px[k] = w->xy ? w->xy[2 * (size_t)t.v[k]] : v[k].x;
       py[k] = w->xy ? w->xy[2 * (size_t)t.v[k] + 1] : v[k].y;
+    }
+    /* Counter-clockwise in the coordinates written: T_SRS may mirror the
+     * plane (a CRS whose x axis points west), the TIN's order is that of
+     * the input map. Corners 1 and 2 swap, with their fields. */
+    if ((px[1] - px[0]) * (py[2] - py[0]) -
+            (py[1] - py[0]) * (px[2] - px[0]) < 0) {
+      double sx = px[1], sy = py[1];
+      px[1] = px[2], py[1] = py[2], px[2] = sx, py[2] = sy;
+      tt_vertex_info sv = v[1];
+      v[1] = v[2], v[2] = sv;
+      int32_t si = t.v[1];
+      t.v[1] = t.v[2], t.v[2] = si;
     }
     if (w->geodesic) {
       double lats[3], lons[3], area = 0, perimeter = 0;

@@ -140,11 +140,36 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   chunk_acc *chunks = NULL;
   size_t *first = NULL;
   double *t_sq = NULL;
+  int32_t *vmap = NULL;
   *out_tin = NULL;
 
-  status = alloc_tin(ctx, m->nv, m->nlive, &tin);
+  /* A TIN without triangles is no surface: refuse it here, where every
+   * caller gets it, rather than write vertices that eval cannot use. */
+  if (m->nlive == 0) {
+    free(ins_err);
+    return tt__error(ctx, TT_ERR_DATA, "no triangle can be made: no grid "
+                     "cell has three valid corners (the valid samples are "
+                     "isolated by nodata)");
+  }
+  /* Vertices in no triangle (the starting corners of a raster whose
+   * corners fall in nodata specks) are dropped: vmap[v] is a mesh vertex's
+   * index in the TIN, or -1. Kept vertices stay in insertion order. */
+  vmap = malloc((m->nv ? m->nv : 1) * sizeof *vmap);
+  if (!vmap) {
+    free(ins_err);
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+  }
+  size_t nv = 0;
+  for (size_t v = 0; v < m->nv; v++)
+    vmap[v] = m->v[v].edge >= 0 ? (int32_t)nv++ : -1;
+  for (size_t v = 0; v < m->nv; v++)
+    if (vmap[v] >= 0 && ins_err)
+      ins_err[vmap[v]] = ins_err[v]; /* vmap[v] <= v: in place */
+
+  status = alloc_tin(ctx, nv, m->nlive, &tin);
   if (status != TT_OK) {
     free(ins_err);
+    free(vmap);
     return status;
   }
   tin->v_ins_err = ins_err;
@@ -157,9 +182,11 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   memcpy(tin->gt, g->gt, sizeof tin->gt);
   memcpy(tin->frame, g->frame, sizeof tin->frame);
   for (size_t v = 0; v < m->nv; v++) {
-    tin->vc[v] = m->v[v].c;
-    tin->vr[v] = m->v[v].r;
-    tin->vz[v] = m->v[v].z;
+    if (vmap[v] < 0)
+      continue;
+    tin->vc[vmap[v]] = m->v[v].c;
+    tin->vr[vmap[v]] = m->v[v].r;
+    tin->vz[vmap[v]] = m->v[v].z;
   }
 
   tt_error_stats *es = &tin->summary.errors;
@@ -198,7 +225,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     int32_t s = order[i];
     slot_to_tri[s] = (int32_t)i;
     for (int k = 0; k < 3; k++)
-      tin->tv[3 * i + k] = m->hv[3 * (size_t)s + k];
+      tin->tv[3 * i + k] = vmap[m->hv[3 * (size_t)s + k]];
   }
   /* the scans, in fixed chunks reduced in chunk order: the sums do not
    * depend on the number of threads */
@@ -246,7 +273,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
       tin->v_star_n[v] += tin->t_n[t];
     }
   }
-  for (size_t v = 0; v < m->nv; v++)
+  for (size_t v = 0; v < nv; v++)
     tin->v_star_rmse[v] = tin->v_star_n[v]
                               ? sqrt(tin->v_star_rmse[v] /
                                      (double)tin->v_star_n[v])
@@ -262,7 +289,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     es->max_col = max_index % (int64_t)g->nx;
     es->max_row = max_index / (int64_t)g->nx;
   }
-  tin->summary.vertices = m->nv;
+  tin->summary.vertices = nv;
   tin->summary.triangles = nt;
   tin->summary.grid_width = g->nx;
   tin->summary.grid_height = g->ny;
@@ -275,6 +302,7 @@ done:
   free(first);
   free(slot_to_tri);
   free(t_sq);
+  free(vmap);
   tt_tin_destroy(tin);
   return status;
 }
