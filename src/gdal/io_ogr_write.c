@@ -51,8 +51,8 @@
  * area_2d). Slope, aspect and angles stay those of the ground frame.
  *
  * Each layer's feature and geometry are made once and reused: per feature
- * only field values and coordinates change. Progress is reported about
- * every 1% of the features.
+ * only field values and coordinates change. Progress is reported after
+ * every feature, so an interruption is seen after at most one.
  *
  * Workload: O(vertices + triangles) feature inserts (about 16 us each into
  * GPKG, R-tree included); memory O(1) beyond what the driver buffers.
@@ -123,7 +123,7 @@ typedef struct write_state {
   int geodesic;            /* the output CRS is geographic */
   struct geod_geodesic geod;
   double deg_per_unit;     /* output angular unit in degrees */
-  size_t done, total, next_report, step;
+  size_t done, total;
   double scale;            /* share of the progress range the rows take */
 } write_state;
 
@@ -194,12 +194,14 @@ static tt_status parse_options(write_state *w, char **options)
   return TT_OK;
 }
 
+/* Called after every feature: the callback is asked every time, so a stop
+ * is seen after one feature even with a driver that takes seconds per
+ * feature (LIBKML); a callback that draws does so only as its bar moves. */
 static tt_status report(write_state *w)
 {
   w->done++;
-  if (!w->progress || w->done < w->next_report)
+  if (!w->progress)
     return TT_OK;
-  w->next_report = w->done + w->step;
   if (!w->progress(w->scale * (double)w->done / (double)w->total,
                    "writing", w->progress_arg))
     return tt__error(w->ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
@@ -660,8 +662,6 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   if (s != TT_OK)
     goto done;
   w.total = nv + nt + 1;
-  w.step = (w.total + 99) / 100; /* at most 100 reports for the rows */
-  w.next_report = w.step;
   w.scale = w.build_rtree ? 0.75 : 1.0; /* the R-trees take about a quarter */
   if (progress && !progress(0.0, "writing", progress_arg)) {
     s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
