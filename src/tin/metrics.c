@@ -6,7 +6,9 @@
  * so every valid sample is measured exactly once; a vertex's own sample has
  * error zero and is counted with the triangle its vertex edge belongs to.
  * A vertex's star statistics gather the samples owned by the triangles
- * around it. Cost: O(samples + triangles); memory: the compact tin arrays
+ * around it. A mesh without triangles is refused (TT_ERR_DATA), and mesh
+ * vertices in no triangle are left out of the TIN, so every TIN vertex is a
+ * corner of a triangle (vertex indices keep their insertion order). Cost: O(samples + triangles); memory: the compact tin arrays
  * plus 12 bytes per vertex and 4 per triangle slot while building.
  */
 #include "mesh/raster_scan.h"
