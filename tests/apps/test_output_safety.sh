@@ -357,6 +357,11 @@ refused "generate -overwrite onto a FIFO" generate fault ori/fifo.gpkg \
   -overwrite
 check "the FIFO stays a FIFO (generate)" [ -p ori/fifo.gpkg ]
 check "orientation etc.: no temporary file" no_temp ori
+echo 'PROJCS["WGS 84 / UTM zone 33N",GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["latitude_of_origin",0],PARAMETER["central_meridian",15],PARAMETER["scale_factor",0.9996],PARAMETER["false_easting",500000],PARAMETER["false_northing",0],UNIT["metre",1]]' >ori/crs.prj
+cp ori/crs.prj ori/crs.orig
+refused "generate -overwrite onto its -a_srs file" generate fault \
+  ori/crs.prj -a_srs ori/crs.prj -overwrite
+check "the -a_srs file intact" cmp -s ori/crs.prj ori/crs.orig
 
 # --- 8. non-finite synthetic heights, long names ---------------------------------
 mkdir gen
