@@ -756,9 +756,8 @@ static tt_status commit_single(tt_context *ctx, tt_output *out)
     return tt__error(ctx, TT_ERR_IO, "nothing was written to %s",
                      out->temp_path);
   const int folder = S_ISDIR(tst.st_mode);
-  const char *final_name = out->final_path + strlen(out->dir) + 1;
-  if (strrchr(out->final_path, '/') == NULL)
-    final_name = out->final_path;
+  const char *slash = strrchr(out->final_path, '/');
+  const char *final_name = slash ? slash + 1 : out->final_path;
   if (folder && strchr(final_name + 1, '.'))
     return tt__error(ctx, TT_ERR_FORMAT, "%s: the driver wrote a folder of "
                      "files, not one file; name the output without an "
