@@ -29,6 +29,12 @@ tt_status tt__app_generate(app_run *r)
       goto done;
     }
   }
+  /* generate reads one file: a CRS given as a file name to -a_srs. */
+  if (s->srs && tt__app_same_file(s->srs, s->output)) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
+                      "is the file -a_srs reads; refusing to replace it");
+    goto done;
+  }
   if (!s->overwrite && VSIStatL(s->output, &sb) == 0) {
     st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, s->output,
                   "exists; use -overwrite to replace it");

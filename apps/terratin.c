@@ -7,28 +7,89 @@
  * Signals: SIGINT, SIGTERM and SIGHUP set a flag that the progress callback
  * turns into a stop; the run then removes its temporary files, and main
  * re-raises the signal with its default action so the shell sees the
- * process killed by it (a second signal kills at once). A run that
- * completed before it saw the flag exits 0 with its output in place.
- * SIGPIPE is ignored: a closed stdout must not kill a run halfway through
- * writing a file.
+ * process killed by it. A run that completed before it saw the flag exits 0
+ * with its output in place. SIGPIPE is ignored: a closed stdout must not
+ * kill a run halfway through writing a file.
+ *
+ * A driver can keep the run from calling back for minutes (GDAL's LIBKML
+ * writer, a close that flushes a large file). So the handler also wakes a
+ * watchdog thread through a pipe (write() is async-signal-safe): if the
+ * run has not ended GRACE_MS after the signal (or at a second signal), the
+ * watchdog removes the temporary files of every output not yet committed
+ * (tt_output_abandon_all(), which a mutex orders with the run's own commit)
+ * and ends the process by the signal. An output already committed is let
+ * finish: its run is only printing its summary.
  */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* sigaction; the build sets it elsewhere */
 #endif
 
 #include "terratin_lib.h"
+#include "terratin/terratin_gdal.h"
 
+#include <errno.h>
+#include <poll.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
-/* The one piece of global state: a signal handler can reach nothing else. */
+#define GRACE_MS 500
+
+/* The global state a signal handler and its watchdog need: nothing else
+ * can reach them. */
 static volatile sig_atomic_t caught_signal = 0;
+static int wake_pipe[2] = {-1, -1};
+static atomic_int run_ended = 0;
 
 static void on_signal(int sig)
 {
+  int saved = errno;
   caught_signal = sig;
-  signal(sig, SIG_DFL); /* a second signal ends the process at once */
+  if (wake_pipe[1] >= 0) {
+    ssize_t n = write(wake_pipe[1], "s", 1);
+    (void)n; /* a full pipe has woken the watchdog already */
+  }
+  errno = saved;
+}
+
+static int wait_wake(int timeout_ms)
+{
+  struct pollfd p = {wake_pipe[0], POLLIN, 0};
+  int r;
+  while ((r = poll(&p, 1, timeout_ms)) < 0 && errno == EINTR)
+    ;
+  if (r > 0) {
+    char c;
+    ssize_t n = read(wake_pipe[0], &c, 1);
+    (void)n;
+  }
+  return r > 0;
+}
+
+static void *watchdog(void *arg)
+{
+  (void)arg;
+  /* Signals go to the main thread, as they did before this thread. */
+  sigset_t all;
+  sigfillset(&all);
+  pthread_sigmask(SIG_BLOCK, &all, NULL);
+  wait_wake(-1);
+  if (atomic_load(&run_ended))
+    return NULL;
+  wait_wake(GRACE_MS); /* the run's own stop, or a second signal */
+  if (atomic_load(&run_ended) || !tt_output_abandon_all())
+    return NULL;
+  int sig = (int)caught_signal;
+  static const char msg[] = "terratin: interrupted; nothing written\n";
+  ssize_t n = write(STDERR_FILENO, msg, sizeof msg - 1);
+  (void)n;
+  signal(sig, SIG_DFL);
+  kill(getpid(), sig); /* the main thread takes it: the process ends */
+  sleep(2);
+  _exit(128 + sig);
 }
 
 static void install_handlers(void)
@@ -56,6 +117,9 @@ int main(int argc, char **argv)
   tt_app_term_progress bar;
   (void)argc;
 
+  pthread_t dog;
+  int have_dog = pipe(wake_pipe) == 0 &&
+                 pthread_create(&dog, NULL, watchdog, NULL) == 0;
   install_handlers();
   if (tt_app_options_new(argv + 1, &opts, &res) == TT_OK) {
     tt_app_term_progress_init(
@@ -65,6 +129,12 @@ int main(int argc, char **argv)
     tt_app_run(opts, &res);
     if (bar.fp && bar.ticks >= 0 && bar.ticks < 40)
       fputc('\n', stdout); /* end a bar cut short by a failure */
+  }
+  atomic_store(&run_ended, 1);
+  if (have_dog) {
+    ssize_t n = write(wake_pipe[1], "e", 1);
+    (void)n;
+    pthread_join(dog, NULL);
   }
   fflush(stdout);
   if (res.message[0])

@@ -195,10 +195,18 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
 typedef struct tt_output tt_output;
 
 /* Plans output to `path` in `format` ("GPKG", "ESRI Shapefile", ...).
- * Refuses (TT_ERR_EXISTS) when a final file exists and overwrite is 0, and
- * (TT_ERR_IO) when the folder is not writable. The caller owns *out_output
- * and frees it with tt_output_destroy(), which removes the temporary files
- * unless tt_output_commit() succeeded. */
+ * Refuses (TT_ERR_EXISTS) when a final file exists and overwrite is 0, or
+ * when it is anything overwrite never replaces: a FIFO, device, socket or
+ * symbolic link, a folder other than an earlier output of a driver that
+ * writes folders (only regular `*triangles.*`, `*vertices.*`,
+ * `*run_parameters.*` files in it); (TT_ERR_IO) when the folder is not
+ * writable. GPKG and SQLite: the sidecars PATH-journal, PATH-wal, PATH-shm
+ * count as final files, and TT_ERR_IO refuses an old file that another
+ * process holds open (SQLite's POSIX locks); stale sidecars are removed at
+ * commit, before the new file takes the name. Temporary names are
+ * `.ttXXXXXXXX` (+ the extension) in path's folder. The caller owns
+ * *out_output and frees it with tt_output_destroy(), which removes the
+ * temporary files (folders included) unless tt_output_commit() succeeded. */
 tt_status tt_output_begin(tt_context *ctx, const char *path,
                           const char *format, int overwrite,
                           tt_output **out_output);
@@ -211,11 +219,32 @@ const char *tt_output_final_path(const tt_output *out);
  * `name_triangles.shp`, `name_vertices.shp`, `name_run_parameters.dbf`),
  * "" for any other format. */
 const char *tt_output_layer_prefix(const tt_output *out);
+/* Registers a file the output must never replace or remove (a file the
+ * input is read from), compared by device and inode, and by resolved path
+ * (for names that do not exist, and for files inside a folder output).
+ * Refuses at once (TT_ERR_ARG, naming both) when a planned final name is
+ * that file; commit checks every name it writes again. */
+tt_status tt_output_protect(tt_context *ctx, tt_output *out,
+                            const char *path);
+/* Registers with tt_output_protect() every local file GDAL reads for the
+ * open dataset src opened as `name`: GDALGetFileList() (sidecars, VRT
+ * sources, recursively through nested VRTs), and the containers named in
+ * those paths and in `name` (the archive of /vsizip/, /vsitar/, /vsigzip/
+ * paths, the file of a `GPKG:file:table`-style name). */
+tt_status tt_output_protect_dataset(tt_context *ctx, tt_output *out,
+                                    GDALDatasetH src, const char *name);
 /* Renames the temporary files to their final names (for a shapefile, moves
  * each file of the temporary folder into place; the old files of those
- * names are put back if a move fails). */
+ * names are put back if a move fails). TT_ERR_INTERRUPTED after
+ * tt_output_abandon_all(). */
 tt_status tt_output_commit(tt_context *ctx, tt_output *out);
 void tt_output_destroy(tt_output *out);
+/* Removes the temporary files of every live tt_output of the process that
+ * is not committed, and makes their commit fail: for a watchdog thread
+ * ending a process whose main thread is stuck in a driver. Returns 1 when
+ * no live output was committed, 0 when one was (its run is finishing and
+ * should be let finish). Thread-safe; not async-signal-safe. */
+int tt_output_abandon_all(void);
 
 #ifdef __cplusplus
 }

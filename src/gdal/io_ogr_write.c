@@ -5,7 +5,9 @@
  * shapefile output uses to make `<name>_triangles.shp` etc.):
  *   <prefix>triangles       POLYGON Z, one feature per triangle; the ring is
  *                           v0 v1 v2 v0 (closed, 4 points), counter-clockwise
- *                           in map space as tt_tin_triangle() gives it.
+ *                           in the coordinates written (tt_tin_triangle()'s
+ *                           order, corners 1 and 2 swapped where T_SRS
+ *                           mirrors the plane).
  *                           (The Shapefile driver rewinds outer rings to the
  *                           clockwise order its format prescribes.)
  *   <prefix>vertices        POINT Z, one feature per vertex.
@@ -41,8 +43,8 @@
  * SQLite (several times faster than a feature at a time through OGR).
  *
  * Each layer's feature and geometry are made once and reused: per feature
- * only field values and coordinates change. Progress is reported about
- * every 1% of the features.
+ * only field values and coordinates change. Progress is reported after
+ * every feature, so an interruption is seen after at most one.
  *
  * Workload: O(vertices + triangles) feature inserts (about 16 us each into
  * GPKG, R-tree included); memory O(1) beyond what the driver buffers.
@@ -82,7 +84,7 @@ typedef struct write_state {
   void *progress_arg;
   char *t_srs;             /* T_SRS as given, NULL: none */
   tt__records rec;         /* the layers' CRS, transformed vertices */
-  size_t done, total, next_report, step;
+  size_t done, total;
   double scale;            /* share of the progress range the rows take */
 } write_state;
 
@@ -166,12 +168,14 @@ static tt_status parse_options(write_state *w, char **options)
   return TT_OK;
 }
 
+/* Called after every feature: the callback is asked every time, so a stop
+ * is seen after one feature even with a driver that takes seconds per
+ * feature (LIBKML); a callback that draws does so only as its bar moves. */
 static tt_status report(write_state *w)
 {
   w->done++;
-  if (!w->progress || w->done < w->next_report)
+  if (!w->progress)
     return TT_OK;
-  w->next_report = w->done + w->step;
   if (!w->progress(w->scale * (double)w->done / (double)w->total,
                    "writing", w->progress_arg))
     return tt__error(w->ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
@@ -495,8 +499,6 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   if (s != TT_OK)
     goto done;
   w.total = w.rows_deferred ? 1 : nv + nt + 1;
-  w.step = (w.total + 99) / 100; /* at most 100 reports for the rows */
-  w.next_report = w.step;
   w.scale = w.build_rtree ? 0.75 : 1.0; /* the R-trees take about a quarter */
   if (progress && !progress(0.0, "writing", progress_arg)) {
     s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "

@@ -9,6 +9,9 @@
  * vertices: the triangles themselves (which vertices, which order) do not
  * change.
  *
+ * Winding: every triangle is counter-clockwise in the coordinates written
+ * (its corners 1 and 2 swap where T_SRS mirrors the plane).
+ *
  * Areas: per-triangle area_2d and area_3d come from the TIN (the ground
  * frame, metres) when the output CRS is projected or absent. When it is
  * geographic, area_2d is the geodesic area of the triangle whose corners
@@ -192,6 +195,18 @@ tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
     size_t v = (size_t)t->v[k];
     out_x[k] = r->xy ? r->xy[2 * v] : out_v[k].x;
     out_y[k] = r->xy ? r->xy[2 * v + 1] : out_v[k].y;
+  }
+  /* Counter-clockwise in the coordinates written: T_SRS may mirror the
+   * plane (a CRS whose x axis points west), the TIN's order is that of the
+   * input map. Corners 1 and 2 swap, with their vertices and indices. */
+  if ((out_x[1] - out_x[0]) * (out_y[2] - out_y[0]) -
+          (out_y[1] - out_y[0]) * (out_x[2] - out_x[0]) < 0) {
+    double sx = out_x[1], sy = out_y[1];
+    out_x[1] = out_x[2], out_y[1] = out_y[2], out_x[2] = sx, out_y[2] = sy;
+    tt_vertex_info sv = out_v[1];
+    out_v[1] = out_v[2], out_v[2] = sv;
+    int32_t si = t->v[1];
+    t->v[1] = t->v[2], t->v[2] = si;
   }
   if (r->geodesic) {
     double lats[3], lons[3], area = 0, perimeter = 0;

@@ -54,8 +54,9 @@ TT_HIDDEN tt_status tt__records_init(tt__records *r, tt_context *ctx,
 TT_HIDDEN void tt__records_free(tt__records *r);
 
 /* Triangle i: its record (areas in the output CRS's terms), its three
- * vertices, and their output x, y. TT_ERR_INTERNAL when the TIN cannot
- * give them. */
+ * vertices, and their output x, y, counter-clockwise in those coordinates
+ * (out_t->v in the same order). TT_ERR_INTERNAL when the TIN cannot give
+ * them. */
 TT_HIDDEN tt_status tt__records_triangle(const tt__records *r,
                                          tt_context *ctx, size_t i,
                                          tt_triangle_info *out_t,

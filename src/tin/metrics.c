@@ -6,7 +6,9 @@
  * so every valid sample is measured exactly once; a vertex's own sample has
  * error zero and is counted with the triangle its vertex edge belongs to.
  * A vertex's star statistics gather the samples owned by the triangles
- * around it. Cost: O(samples + triangles); memory: the compact tin arrays
+ * around it. A mesh without triangles is refused (TT_ERR_DATA), and mesh
+ * vertices in no triangle are left out of the TIN, so every TIN vertex is a
+ * corner of a triangle (vertex indices keep their insertion order). Cost: O(samples + triangles); memory: the compact tin arrays
  * plus 12 bytes per vertex and 4 per triangle slot while building.
  */
 #include "mesh/raster_scan.h"
@@ -143,11 +145,36 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   chunk_acc *chunks = NULL;
   size_t *first = NULL;
   double *t_sq = NULL;
+  int32_t *vmap = NULL;
   *out_tin = NULL;
 
-  status = alloc_tin(ctx, m->nv, m->nlive, m->vz != NULL, &tin);
+  /* A TIN without triangles is no surface: refuse it here, where every
+   * caller gets it, rather than write vertices that eval cannot use. */
+  if (m->nlive == 0) {
+    free(ins_err);
+    return tt__error(ctx, TT_ERR_DATA, "no triangle can be made: no grid "
+                     "cell has three valid corners (the valid samples are "
+                     "isolated by nodata)");
+  }
+  /* Vertices in no triangle (the starting corners of a raster whose
+   * corners fall in nodata specks) are dropped: vmap[v] is a mesh vertex's
+   * index in the TIN, or -1. Kept vertices stay in insertion order. */
+  vmap = malloc((m->nv ? m->nv : 1) * sizeof *vmap);
+  if (!vmap) {
+    free(ins_err);
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+  }
+  size_t nv = 0;
+  for (size_t v = 0; v < m->nv; v++)
+    vmap[v] = m->v[v].edge >= 0 ? (int32_t)nv++ : -1;
+  for (size_t v = 0; v < m->nv; v++)
+    if (vmap[v] >= 0 && ins_err)
+      ins_err[vmap[v]] = ins_err[v]; /* vmap[v] <= v: in place */
+
+  status = alloc_tin(ctx, nv, m->nlive, m->vz != NULL, &tin);
   if (status != TT_OK) {
     free(ins_err);
+    free(vmap);
     return status;
   }
   tin->v_ins_err = ins_err;
@@ -160,12 +187,14 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   memcpy(tin->gt, g->gt, sizeof tin->gt);
   memcpy(tin->frame, g->frame, sizeof tin->frame);
   for (size_t v = 0; v < m->nv; v++) {
-    tin->vc[v] = m->v[v].c;
-    tin->vr[v] = m->v[v].r;
+    if (vmap[v] < 0)
+      continue;
+    tin->vc[vmap[v]] = m->v[v].c;
+    tin->vr[vmap[v]] = m->v[v].r;
     if (tin->vzd)
-      tin->vzd[v] = tt__mesh_z(m, (int32_t)v);
+      tin->vzd[vmap[v]] = tt__mesh_z(m, (int32_t)v);
     else
-      tin->vz[v] = m->v[v].z;
+      tin->vz[vmap[v]] = m->v[v].z;
   }
 
   tt_error_stats *es = &tin->summary.errors;
@@ -204,7 +233,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     int32_t s = order[i];
     slot_to_tri[s] = (int32_t)i;
     for (int k = 0; k < 3; k++)
-      tin->tv[3 * i + k] = m->hv[3 * (size_t)s + k];
+      tin->tv[3 * i + k] = vmap[m->hv[3 * (size_t)s + k]];
   }
   /* the scans, in fixed chunks reduced in chunk order: the sums do not
    * depend on the number of threads */
@@ -252,7 +281,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
       tin->v_star_n[v] += tin->t_n[t];
     }
   }
-  for (size_t v = 0; v < m->nv; v++)
+  for (size_t v = 0; v < nv; v++)
     tin->v_star_rmse[v] = tin->v_star_n[v]
                               ? sqrt(tin->v_star_rmse[v] /
                                      (double)tin->v_star_n[v])
@@ -268,7 +297,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     es->max_col = max_index % (int64_t)g->nx;
     es->max_row = max_index / (int64_t)g->nx;
   }
-  tin->summary.vertices = m->nv;
+  tin->summary.vertices = nv;
   tin->summary.triangles = nt;
   tin->summary.grid_width = g->nx;
   tin->summary.grid_height = g->ny;
@@ -281,6 +310,7 @@ done:
   free(first);
   free(slot_to_tri);
   free(t_sq);
+  free(vmap);
   tt_tin_destroy(tin);
   return status;
 }

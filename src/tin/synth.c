@@ -256,6 +256,13 @@ static tt_status synth_check(tt_context *ctx, const tt_synth_options *opt)
     if (!isfinite(opt->wave_size) || opt->wave_size < 0)
       return tt__error(ctx, TT_ERR_ARG, "fault wave size must be finite and "
                        ">= 0 (0: step faults), got %g", opt->wave_size);
+    /* The ramp's phase pi (d + w) / (2 w), d up to the grid's diagonal:
+     * past DBL_MAX / pi, pi (d + w) overflows and every height is NaN
+     * (inf / inf); a quarter of DBL_MAX keeps a margin. */
+    if (opt->wave_size > 0.25 * DBL_MAX)
+      return tt__error(ctx, TT_ERR_LIMIT, "fault wave size %g is too large: "
+                       "the cosine ramp overflows (at most %g)",
+                       opt->wave_size, 0.25 * DBL_MAX);
   } else if (opt->kind == TT_SYNTH_DIAMOND_SQUARE) {
     int levels = synth_ds_levels(opt->nx);
     if (opt->nx != opt->ny || levels < 0)
@@ -568,6 +575,17 @@ tt_status tt_synth_generate(tt_context *ctx, const tt_synth_options *opt,
   }
   if (status != TT_OK)
     goto done;
+  /* The last guard: parameters that pass the checks above but still give
+   * a height that is not finite are refused rather than written. */
+  const float *z = tt_grid_heights_const(grid);
+  for (size_t i = 0; i < opt->nx * opt->ny; i++)
+    if (!isfinite(z[i])) {
+      status = tt__error(ctx, TT_ERR_LIMIT, "%s terrain: the height at "
+                         "column %zu, row %zu is %g; the parameters "
+                         "overflow", tt_synth_kind_name(opt->kind),
+                         i % opt->nx, i / opt->nx, (double)z[i]);
+      goto done;
+    }
 
   *out_grid = grid;
   grid = NULL;

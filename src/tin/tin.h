@@ -1,7 +1,8 @@
 /*
  * tin.h -- the finished TIN (struct tt_tin): compact vertex and triangle
  * arrays with the bookkeeping of the run, built from a mesh by metrics.c
- * and read through the accessors of tin.c. Vertex index = insertion rank.
+ * and read through the accessors of tin.c. Vertex index = insertion rank
+ * among the vertices kept (those in some triangle).
  * Triangles are counter-clockwise in map space (the ground frame keeps the
  * geotransform's orientation, grid.c).
  */

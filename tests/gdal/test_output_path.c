@@ -8,6 +8,11 @@
  * unwritable folders are refused up front (a missing folder and /proc: the
  * tests run as root, where access() ignores permissions); a write abandoned
  * in the middle leaves the old files untouched and no temporary file.
+ * Issue 11: FIFOs, devices and symbolic links are never replaced; a 255-byte
+ * name works; folder outputs (FlatGeobuf) are removed on failure, renamed
+ * into place and replaced only when they hold layer files alone; protected
+ * (input) files are refused under any name; stale SQLite sidecars are
+ * refused or removed; abandoning removes the temporary files.
  */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
@@ -136,7 +141,7 @@ static void test_gpkg(tt_context *ctx)
     return;
   const char *tmp = tt_output_temp_path(out);
   char prefix[400];
-  snprintf(prefix, sizeof prefix, "%s/.tin.tmp-", dir);
+  snprintf(prefix, sizeof prefix, "%s/.tt", dir);
   CHECK(strncmp(tmp, prefix, strlen(prefix)) == 0);
   CHECK(strcmp(tmp + strlen(tmp) - 5, ".gpkg") == 0);
   CHECK(access(tmp, F_OK) != 0);
@@ -269,7 +274,7 @@ static void test_shapefile(tt_context *ctx)
   struct stat st;
   CHECK(stat(tt_output_temp_path(out), &st) == 0 && S_ISDIR(st.st_mode));
   char prefix[400];
-  snprintf(prefix, sizeof prefix, "%s/.tin.tmp-", dir);
+  snprintf(prefix, sizeof prefix, "%s/.tt", dir);
   CHECK(strncmp(tt_output_temp_path(out), prefix, strlen(prefix)) == 0);
   shp_write(out, 1, 0);
   list_dir(dir, listing, sizeof listing);
@@ -373,6 +378,232 @@ static void test_shapefile(tt_context *ctx)
   CHECK_STR_EQ(listing, expect);
 }
 
+/* Issue 11 item 7: -overwrite replaces regular files only (and a folder
+ * output's own folder, below): a FIFO, a symbolic link to /dev/null and a
+ * character device stay. */
+static void test_not_regular(tt_context *ctx)
+{
+  char dir[300], path[400];
+  tt_output *out = NULL;
+  snprintf(dir, sizeof dir, "%s/kinds", tmpdir);
+  mkdir(dir, 0777);
+  snprintf(path, sizeof path, "%s/fifo.gpkg", dir);
+  CHECK(mkfifo(path, 0666) == 0);
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "GPKG", 1, &out), TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), "FIFO") != NULL);
+  CHECK(out == NULL);
+  snprintf(path, sizeof path, "%s/null.gpkg", dir);
+  CHECK(symlink("/dev/null", path) == 0);
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "GPKG", 1, &out), TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), "symbolic link") != NULL);
+  CHECK_INT_EQ(tt_output_begin(ctx, "/dev/null", "GPKG", 1, &out),
+               TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), "character device") != NULL);
+  /* A shapefile layer file that is a FIFO. */
+  snprintf(path, sizeof path, "%s/s_vertices.dbf", dir);
+  CHECK(mkfifo(path, 0666) == 0);
+  snprintf(path, sizeof path, "%s/s.shp", dir);
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "ESRI Shapefile", 1, &out),
+               TT_ERR_EXISTS);
+  char listing[1024];
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "fifo.gpkg null.gpkg s_vertices.dbf");
+  struct stat st;
+  snprintf(path, sizeof path, "%s/fifo.gpkg", dir);
+  CHECK(lstat(path, &st) == 0 && S_ISFIFO(st.st_mode));
+}
+
+/* Issue 11 item 8: a final name of 255 bytes (NAME_MAX) gets a temporary
+ * name it fits beside. */
+static void test_long_name(tt_context *ctx)
+{
+  char dir[300], name[256], path[600], listing[1024];
+  snprintf(dir, sizeof dir, "%s/long", tmpdir);
+  mkdir(dir, 0777);
+  memset(name, 'n', 250);
+  memcpy(name + 250, ".gpkg", 6);
+  CHECK_INT_EQ(strlen(name), 255);
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  static const char *const layers[] = {"vertices", NULL};
+  tt_output *out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "GPKG", 0, &out));
+  if (!out)
+    return;
+  CHECK(strlen(strrchr(tt_output_temp_path(out), '/') + 1) <= 20);
+  write_vector("GPKG", tt_output_temp_path(out), layers, 7, 0);
+  CHECK_OK(ctx, tt_output_commit(ctx, out));
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, name);
+  CHECK_INT_EQ(read_tag(path, "vertices"), 7);
+}
+
+/* Issue 11 item 5: a driver that makes a folder under the temporary name
+ * (FlatGeobuf, MapInfo with several layers): removed on failure; renamed
+ * into place when the name has no extension; -overwrite replaces such a
+ * folder (only layer files in it) but no other folder; a folder under a
+ * name with an extension is refused. */
+static void test_folder_output(tt_context *ctx)
+{
+  char dir[300], path[400], listing[1024], probe[500];
+  snprintf(dir, sizeof dir, "%s/fgb", tmpdir);
+  mkdir(dir, 0777);
+  static const char *const layers[] = {"triangles", "vertices",
+                                       "run_parameters", NULL};
+  snprintf(path, sizeof path, "%s/tin", dir);
+  tt_output *out = NULL;
+  /* A failed write: nothing stays. */
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "FlatGeobuf", 0, &out));
+  if (out)
+    write_vector("FlatGeobuf", tt_output_temp_path(out), layers, 1, 0);
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "");
+  /* A good one, twice: the second with overwrite replaces the folder. */
+  for (int tag = 1; tag <= 2; tag++) {
+    out = NULL;
+    CHECK_OK(ctx, tt_output_begin(ctx, path, "FlatGeobuf", tag == 2, &out));
+    if (!out)
+      return;
+    write_vector("FlatGeobuf", tt_output_temp_path(out), layers, tag, 0);
+    CHECK_OK(ctx, tt_output_commit(ctx, out));
+    tt_output_destroy(out);
+    list_dir(dir, listing, sizeof listing);
+    CHECK_STR_EQ(listing, "tin");
+    snprintf(probe, sizeof probe, "%s/vertices.fgb", path);
+    CHECK_INT_EQ(read_tag(probe, "vertices"), tag);
+  }
+  /* Without overwrite: refused. */
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "FlatGeobuf", 0, &out),
+               TT_ERR_EXISTS);
+  /* A folder holding anything else is not replaced. */
+  snprintf(probe, sizeof probe, "%s/notes.txt", path);
+  FILE *f = fopen(probe, "w");
+  fclose(f);
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "FlatGeobuf", 1, &out),
+               TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), "is a folder") != NULL);
+  /* A folder under a file's name. */
+  snprintf(path, sizeof path, "%s/tin.gpkg", dir);
+  out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "FlatGeobuf", 0, &out));
+  if (out) {
+    write_vector("FlatGeobuf", tt_output_temp_path(out), layers, 3, 0);
+    CHECK_INT_EQ(tt_output_commit(ctx, out), TT_ERR_FORMAT);
+    tt_output_destroy(out);
+  }
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "tin");
+}
+
+/* Issue 11 item 3: a protected file (the input) is never replaced, by
+ * whatever name, nor removed as part of a folder output. */
+static void test_protect(tt_context *ctx)
+{
+  char dir[300], path[400], alias[400], listing[1024];
+  snprintf(dir, sizeof dir, "%s/prot", tmpdir);
+  mkdir(dir, 0777);
+  static const char *const layers[] = {"vertices", NULL};
+  snprintf(path, sizeof path, "%s/dem.gpkg", dir);
+  write_vector("GPKG", path, layers, 1, 0);
+  snprintf(alias, sizeof alias, "%s/../prot/./dem.gpkg", dir);
+  tt_output *out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, alias, "GPKG", 1, &out));
+  CHECK_INT_EQ(tt_output_protect(ctx, out, path), TT_ERR_ARG);
+  CHECK(strstr(tt_context_errmsg(ctx), "input") != NULL);
+  tt_output_destroy(out);
+  /* A hard link is the same file. */
+  snprintf(alias, sizeof alias, "%s/hard.gpkg", dir);
+  CHECK(link(path, alias) == 0);
+  out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "GPKG", 1, &out));
+  CHECK_INT_EQ(tt_output_protect(ctx, out, alias), TT_ERR_ARG);
+  tt_output_destroy(out);
+  unlink(alias);
+  /* An unrelated protected file: the output goes ahead. */
+  snprintf(alias, sizeof alias, "%s/other.gpkg", dir);
+  out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, alias, "GPKG", 0, &out));
+  CHECK_OK(ctx, tt_output_protect(ctx, out, path));
+  if (out)
+    write_vector("GPKG", tt_output_temp_path(out), layers, 2, 0);
+  CHECK_OK(ctx, tt_output_commit(ctx, out));
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "dem.gpkg other.gpkg");
+  CHECK_INT_EQ(read_tag(path, "vertices"), 1);
+}
+
+/* Issue 11 item 2: the SQLite sidecars of the name being replaced. A stale
+ * journal (a crashed writer's) is refused without overwrite and removed
+ * with it before the new file takes the name. (The live-connection case
+ * needs a second process: tests/apps/test_output_safety.sh.) */
+static void test_sqlite_sidecars(tt_context *ctx)
+{
+  char dir[300], path[400], side[420], listing[1024];
+  snprintf(dir, sizeof dir, "%s/side", tmpdir);
+  mkdir(dir, 0777);
+  static const char *const layers[] = {"vertices", NULL};
+  snprintf(path, sizeof path, "%s/tin.gpkg", dir);
+  snprintf(side, sizeof side, "%s-journal", path);
+  FILE *f = fopen(side, "w");
+  fputs("stale", f);
+  fclose(f);
+  tt_output *out = NULL;
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "GPKG", 0, &out), TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), "-journal") != NULL);
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "GPKG", 1, &out));
+  if (!out)
+    return;
+  write_vector("GPKG", tt_output_temp_path(out), layers, 4, 0);
+  CHECK_OK(ctx, tt_output_commit(ctx, out));
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "tin.gpkg");
+  /* A sidecar that is a FIFO is not replaced. */
+  snprintf(side, sizeof side, "%s-wal", path);
+  CHECK(mkfifo(side, 0666) == 0);
+  CHECK_INT_EQ(tt_output_begin(ctx, path, "GPKG", 1, &out), TT_ERR_EXISTS);
+  unlink(side);
+}
+
+/* Issue 11 item 6: tt_output_abandon_all() removes the temporary files of
+ * an uncommitted output (a watchdog thread does it while the main thread
+ * is stuck in a driver), and its commit then fails. */
+static void test_abandon(tt_context *ctx)
+{
+  char dir[300], path[400], listing[1024];
+  snprintf(dir, sizeof dir, "%s/abandon", tmpdir);
+  mkdir(dir, 0777);
+  static const char *const layers[] = {"vertices", NULL};
+  snprintf(path, sizeof path, "%s/tin.gpkg", dir);
+  tt_output *out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "GPKG", 0, &out));
+  if (!out)
+    return;
+  write_vector("GPKG", tt_output_temp_path(out), layers, 5, 0);
+  list_dir(dir, listing, sizeof listing);
+  CHECK(listing[0] != '\0');
+  CHECK_INT_EQ(tt_output_abandon_all(), 1);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "");
+  CHECK_INT_EQ(tt_output_commit(ctx, out), TT_ERR_INTERRUPTED);
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "");
+  /* A committed output is left alone and reported. */
+  out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "GPKG", 0, &out));
+  if (!out)
+    return;
+  write_vector("GPKG", tt_output_temp_path(out), layers, 6, 0);
+  CHECK_OK(ctx, tt_output_commit(ctx, out));
+  CHECK_INT_EQ(tt_output_abandon_all(), 0);
+  tt_output_destroy(out);
+  CHECK_INT_EQ(tt_output_abandon_all(), 1);
+  CHECK_INT_EQ(read_tag(path, "vertices"), 6);
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -386,6 +617,12 @@ int main(void)
   test_gpkg(ctx);
   test_unwritable(ctx);
   test_shapefile(ctx);
+  test_not_regular(ctx);
+  test_long_name(ctx);
+  test_folder_output(ctx);
+  test_protect(ctx);
+  test_sqlite_sidecars(ctx);
+  test_abandon(ctx);
   CPLPopErrorHandler();
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);

@@ -473,6 +473,22 @@ static void test_refusals(tt_context *ctx)
   CHECK_INT_EQ(tt_synth_generate(ctx, &opt, &g), TT_ERR_ARG);
   opt.wave_size = NAN;
   CHECK_INT_EQ(tt_synth_generate(ctx, &opt, &g), TT_ERR_ARG);
+  /* Issue 11 item 8: a finite but huge wave size made every height NaN
+   * (pi (d + w) overflows) and was written with exit 0. */
+  opt.wave_size = 1e308;
+  CHECK_INT_EQ(tt_synth_generate(ctx, &opt, &g), TT_ERR_LIMIT);
+  CHECK(g == NULL);
+  CHECK(strstr(tt_context_errmsg(ctx), "wave size") != NULL);
+  opt.wave_size = 1e300; /* large but fine: finite heights */
+  CHECK_INT_EQ(tt_synth_generate(ctx, &opt, &g), TT_OK);
+  if (g) {
+    size_t bad = 0;
+    for (size_t i = 0; i < opt.nx * opt.ny; i++)
+      bad += !isfinite(tt_grid_heights_const(g)[i]);
+    CHECK_INT_EQ(bad, 0);
+  }
+  tt_grid_destroy(g);
+  g = NULL;
   tt_synth_options_init(&opt, TT_SYNTH_FAULT);
   opt.iterations = (size_t)-1;
   CHECK_INT_EQ(tt_synth_generate(ctx, &opt, &g), TT_ERR_LIMIT);
