@@ -891,3 +891,167 @@ done:
   }
   return ok;
 }
+
+int tt__mesh_star(const tt__mesh *m, int32_t v, int32_t *ring,
+                  int32_t *slots, int max, bool *out_closed)
+{
+  int32_t e0 = m->v[v].edge;
+  if (e0 < 0)
+    return -1;
+  /* turn clockwise (e -> next(twin(e)), both leave v) to the boundary, or
+   * once around */
+  int32_t e = e0;
+  bool closed = true;
+  for (;;) {
+    int32_t f = m->twin[e];
+    if (f < 0) {
+      closed = false;
+      break;
+    }
+    e = tt__next(f);
+    if (e == e0)
+      break;
+  }
+  /* then counter-clockwise: the triangle of e is (v, a, b); the next one
+   * around v holds twin(prev(e)) = v -> b */
+  int n = 0;
+  int32_t start = e;
+  if (n < max)
+    ring[n] = m->hv[tt__next(e)];
+  n++;
+  int nt = 0;
+  for (;;) {
+    if (slots && nt < max)
+      slots[nt] = e / 3;
+    nt++;
+    int32_t b = m->hv[tt__prev(e)];
+    int32_t f = m->twin[tt__prev(e)];
+    if (f < 0) {
+      if (n < max)
+        ring[n] = b;
+      n++;
+      break;
+    }
+    if (f == start)
+      break;
+    if (n < max)
+      ring[n] = b;
+    n++;
+    e = f;
+  }
+  *out_closed = closed;
+  return n;
+}
+
+bool tt__mesh_remove_vertex(tt__mesh *m, int32_t v, const int32_t (*tris)[3],
+                            int ntri)
+{
+  enum { SMALL = 64 };
+  bool ok = false, closed = false;
+  int32_t s_ring[SMALL], s_slot[SMALL], s_otwin[SMALL], s_pair[3 * SMALL];
+  uint8_t s_oflag[SMALL];
+  int32_t *ring = s_ring, *slot = s_slot, *otwin = s_otwin, *pair = s_pair;
+  uint8_t *oflag = s_oflag;
+  int n = tt__mesh_star(m, v, ring, slot, SMALL, &closed);
+  if (n < 0)
+    return false;
+  int nstar = closed ? n : n - 1;
+  if (ntri != n - 2 || ntri < 1)
+    return false;
+  if (n > SMALL) {
+    ring = malloc((size_t)n * sizeof *ring);
+    slot = malloc((size_t)n * sizeof *slot);
+    otwin = malloc((size_t)n * sizeof *otwin);
+    oflag = malloc((size_t)n);
+    pair = malloc(3 * (size_t)ntri * sizeof *pair);
+    if (!ring || !slot || !otwin || !oflag || !pair)
+      goto done;
+    (void)tt__mesh_star(m, v, ring, slot, n, &closed);
+  }
+  /* the hole's outline: link edge i runs ring[i] -> ring[i + 1] (opposite
+   * v in star triangle i), with its outside twin and flag; for an open
+   * star, edge n - 1 is the new boundary edge ring[n-1] -> ring[0] */
+  for (int i = 0; i < nstar; i++) {
+    int32_t t = slot[i], e = -1;
+    for (int k = 0; k < 3; k++)
+      if (m->hv[3 * t + k] == v)
+        e = tt__next(3 * t + k);
+    otwin[i] = m->twin[e];
+    oflag[i] = m->eflag[e];
+  }
+  if (!closed) {
+    otwin[n - 1] = -1;
+    int32_t out = -1; /* v's outgoing boundary edge, in star triangle 0 */
+    for (int k = 0; k < 3; k++)
+      if (m->hv[3 * slot[0] + k] == v)
+        out = 3 * slot[0] + k;
+    oflag[n - 1] = m->eflag[out];
+  }
+  /* pair each new half-edge with its reverse among the new ones or with
+   * the outline edge it replaces; each outline edge once */
+  int nhalf = 3 * ntri, used = 0;
+  for (int h = 0; h < nhalf; h++) {
+    int32_t a = tris[h / 3][h % 3], b = tris[h / 3][(h % 3 + 1) % 3];
+    pair[h] = -1;
+    for (int g = 0; g < nhalf && pair[h] == -1; g++)
+      if (g != h && tris[g / 3][g % 3] == b &&
+          tris[g / 3][(g % 3 + 1) % 3] == a)
+        pair[h] = g;
+    for (int i = 0; i < n && pair[h] == -1; i++)
+      if (ring[i] == a && ring[(i + 1) % n] == b)
+        pair[h] = -2 - i;
+    if (pair[h] == -1)
+      goto done;
+    used += pair[h] <= -2;
+  }
+  for (int h = 0; h < nhalf; h++) {
+    if (pair[h] >= 0 && pair[pair[h]] != h)
+      goto done;
+    for (int g = 0; g < h && pair[h] <= -2; g++)
+      if (pair[g] == pair[h])
+        goto done;
+  }
+  if (used != n)
+    goto done;
+  for (int t = 0; t < ntri; t++)
+    if (tris[t][0] == tris[t][1] || tris[t][1] == tris[t][2] ||
+        tris[t][2] == tris[t][0] ||
+        tt__mesh_orient(m, tris[t][0], tris[t][1], tris[t][2]) <= 0)
+      goto done;
+  if (!tt__grow((void **)&m->touched, &m->touchedcap,
+                m->ntouched + (size_t)ntri, sizeof(int32_t)) ||
+      !tt__grow((void **)&m->freelist, &m->freecap,
+                m->nfree + (size_t)nstar, sizeof(int32_t)))
+    goto done;
+  /* write: ntri < nstar, so the star's slots suffice */
+  for (int i = 0; i < nstar; i++) {
+    bump_slot(m, slot[i]);
+    m->hv[3 * slot[i]] = -1;
+    m->nlive--;
+  }
+  m->v[v].edge = -1;
+  bump(m, v);
+  for (int t = 0; t < ntri; t++) {
+    set_triangle(m, slot[t], tris[t][0], tris[t][1], tris[t][2]);
+    bump_slot(m, slot[t]);
+  }
+  for (int i = ntri; i < nstar; i++)
+    m->freelist[m->nfree++] = slot[i];
+  for (int h = 0; h < nhalf; h++) {
+    int32_t e = 3 * slot[h / 3] + h % 3;
+    if (pair[h] >= 0)
+      link(m, e, 3 * slot[pair[h] / 3] + pair[h] % 3, 0);
+    else
+      link(m, e, otwin[-2 - pair[h]], oflag[-2 - pair[h]]);
+  }
+  ok = true;
+done:
+  if (ring != s_ring) {
+    free(ring);
+    free(slot);
+    free(otwin);
+    free(oflag);
+    free(pair);
+  }
+  return ok;
+}
