@@ -65,7 +65,7 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * feet), gives the grid a local metric ground frame chosen with PROJ: the
  * Jacobian at the grid's centre of pixel -> UTM zone of the centre (or
  * WORK_SRS) coordinates; metric projected CRSs keep the geotransform's
- * frame unless WORK_SRS is given (src/georef_proj.c; info->frame_name says
+ * frame unless WORK_SRS is given (src/gdal/georef_proj.c; info->frame_name says
  * which frame). Heights are never changed by the frame. Unless the user set
  * GDAL_CACHEMAX, GDAL's block cache limit (process-wide) is lowered to a
  * few MiB during the read and restored after.

@@ -21,10 +21,9 @@ static void place(tt__heap *h, size_t i, tt__heap_entry x)
 
 /* A 4-ary heap: children of i are 4i+1 .. 4i+4, parent (i-1)/4. Half the
  * depth of a binary heap, and the four children of a node (16 bytes each)
- * lie in one or two 64-byte cache lines (malloc aligns e to 16 bytes;
- * placing e[1] on a line so that every group fits one was tried and
- * measured no gain on a 4097^2 run): sift-downs touch fewer lines, which
- * matters once the heap (16 bytes a triangle) outgrows the caches. */
+ * lie in one or two 64-byte cache lines (malloc aligns e to 16 bytes):
+ * sift-downs touch fewer lines, which matters once the heap (16 bytes a
+ * triangle) outgrows the caches. */
 #define ARITY 4
 
 static void sift_up(tt__heap *h, size_t i)

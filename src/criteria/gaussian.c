@@ -34,7 +34,7 @@
  * pair in the star's cyclic order with an O(d) proof of its result, else
  * gift wrapping (hull_wrap). Classes, hull rays and so the bits of |K| are
  * those of testing every pair against every ray and gift wrapping
- * (tests/core/test_gaussian_speed.c checks it against that reference).
+ * (tests/criteria/test_gaussian_speed.c checks it against that reference).
  * Swap value: sum |K| over the quad's four vertices before minus after
  * (the stars of those four change: a and b lose the diagonal, c and d gain
  * the new one); positive when the swap lowers the sum. Differences below
@@ -56,35 +56,11 @@
  * Cost: per star d square roots, one atan2 (angle sums as arguments of
  * complex products, below), d triple products for the t_i, d - 2 more per
  * candidate pair tested, about 3d for a mixed star's hull (and a second
- * atan2); eight stars per swap value. In greedy insertion with Lawson
- * flips from the new vertex (Crater Lake, 25 %: 166,000 values, about 4.3
- * per insertion) the star in the mesh is found in the cache about three
- * times in four, the edited star of the other configuration never (it only
- * comes back when the swap is taken): five stars computed per value, of
- * mean degree 6.8; 65 % of them mixed, 17 % convex, 17 % saddle. A star
- * costs about 2,700 instructions (callgrind; 3,090 under the O(d^2) tests
- * and gift wrapping this replaced), spread over its parts: loading the
- * rays and the angles' cross products and roots, the serial turn products
- * and atan2, the sign tests, the hull: none dominates (measured in wall
- * clock by doing work twice: the other configuration's four stars, 27 %
- * of the run; only their rays and angle terms, 5 %).
- * The star versions (cache, below) took the walks around the stars from
- * four per value to one (662,000 to 175,000 at 25 %), 6 % of the run's
- * time with the same meshes. Gaussian greedy insertion runs 3.9 to 4.8
- * times Delaunay's (Crater Lake and a 1025^2 fractal, 10 to 50 %). The
- * other configuration's four stars are the part that could go: replayed
- * from a recording of a full run (the same flips, so the same work
- * otherwise, thread CPU time in one process), the run takes 2.6 / 2.9 /
- * 2.9 times Delaunay's on Crater Lake at 10 / 25 / 50 % and 2.6 / 2.5 on
- * the fractal at 10 / 25 %, against 3.6 / 4.7 / 4.5 and 4.1 / 4.0 computed.
- * So the 3x goal needs those stars nearly free -- derived from the cached
- * ones (an angle sum changed by three corner angles in fixed point, so
- * that sums stay exact; the class and hull kept when the edited ray is
- * inside the hull), a redesign of this file's definitions -- and the rest
- * of a value cheaper as well. (Not the walks left: deriving the stars
- * around a new vertex from their entries at the split took them from
- * 175,000 to 25,000 and saved no time -- those stars lie around the
- * triangles just written, already in cache.)
+ * atan2); eight stars per swap value, of which the star in the mesh mostly
+ * comes from the cache and the four of the other configuration never do
+ * (they only come back when the swap is taken). Those four stars are the
+ * bulk of the criterion's cost; docs/criteria.md gives the measurements and
+ * what a cheaper design would need.
  */
 #include "criteria/geometry.h"
 

@@ -7,11 +7,10 @@
  * |H - H'| (raster_scan.c); candidates sit in an indexed max-heap keyed by
  * that error -- those above max_error only: one within it can never be
  * taken, and at the end most triangles are such (keeping them out makes
- * the heap small and its misses fewer: 8-9 % of the run on fractal DEMs of
- * 1025^2 and 4097^2, same meshes). Repeat: take the worst candidate, check
- * the stop conditions, insert it (split its triangle, or the edge it lies
- * on), restore the criterion around it by flips (swap.c), and rescan only
- * the triangles the mesh logged as written.
+ * the heap small and its misses fewer). Repeat: take the worst candidate,
+ * check the stop conditions, insert it (split its triangle, or the edge it
+ * lies on), restore the criterion around it by flips (swap.c), and rescan
+ * only the triangles the mesh logged as written.
  *
  * Stop conditions (the first reached wins, and each is exact): the worst
  * error is <= max_error; one more vertex would pass max_points (or the

@@ -13,7 +13,7 @@
  *  - libFuzzer: define TT_FUZZ_LIBFUZZER and link with -fsanitize=fuzzer,
  *    e.g. with a clang build of the libraries in /tmp/build-fuzz:
  *      clang -DTT_FUZZ_LIBFUZZER -fsanitize=fuzzer,address,undefined \
- *        -Iinclude -Iapps -I/usr/include/gdal tests/gdal/test_fuzz_options.c \
+ *        -Iinclude -Iapps -I/usr/include/gdal tests/apps/test_fuzz_options.c \
  *        /tmp/build-fuzz/libterratin_app.a /tmp/build-fuzz/libterratin_gdal.a \
  *        /tmp/build-fuzz/libterratin.a -lgdal -lproj -lm -o fuzz_options
  *      ./fuzz_options tests/corpus/options

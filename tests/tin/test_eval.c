@@ -1,5 +1,5 @@
 /*
- * test_eval.c -- tt_eval_triangles (src/eval.c): planes reproduced exactly,
+ * test_eval.c -- tt_eval_triangles (src/tin/eval.c): planes reproduced exactly,
  * hand-computed errors, coverage, overlap and degenerate counts, the 1e-9
  * pixel tolerance, nodata, refusals, and random soups on random grids
  * against a brute-force oracle that tests every sample against every

@@ -1,5 +1,5 @@
 /*
- * test_synth.c -- the synthetic terrains (src/synth.c): reproducibility,
+ * test_synth.c -- the synthetic terrains (src/tin/synth.c): reproducibility,
  * the study's default sizes, known values of the functions, the fault
  * displacement arithmetic, diamond-square sizes and seeding, refusals.
  */

@@ -1,0 +1,189 @@
+/*
+ * app.h -- what the files of the terratin command share (internal; the
+ * public face is terratin_lib.h): the options object, a run's state, the
+ * one-line failure helpers, the phase-scaled progress, the JSON writer, and
+ * one entry point per subcommand.
+ *
+ *   options.c   the option table, parsing, the options object
+ *   help.c      the help texts
+ *   run.c       tt_app_run, GDAL messages, failures, opening and reading
+ *               the DEM, choosing the output driver
+ *   progress.c  the text progress bar and the phase scaling
+ *   report.c    the JSON writer and simplify's summary and JSON
+ *   simplify.c, generate.c, eval.c   one file per subcommand
+ *
+ * Invariants: a run reports at most one failure (the first), as one line;
+ * every run either commits its output or leaves nothing behind; GDAL never
+ * prints by itself while a run is active.
+ */
+#ifndef TERRATIN_APP_H
+#define TERRATIN_APP_H
+
+/* GDAL's VSIStatBufL is a struct stat64 on glibc: declare it. */
+#define _LARGEFILE64_SOURCE 1
+
+#include "terratin_lib.h"
+
+#include "terratin/terratin_gdal.h"
+
+#include <cpl_error.h>
+#include <gdal.h>
+
+#include <stdint.h>
+#include <stdio.h>
+
+#if defined(__GNUC__)
+#define TT_APP_PRINTF_(a, b) __attribute__((format(printf, a, b)))
+#else
+#define TT_APP_PRINTF_(a, b)
+#endif
+
+/* --- the options object (options.c) -------------------------------------- */
+
+/* A NULL-terminated list of owned strings. */
+typedef struct app_strlist {
+  char **v;
+  size_t n, cap;
+} app_strlist;
+
+struct tt_app_options {
+  tt_app_settings s;     /* the public view; strings point into the lists */
+  app_strlist strings;   /* every single string (input, output, -of, ...) */
+  app_strlist config, lco, dsco;
+  tt_progress_fn progress;
+  void *progress_arg;
+  FILE *out, *err;
+};
+
+/* "simplify", "generate", "eval" or "" (help.c). */
+const char *tt__app_command_name(tt_app_command c);
+
+/* --- results and messages (run.c) ---------------------------------------- */
+
+/* Seconds of a monotonic clock (the app's own; the engine keeps its own). */
+double tt__app_now(void);
+/* Fills a result, keeping the first failure: later ones are consequences. */
+void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
+                        const char *fmt, ...) TT_APP_PRINTF_(4, 5);
+void tt__app_result_ok(tt_app_result *res);
+int tt__app_str_ieq(const char *a, const char *b);
+
+/* GDAL's failures and warnings while a run is active (run.c). */
+typedef struct app_messages {
+  FILE *err;
+  size_t warnings;           /* printed or dropped */
+  unsigned failures;         /* GDAL failures seen */
+  char last[TT_APP_MESSAGE_MAX];
+} app_messages;
+
+/* Prints "terratin: warning: ..." (at most a fixed number per run). */
+void tt__app_warn(app_messages *m, const char *fmt, ...) TT_APP_PRINTF_(2, 3);
+
+/* --- progress (progress.c) ----------------------------------------------- */
+
+/* Maps a phase's [0,1] onto [lo,hi] of the whole run and passes it on. */
+typedef struct app_phase {
+  tt_progress_fn fn;
+  void *arg;
+  double lo, hi;
+} app_phase;
+
+/* A tt_progress_fn; arg is an app_phase. */
+int tt__app_phase_fn(double complete, const char *message, void *arg);
+void tt__app_phase_set(app_phase *p, double lo, double hi);
+
+/* --- a run: what every subcommand shares (run.c) ------------------------- */
+
+typedef struct app_run {
+  const tt_app_options *o;
+  const tt_app_settings *s;
+  tt_app_result *res;
+  FILE *out, *err;
+  tt_context *ctx;
+  app_messages msg;
+  app_phase prog;
+  double t0;
+} app_run;
+
+/* Records the run's failure "<file>: <problem>" (or "<problem>" when file
+ * is NULL) and returns st. */
+tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
+                       const char *file, const char *fmt, ...)
+    TT_APP_PRINTF_(5, 6);
+/* The best one-line explanation of a failed engine or glue call about file
+ * (the context's message, GDAL's last failure, or the status's). */
+const char *tt__app_why(app_run *r, tt_status st, const char *file);
+/* Fails with the glue's or engine's message about file. */
+tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file);
+/* An output refused because something exists in its way. */
+tt_status tt__app_fail_exists(app_run *r, const char *output);
+/* Polls the progress callback between phases: 0 means stop. */
+int tt__app_continue(app_run *r, double at);
+
+/* Opens a raster for reading and checks the band; on failure explains in
+ * one line why and returns NULL. */
+GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
+                                 GDALRasterBandH *out_band);
+/* Reads the band into a grid (with -srcnodata, -z_factor, -z_unit,
+ * -work_srs) and checks it has valid samples. The caller owns *out_grid and
+ * *out_info. */
+tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
+                           tt_progress_fn progress, void *progress_arg,
+                           tt_grid **out_grid, tt_raster_info **out_info,
+                           size_t *out_valid);
+void tt__app_height_range(const tt_grid *grid, double *out_min,
+                          double *out_max);
+const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
+const char *tt__app_nonempty_or_null(const char *s);
+/* "2026-11-22T10:38:55Z" */
+void tt__app_iso8601_utc(char *buf, size_t size);
+/* The output driver of simplify: -of, else OUTPUT's extension, else GPKG. */
+GDALDriverH tt__app_output_driver(app_run *r);
+/* Whether two paths name the same existing file. */
+int tt__app_same_file(const char *a, const char *b);
+
+/* --- JSON (report.c) ----------------------------------------------------- */
+
+/* One object, strings escaped, non-finite numbers as null, bytes that are
+ * not UTF-8 replaced by U+FFFD so the output always parses. */
+typedef struct app_json {
+  FILE *fp;
+  int depth;
+  int first[8];
+} app_json;
+
+/* The shortest "%.Ng" text of d (N = 6..17) that reads back as d. */
+void tt__app_format_double(char *buf, size_t size, double d);
+void tt__json_begin(app_json *j, FILE *fp);
+void tt__json_open(app_json *j, const char *key);
+void tt__json_close(app_json *j);
+void tt__json_str(app_json *j, const char *key, const char *v);
+void tt__json_num(app_json *j, const char *key, double v);
+void tt__json_size(app_json *j, const char *key, size_t v);
+void tt__json_i64(app_json *j, const char *key, int64_t v);
+void tt__json_bool(app_json *j, const char *key, int v);
+void tt__json_null(app_json *j, const char *key);
+
+/* What simplify reports, as text or JSON (report.c). */
+typedef struct app_simplify_report {
+  const tt_raster_info *info;
+  const char *driver;
+  size_t cells, valid;
+  double zmin, zmax;
+  const tt_refine_options *ropt;
+  int default_error;            /* max_error came from the 0.5% rule */
+  tt_tin_summary sum;
+  double t_read, t_simplify, t_write, t_total;
+} app_simplify_report;
+
+void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p);
+void tt__app_print_simplify_summary(app_run *r,
+                                    const app_simplify_report *p);
+
+/* --- the subcommands ----------------------------------------------------- */
+
+tt_status tt__app_simplify(app_run *r);  /* simplify.c */
+tt_status tt__app_generate(app_run *r);  /* generate.c */
+tt_status tt__app_eval(app_run *r);      /* eval.c */
+
+#endif /* TERRATIN_APP_H */

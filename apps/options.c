@@ -1,0 +1,701 @@
+/*
+ * options.c -- the command line of terratin: one table of options (which
+ * option applies to which subcommand, whether it takes a value), the parser
+ * that turns the words after the program name into a tt_app_options object,
+ * and the object's accessors.
+ *
+ * Invariants: parsing has no side effects beyond the options object (GDAL is
+ * not touched: --config is applied by tt_app_run); --help and --version win
+ * over anything else on the line; a usage error is one line naming the word
+ * at fault and the help page to read.
+ *
+ * Workload: a single pass over a few dozen words.
+ */
+#include "app.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static int strlist_add(app_strlist *l, const char *s)
+{
+  if (l->n + 2 > l->cap) {
+    size_t cap = l->cap ? 2 * l->cap : 8;
+    char **v = realloc(l->v, cap * sizeof *v);
+    if (!v)
+      return 0;
+    l->v = v;
+    l->cap = cap;
+  }
+  char *copy = malloc(strlen(s) + 1);
+  if (!copy)
+    return 0;
+  strcpy(copy, s);
+  l->v[l->n++] = copy;
+  l->v[l->n] = NULL;
+  return 1;
+}
+
+static void strlist_free(app_strlist *l)
+{
+  for (size_t i = 0; i < l->n; i++)
+    free(l->v[i]);
+  free(l->v);
+  l->v = NULL;
+  l->n = l->cap = 0;
+}
+
+static const char *const empty_list[] = {NULL};
+
+void tt_app_options_destroy(tt_app_options *o)
+{
+  if (!o)
+    return;
+  strlist_free(&o->strings);
+  strlist_free(&o->config);
+  strlist_free(&o->lco);
+  strlist_free(&o->dsco);
+  free(o);
+}
+
+const tt_app_settings *tt_app_options_settings(const tt_app_options *o)
+{
+  return o ? &o->s : NULL;
+}
+
+void tt_app_options_set_progress(tt_app_options *o, tt_progress_fn fn,
+                                 void *arg)
+{
+  if (!o)
+    return;
+  o->progress = fn;
+  o->progress_arg = arg;
+}
+
+void tt_app_options_set_streams(tt_app_options *o, FILE *out, FILE *err)
+{
+  if (!o)
+    return;
+  o->out = out ? out : stdout;
+  o->err = err ? err : stderr;
+}
+
+int tt_app_options_wants_progress_bar(const tt_app_options *o)
+{
+  return o && o->s.command == TT_APP_SIMPLIFY && !o->s.quiet && !o->s.json;
+}
+
+/* ===========================================================================
+ * Parsing
+ * ========================================================================= */
+
+/* A finite double, the whole word. */
+static int parse_double(const char *w, double *out)
+{
+  char *end = NULL;
+  if (!*w || strchr(" \t\n", w[0]))
+    return 0;
+  errno = 0;
+  double d = strtod(w, &end);
+  if (end == w || *end != '\0' || errno == ERANGE || !isfinite(d))
+    return 0;
+  *out = d;
+  return 1;
+}
+
+/* An unsigned decimal integer, the whole word, no sign, no overflow. */
+static int parse_u64(const char *w, uint64_t *out)
+{
+  uint64_t v = 0;
+  if (!*w)
+    return 0;
+  for (const char *p = w; *p; p++) {
+    if (*p < '0' || *p > '9')
+      return 0;
+    unsigned d = (unsigned)(*p - '0');
+    if (v > (UINT64_MAX - d) / 10)
+      return 0;
+    v = v * 10 + d;
+  }
+  *out = v;
+  return 1;
+}
+
+static int parse_size(const char *w, size_t *out)
+{
+  uint64_t v;
+  if (!parse_u64(w, &v) || v > (uint64_t)SIZE_MAX)
+    return 0;
+  *out = (size_t)v;
+  return 1;
+}
+
+/* Which option applies to which command: one table, so the parser, the
+ * error messages and the tests agree. */
+enum opt_id {
+  O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
+  O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_OPTIMIZE, O_REPAIR, O_JSON,
+  O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE,
+  O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
+  O_Z_UNIT, O_WORK_SRS, O_T_SRS
+};
+
+#define FOR_S (1u << TT_APP_SIMPLIFY)
+#define FOR_G (1u << TT_APP_GENERATE)
+#define FOR_E (1u << TT_APP_EVAL)
+
+static const struct opt_def {
+  const char *name;
+  enum opt_id id;
+  int takes_value;
+  unsigned commands;
+} opt_defs[] = {
+    {"-b", O_B, 1, FOR_S | FOR_E},
+    {"-max_error", O_MAX_ERROR, 1, FOR_S | FOR_E},
+    {"-max_points", O_MAX_POINTS, 1, FOR_S},
+    {"-max_triangles", O_MAX_TRIANGLES, 1, FOR_S},
+    {"-percent", O_PERCENT, 1, FOR_S},
+    {"-of", O_OF, 1, FOR_S},
+    {"-f", O_OF, 1, FOR_S}, /* ogr2ogr's spelling */
+    {"-lco", O_LCO, 1, FOR_S},
+    {"-dsco", O_DSCO, 1, FOR_S},
+    {"-nln", O_NLN, 1, FOR_S},
+    {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G},
+    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E},
+    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E},
+    {"-criterion", O_CRITERION, 1, FOR_S},
+    {"-optimize", O_OPTIMIZE, 1, FOR_S},
+    {"-repair", O_REPAIR, 1, FOR_S},
+    {"-json", O_JSON, 0, FOR_S | FOR_E},
+    {"-layer", O_LAYER, 1, FOR_E},
+    {"-size", O_SIZE, 1, FOR_G},
+    {"-seed", O_SEED, 1, FOR_G},
+    {"-iterations", O_ITERATIONS, 1, FOR_G},
+    {"-displacement", O_DISPLACEMENT, 1, FOR_G},
+    {"-wave_size", O_WAVE_SIZE, 1, FOR_G},
+    {"-roughness", O_ROUGHNESS, 1, FOR_G},
+    {"-amplitude", O_AMPLITUDE, 1, FOR_G},
+    {"-seeding", O_SEEDING, 1, FOR_G},
+    {"-a_srs", O_A_SRS, 1, FOR_G},
+    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E},
+    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E},
+    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E},
+    {"-work_srs", O_WORK_SRS, 1, FOR_S},
+    {"-t_srs", O_T_SRS, 1, FOR_S},
+};
+
+static const struct opt_def *find_opt(const char *w)
+{
+  for (size_t i = 0; i < sizeof opt_defs / sizeof opt_defs[0]; i++)
+    if (tt__app_str_ieq(w, opt_defs[i].name))
+      return &opt_defs[i];
+  /* GDAL accepts --of as well as -of for its own options: do the same. */
+  if (w[0] == '-' && w[1] == '-' && w[2] != '\0')
+    return find_opt(w + 1);
+  return NULL;
+}
+
+/* What generate was told, applied after tt_synth_options_init(kind). */
+typedef struct synth_flags {
+  int size, seed, iterations, displacement, wave_size, roughness, amplitude,
+      seeding;
+  size_t nx, ny;
+  uint64_t seed_value;
+  size_t iterations_value;
+  double displacement_value, wave_size_value, roughness_value,
+      amplitude_value;
+  tt_synth_seeding seeding_value;
+} synth_flags;
+
+static int parse_grid_size(const char *w, size_t *nx, size_t *ny)
+{
+  const char *x = strpbrk(w, "xX");
+  char buf[64];
+  if (strlen(w) >= sizeof buf)
+    return 0;
+  if (!x)
+    return parse_size(w, nx) && (*ny = *nx, 1);
+  memcpy(buf, w, (size_t)(x - w));
+  buf[x - w] = '\0';
+  return parse_size(buf, nx) && parse_size(x + 1, ny);
+}
+
+static int is_pow2_plus1(size_t n)
+{
+  size_t m = n - 1;
+  return n >= 3 && (m & (m - 1)) == 0;
+}
+
+#define USAGE(...)                                                             \
+  do {                                                                         \
+    tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG, __VA_ARGS__);       \
+    st = TT_ERR_ARG;                                                           \
+    goto done;                                                                 \
+  } while (0)
+
+#define NOMEM()                                                                \
+  do {                                                                         \
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM,                 \
+                       "out of memory");                                       \
+    st = TT_ERR_NOMEM;                                                         \
+    goto done;                                                                 \
+  } while (0)
+
+static int is_help_word(const char *w)
+{
+  return tt__app_str_ieq(w, "--help") || tt__app_str_ieq(w, "-help") ||
+         tt__app_str_ieq(w, "-h") || tt__app_str_ieq(w, "-?");
+}
+
+static const char *keep(tt_app_options *o, const char *w)
+{
+  if (!strlist_add(&o->strings, w))
+    return NULL;
+  return o->strings.v[o->strings.n - 1];
+}
+
+tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
+                             tt_app_result *out_result)
+{
+  tt_app_result local;
+  tt_app_result *res = out_result ? out_result : &local;
+  tt_status st = TT_OK;
+  tt_context *ctx = NULL;
+  const char *pos[3] = {NULL, NULL, NULL};
+  size_t npos = 0;
+  synth_flags sf;
+  const char *cmdname = "";
+  char hint[64] = "";
+  memset(&sf, 0, sizeof sf);
+  tt__app_result_ok(res);
+  if (out_options)
+    *out_options = NULL;
+
+  tt_app_options *o = calloc(1, sizeof *o);
+  if (!o || !(ctx = tt_context_create()))
+    NOMEM();
+  o->out = stdout;
+  o->err = stderr;
+  o->s.command = TT_APP_NONE;
+  o->s.band = 1;
+  o->s.z_factor = 1.0;
+  o->s.max_error = -1.0;
+  o->s.criterion = TT_CRITERION_DELAUNAY;
+  o->s.nln = "";
+  o->s.config = empty_list;
+  o->s.lco = empty_list;
+  o->s.dsco = empty_list;
+
+  if (!argv)
+    argv = (char **)empty_list;
+
+  /* --help and --version win over anything else on the line, even over an
+   * error earlier in it, as in GDAL's utilities: a user who asks for help
+   * gets it. The command word, if any, picks the help page. */
+  int want_help = 0, want_version = 0;
+  tt_app_command first_cmd = TT_APP_NONE;
+  for (size_t i = 0; argv[i]; i++) {
+    const char *w = argv[i];
+    if (is_help_word(w))
+      want_help = 1;
+    else if (tt__app_str_ieq(w, "--version"))
+      want_version = 1;
+    else if (first_cmd == TT_APP_NONE && w[0] != '-') {
+      if (tt__app_str_ieq(w, "simplify")) first_cmd = TT_APP_SIMPLIFY;
+      else if (tt__app_str_ieq(w, "generate")) first_cmd = TT_APP_GENERATE;
+      else if (tt__app_str_ieq(w, "eval")) first_cmd = TT_APP_EVAL;
+      else if (tt__app_str_ieq(w, "help")) { want_help = 1; continue; }
+      if (first_cmd == TT_APP_NONE)
+        break; /* an unknown command: reported below */
+    }
+    /* skip the values of the global options */
+    if (tt__app_str_ieq(w, "--config")) {
+      size_t skip = (argv[i + 1] && strchr(argv[i + 1], '=')) ? 1 : 2;
+      for (size_t k = 0; k < skip && argv[i + 1]; k++)
+        i++;
+    } else if (tt__app_str_ieq(w, "--debug") && argv[i + 1]) {
+      i++;
+    }
+  }
+  if (want_help) {
+    o->s.command = TT_APP_HELP;
+    o->s.help_topic = first_cmd;
+    goto done;
+  }
+  if (want_version) {
+    o->s.command = TT_APP_VERSION;
+    goto done;
+  }
+
+  for (size_t i = 0; argv[i]; i++) {
+    const char *w = argv[i];
+    const char *v = NULL;
+
+    /* Global options, before or after the command word. */
+    if (tt__app_str_ieq(w, "--config")) {
+      const char *k = argv[i + 1];
+      if (!k)
+        USAGE("--config needs KEY VALUE");
+      const char *eq = strchr(k, '=');
+      if (eq == k)
+        USAGE("--config: empty KEY in '%s'", k);
+      if (eq) {
+        /* --config KEY=VALUE (GDAL >= 3.9 accepts it too) */
+        char *key = malloc((size_t)(eq - k) + 1);
+        if (!key)
+          NOMEM();
+        memcpy(key, k, (size_t)(eq - k));
+        key[eq - k] = '\0';
+        int ok = strlist_add(&o->config, key) &&
+                 strlist_add(&o->config, eq + 1);
+        free(key);
+        if (!ok)
+          NOMEM();
+        i += 1;
+      } else {
+        if (!argv[i + 2])
+          USAGE("--config %s needs a VALUE", k);
+        if (!*k)
+          USAGE("--config needs a non-empty KEY");
+        if (!strlist_add(&o->config, k) ||
+            !strlist_add(&o->config, argv[i + 2]))
+          NOMEM();
+        i += 2;
+      }
+      continue;
+    }
+    if (tt__app_str_ieq(w, "--debug")) {
+      if (!argv[i + 1])
+        USAGE("--debug needs a value: on or off");
+      if (!strlist_add(&o->config, "CPL_DEBUG") ||
+          !strlist_add(&o->config, argv[i + 1]))
+        NOMEM();
+      i += 1;
+      continue;
+    }
+
+    if (o->s.command == TT_APP_NONE) {
+      if (w[0] == '-' && w[1] != '\0')
+        USAGE("unknown option '%s' before the command; expected simplify, "
+              "generate or eval (see 'terratin --help')", w);
+      if (tt__app_str_ieq(w, "simplify")) o->s.command = TT_APP_SIMPLIFY;
+      else if (tt__app_str_ieq(w, "generate")) o->s.command = TT_APP_GENERATE;
+      else if (tt__app_str_ieq(w, "eval")) o->s.command = TT_APP_EVAL;
+      else
+        USAGE("unknown command '%s'; expected simplify, generate or eval "
+              "(see 'terratin --help')", w);
+      cmdname = tt__app_command_name(o->s.command);
+      snprintf(hint, sizeof hint, " (see 'terratin %s --help')", cmdname);
+      continue;
+    }
+
+    /* "-" alone and negative numbers are positional words. */
+    const struct opt_def *d = NULL;
+    double dummy;
+    if (w[0] == '-' && w[1] != '\0' && !parse_double(w, &dummy)) {
+      d = find_opt(w);
+      if (!d)
+        USAGE("%s: unknown option '%s'%s", cmdname, w, hint);
+      if (!(d->commands & (1u << o->s.command)))
+        USAGE("%s: option %s does not apply to this command%s", cmdname,
+              d->name, hint);
+      if (d->takes_value) {
+        v = argv[i + 1];
+        if (!v)
+          USAGE("%s: option %s needs a value%s", cmdname, d->name, hint);
+        i++;
+      }
+    } else {
+      if (npos >= 2)
+        USAGE("%s: unexpected argument '%s'%s", cmdname, w, hint);
+      pos[npos++] = w;
+      continue;
+    }
+
+    size_t z;
+    double x;
+    uint64_t u;
+    switch (d->id) {
+    case O_B:
+      if (!parse_size(v, &z) || z < 1 || z > INT_MAX)
+        USAGE("%s: -b must be a band number >= 1, got '%s'", cmdname, v);
+      o->s.band = (int)z;
+      break;
+    case O_MAX_ERROR:
+      if (!parse_double(v, &x) || x < 0)
+        USAGE("%s: -max_error must be a finite number >= 0 (z units), got "
+              "'%s'", cmdname, v);
+      o->s.max_error = x + 0.0; /* -0 reads as "no limit" to the engine */
+      break;
+    case O_MAX_POINTS:
+      if (!parse_size(v, &z) || z < 1)
+        USAGE("%s: -max_points must be an integer >= 1, got '%s'", cmdname,
+              v);
+      if (z > TT_MAX_VERTICES)
+        USAGE("%s: -max_points %s is above the limit of %zu vertices",
+              cmdname, v, (size_t)TT_MAX_VERTICES);
+      o->s.max_points = z;
+      break;
+    case O_MAX_TRIANGLES:
+      if (!parse_size(v, &z) || z < 1)
+        USAGE("%s: -max_triangles must be an integer >= 1, got '%s'",
+              cmdname, v);
+      if (z > 2 * TT_MAX_VERTICES)
+        USAGE("%s: -max_triangles %s is above the limit of %zu triangles "
+              "(twice the %zu vertices a TIN may have)", cmdname, v,
+              2 * (size_t)TT_MAX_VERTICES, (size_t)TT_MAX_VERTICES);
+      o->s.max_triangles = z;
+      break;
+    case O_PERCENT:
+      if (!parse_double(v, &x) || !(x > 0 && x <= 100))
+        USAGE("%s: -percent must be in (0, 100], got '%s'", cmdname, v);
+      o->s.percent = x;
+      break;
+    case O_OF:
+      if (!*v)
+        USAGE("%s: -of needs a driver name%s", cmdname, hint);
+      if (!(o->s.format = keep(o, v)))
+        NOMEM();
+      break;
+    case O_LCO:
+    case O_DSCO: {
+      const char *eq = strchr(v, '=');
+      if (!eq || eq == v)
+        USAGE("%s: %s expects NAME=VALUE, got '%s'", cmdname,
+              d->id == O_LCO ? "-lco" : "-dsco", v);
+      if (!strlist_add(d->id == O_LCO ? &o->lco : &o->dsco, v))
+        NOMEM();
+      break;
+    }
+    case O_NLN:
+      if (!(o->s.nln = keep(o, v)))
+        NOMEM();
+      break;
+    case O_OVERWRITE: o->s.overwrite = 1; break;
+    case O_Q: o->s.quiet = 1; break;
+    case O_JSON: o->s.json = 1; break;
+    case O_CRITERION: {
+      tt_criterion c;
+      if (tt_criterion_parse(ctx, v, &c) != TT_OK) {
+        /* The engine's list, so new criteria show up here by themselves. */
+        char known[256] = "";
+        size_t n = 0;
+        for (int k = 0; k < 64 && n < sizeof known; k++) {
+          const char *name = tt_criterion_name((tt_criterion)k);
+          if (!name)
+            break;
+          n += (size_t)snprintf(known + n, sizeof known - n, "%s%s",
+                                k ? ", " : "", name);
+        }
+        USAGE("%s: unknown -criterion '%s'; known: %s", cmdname, v, known);
+      }
+      o->s.criterion = c;
+      break;
+    }
+    case O_OPTIMIZE:
+      if (tt_optimize_parse(ctx, v, &o->s.optimize) != TT_OK)
+        USAGE("%s: unknown -optimize '%s'; known: local, lookahead, none, "
+              "auto", cmdname, v);
+      break;
+    case O_REPAIR:
+      if (tt_repair_parse(ctx, v, &o->s.repair) != TT_OK)
+        USAGE("%s: unknown -repair '%s'; known: flip, local, lookahead, "
+              "delaunay, auto", cmdname, v);
+      break;
+    case O_LAYER:
+      if (!*v)
+        USAGE("%s: -layer needs a layer name", cmdname);
+      if (!(o->s.layer = keep(o, v)))
+        NOMEM();
+      break;
+    case O_SIZE:
+      if (!parse_grid_size(v, &sf.nx, &sf.ny) || sf.nx < 2 || sf.ny < 2 ||
+          sf.nx > TT_MAX_GRID_SIDE || sf.ny > TT_MAX_GRID_SIDE)
+        USAGE("%s: -size must be N or NXxNY with sides >= 2, got '%s'",
+              cmdname, v);
+      if (sf.nx > SIZE_MAX / sf.ny ||
+          sf.nx * sf.ny > (size_t)1 << 31)
+        USAGE("%s: -size '%s' is too large (at most 2^31 samples)", cmdname,
+              v);
+      sf.size = 1;
+      break;
+    case O_SEED:
+      if (!parse_u64(v, &u))
+        USAGE("%s: -seed must be an unsigned integer, got '%s'", cmdname, v);
+      sf.seed = 1;
+      sf.seed_value = u;
+      break;
+    case O_ITERATIONS:
+      if (!parse_size(v, &z) || z < 1)
+        USAGE("%s: -iterations must be an integer >= 1, got '%s'", cmdname,
+              v);
+      sf.iterations = 1;
+      sf.iterations_value = z;
+      break;
+    case O_DISPLACEMENT:
+      if (!parse_double(v, &x) || x < 0)
+        USAGE("%s: -displacement must be a finite number >= 0, got '%s'",
+              cmdname, v);
+      sf.displacement = 1;
+      sf.displacement_value = x;
+      break;
+    case O_WAVE_SIZE:
+      if (!parse_double(v, &x) || x < 0)
+        USAGE("%s: -wave_size must be a finite number >= 0, got '%s'",
+              cmdname, v);
+      sf.wave_size = 1;
+      sf.wave_size_value = x;
+      break;
+    case O_ROUGHNESS:
+      if (!parse_double(v, &x) || x <= 0)
+        USAGE("%s: -roughness must be a finite number > 0, got '%s'",
+              cmdname, v);
+      sf.roughness = 1;
+      sf.roughness_value = x;
+      break;
+    case O_AMPLITUDE:
+      if (!parse_double(v, &x) || x < 0)
+        USAGE("%s: -amplitude must be a finite number >= 0, got '%s'",
+              cmdname, v);
+      sf.amplitude = 1;
+      sf.amplitude_value = x;
+      break;
+    case O_SEEDING:
+      sf.seeding = 1;
+      if (tt__app_str_ieq(v, "none")) sf.seeding_value = TT_SEED_NONE;
+      else if (tt__app_str_ieq(v, "peak")) sf.seeding_value = TT_SEED_PEAK;
+      else if (tt__app_str_ieq(v, "valley")) sf.seeding_value = TT_SEED_VALLEY;
+      else if (tt__app_str_ieq(v, "hybrid")) sf.seeding_value = TT_SEED_HYBRID;
+      else
+        USAGE("%s: -seeding must be none, peak, valley or hybrid, got '%s'",
+              cmdname, v);
+      break;
+    case O_SRCNODATA:
+      if (!tt__app_str_ieq(v, "nan") && !parse_double(v, &x))
+        USAGE("%s: -srcnodata must be a number or nan, got '%s'", cmdname,
+              v);
+      if (!(o->s.srcnodata = keep(o, v)))
+        NOMEM();
+      break;
+    case O_Z_FACTOR:
+      if (!parse_double(v, &x) || x == 0)
+        USAGE("%s: -z_factor must be a finite non-zero number, got '%s'",
+              cmdname, v);
+      o->s.z_factor = x;
+      o->s.z_factor_set = 1;
+      break;
+    case O_Z_UNIT:
+      if (!tt__app_str_ieq(v, "m"))
+        USAGE("%s: -z_unit must be m (heights in ft or us-ft converted to "
+              "metres), got '%s'", cmdname, v);
+      o->s.z_unit = "m";
+      break;
+    case O_WORK_SRS:
+    case O_T_SRS:
+      if (!*v)
+        USAGE("%s: %s needs a CRS (EPSG:n, WKT, ...)", cmdname, d->name);
+      if (!(*(d->id == O_WORK_SRS ? &o->s.work_srs : &o->s.t_srs) =
+                keep(o, v)))
+        NOMEM();
+      break;
+    case O_A_SRS:
+      if (!*v)
+        USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);
+      if (!(o->s.srs = keep(o, v)))
+        NOMEM();
+      break;
+    }
+  }
+
+  switch (o->s.command) {
+  case TT_APP_NONE:
+    USAGE("missing command: simplify, generate or eval (see 'terratin "
+          "--help')");
+  case TT_APP_SIMPLIFY:
+    if (npos < 1)
+      USAGE("simplify: missing INPUT and OUTPUT%s", hint);
+    if (npos < 2)
+      USAGE("simplify: missing OUTPUT after '%s'%s", pos[0], hint);
+    if (!(o->s.input = keep(o, pos[0])) || !(o->s.output = keep(o, pos[1])))
+      NOMEM();
+    break;
+  case TT_APP_EVAL:
+    if (npos < 1)
+      USAGE("eval: missing DEM and TIN%s", hint);
+    if (npos < 2)
+      USAGE("eval: missing TIN after '%s'%s", pos[0], hint);
+    if (!(o->s.input = keep(o, pos[0])) || !(o->s.tin = keep(o, pos[1])))
+      NOMEM();
+    break;
+  case TT_APP_GENERATE: {
+    tt_synth_kind kind;
+    if (npos < 1)
+      USAGE("generate: missing TYPE and OUTPUT%s", hint);
+    if (tt_synth_kind_parse(ctx, pos[0], &kind) != TT_OK)
+      USAGE("generate: unknown TYPE '%s'; expected fault, diamond_square, "
+            "sphere, cylinder or bump", pos[0]);
+    if (npos < 2)
+      USAGE("generate: missing OUTPUT after '%s'%s", pos[0], hint);
+    if (!(o->s.output = keep(o, pos[1])))
+      NOMEM();
+    const char *kname = tt_synth_kind_name(kind);
+    if (!kname)
+      kname = pos[0];
+    if (kind != TT_SYNTH_FAULT &&
+        (sf.iterations || sf.displacement || sf.wave_size))
+      USAGE("generate: -%s applies to fault terrains only, not %s",
+            sf.iterations ? "iterations"
+                          : sf.displacement ? "displacement" : "wave_size",
+            kname);
+    if (kind != TT_SYNTH_DIAMOND_SQUARE &&
+        (sf.roughness || sf.amplitude || sf.seeding))
+      USAGE("generate: -%s applies to diamond_square terrains only, not %s",
+            sf.roughness ? "roughness"
+                         : sf.amplitude ? "amplitude" : "seeding",
+            kname);
+    tt_synth_options_init(&o->s.synth, kind);
+    if (sf.size) {
+      o->s.synth.nx = sf.nx;
+      o->s.synth.ny = sf.ny;
+    }
+    if (kind == TT_SYNTH_DIAMOND_SQUARE &&
+        (o->s.synth.nx != o->s.synth.ny || !is_pow2_plus1(o->s.synth.nx)))
+      USAGE("generate: diamond_square needs a square size 2^n+1 (e.g. 129, "
+            "257, 513), got %zux%zu", o->s.synth.nx, o->s.synth.ny);
+    if (sf.seed) o->s.synth.seed = sf.seed_value;
+    if (sf.iterations) o->s.synth.iterations = sf.iterations_value;
+    if (sf.displacement) o->s.synth.displacement = sf.displacement_value;
+    if (sf.wave_size) o->s.synth.wave_size = sf.wave_size_value;
+    if (sf.roughness) o->s.synth.roughness = sf.roughness_value;
+    if (sf.amplitude) o->s.synth.amplitude = sf.amplitude_value;
+    if (sf.seeding) o->s.synth.seeding = sf.seeding_value;
+    break;
+  }
+  default:
+    break;
+  }
+
+done:
+  if (o) {
+    if (o->config.n)
+      o->s.config = (const char *const *)o->config.v;
+    if (o->lco.n)
+      o->s.lco = (const char *const *)o->lco.v;
+    if (o->dsco.n)
+      o->s.dsco = (const char *const *)o->dsco.v;
+  }
+  tt_context_destroy(ctx);
+  if (st != TT_OK) {
+    tt_app_options_destroy(o);
+    return st;
+  }
+  if (out_options)
+    *out_options = o;
+  else
+    tt_app_options_destroy(o);
+  return TT_OK;
+}

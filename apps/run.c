@@ -1,0 +1,579 @@
+/*
+ * run.c -- tt_app_run() and what every subcommand shares: the result and
+ * its one-line failure, GDAL's messages while a run is active (failures
+ * stored, warnings printed as "terratin: warning: ..."), opening the DEM and
+ * reading it into a grid, choosing the output driver.
+ *
+ * Invariants: a run reports at most one failure (the first; later ones are
+ * consequences); GDAL never prints by itself while a run is active (a pushed
+ * CPL error handler catches everything); --config options are applied
+ * before any driver is registered or file opened.
+ */
+#include "app.h"
+
+#include <cpl_conv.h>
+#include <cpl_string.h>
+#include <cpl_vsi.h>
+#include <ogr_srs_api.h>
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+
+/* Seconds of a monotonic clock (the app's own; the engine keeps its own). */
+double tt__app_now(void)
+{
+  struct timespec ts;
+  if (clock_gettime(CLOCK_MONOTONIC, &ts) != 0)
+    return 0.0;
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
+                       const char *fmt, ...) TT_APP_PRINTF_(4, 5);
+
+/* Fills a result, keeping the first failure: later ones are consequences. */
+void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
+                       const char *fmt, ...)
+{
+  if (!res || res->exit_code != TT_APP_EXIT_OK)
+    return;
+  res->exit_code = exit_code;
+  res->status = status;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(res->message, sizeof res->message, fmt, ap);
+  va_end(ap);
+  /* One line: fold any newline GDAL or a driver put into a message. */
+  for (char *p = res->message; *p; p++)
+    if (*p == '\n' || *p == '\r')
+      *p = ' ';
+}
+
+void tt__app_result_ok(tt_app_result *res)
+{
+  if (!res)
+    return;
+  res->exit_code = TT_APP_EXIT_OK;
+  res->status = TT_OK;
+  res->message[0] = '\0';
+}
+
+int tt__app_str_ieq(const char *a, const char *b)
+{
+  return strcasecmp(a, b) == 0;
+}
+
+/* ===========================================================================
+ * GDAL messages and engine warnings
+ *
+ * While a run is active a CPL error handler is pushed: failures are stored
+ * (the run turns them into its one-line message, so the user never sees
+ * GDAL's line and ours), warnings are printed as "terratin: warning: ..."
+ * (at most MAX_WARNINGS, then one line saying the rest were dropped), debug
+ * messages (only emitted with CPL_DEBUG on) pass through.
+ * ========================================================================= */
+
+#define MAX_WARNINGS 20
+
+static void one_line(char *s)
+{
+  for (; *s; s++)
+    if (*s == '\n' || *s == '\r')
+      *s = ' ';
+}
+
+void tt__app_warn(app_messages *m, const char *fmt, ...) TT_APP_PRINTF_(2, 3);
+
+void tt__app_warn(app_messages *m, const char *fmt, ...)
+{
+  char buf[TT_APP_MESSAGE_MAX];
+  va_list ap;
+  m->warnings++;
+  if (m->warnings > MAX_WARNINGS + 1)
+    return;
+  if (m->warnings == MAX_WARNINGS + 1) {
+    fprintf(m->err, "terratin: warning: further warnings are not shown\n");
+    return;
+  }
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  one_line(buf);
+  fprintf(m->err, "terratin: warning: %s\n", buf);
+}
+
+static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
+                                        const char *msg)
+{
+  app_messages *m = CPLGetErrorHandlerUserData();
+  (void)num;
+  if (!m || !msg)
+    return;
+  if (cls == CE_Debug) {
+    fprintf(m->err, "terratin: debug: %s\n", msg);
+  } else if (cls == CE_Warning) {
+    tt__app_warn(m, "%s", msg);
+  } else if (cls != CE_None) {
+    m->failures++;
+    snprintf(m->last, sizeof m->last, "%s", msg);
+    one_line(m->last);
+  }
+}
+
+static void on_engine_warning(void *user, const char *message)
+{
+  tt__app_warn(user, "%s", message);
+}
+
+/* ===========================================================================
+ * A run: what every subcommand shares
+ * ========================================================================= */
+
+tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
+                          const char *file, const char *fmt, ...)
+    TT_APP_PRINTF_(5, 6);
+
+/* Records the run's failure "<file>: <problem>" (or "<problem>"). */
+tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
+                          const char *file, const char *fmt, ...)
+{
+  char buf[TT_APP_MESSAGE_MAX];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (file)
+    tt__app_result_set(r->res, exit_code, st, "%s: %s", file, buf);
+  else
+    tt__app_result_set(r->res, exit_code, st, "%s", buf);
+  return st;
+}
+
+/* The best one-line explanation of a failed engine or glue call: the
+ * context's message, else GDAL's last failure, else the status's generic
+ * message. A leading "<file>: " or "<file> " is dropped, the caller puts
+ * the file first ("out.gpkg exists and is a folder" reads
+ * "out.gpkg: exists and is a folder"). */
+const char *tt__app_why(app_run *r, tt_status st, const char *file)
+{
+  const char *m = tt_context_errmsg(r->ctx);
+  if (!m || !*m)
+    m = r->msg.last;
+  if (!m || !*m)
+    m = tt_status_message(st);
+  size_t n = file ? strlen(file) : 0;
+  if (n && strncmp(m, file, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
+    m += n + 2;
+  else if (n && strncmp(m, file, n) == 0 && m[n] == ' ' && m[n + 1])
+    m += n + 1;
+  return m;
+}
+
+/* Fails with the glue's or engine's message about file. */
+tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file)
+{
+  if (st == TT_ERR_INTERRUPTED)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file,
+                    "interrupted; nothing written");
+  if (st == TT_ERR_NOMEM)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "out of memory");
+  return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s",
+                      tt__app_why(r, st, file));
+}
+
+/* An output refused because something exists: name the file that is in
+ * the way (for a shapefile, one of the layer files), and the way out. */
+tt_status tt__app_fail_exists(app_run *r, const char *output)
+{
+  static const char tail[] = " exists; not overwriting it without permission";
+  const char *m = tt_context_errmsg(r->ctx);
+  size_t n = m ? strlen(m) : 0, t = sizeof tail - 1;
+  if (n > t && strcmp(m + n - t, tail) == 0)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, NULL,
+                    "%.*s: exists; use -overwrite to replace it",
+                    (int)(n - t), m);
+  if (m && *m)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, output, "%s",
+                    tt__app_why(r, TT_ERR_EXISTS, output));
+  return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, output,
+                  "exists; use -overwrite to replace it");
+}
+
+/* Polls the progress callback outside the phases that report progress, so
+ * an interruption is seen between steps too. */
+int tt__app_continue(app_run *r, double at)
+{
+  if (!r->o->progress)
+    return 1;
+  return r->o->progress(at, NULL, r->o->progress_arg);
+}
+
+static void apply_config(const tt_app_settings *s)
+{
+  for (size_t i = 0; s->config[i] && s->config[i + 1]; i += 2)
+    CPLSetConfigOption(s->config[i], s->config[i + 1]);
+}
+
+/* Opens a raster for reading and checks the band; on failure explains in
+ * one line why: missing, a folder, empty, a vector dataset, unreadable. */
+GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
+                                GDALRasterBandH *out_band)
+{
+  VSIStatBufL sb;
+  *out_band = NULL;
+  r->msg.last[0] = '\0';
+  GDALDatasetH ds = GDALOpenEx(path, GDAL_OF_RASTER | GDAL_OF_READONLY |
+                                         GDAL_OF_VERBOSE_ERROR,
+                               NULL, NULL, NULL);
+  if (!ds) {
+    char gdal_msg[TT_APP_MESSAGE_MAX];
+    snprintf(gdal_msg, sizeof gdal_msg, "%s", r->msg.last);
+    int stat_ok = VSIStatL(path, &sb) == 0;
+    if (!stat_ok && !strchr(path, ':') && strncmp(path, "/vsi", 4) != 0) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path,
+               "no such file or directory");
+      return NULL;
+    }
+    if (stat_ok && VSI_ISDIR(sb.st_mode)) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+               "is a folder, not a raster");
+      return NULL;
+    }
+    if (stat_ok && VSI_ISREG(sb.st_mode) && sb.st_size == 0) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+               "is an empty file, not a raster");
+      return NULL;
+    }
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    GDALDatasetH vec = GDALOpenEx(path, GDAL_OF_VECTOR | GDAL_OF_READONLY,
+                                  NULL, NULL, NULL);
+    CPLPopErrorHandler();
+    if (vec) {
+      GDALDriverH drv = GDALGetDatasetDriver(vec);
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+               "is a vector dataset (%s), not a raster",
+               drv ? GDALGetDriverShortName(drv) : "?");
+      GDALClose(vec);
+      return NULL;
+    }
+    if (gdal_msg[0] && !strstr(gdal_msg, "not recognized"))
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+               "cannot be opened as a raster: %s", gdal_msg);
+    else
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+               "not a raster format GDAL can read");
+    return NULL;
+  }
+  int nbands = GDALGetRasterCount(ds);
+  if (nbands < 1) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+             "has no raster band");
+    GDALClose(ds);
+    return NULL;
+  }
+  if (band > nbands) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, path,
+             "-b %d: the raster has %d band%s", band, nbands,
+             nbands == 1 ? "" : "s");
+    GDALClose(ds);
+    return NULL;
+  }
+  int w = GDALGetRasterXSize(ds), h = GDALGetRasterYSize(ds);
+  if (w < 2 || h < 2) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, path,
+             "raster is %dx%d; at least 2x2 samples are needed", w, h);
+    GDALClose(ds);
+    return NULL;
+  }
+  *out_band = GDALGetRasterBand(ds, band);
+  return ds;
+}
+
+/* Reads the band into a grid and checks it has usable samples. */
+tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
+                          tt_progress_fn progress, void *progress_arg,
+                          tt_grid **out_grid, tt_raster_info **out_info,
+                          size_t *out_valid)
+{
+  tt_grid *grid = NULL;
+  tt_raster_info *info = NULL;
+  size_t valid = 0;
+  char **ropts = NULL;
+  if (r->s->srcnodata)
+    ropts = CSLSetNameValue(ropts, "SRCNODATA", r->s->srcnodata);
+  if (r->s->z_factor != 1.0 || r->s->z_factor_set) {
+    char num[40];
+    tt__app_format_double(num, sizeof num, r->s->z_factor);
+    ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
+  }
+  if (r->s->z_unit)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", r->s->z_unit);
+  if (r->s->work_srs)
+    ropts = CSLSetNameValue(ropts, "WORK_SRS", r->s->work_srs);
+  r->msg.last[0] = '\0';
+  tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
+                                   progress_arg, &grid, &info);
+  CSLDestroy(ropts);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, path);
+    goto done;
+  }
+  st = tt_grid_check(r->ctx, grid, &valid);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, path);
+    goto done;
+  }
+  if (valid == 0) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, path,
+                  "band %d has no valid samples (all nodata)", r->s->band);
+    goto done;
+  }
+done:
+  if (st != TT_OK) {
+    tt_grid_destroy(grid);
+    tt_raster_info_destroy(info);
+    grid = NULL;
+    info = NULL;
+  }
+  *out_grid = grid;
+  *out_info = info;
+  *out_valid = valid;
+  return st;
+}
+
+void tt__app_height_range(const tt_grid *grid, double *out_min,
+                         double *out_max)
+{
+  const float *z = tt_grid_heights_const(grid);
+  size_t n = tt_grid_width(grid) * tt_grid_height(grid);
+  double lo = INFINITY, hi = -INFINITY;
+  for (size_t i = 0; i < n; i++) {
+    if (isnan(z[i]))
+      continue;
+    if (z[i] < lo) lo = z[i];
+    if (z[i] > hi) hi = z[i];
+  }
+  *out_min = lo;
+  *out_max = hi;
+}
+
+const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt)
+{
+  return info && info->z_unit && *info->z_unit ? info->z_unit : dflt;
+}
+
+const char *tt__app_nonempty_or_null(const char *s)
+{
+  return s && *s ? s : NULL;
+}
+
+/* "2026-11-22T10:38:55Z" */
+void tt__app_iso8601_utc(char *buf, size_t size)
+{
+  time_t now = time(NULL);
+  struct tm tm;
+  if (!gmtime_r(&now, &tm) ||
+      strftime(buf, size, "%Y-%m-%dT%H:%M:%SZ", &tm) == 0)
+    snprintf(buf, size, "unknown");
+}
+
+static int driver_can_create_vector(GDALDriverH drv)
+{
+  return GDALGetMetadataItem(drv, GDAL_DCAP_VECTOR, NULL) &&
+         GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL);
+}
+
+/* Whether the space-separated list holds ext (case-insensitive). */
+static int ext_in_list(const char *list, const char *ext)
+{
+  size_t n = strlen(ext);
+  const char *p = list;
+  while (p && *p) {
+    while (*p == ' ')
+      p++;
+    const char *e = strchr(p, ' ');
+    size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (len == n && strncasecmp(p, ext, n) == 0)
+      return 1;
+    p = e;
+  }
+  return 0;
+}
+
+/* Drivers whose datasets tt_output cannot keep safe: they write no file
+ * (Memory, database connections), or they put each further layer in a file
+ * of its own beside OUTPUT (CSV), outside the temporary name, where it could
+ * replace a file without -overwrite and survive a failure. */
+static int refuse_driver(app_run *r, GDALDriverH drv)
+{
+  const char *name = GDALGetDriverShortName(drv);
+  if (!GDALGetMetadataItem(drv, GDAL_DMD_EXTENSIONS, NULL) &&
+      !GDALGetMetadataItem(drv, GDAL_DMD_EXTENSION, NULL)) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: -of '%s': the driver does not write files", name);
+    return 1;
+  }
+  if (tt__app_str_ieq(name, "CSV")) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: -of CSV writes each layer to a file of its own "
+             "beside OUTPUT, which cannot be written safely; use GPKG, "
+             "SQLite or \"ESRI Shapefile\"");
+    return 1;
+  }
+  return 0;
+}
+
+/* The output driver: -of, else the first vector driver that can create and
+ * claims OUTPUT's extension (GPKG and ESRI Shapefile first), else GPKG. */
+GDALDriverH tt__app_output_driver(app_run *r)
+{
+  const char *of = r->s->format;
+  if (of) {
+    GDALDriverH drv = GDALGetDriverByName(of);
+    if (!drv) {
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+               "simplify: -of '%s': no such GDAL driver (see 'ogrinfo "
+               "--formats')", of);
+      return NULL;
+    }
+    if (!driver_can_create_vector(drv)) {
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+               "simplify: -of '%s': the driver cannot create vector "
+               "datasets", of);
+      return NULL;
+    }
+    return refuse_driver(r, drv) ? NULL : drv;
+  }
+  char ext[32] = "";
+  const char *base = strrchr(r->s->output, '/');
+  base = base ? base + 1 : r->s->output;
+  const char *dot = strrchr(base, '.');
+  if (dot && dot[1] && strlen(dot + 1) < sizeof ext)
+    snprintf(ext, sizeof ext, "%s", dot + 1);
+  if (ext[0]) {
+    static const char *const preferred[] = {"GPKG", "ESRI Shapefile"};
+    for (size_t i = 0; i < 2; i++) {
+      GDALDriverH drv = GDALGetDriverByName(preferred[i]);
+      if (drv && driver_can_create_vector(drv) &&
+          ext_in_list(GDALGetMetadataItem(drv, GDAL_DMD_EXTENSIONS, NULL),
+                      ext))
+        return drv;
+    }
+    for (int i = 0; i < GDALGetDriverCount(); i++) {
+      GDALDriverH drv = GDALGetDriver(i);
+      if (!driver_can_create_vector(drv))
+        continue;
+      const char *exts = GDALGetMetadataItem(drv, GDAL_DMD_EXTENSIONS, NULL);
+      if (!exts)
+        exts = GDALGetMetadataItem(drv, GDAL_DMD_EXTENSION, NULL);
+      if (exts && ext_in_list(exts, ext))
+        return refuse_driver(r, drv) ? NULL : drv;
+    }
+  }
+  GDALDriverH drv = GDALGetDriverByName("GPKG");
+  if (!drv || !driver_can_create_vector(drv)) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, NULL,
+             "simplify: this GDAL has no GPKG driver; choose one with -of");
+    return NULL;
+  }
+  if (ext[0])
+    tt__app_warn(&r->msg, "%s: no vector driver claims the extension '.%s'; "
+                  "writing a GeoPackage (use -of to choose)",
+         r->s->output, ext);
+  return drv;
+}
+
+/* Whether two paths name the same existing file. */
+int tt__app_same_file(const char *a, const char *b)
+{
+  struct stat sa, sb;
+  return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+         sa.st_ino == sb.st_ino;
+}
+
+/* ===========================================================================
+ * Running
+ * ========================================================================= */
+
+static void print_version(FILE *out)
+{
+  int maj = 0, min = 0, pat = 0;
+  OSRGetPROJVersion(&maj, &min, &pat);
+  fprintf(out, "terratin %s (%s; PROJ %d.%d.%d)\n", tt_version(),
+          GDALVersionInfo("--version"), maj, min, pat);
+}
+
+tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
+{
+  tt_app_result local;
+  tt_app_result *res = out_result ? out_result : &local;
+  app_run r;
+  tt_status st = TT_OK;
+  tt__app_result_ok(res);
+  if (!o) {
+    tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG, "no options");
+    return TT_ERR_ARG;
+  }
+  memset(&r, 0, sizeof r);
+  r.o = o;
+  r.s = &o->s;
+  r.res = res;
+  r.out = o->out ? o->out : stdout;
+  r.err = o->err ? o->err : stderr;
+  r.msg.err = r.err;
+  r.prog.fn = o->progress;
+  r.prog.arg = o->progress_arg;
+  r.t0 = tt__app_now();
+
+  switch (o->s.command) {
+  case TT_APP_HELP:
+    fputs(tt_app_help(o->s.help_topic), r.out);
+    fflush(r.out);
+    return TT_OK;
+  case TT_APP_VERSION:
+    print_version(r.out);
+    fflush(r.out);
+    return TT_OK;
+  case TT_APP_SIMPLIFY:
+  case TT_APP_GENERATE:
+  case TT_APP_EVAL:
+    break;
+  default:
+    tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+               "missing command: simplify, generate or eval");
+    return TT_ERR_ARG;
+  }
+
+  /* Configuration first, so that GDAL_SKIP, GDAL_DRIVER_PATH and friends
+   * apply to the drivers registered and to every file opened. */
+  apply_config(&o->s);
+  CPLPushErrorHandlerEx(on_gdal_message, &r.msg);
+  GDALAllRegister();
+  r.ctx = tt_context_create();
+  if (!r.ctx) {
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, "out of memory");
+    st = TT_ERR_NOMEM;
+    goto done;
+  }
+  tt_context_set_log(r.ctx, on_engine_warning, &r.msg);
+
+  switch (o->s.command) {
+  case TT_APP_SIMPLIFY: st = tt__app_simplify(&r); break;
+  case TT_APP_GENERATE: st = tt__app_generate(&r); break;
+  default: st = tt__app_eval(&r); break;
+  }
+done:
+  tt_context_destroy(r.ctx);
+  CPLPopErrorHandler();
+  fflush(r.out);
+  fflush(r.err);
+  if (st != TT_OK && res->exit_code == TT_APP_EXIT_OK)
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, st, "%s",
+                       tt_status_message(st));
+  return st;
+}

@@ -1,0 +1,329 @@
+/*
+ * simplify.c -- `terratin simplify INPUT OUTPUT`: open the DEM, read the
+ * band into a grid, run the refinement, write the TIN's layers under a
+ * temporary name and commit it, then print the summary or JSON.
+ *
+ * Invariants: the input is never written; an existing output is replaced
+ * only with -overwrite and only once the new one is complete; a failure or
+ * an interruption at any phase leaves nothing behind.
+ */
+#include "app.h"
+
+#include <cpl_conv.h>
+#include <cpl_string.h>
+#include <cpl_vsi.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* -work_srs and -t_srs: a CRS GDAL understands (usage error otherwise);
+ * -work_srs must also be projected. */
+static int check_srs(app_run *r, const char *option, const char *value,
+                     int projected)
+{
+  if (!value)
+    return 1;
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
+  r->msg.last[0] = '\0';
+  int ok = srs && OSRSetFromUserInput(srs, value) == OGRERR_NONE;
+  if (!ok)
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: %s '%s' is not a CRS GDAL understands%s%s", option,
+             value, r->msg.last[0] ? ": " : "", r->msg.last);
+  else if (projected && !OSRIsProjected(srs)) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+             "simplify: %s '%s' is not a projected CRS: the working frame "
+             "must be in metres", option, value);
+    ok = 0;
+  }
+  if (srs)
+    OSRDestroySpatialReference(srs);
+  return ok;
+}
+
+
+tt_status tt__app_simplify(app_run *r)
+{
+  const tt_app_settings *s = r->s;
+  tt_status st = TT_OK;
+  tt_output *outp = NULL;
+  GDALDatasetH src = NULL, dst = NULL;
+  GDALRasterBandH band = NULL;
+  tt_grid *grid = NULL;
+  tt_raster_info *info = NULL;
+  tt_tin *tin = NULL;
+  OGRSpatialReferenceH srs = NULL;
+  char **wopts = NULL;
+  app_simplify_report rep;
+  tt_refine_options ro;
+  size_t valid = 0;
+  memset(&rep, 0, sizeof rep);
+
+  if (tt__app_same_file(s->input, s->output))
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
+                    "is the input raster; refusing to replace it");
+  if (!check_srs(r, "-work_srs", s->work_srs, 1) ||
+      !check_srs(r, "-t_srs", s->t_srs, 0))
+    return r->res->status;
+  GDALDriverH drv = tt__app_output_driver(r);
+  if (!drv)
+    return r->res->status;
+  const char *drvname = GDALGetDriverShortName(drv);
+
+  /* Plan the output first: a refusal costs nothing yet. */
+  r->msg.last[0] = '\0';
+  st = tt_output_begin(r->ctx, s->output, drvname, s->overwrite, &outp);
+  if (st == TT_OK && !s->overwrite && s->nln[0] &&
+      tt__app_str_ieq(drvname, "ESRI Shapefile")) {
+    /* tt_output checked the files of the plain layer names; with -nln the
+     * files are named otherwise: check those too, before the work. */
+    static const char *const names[] = {"triangles.shp", "triangles.dbf",
+                                        "vertices.shp", "vertices.dbf",
+                                        "run_parameters.dbf"};
+    const char *slash = strrchr(s->output, '/');
+    int dirlen = slash ? (int)(slash - s->output) : 1;
+    const char *dir = slash ? s->output : ".";
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+      VSIStatBufL sb;
+      const char *p = CPLSPrintf("%.*s/%s%s%s", dirlen, dir,
+                                 tt_output_layer_prefix(outp), s->nln,
+                                 names[i]);
+      if (VSIStatL(p, &sb) == 0) {
+        st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, p,
+                      "exists; use -overwrite to replace it");
+        goto done;
+      }
+    }
+  }
+  if (st == TT_ERR_EXISTS) {
+    tt__app_fail_exists(r, s->output);
+    goto done;
+  }
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
+
+  /* Read: 0 - 10%. */
+  tt__app_phase_set(&r->prog, 0.0, 0.10);
+  src = tt__app_open_raster(r, s->input, s->band, &band);
+  if (!src) {
+    st = r->res->status;
+    goto done;
+  }
+  if (!tt__app_continue(r, 0.0)) {
+    st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
+    goto done;
+  }
+  st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
+                        &info, &valid);
+  if (st != TT_OK)
+    goto done;
+  GDALClose(src);
+  src = NULL;
+  rep.info = info;
+  rep.driver = drvname;
+  rep.cells = tt_grid_width(grid) * tt_grid_height(grid);
+  rep.valid = valid;
+  tt__app_height_range(grid, &rep.zmin, &rep.zmax);
+  rep.t_read = tt__app_now() - r->t0;
+
+  /* Simplify: 10 - 85%. */
+  tt_refine_options_init(&ro);
+  ro.max_error = s->max_error;
+  ro.max_points = s->max_points;
+  ro.max_triangles = s->max_triangles;
+  ro.percent = s->percent;
+  ro.criterion = s->criterion;
+  ro.optimize = s->optimize;
+  ro.repair = s->repair;
+  if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
+      !(s->percent > 0)) {
+    ro.max_error = 0.005 * (rep.zmax - rep.zmin);
+    rep.default_error = 1;
+  }
+  tt__app_phase_set(&r->prog, 0.10, 0.85);
+  ro.progress = tt__app_phase_fn;
+  ro.progress_arg = &r->prog;
+  rep.ropt = &ro;
+  double t = tt__app_now();
+  st = tt_refine_run(r->ctx, grid, &ro, &tin);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, st == TT_ERR_INTERRUPTED ? s->output : s->input);
+    goto done;
+  }
+  rep.t_simplify = tt__app_now() - t;
+  tt_tin_get_summary(tin, &rep.sum);
+  /* The TIN keeps what it needs; the grid can go before the write. */
+  tt_grid_destroy(grid);
+  grid = NULL;
+
+  /* Write: 85 - 100%. */
+  t = tt__app_now();
+  tt__app_phase_set(&r->prog, 0.85, 0.99);
+  if (!tt__app_continue(r, 0.85)) {
+    st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
+    goto done;
+  }
+  r->msg.last[0] = '\0';
+  dst = GDALCreate(drv, tt_output_temp_path(outp), 0, 0, 0, GDT_Unknown,
+                   (CSLConstList)s->dsco);
+  if (!dst) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
+                  "cannot create %s dataset: %s", drvname,
+                  r->msg.last[0] ? r->msg.last : "unknown reason");
+    goto done;
+  }
+  if (info->crs_wkt && *info->crs_wkt) {
+    srs = OSRNewSpatialReference(info->crs_wkt);
+    if (srs)
+      OSRSetAxisMappingStrategy(srs, OAMS_TRADITIONAL_GIS_ORDER);
+    else
+      tt__app_warn(&r->msg,
+                   "%s: the raster's CRS could not be parsed; the layers "
+                   "have none",
+                   s->input);
+  }
+
+  char created[32];
+  tt__app_iso8601_utc(created, sizeof created);
+  const tt_error_stats *e = &rep.sum.errors;
+  const tt_run_field fields[] = {
+      {"input", TT_FIELD_STRING, s->input, 0, 0},
+      {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
+      {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
+      {"criterion", TT_FIELD_STRING, tt_criterion_name(ro.criterion), 0, 0},
+      {"repair", TT_FIELD_STRING,
+       tt_repair_name(tt_repair_resolve(ro.repair, ro.criterion)), 0, 0},
+      {"optimize", TT_FIELD_STRING,
+       tt_optimize_name(tt_optimize_resolve(ro.optimize, ro.criterion,
+                                            ro.repair)), 0, 0},
+      {"max_error", TT_FIELD_REAL, NULL, 0, ro.max_error},
+      {"max_points", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_points, 0},
+      {"max_tris", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_triangles, 0},
+      {"percent", TT_FIELD_REAL, NULL, 0, ro.percent},
+      {"stop", TT_FIELD_STRING, tt_stop_reason_name(rep.sum.stop_reason), 0,
+       0},
+      {"vertices", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.vertices, 0},
+      {"triangles", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.triangles, 0},
+      {"cells", TT_FIELD_INTEGER, NULL, (int64_t)rep.cells, 0},
+      {"valid", TT_FIELD_INTEGER, NULL, (int64_t)rep.valid, 0},
+      {"lone", TT_FIELD_INTEGER, NULL,
+       (int64_t)(e->samples - e->covered), 0},
+      {"pieces", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.components, 0},
+      {"ach_max", TT_FIELD_REAL, NULL, 0, e->max_error},
+      {"ach_rmse", TT_FIELD_REAL, NULL, 0, e->rmse},
+      {"ach_mean", TT_FIELD_REAL, NULL, 0, e->mean_abs},
+      {"ach_l2", TT_FIELD_REAL, NULL, 0, e->l2},
+      {"z_unit", TT_FIELD_STRING, info->z_unit ? info->z_unit : "", 0, 0},
+      {"z_unit_in", TT_FIELD_STRING,
+       info->z_unit_declared ? info->z_unit_declared : "", 0, 0},
+      {"z_factor", TT_FIELD_REAL, NULL, 0, info->z_unit_factor *
+                                               info->z_factor},
+      {"pixel_is", TT_FIELD_STRING,
+       info->area_or_point ? info->area_or_point : "", 0, 0},
+      {"crs", TT_FIELD_STRING, info->crs_name ? info->crs_name : "", 0, 0},
+      {"out_crs", TT_FIELD_STRING, s->t_srs ? s->t_srs : "", 0, 0},
+      {"frame", TT_FIELD_STRING, info->frame_name ? info->frame_name : "", 0,
+       0},
+      {"version", TT_FIELD_STRING, tt_version(), 0, 0},
+      {"t_read", TT_FIELD_REAL, NULL, 0, rep.t_read},
+      {"t_simplify", TT_FIELD_REAL, NULL, 0, rep.t_simplify},
+      {"t_mesh", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_mesh},
+      {"t_stats", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_statistics},
+      {"created", TT_FIELD_STRING, created, 0, 0},
+  };
+  /* Shapefile outputs name their files "<name>_<layer>": the planned
+   * prefix comes first, then the user's -nln. */
+  char *prefix = CPLStrdup(CPLSPrintf("%s%s", tt_output_layer_prefix(outp),
+                                      s->nln));
+  wopts = CSLSetNameValue(wopts, "NLN_PREFIX", prefix);
+  CPLFree(prefix);
+  for (size_t i = 0; s->lco[i]; i++)
+    wopts = CSLAddNameValue(wopts, "LCO", s->lco[i]);
+  if (s->t_srs)
+    wopts = CSLSetNameValue(wopts, "T_SRS", s->t_srs);
+  /* GPKG R-trees: bulk-loaded on the closed file by tt_gpkg_build_rtree()
+   * (GDAL 3.6 inserts them one by one); -lco SPATIAL_INDEX=NO: none. */
+  const char *si = CSLFetchNameValue((CSLConstList)s->lco, "SPATIAL_INDEX");
+  int rtree = tt__app_str_ieq(drvname, "GPKG") && (!si || CPLTestBool(si));
+  if (rtree) {
+    wopts = CSLSetNameValue(wopts, "RTREE", "DEFERRED");
+    tt__app_phase_set(&r->prog, 0.85, 0.95);
+  }
+  r->msg.last[0] = '\0';
+  st = tt_ogr_write_tin(r->ctx, dst, tin, srs, fields,
+                        sizeof fields / sizeof fields[0], wopts,
+                        tt__app_phase_fn, &r->prog);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
+  unsigned failures = r->msg.failures;
+  GDALClose(dst);
+  dst = NULL;
+  if (r->msg.failures != failures) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
+                  "error while closing: %s", r->msg.last);
+    goto done;
+  }
+  for (int k = 0; rtree && k < 2; k++) {
+    const char *geom = CSLFetchNameValueDef((CSLConstList)s->lco,
+                                            "GEOMETRY_NAME", "geom");
+    char *layer = CPLStrdup(CPLSPrintf("%s%s", s->nln,
+                                       k ? "vertices" : "triangles"));
+    tt__app_phase_set(&r->prog, k ? 0.98 : 0.95, k ? 0.99 : 0.98);
+    st = tt_gpkg_build_rtree(r->ctx, tt_output_temp_path(outp), layer, geom,
+                             tt__app_phase_fn, &r->prog);
+    CPLFree(layer);
+    if (st == TT_ERR_INTERRUPTED || st == TT_ERR_NOMEM) {
+      tt__app_fail_tt(r, st, s->output);
+      goto done;
+    }
+    if (st != TT_OK) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, st, s->output, "%s",
+               tt__app_why(r, st, tt_output_temp_path(outp)));
+      goto done;
+    }
+  }
+  if (!tt__app_continue(r, 0.99)) {
+    st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
+    goto done;
+  }
+  st = tt_output_commit(r->ctx, outp);
+  if (st == TT_ERR_EXISTS) {
+    tt__app_fail_exists(r, s->output); /* it appeared while we worked */
+    goto done;
+  }
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
+  rep.t_write = tt__app_now() - t;
+  rep.t_total = tt__app_now() - r->t0;
+  tt__app_continue(r, 1.0);
+
+  if (s->json)
+    tt__app_print_simplify_json(r, &rep);
+  else if (!s->quiet)
+    tt__app_print_simplify_summary(r, &rep);
+  fflush(r->out);
+
+done:
+  if (dst)
+    GDALClose(dst);
+  if (src)
+    GDALClose(src);
+  tt_output_destroy(outp); /* removes the temporary files unless committed */
+  if (srs)
+    OSRDestroySpatialReference(srs);
+  CSLDestroy(wopts);
+  tt_tin_destroy(tin);
+  tt_grid_destroy(grid);
+  tt_raster_info_destroy(info);
+  return st;
+}
