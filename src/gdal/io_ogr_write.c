@@ -91,13 +91,16 @@ static const field_spec triangle_fields[TF_COUNT] = {
     {"slope", OFTReal},         {"aspect", OFTReal},
     {"min_angle", OFTReal},     {"max_angle", OFTReal}};
 
+/* The last field, importance, exists for decimated TINs only (they also
+ * leave ins_err and ins_rank NULL: there was no insertion). */
 enum { VF_ID, VF_COL, VF_ROW, VF_INS_ERR, VF_INS_RANK, VF_STAR_MAX,
-       VF_STAR_RMSE, VF_STAR_N, VF_COUNT };
+       VF_STAR_RMSE, VF_STAR_N, VF_IMPORTANCE, VF_COUNT };
 static const field_spec vertex_fields[VF_COUNT] = {
     {"vertex_id", OFTInteger},  {"col", OFTInteger},
     {"row", OFTInteger},        {"ins_err", OFTReal},
     {"ins_rank", OFTInteger64}, {"star_max", OFTReal},
-    {"star_rmse", OFTReal},     {"star_n", OFTInteger64}};
+    {"star_rmse", OFTReal},     {"star_n", OFTInteger64},
+    {"importance", OFTReal}};
 
 typedef struct write_state {
   tt_context *ctx;
@@ -338,6 +341,9 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
   OGRGeometryH pt = OGR_G_CreateGeometry(wkbPoint25D);
   OGR_G_Set3D(pt, TRUE);
   const size_t nv = tt_tin_vertex_count(tin);
+  tt_tin_summary sum;
+  tt_tin_get_summary(tin, &sum);
+  const int decimated = sum.start_vertices > 0;
   for (size_t i = 0; i < nv && s == TT_OK; i++) {
     tt_vertex_info v;
     if (tt_tin_vertex(tin, i, &v) != TT_OK) {
@@ -352,10 +358,15 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
     OGR_F_SetFieldInteger(f, idx[VF_COL], v.col);
     OGR_F_SetFieldInteger(f, idx[VF_ROW], v.row);
     set_real(f, idx[VF_INS_ERR], v.insert_error);
-    OGR_F_SetFieldInteger64(f, idx[VF_INS_RANK], (GIntBig)v.rank);
+    if (decimated)
+      OGR_F_SetFieldNull(f, idx[VF_INS_RANK]);
+    else
+      OGR_F_SetFieldInteger64(f, idx[VF_INS_RANK], (GIntBig)v.rank);
     set_real(f, idx[VF_STAR_MAX], v.star_max_error);
     set_real(f, idx[VF_STAR_RMSE], v.star_rmse);
     OGR_F_SetFieldInteger64(f, idx[VF_STAR_N], (GIntBig)v.star_samples);
+    if (decimated)
+      set_real(f, idx[VF_IMPORTANCE], v.importance);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(pt);
@@ -637,6 +648,9 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
 
   const size_t nv = tt_tin_vertex_count(tin);
   const size_t nt = tt_tin_triangle_count(tin);
+  tt_tin_summary tsum;
+  tt_tin_get_summary(tin, &tsum);
+  const int decimated = tsum.start_vertices > 0;
   if (nv > (size_t)INT32_MAX || nt > (size_t)INT32_MAX) {
     s = tt__error(ctx, TT_ERR_LIMIT, "TIN of %zu vertices and %zu triangles "
                   "is too large for 32-bit feature fields", nv, nt);
@@ -666,7 +680,8 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   if (s == TT_OK)
     s = create_fields(&w, w.tri_layer, triangle_fields, TF_COUNT, w.tri_idx);
   if (s == TT_OK)
-    s = create_fields(&w, w.vtx_layer, vertex_fields, VF_COUNT, w.vtx_idx);
+    s = create_fields(&w, w.vtx_layer, vertex_fields,
+                      decimated ? VF_COUNT : VF_COUNT - 1, w.vtx_idx);
   if (s == TT_OK)
     s = create_run_fields(&w, fields, nfields);
   if (s != TT_OK)
