@@ -344,9 +344,16 @@ static bool repair(run *r)
   if (!tt__grow((void **)&r->seeds, &r->seedcap, 3 * m->ntouched + 1,
                 sizeof(int32_t)))
     return false;
+  /* each edge once: an inner diagonal of the fill by one half-edge */
   for (size_t i = 0; i < m->ntouched; i++)
-    for (int k = 0; k < 3; k++)
-      r->seeds[nseeds++] = 3 * m->touched[i] + k;
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * m->touched[i] + k, f = m->twin[e];
+      bool inner_twice = false;
+      for (size_t j = 0; j < m->ntouched && f >= 0 && f < e; j++)
+        inner_twice |= m->touched[j] == f / 3;
+      if (!inner_twice)
+        r->seeds[nseeds++] = e;
+    }
   if (d->repair == TT_REPAIR_DELAUNAY ||
       d->crit->id == TT_CRITERION_DELAUNAY)
     return lawson(r, &tt__criterion_delaunay, nseeds);

@@ -140,16 +140,17 @@ static double max_angle(const tt__dhole *h, int i, int j, int k)
   return fmax(a, fmax(b, c));
 }
 
-/* Circumradius R = abc / (4 area). */
-static double circumradius(const tt__dhole *h, int i, int j, int k)
+/* The squared circumradius R^2 = a^2 b^2 c^2 / (4 area)^2 (no square
+ * roots: it only ranks ears). */
+static double circumradius2(const tt__dhole *h, int i, int j, int k)
 {
-  double a = hypot(h->gx[j] - h->gx[i], h->gy[j] - h->gy[i]);
-  double b = hypot(h->gx[k] - h->gx[j], h->gy[k] - h->gy[j]);
-  double c = hypot(h->gx[i] - h->gx[k], h->gy[i] - h->gy[k]);
-  double cross = (h->gx[j] - h->gx[i]) * (h->gy[k] - h->gy[i]) -
-                 (h->gy[j] - h->gy[i]) * (h->gx[k] - h->gx[i]);
-  double area2 = fabs(cross);
-  return area2 > 0 ? a * b * c / (2 * area2) : INFINITY;
+  double ax = h->gx[j] - h->gx[i], ay = h->gy[j] - h->gy[i];
+  double bx = h->gx[k] - h->gx[j], by = h->gy[k] - h->gy[j];
+  double cx = h->gx[i] - h->gx[k], cy = h->gy[i] - h->gy[k];
+  double cross = ax * (h->gy[k] - h->gy[i]) - ay * (h->gx[k] - h->gx[i]);
+  double a2 = ax * ax + ay * ay, b2 = bx * bx + by * by,
+         c2 = cx * cx + cy * cy;
+  return cross != 0 ? a2 * b2 * c2 / (4 * cross * cross) : INFINITY;
 }
 
 /* The ear status and score of position i (larger score: cut first). */
@@ -168,7 +169,7 @@ static void examine(tt__dhole *h, const tt__mesh *m, int i, tt_hole rule)
       return;
   }
   h->ear[i] = true;
-  h->score[i] = rule == TT_HOLE_CIRCUMRADIUS ? -circumradius(h, a, i, c)
+  h->score[i] = rule == TT_HOLE_CIRCUMRADIUS ? -circumradius2(h, a, i, c)
                                              : min_angle(h, a, i, c);
 }
 

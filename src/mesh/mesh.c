@@ -189,52 +189,44 @@ int32_t tt__mesh_add_triangle(tt__mesh *m, int32_t a, int32_t b, int32_t c)
   return t;
 }
 
+typedef struct link_key {
+  int64_t key;   /* start << 32 | end */
+  int32_t e;
+} link_key;
+
+static int cmp_link_key(const void *a, const void *b)
+{
+  const link_key *x = a, *y = b;
+  if (x->key != y->key)
+    return x->key < y->key ? -1 : 1;
+  return (x->e > y->e) - (x->e < y->e);
+}
+
 bool tt__mesh_link_all(tt__mesh *m)
 {
   /* Sort boundary half-edges by (start, end) and pair each with its
-   * reverse. O(E log E); used once per starting triangulation. */
+   * reverse, found by binary search. O(E log E): once per starting
+   * triangulation, which for decimation's start is the whole grid (an
+   * earlier shell sort took 40 % of a 513^2 decimation). */
   size_t n = 0;
   for (size_t e = 0; e < 3 * m->nslots; e++)
     if (m->hv[e - e % 3] >= 0 && m->twin[e] < 0)
       n++;
-  int64_t *keys = malloc((n ? n : 1) * sizeof *keys);
-  int32_t *edges = malloc((n ? n : 1) * sizeof *edges);
-  if (!keys || !edges) {
-    free(keys);
-    free(edges);
+  link_key *k = malloc((n ? n : 1) * sizeof *k);
+  if (!k)
     return false;
-  }
-  /* Simple approach: for each boundary half-edge store key (a<<32 | b) and
-   * search the reverse with bsearch over the sorted keys. */
-  size_t k = 0;
+  size_t w = 0;
   for (size_t e = 0; e < 3 * m->nslots; e++) {
     if (m->hv[e - e % 3] < 0 || m->twin[e] >= 0)
       continue;
     int64_t a = m->hv[e], b = m->hv[tt__next((int32_t)e)];
-    keys[k] = (a << 32) | b;
-    edges[k] = (int32_t)e;
-    k++;
+    k[w].key = (a << 32) | b;
+    k[w].e = (int32_t)e;
+    w++;
   }
-  /* insertion into a sorted order via qsort on an index array */
-  size_t *idx = malloc((n ? n : 1) * sizeof *idx);
-  if (!idx) {
-    free(keys);
-    free(edges);
-    return false;
-  }
-  for (size_t i = 0; i < n; i++)
-    idx[i] = i;
-  /* shell sort on keys (no qsort context pointer in C11) */
-  for (size_t gap = n / 2; gap > 0; gap /= 2)
-    for (size_t i = gap; i < n; i++)
-      for (size_t j = i; j >= gap && keys[idx[j - gap]] > keys[idx[j]];
-           j -= gap) {
-        size_t tmp = idx[j];
-        idx[j] = idx[j - gap];
-        idx[j - gap] = tmp;
-      }
+  qsort(k, n, sizeof *k, cmp_link_key);
   for (size_t i = 0; i < n; i++) {
-    int32_t e = edges[idx[i]];
+    int32_t e = k[i].e;
     if (m->twin[e] >= 0)
       continue;
     int64_t a = m->hv[e], b = m->hv[tt__next(e)];
@@ -242,13 +234,13 @@ bool tt__mesh_link_all(tt__mesh *m)
     size_t lo = 0, hi = n;
     while (lo < hi) {
       size_t mid = lo + (hi - lo) / 2;
-      if (keys[idx[mid]] < want)
+      if (k[mid].key < want)
         lo = mid + 1;
       else
         hi = mid;
     }
-    if (lo < n && keys[idx[lo]] == want) {
-      int32_t f = edges[idx[lo]];
+    if (lo < n && k[lo].key == want) {
+      int32_t f = k[lo].e;
       if (m->twin[f] < 0) {
         link(m, e, f, 0);
         bump(m, (int32_t)a);
@@ -256,9 +248,7 @@ bool tt__mesh_link_all(tt__mesh *m)
       }
     }
   }
-  free(idx);
-  free(keys);
-  free(edges);
+  free(k);
   return true;
 }
 
@@ -892,34 +882,17 @@ done:
   return ok;
 }
 
-int tt__mesh_star(const tt__mesh *m, int32_t v, int32_t *ring,
-                  int32_t *slots, int max, bool *out_closed)
+/* The counter-clockwise walk of tt__mesh_star from half-edge e (leaving
+ * v): the triangle of e is (v, a, b); the next one around v holds
+ * twin(prev(e)) = v -> b. Stops at the boundary or back at e. */
+static int star_walk(const tt__mesh *m, int32_t e, int32_t *ring,
+                     int32_t *slots, int max, bool *out_closed)
 {
-  int32_t e0 = m->v[v].edge;
-  if (e0 < 0)
-    return -1;
-  /* turn clockwise (e -> next(twin(e)), both leave v) to the boundary, or
-   * once around */
-  int32_t e = e0;
-  bool closed = true;
-  for (;;) {
-    int32_t f = m->twin[e];
-    if (f < 0) {
-      closed = false;
-      break;
-    }
-    e = tt__next(f);
-    if (e == e0)
-      break;
-  }
-  /* then counter-clockwise: the triangle of e is (v, a, b); the next one
-   * around v holds twin(prev(e)) = v -> b */
-  int n = 0;
+  int n = 0, nt = 0;
   int32_t start = e;
   if (n < max)
     ring[n] = m->hv[tt__next(e)];
   n++;
-  int nt = 0;
   for (;;) {
     if (slots && nt < max)
       slots[nt] = e / 3;
@@ -930,17 +903,35 @@ int tt__mesh_star(const tt__mesh *m, int32_t v, int32_t *ring,
       if (n < max)
         ring[n] = b;
       n++;
-      break;
+      *out_closed = false;
+      return n;
     }
-    if (f == start)
-      break;
+    if (f == start) {
+      *out_closed = true;
+      return n;
+    }
     if (n < max)
       ring[n] = b;
     n++;
     e = f;
   }
-  *out_closed = closed;
-  return n;
+}
+
+int tt__mesh_star(const tt__mesh *m, int32_t v, int32_t *ring,
+                  int32_t *slots, int max, bool *out_closed)
+{
+  int32_t e0 = m->v[v].edge;
+  if (e0 < 0)
+    return -1;
+  /* one walk when the fan is closed (most vertices); otherwise turn
+   * clockwise (e -> next(twin(e))) to the boundary and walk again */
+  int n = star_walk(m, e0, ring, slots, max, out_closed);
+  if (*out_closed)
+    return n;
+  int32_t e = e0;
+  for (int32_t f = m->twin[e]; f >= 0; f = m->twin[e])
+    e = tt__next(f);
+  return star_walk(m, e, ring, slots, max, out_closed);
 }
 
 bool tt__mesh_remove_vertex(tt__mesh *m, int32_t v, const int32_t (*tris)[3],
