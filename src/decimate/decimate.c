@@ -429,6 +429,51 @@ static int score(run *r, int32_t v)
   return ok;
 }
 
+/* Scores of many vertices at once: jobs of SCORE_CHUNK vertices, each
+ * with its own hole scratch, writing only their vertices' vimp and flags
+ * (so the result does not depend on the threads). */
+#define SCORE_CHUNK 1024
+
+typedef struct score_batch {
+  run *r;
+  const int32_t *v;
+  size_t n;
+  int failed;      /* a job ran out of memory (set by any) */
+} score_batch;
+
+static void score_job(void *arg, size_t index)
+{
+  score_batch *b = arg;
+  tt__dec *d = &b->r->d;
+  tt__dhole h;
+  tt__dhole_init(&h);
+  if (!tt__dhole_reserve(&h, 16)) {
+    b->failed = 1;
+    return;
+  }
+  size_t lo = index * SCORE_CHUNK;
+  size_t hi = lo + SCORE_CHUNK < b->n ? lo + SCORE_CHUNK : b->n;
+  for (size_t i = lo; i < hi; i++) {
+    int32_t v = b->v[i];
+    double imp;
+    int ok = tt__dec_evaluate_in(d, &h, v, TT__DEC_SCORE, &imp, NULL);
+    if (ok < 0)
+      b->failed = 1;
+    d->vimp[v] = ok > 0 ? imp : NAN;
+    d->vflag[v] &= (uint8_t)~TT__DV_DIRTY;
+  }
+  tt__dhole_free(&h);
+}
+
+/* Scores the n vertices of list (distinct); false when out of memory. */
+static bool score_many(run *r, const int32_t *list, size_t n)
+{
+  score_batch b = {r, list, n, 0};
+  size_t njobs = (n + SCORE_CHUNK - 1) / SCORE_CHUNK;
+  tt__pool_run(njobs > 1 ? r->pool : NULL, njobs, score_job, &b);
+  return !b.failed;
+}
+
 typedef struct cand {
   double key;
   int32_t v;
@@ -460,20 +505,25 @@ static tt_status run_independent(run *r)
   for (uint32_t round = 1;; round++) {
     if (count_stop(r))
       break;
+    /* onepass: a vertex is scored once (or until it first may go) */
+    size_t ns = 0;
+    for (size_t v = 0; v < nv; v++) {
+      uint8_t f = d->vflag[v];
+      if (m->v[v].edge < 0 || (f & TT__DV_PINNED))
+        continue;
+      if (round == 1 || ((f & TT__DV_DIRTY) &&
+                         (!d->opt->onepass || isnan(d->vimp[v]))))
+        picked[ns++] = (int32_t)v;
+    }
+    if (!score_many(r, picked, ns)) {
+      status = oom(r);
+      goto done;
+    }
     size_t nc = 0;
     for (size_t v = 0; v < nv; v++) {
       uint8_t f = d->vflag[v];
       if (m->v[v].edge < 0 || (f & TT__DV_PINNED))
         continue;
-      /* onepass: a vertex is scored once (or until it first may go) */
-      if (round == 1 || ((f & TT__DV_DIRTY) &&
-                         (!d->opt->onepass || isnan(d->vimp[v])))) {
-        if (score(r, (int32_t)v) < 0) {
-          status = oom(r);
-          goto done;
-        }
-        f = d->vflag[v];
-      }
       if (isnan(d->vimp[v]) || (f & TT__DV_BLOCKED))
         continue;
       if (d->importance == TT_IMPORTANCE_ERROR && d->max_error >= 0 &&
@@ -731,8 +781,8 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
   d->env.mesh = &d->m;
   d->env.grid = grid;
   int nthreads = opt->threads;
-  if (nthreads == 0 && grid->nx * grid->ny < ((size_t)1 << 20))
-    nthreads = 1;
+  if (nthreads == 0 && grid->nx * grid->ny < ((size_t)1 << 18))
+    nthreads = 1; /* small grids: handing jobs over costs more */
   r.pool = tt__pool_create(tt__pool_threads(nthreads));
   r.target_v = opt->max_points;
   if (opt->percent > 0) {
@@ -780,11 +830,19 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
     goto done;
   }
   /* the importance each vertex has now */
-  for (size_t v = 0; v < d->m.nv; v++)
-    if (d->m.v[v].edge >= 0 && score(&r, (int32_t)v) < 0) {
+  {
+    int32_t *all = malloc((d->m.nv ? d->m.nv : 1) * sizeof *all);
+    size_t na = 0;
+    for (size_t v = 0; all && v < d->m.nv; v++)
+      if (d->m.v[v].edge >= 0)
+        all[na++] = (int32_t)v;
+    bool ok = all && score_many(&r, all, na);
+    free(all);
+    if (!ok) {
       status = oom(&r);
       goto done;
     }
+  }
   tt__heap_free(&r.heap);
   tt__scan_tiles_free(&d->tiles);
   double t_meshed = tt__now();

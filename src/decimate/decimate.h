@@ -59,6 +59,12 @@ typedef enum tt__dec_eval {
  * or no fill, which tests show never happens), -1 when out of memory. */
 TT_HIDDEN int tt__dec_evaluate(tt__dec *d, int32_t v, tt__dec_eval what,
                                double *out_importance, double *out_error);
+/* The same with the hole in h (not d->h): it only reads d and the mesh,
+ * so scores of several vertices may be computed at once in threads, each
+ * with its own h. */
+TT_HIDDEN int tt__dec_evaluate_in(const tt__dec *d, tt__dhole *h, int32_t v,
+                                  tt__dec_eval what, double *out_importance,
+                                  double *out_error);
 
 /* The largest |H - H'| over the valid samples of the closed triangle
  * (a, b, c) of mesh vertices; 0 when none. */

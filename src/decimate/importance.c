@@ -68,10 +68,10 @@ static double prism(const tt__dec *d, int32_t a, int32_t b, int32_t c)
 
 /* Height of the filled hole at v's position (v lies in or on one of its
  * triangles: the star covers v). */
-static double hole_height_at(const tt__dec *d, int32_t v)
+static double hole_height_at(const tt__dec *d, const tt__dhole *h,
+                             int32_t v)
 {
   const tt__mesh *m = &d->m;
-  const tt__dhole *h = &d->h;
   for (int t = 0; t < h->ntri; t++) {
     const int32_t *q = h->tri[t];
     if (tt__mesh_orient(m, q[0], q[1], v) >= 0 &&
@@ -93,20 +93,26 @@ static double hole_height_at(const tt__dec *d, int32_t v)
 }
 
 /* The largest error over the filled hole's triangles. */
-static double fill_error(const tt__dec *d)
+static double fill_error(const tt__dec *d, const tt__dhole *h)
 {
   double err = 0;
-  for (int t = 0; t < d->h.ntri; t++)
-    err = fmax(err, tt__dec_triangle_error(d, d->h.tri[t][0], d->h.tri[t][1],
-                                           d->h.tri[t][2]));
+  for (int t = 0; t < h->ntri; t++)
+    err = fmax(err, tt__dec_triangle_error(d, h->tri[t][0], h->tri[t][1],
+                                           h->tri[t][2]));
   return err;
 }
 
 int tt__dec_evaluate(tt__dec *d, int32_t v, tt__dec_eval what,
                      double *out_importance, double *out_error)
 {
-  tt__mesh *m = &d->m;
-  tt__dhole *h = &d->h;
+  return tt__dec_evaluate_in(d, &d->h, v, what, out_importance, out_error);
+}
+
+int tt__dec_evaluate_in(const tt__dec *d, tt__dhole *h, int32_t v,
+                        tt__dec_eval what, double *out_importance,
+                        double *out_error)
+{
+  const tt__mesh *m = &d->m;
   *out_importance = NAN;
   if (out_error)
     *out_error = NAN;
@@ -140,7 +146,7 @@ int tt__dec_evaluate(tt__dec *d, int32_t v, tt__dec_eval what,
       !tt__dhole_fill(h, m, d->g->frame, d->hole, d->opt->criterion))
     return 0;
   if (what == TT__DEC_CHECK) {
-    double err = fill_error(d);
+    double err = fill_error(d, h);
     if (out_error)
       *out_error = err;
     if (d->importance == TT_IMPORTANCE_ERROR)
@@ -182,10 +188,10 @@ int tt__dec_evaluate(tt__dec *d, int32_t v, tt__dec_eval what,
     break;
   }
   case TT_IMPORTANCE_DROP:
-    imp = fabs(zv - hole_height_at(d, v));
+    imp = fabs(zv - hole_height_at(d, h, v));
     break;
   default: /* error */
-    imp = fill_error(d);
+    imp = fill_error(d, h);
     if (out_error)
       *out_error = imp;
     break;
