@@ -84,21 +84,24 @@ def versus():
     dems = [("Crater Lake", CRATER, 2.0, 10000),
             ("Mt Hood", HOOD, 5.0, 20000),
             ("fractal 1025^2", fractal(), 4.0, 21000)]
-    print("| DEM | -max_error | insert: vertices, s | decimate: vertices, s |"
-          " budget | insert RMSE / mean | decimate RMSE / mean |")
+    print("| DEM | method | at -max_error: vertices | s (cpu) | "
+          "at the budget: RMSE | mean | max |")
     print("|---|---|---|---|---|---|---|")
     for name, dem, e, budget in dems:
         start = "all" if "fractal" in name else "greedy"
-        a = run(dem, "-max_error", e)
-        b = run(dem, "-method", "decimate", "-start", start, "-max_error", e)
-        c = run(dem, "-max_points", budget)
-        d = run(dem, "-method", "decimate", "-start", start,
-                "-importance", "error", "-max_points", budget)
-        print(f"| {name} | {e} | {a['vertices']}, {a['_wall']:.2f} "
-              f"(cpu {a['_cpu']:.2f}) | {b['vertices']}, {b['_wall']:.2f} "
-              f"(cpu {b['_cpu']:.2f}) | {budget} | {c['rmse']:.4g} / "
-              f"{c['mean_abs_error']:.4g} | {d['rmse']:.4g} / "
-              f"{d['mean_abs_error']:.4g} |", flush=True)
+        runs = [("insert", ["-max_error", e], ["-max_points", budget])]
+        for sel in ("independent", "sequential"):
+            dec = ["-method", "decimate", "-start", start, "-importance",
+                   "error", "-selection", sel]
+            runs.append((f"decimate {sel}", dec + ["-max_error", e],
+                         dec + ["-max_points", budget]))
+        for label, at_bound, at_budget in runs:
+            a = run(dem, *at_bound)
+            b = run(dem, *at_budget)
+            print(f"| {name} (E {e}, budget {budget}) | {label} | "
+                  f"{a['vertices']} | {a['_wall']:.2f} ({a['_cpu']:.2f}) | "
+                  f"{b['rmse']:.4g} | {b['mean_abs_error']:.4g} | "
+                  f"{b['max_error']:.4g} |", flush=True)
 
 
 def speed():
