@@ -34,6 +34,47 @@
 #include <math.h>
 #include <stdlib.h>
 
+/* Small triangles (most fills): the bounding box's samples one by one,
+ * each tested against the three closed edges exactly in integers, the
+ * plane evaluated as the scans do (rowbase + gx (x - x0)). Cheaper than
+ * the scan's row set-up for a handful of samples; same samples. */
+#define SMALL_BOX 192
+
+static double small_error(const tt__dec *d, const tt__scan_tri *st)
+{
+  int64_t x0, x1, y0, y1;
+  tt__scan_tri_bbox(st, &x0, &x1, &y0, &y1);
+  tt__scan_plane p;
+  tt__scan_plane_of(st, &p);
+  /* orientation of the corners in pixel space: inside means every edge
+   * function has that sign or is zero */
+  int64_t o = (st->x[1] - st->x[0]) * (st->y[2] - st->y[0]) -
+              (st->y[1] - st->y[0]) * (st->x[2] - st->x[0]);
+  int s = o > 0 ? 1 : -1;
+  const size_t nx = d->g->nx;
+  double err = 0;
+  for (int64_t y = y0; y <= y1; y++) {
+    const float *zr = d->g->z + (size_t)y * nx;
+    double rowbase = p.z0 + p.gy * (double)(y - p.y0);
+    for (int64_t x = x0; x <= x1; x++) {
+      bool in = true;
+      for (int k = 0; k < 3 && in; k++) {
+        int k1 = k == 2 ? 0 : k + 1;
+        int64_t e = (st->x[k1] - st->x[k]) * (y - st->y[k]) -
+                    (st->y[k1] - st->y[k]) * (x - st->x[k]);
+        in = s * e >= 0;
+      }
+      if (!in)
+        continue;
+      double v = rowbase + p.gx * (double)(x - p.x0);
+      double e = fabs((double)zr[x] - v);
+      if (e > err) /* false for NaN (nodata) */
+        err = e;
+    }
+  }
+  return err;
+}
+
 double tt__dec_triangle_error(const tt__dec *d, int32_t a, int32_t b,
                               int32_t c)
 {
@@ -46,6 +87,10 @@ double tt__dec_triangle_error(const tt__dec *d, int32_t a, int32_t b,
     st.z[k] = (double)m->v[w[k]].z;
     st.own[k] = true;
   }
+  int64_t bx0, bx1, by0, by1;
+  tt__scan_tri_bbox(&st, &bx0, &bx1, &by0, &by1);
+  if ((bx1 - bx0 + 1) * (by1 - by0 + 1) <= SMALL_BOX)
+    return small_error(d, &st);
   double err = 0;
   int64_t idx = -1;
   tt__scan_candidate_rows(d->g, d->tiles.t ? &d->tiles : NULL, &st,
