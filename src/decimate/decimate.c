@@ -487,6 +487,12 @@ static int cmp_cand(const void *a, const void *b)
   return (x->v > y->v) - (x->v < y->v);
 }
 
+static int cmp_i32(const void *a, const void *b)
+{
+  int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+  return (x > y) - (x < y);
+}
+
 static tt_status run_independent(run *r)
 {
   tt__dec *d = &r->d;
@@ -554,6 +560,14 @@ static tt_status run_independent(run *r)
       for (int k = 0; k < n; k++)
         lock[ring[k]] = round;
     }
+    /* The set goes together: unless this round may reach a count stop
+     * (then in importance order, so the cut keeps the important ones),
+     * in index order, which follows the start's spatial order and keeps
+     * the mesh walks in cache (about a fifth of a run, measured). */
+    bool last = (r->target_v && d->nvert <= r->target_v + np) ||
+                (r->target_t && m->nlive <= r->target_t + 2 * np);
+    if (!last)
+      qsort(picked, np, sizeof *picked, cmp_i32);
     size_t before = r->removed;
     r->rounds++;
     for (size_t i = 0; i < np; i++) {
