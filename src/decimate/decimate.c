@@ -487,6 +487,55 @@ static int cmp_cand(const void *a, const void *b)
   return (x->v > y->v) - (x->v < y->v);
 }
 
+/* Sorts candidates by (key, vertex) like cmp_cand, by a stable LSD radix
+ * sort of the keys' bits: the keys are >= 0 (every importance is), where
+ * the IEEE order is the unsigned order of the bits, and the list comes in
+ * vertex order, which stability keeps for equal keys. A byte that is the
+ * same in every key costs no pass. False when out of memory. */
+static bool sort_cands(cand *c, size_t n)
+{
+  if (n < 64) {
+    qsort(c, n, sizeof *c, cmp_cand);
+    return true;
+  }
+  cand *tmp = malloc(n * sizeof *tmp);
+  if (!tmp)
+    return false;
+  cand *src = c, *dst = tmp;
+  for (int pass = 0; pass < 8; pass++) {
+    size_t count[256] = {0};
+    int shift = 8 * pass;
+    for (size_t i = 0; i < n; i++) {
+      uint64_t u;
+      memcpy(&u, &src[i].key, sizeof u);
+      count[(u >> shift) & 255]++;
+    }
+    bool one = false;
+    for (int b = 0; b < 256; b++)
+      one |= count[b] == n;
+    if (one)
+      continue;
+    size_t at = 0;
+    for (int b = 0; b < 256; b++) {
+      size_t k = count[b];
+      count[b] = at;
+      at += k;
+    }
+    for (size_t i = 0; i < n; i++) {
+      uint64_t u;
+      memcpy(&u, &src[i].key, sizeof u);
+      dst[count[(u >> shift) & 255]++] = src[i];
+    }
+    cand *t = src;
+    src = dst;
+    dst = t;
+  }
+  if (src != c)
+    memcpy(c, src, n * sizeof *c);
+  free(tmp);
+  return true;
+}
+
 static int cmp_i32(const void *a, const void *b)
 {
   int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
@@ -539,7 +588,10 @@ static tt_status run_independent(run *r)
       c[nc].v = (int32_t)v;
       nc++;
     }
-    qsort(c, nc, sizeof *c, cmp_cand);
+    if (!sort_cands(c, nc)) {
+      status = oom(r);
+      goto done;
+    }
     /* a maximal independent set in importance order */
     size_t np = 0;
     for (size_t i = 0; i < nc; i++) {
