@@ -153,19 +153,29 @@ static double circumradius2(const tt__dhole *h, int i, int j, int k)
   return cross != 0 ? a2 * b2 * c2 / (4 * cross * cross) : INFINITY;
 }
 
+/* The ground-frame orientation of polygon positions i, j, k, exactly:
+ * the pixel-space determinant (differences below 2^29, products below
+ * 2^58: int64 suffices for grid sides below 2^28) times the frame's
+ * handedness s, the same sign tt__mesh_orient gives, from the hole's own
+ * contiguous coordinates. */
+static inline int orient3(const tt__dhole *h, int s, int i, int j, int k)
+{
+  int64_t det = (h->px[i] - h->px[k]) * (h->py[j] - h->py[k]) -
+                (h->py[i] - h->py[k]) * (h->px[j] - h->px[k]);
+  return det > 0 ? s : (det < 0 ? -s : 0);
+}
+
 /* The ear status and score of position i (larger score: cut first). */
 static void examine(tt__dhole *h, const tt__mesh *m, int i, tt_hole rule)
 {
   int a = h->prev[i], c = h->next[i];
-  int32_t pa = h->p[a], pi = h->p[i], pc = h->p[c];
+  int s = m->metric.det_sign;
   h->ear[i] = false;
-  if (tt__mesh_orient(m, pa, pi, pc) <= 0)
+  if (orient3(h, s, a, i, c) <= 0)
     return;
   for (int q = h->next[c]; q != a; q = h->next[q]) {
-    int32_t pq = h->p[q];
-    if (tt__mesh_orient(m, pa, pi, pq) >= 0 &&
-        tt__mesh_orient(m, pi, pc, pq) >= 0 &&
-        tt__mesh_orient(m, pc, pa, pq) >= 0)
+    if (orient3(h, s, a, i, q) >= 0 && orient3(h, s, i, c, q) >= 0 &&
+        orient3(h, s, c, a, q) >= 0)
       return;
   }
   h->ear[i] = true;
@@ -208,7 +218,7 @@ static bool ear_cut(tt__dhole *h, const tt__mesh *m, tt_hole rule)
     examine(h, m, c, rule);
   }
   int a = first, b = h->next[a], c = h->next[b];
-  if (tt__mesh_orient(m, h->p[a], h->p[b], h->p[c]) <= 0)
+  if (orient3(h, m->metric.det_sign, a, b, c) <= 0)
     return false;
   h->tri[h->ntri][0] = h->p[a];
   h->tri[h->ntri][1] = h->p[b];
