@@ -17,7 +17,8 @@ if [ ! -f "$OUT/npm/node_modules/meshoptimizer/index.js" ]; then
   npm install --prefix "$OUT/npm" --no-audit --no-fund --no-save \
     --loglevel=error meshoptimizer@1.3.0
 fi
-python3 -c "import vtk" 2>/dev/null || {
+PY=/usr/bin/python3  # Debian's, where python3-vtk9 lives
+"$PY" -c "import vtk" 2>/dev/null || {
   echo "bench: needs python3-vtk9 (apt-get install python3-vtk9)" >&2; exit 1; }
 DEM=${1:-}
 PCT=${2:-2}
@@ -34,7 +35,7 @@ N=$(python3 -c "import json; print(json.load(open('$OUT/terratin.json'))['vertic
 node "$HERE/meshopt_run.mjs" --meshopt "$OUT/npm/node_modules/meshoptimizer/index.js" \
   --raw "$OUT/dem.raw" --info "$OUT/dem.info.json" --vertices "$N" \
   --out "$OUT/meshopt.geojsonl" > "$OUT/meshopt.json"
-python3 "$HERE/vtk_run.py" "$OUT/dem.raw" "$OUT/dem.info.json" "$N" \
+"$PY" "$HERE/vtk_run.py" "$OUT/dem.raw" "$OUT/dem.info.json" "$N" \
   "$OUT/vtk.geojsonl" > "$OUT/vtk.json"
 for t in terratin meshopt vtk; do
   f=$OUT/$t.gpkg; [ "$t" = terratin ] || f=$OUT/$t.geojsonl

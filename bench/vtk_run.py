@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """vtk_run.py -- VTK's vtkQuadricDecimation on the full-grid TIN of a DEM,
 for bench/decimate_peers.sh.
 
