@@ -30,7 +30,8 @@ gdal_translate -q -of ENVI -ot Float32 "$DEM" "$OUT/dem.raw"
 gdalinfo -json "$DEM" > "$OUT/dem.info.json"
 
 "$TT" simplify -q -json -overwrite -method decimate -start all \
-  -importance error -percent "$PCT" "$DEM" "$OUT/terratin.gpkg" > "$OUT/terratin.json"
+  -importance error -selection sequential -percent "$PCT" "$DEM" \
+  "$OUT/terratin.gpkg" > "$OUT/terratin.json"
 N=$(python3 -c "import json; print(json.load(open('$OUT/terratin.json'))['vertices'])")
 node "$HERE/meshopt_run.mjs" --meshopt "$OUT/npm/node_modules/meshoptimizer/index.js" \
   --raw "$OUT/dem.raw" --info "$OUT/dem.info.json" --vertices "$N" \
@@ -45,7 +46,7 @@ python3 - "$OUT" <<'PY'
 import json, sys
 o = sys.argv[1]
 rows = []
-for t, name in (("terratin", "terratin decimate (error)"), ("meshopt", "meshoptimizer"),
+for t, name in (("terratin", "terratin decimate (error, sequential)"), ("meshopt", "meshoptimizer"),
                 ("vtk", "vtkQuadricDecimation")):
     run = json.load(open(f"{o}/{t}.json"))
     ev = json.load(open(f"{o}/{t}.eval.json"))
