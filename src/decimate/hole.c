@@ -32,6 +32,7 @@ void tt__dhole_init(tt__dhole *h)
   h->tri = NULL;
   h->prev = h->next = NULL;
   h->ear = NULL;
+  h->convex = NULL;
   h->score = h->gx = h->gy = NULL;
   h->px = h->py = NULL;
   h->idx = NULL;
@@ -45,6 +46,7 @@ void tt__dhole_free(tt__dhole *h)
   free(h->prev);
   free(h->next);
   free(h->ear);
+  free(h->convex);
   free(h->score);
   free(h->gx);
   free(h->gy);
@@ -78,6 +80,9 @@ bool tt__dhole_reserve(tt__dhole *h, int n)
   bool *ear = realloc(h->ear, cap * sizeof *ear);
   if (ear)
     h->ear = ear;
+  bool *cv = realloc(h->convex, cap * sizeof *cv);
+  if (cv)
+    h->convex = cv;
   double *sc = realloc(h->score, cap * sizeof *sc);
   if (sc)
     h->score = sc;
@@ -96,7 +101,7 @@ bool tt__dhole_reserve(tt__dhole *h, int n)
   int32_t *idx = realloc(h->idx, 3 * cap * sizeof *idx);
   if (idx)
     h->idx = idx;
-  if (!p || !tri || !pv || !nx || !ear || !sc || !gx || !gy || !px || !py ||
+  if (!p || !tri || !pv || !nx || !ear || !cv || !sc || !gx || !gy || !px || !py ||
       !idx)
     return false;
   h->cap = cap;
@@ -165,15 +170,21 @@ static inline int orient3(const tt__dhole *h, int s, int i, int j, int k)
   return det > 0 ? s : (det < 0 ? -s : 0);
 }
 
-/* The ear status and score of position i (larger score: cut first). */
-static void examine(tt__dhole *h, const tt__mesh *m, int i, tt_hole rule)
+/* The ear status and score of position i (larger score: cut first).
+ * Only a vertex whose own corner does not turn strictly can lie in the
+ * closed triangle of an ear candidate of a simple polygon (a strictly
+ * convex one inside would put a reflex or straight one inside too, the
+ * classic ear-clipping argument, which holds with straight corners counted
+ * among the reflex ones), so only those are tested. */
+static void examine(tt__dhole *h, int s, int i, tt_hole rule)
 {
   int a = h->prev[i], c = h->next[i];
-  int s = m->metric.det_sign;
   h->ear[i] = false;
-  if (orient3(h, s, a, i, c) <= 0)
+  if (!h->convex[i])
     return;
   for (int q = h->next[c]; q != a; q = h->next[q]) {
+    if (h->convex[q])
+      continue;
     if (orient3(h, s, a, i, q) >= 0 && orient3(h, s, i, c, q) >= 0 &&
         orient3(h, s, c, a, q) >= 0)
       return;
@@ -190,8 +201,11 @@ static bool ear_cut(tt__dhole *h, const tt__mesh *m, tt_hole rule)
     h->prev[i] = i == 0 ? n - 1 : i - 1;
     h->next[i] = i == n - 1 ? 0 : i + 1;
   }
+  int s = m->metric.det_sign;
   for (int i = 0; i < n; i++)
-    examine(h, m, i, rule);
+    h->convex[i] = orient3(h, s, h->prev[i], i, h->next[i]) > 0;
+  for (int i = 0; i < n; i++)
+    examine(h, s, i, rule);
   h->ntri = 0;
   int first = 0; /* a position still in the polygon */
   while (left > 3) {
@@ -214,8 +228,10 @@ static bool ear_cut(tt__dhole *h, const tt__mesh *m, tt_hole rule)
     left--;
     if (first == best)
       first = c;
-    examine(h, m, a, rule);
-    examine(h, m, c, rule);
+    h->convex[a] = orient3(h, s, h->prev[a], a, c) > 0;
+    h->convex[c] = orient3(h, s, a, c, h->next[c]) > 0;
+    examine(h, s, a, rule);
+    examine(h, s, c, rule);
   }
   int a = first, b = h->next[a], c = h->next[b];
   if (orient3(h, m->metric.det_sign, a, b, c) <= 0)

@@ -27,6 +27,7 @@ typedef struct tt__dhole {
   /* scratch of the ear cutting and the DP */
   int *prev, *next;
   bool *ear;
+  bool *convex;         /* corner turns strictly (ear cutting) */
   double *score;
   double *gx, *gy;      /* ground coordinates relative to p_0 */
   int64_t *px, *py;     /* pixel coordinates */
