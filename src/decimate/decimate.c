@@ -749,14 +749,15 @@ static tt_status build_tin(run *r, tt_tin **out_tin)
   tt__mesh_init(&c, &m->metric);
   int32_t *map = malloc((m->nv ? m->nv : 1) * sizeof *map);
   double *ins = NULL, *imp = NULL;
-  if (!map || !tt__mesh_reserve(&c, d->nvert, m->nlive)) {
+  if (!map || !tt__mesh_reserve(&c, d->nvert, m->nlive) ||
+      (m->vz && !tt__mesh_keep_f64(&c))) {
     status = oom(r);
     goto done;
   }
   for (size_t v = 0; v < m->nv; v++) {
     map[v] = -1;
     if (m->v[v].edge >= 0) {
-      map[v] = tt__mesh_add_vertex(&c, m->v[v].c, m->v[v].r, m->v[v].z);
+      map[v] = tt__mesh_add_vertex(&c, m->v[v].c, m->v[v].r, tt__mesh_z(m, (int32_t)v));
       if (map[v] < 0) {
         status = oom(r);
         goto done;
@@ -843,6 +844,10 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
   tt__metric_from_frame(grid->frame, &metric);
   tt__mesh_init(&d->m, &metric);
   tt__heap_init(&r.heap);
+  if (grid->zd && !tt__mesh_keep_f64(&d->m)) {
+    tt__mesh_free(&d->m);
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the heights");
+  }
   tt__dhole_init(&d->h);
   d->env.mesh = &d->m;
   d->env.grid = grid;

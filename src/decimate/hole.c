@@ -254,11 +254,11 @@ typedef struct dp_arg {
 static double area3(const dp_arg *d, int i, int j, int k)
 {
   const tt__dhole *h = d->h;
-  double z0 = d->m->v[h->p[i]].z;
+  double z0 = tt__mesh_z(d->m, h->p[i]);
   double ux = h->gx[j] - h->gx[i], uy = h->gy[j] - h->gy[i];
-  double uz = (double)d->m->v[h->p[j]].z - z0;
+  double uz = tt__mesh_z(d->m, h->p[j]) - z0;
   double vx = h->gx[k] - h->gx[i], vy = h->gy[k] - h->gy[i];
-  double vz = (double)d->m->v[h->p[k]].z - z0;
+  double vz = tt__mesh_z(d->m, h->p[k]) - z0;
   double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz,
          nz = ux * vy - uy * vx;
   return 0.5 * sqrt(nx * nx + ny * ny + nz * nz);

@@ -53,8 +53,9 @@ static double small_error(const tt__dec *d, const tt__scan_tri *st)
   int s = o > 0 ? 1 : -1;
   const size_t nx = d->g->nx;
   double err = 0;
+  const tt_grid *g = d->g;
   for (int64_t y = y0; y <= y1; y++) {
-    const float *zr = d->g->z + (size_t)y * nx;
+    size_t row = (size_t)y * nx;
     double rowbase = p.z0 + p.gy * (double)(y - p.y0);
     for (int64_t x = x0; x <= x1; x++) {
       bool in = true;
@@ -67,7 +68,7 @@ static double small_error(const tt__dec *d, const tt__scan_tri *st)
       if (!in)
         continue;
       double v = rowbase + p.gx * (double)(x - p.x0);
-      double e = fabs((double)zr[x] - v);
+      double e = fabs(tt__grid_z(g, row + (size_t)x) - v);
       if (e > err) /* false for NaN (nodata) */
         err = e;
     }
@@ -84,7 +85,7 @@ double tt__dec_triangle_error(const tt__dec *d, int32_t a, int32_t b,
   for (int k = 0; k < 3; k++) {
     st.x[k] = m->v[w[k]].c;
     st.y[k] = m->v[w[k]].r;
-    st.z[k] = (double)m->v[w[k]].z;
+    st.z[k] = tt__mesh_z(m, w[k]);
     st.own[k] = true;
   }
   int64_t bx0, bx1, by0, by1;
@@ -107,7 +108,7 @@ static double prism(const tt__dec *d, int32_t a, int32_t b, int32_t c)
   double dc2 = m->v[c].c - m->v[a].c, dr2 = m->v[c].r - m->v[a].r;
   double det = fabs(f[0] * f[3] - f[1] * f[2]);
   double area = 0.5 * fabs(dc1 * dr2 - dc2 * dr1) * det;
-  return area * ((double)m->v[a].z + (double)m->v[b].z + (double)m->v[c].z) /
+  return area * (tt__mesh_z(m, a) + tt__mesh_z(m, b) + tt__mesh_z(m, c)) /
          3.0;
 }
 
@@ -126,7 +127,7 @@ static double hole_height_at(const tt__dec *d, const tt__dhole *h,
       for (int k = 0; k < 3; k++) {
         st.x[k] = m->v[q[k]].c;
         st.y[k] = m->v[q[k]].r;
-        st.z[k] = (double)m->v[q[k]].z;
+        st.z[k] = tt__mesh_z(m, q[k]);
       }
       tt__scan_plane p;
       tt__scan_plane_of(&st, &p);
@@ -134,7 +135,7 @@ static double hole_height_at(const tt__dec *d, const tt__dhole *h,
              p.gy * (double)(m->v[v].r - p.y0);
     }
   }
-  return (double)m->v[v].z; /* not reached for a valid fill */
+  return tt__mesh_z(m, v); /* not reached for a valid fill */
 }
 
 /* The largest error over the filled hole's triangles. */
@@ -200,7 +201,7 @@ int tt__dec_evaluate_in(const tt__dec *d, tt__dhole *h, int32_t v,
   }
   if (!score)
     return 1;
-  double zv = (double)m->v[v].z, imp = 0;
+  double zv = tt__mesh_z(m, v), imp = 0;
   switch (d->importance) {
   case TT_IMPORTANCE_DEGREE:
     imp = n;
@@ -208,14 +209,14 @@ int tt__dec_evaluate_in(const tt__dec *d, tt__dhole *h, int32_t v,
   case TT_IMPORTANCE_HDH: {
     double s = 0;
     for (int i = 0; i < n; i++)
-      s += zv - (double)m->v[h->p[i]].z;
+      s += zv - tt__mesh_z(m, h->p[i]);
     imp = fabs(s);
     break;
   }
   case TT_IMPORTANCE_ABH: {
     int below = 0, above = 0;
     for (int i = 0; i < n; i++) {
-      double z = (double)m->v[h->p[i]].z;
+      double z = tt__mesh_z(m, h->p[i]);
       below += z < zv;
       above += z > zv;
     }

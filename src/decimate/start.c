@@ -55,16 +55,17 @@ static tt_status start_all(tt__dec *d)
   for (size_t r = 0; r < ny; r++)
     for (size_t c = 0; c < nx; c++) {
       id[r * nx + c] = -1;
-      if (isnan(g->z[r * nx + c]))
+      if (isnan(tt__grid_z(g, r * nx + c)))
         continue;
       bool carried = false;
       for (size_t cy = r ? r - 1 : 0; cy <= r && cy + 1 < ny && !carried;
            cy++)
         for (size_t cx = c ? c - 1 : 0; cx <= c && cx + 1 < nx && !carried;
              cx++) {
-          int k = !isnan(g->z[cy * nx + cx]) + !isnan(g->z[cy * nx + cx + 1]) +
-                  !isnan(g->z[(cy + 1) * nx + cx]) +
-                  !isnan(g->z[(cy + 1) * nx + cx + 1]);
+          int k = !isnan(tt__grid_z(g, cy * nx + cx)) +
+                  !isnan(tt__grid_z(g, cy * nx + cx + 1)) +
+                  !isnan(tt__grid_z(g, (cy + 1) * nx + cx)) +
+                  !isnan(tt__grid_z(g, (cy + 1) * nx + cx + 1));
           carried = k >= 3;
         }
       if (carried)
@@ -82,21 +83,23 @@ static tt_status start_all(tt__dec *d)
   }
   for (size_t r = 0; r < ny; r++)
     for (size_t c = 0; c < nx; c++) {
-      if (isnan(g->z[r * nx + c]))
+      if (isnan(tt__grid_z(g, r * nx + c)))
         continue;
       bool carried = false;
       for (size_t cy = r ? r - 1 : 0; cy <= r && cy + 1 < ny && !carried;
            cy++)
         for (size_t cx = c ? c - 1 : 0; cx <= c && cx + 1 < nx && !carried;
              cx++) {
-          int k = !isnan(g->z[cy * nx + cx]) + !isnan(g->z[cy * nx + cx + 1]) +
-                  !isnan(g->z[(cy + 1) * nx + cx]) +
-                  !isnan(g->z[(cy + 1) * nx + cx + 1]);
+          int k = !isnan(tt__grid_z(g, cy * nx + cx)) +
+                  !isnan(tt__grid_z(g, cy * nx + cx + 1)) +
+                  !isnan(tt__grid_z(g, (cy + 1) * nx + cx)) +
+                  !isnan(tt__grid_z(g, (cy + 1) * nx + cx + 1));
           carried = k >= 3;
         }
       if (carried) {
         id[r * nx + c] =
-            tt__mesh_add_vertex(m, (int32_t)c, (int32_t)r, g->z[r * nx + c]);
+            tt__mesh_add_vertex(m, (int32_t)c, (int32_t)r,
+                                tt__grid_z(g, r * nx + c));
         if (id[r * nx + c] < 0) {
           status = oom(d);
           goto done;
@@ -151,7 +154,7 @@ static tt_status start_greedy(tt__dec *d, size_t points)
     goto done;
   }
   for (size_t v = 0; v < tin->nv; v++)
-    if (tt__mesh_add_vertex(m, tin->vc[v], tin->vr[v], tin->vz[v]) < 0) {
+    if (tt__mesh_add_vertex(m, tin->vc[v], tin->vr[v], tt__tin_z(tin, v)) < 0) {
       status = oom(d);
       goto done;
     }
