@@ -9,6 +9,7 @@
  *    every valid sample a triangle can carry is covered;
  *  - the count stops are exact; grid corners stay;
  *  - same input, same bytes, whatever the thread count;
+ *  - a grid of doubles keeps the bound and the exact heights;
  *  - options are checked. */
 #include "decimate/decimate.h"
 #include "terratin/terratin.h"
@@ -327,6 +328,37 @@ static void test_stops(void)
   tt_grid_destroy(g);
 }
 
+/* A grid of doubles (heights no float holds, about 10^6 + cm): the bound
+ * still holds at every sample by the oracle, and the vertices keep their
+ * exact heights. */
+static void test_double_heights(void)
+{
+  tt_grid *g = terrain(40, 30, 21, 0.3, 0);
+  CHECK(tt__grid_widen(g));
+  for (size_t i = 0; i < 40 * 30; i++)
+    g->zd[i] = 1e6 + g->zd[i] * 0.01 + 1e-4 * (double)(i % 7);
+  for (int sel = 0; sel < 2; sel++) {
+    tt_decimate_options o;
+    tt_decimate_options_init(&o);
+    o.max_error = 0.05;
+    o.selection = (tt_selection)sel;
+    tt_tin *tin = NULL;
+    CHECK_OK(ctx, tt_decimate_run(ctx, g, &o, &tin));
+    if (!tin)
+      continue;
+    size_t unc;
+    CHECK_DBL_LE(oracle_max(g, tin, &unc), 0.05 + 1e-9);
+    CHECK(tt_tin_vertex_count(tin) < 40 * 30 / 2);
+    for (size_t i = 0; i < tt_tin_vertex_count(tin); i++) {
+      tt_vertex_info vi;
+      tt_tin_vertex(tin, i, &vi);
+      CHECK(vi.z == g->zd[(size_t)vi.row * 40 + (size_t)vi.col]);
+    }
+    tt_tin_destroy(tin);
+  }
+  tt_grid_destroy(g);
+}
+
 static void test_options(void)
 {
   tt_grid *g = terrain(10, 10, 1, 0, 0);
@@ -370,6 +402,7 @@ int main(void)
   test_exact_bound();
   test_final_importance();
   test_determinism();
+  test_double_heights();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
