@@ -10,6 +10,7 @@
  *  - the count stops are exact; grid corners stay;
  *  - same input, same bytes, whatever the thread count;
  *  - a grid of doubles keeps the bound and the exact heights;
+ *  - progress goes forward and a callback returning 0 interrupts;
  *  - options are checked. */
 #include "decimate/decimate.h"
 #include "terratin/terratin.h"
@@ -359,6 +360,50 @@ static void test_double_heights(void)
   tt_grid_destroy(g);
 }
 
+typedef struct stopper {
+  int calls, stop_at;
+  double last;
+  bool backwards;
+} stopper;
+
+static int stop_progress(double complete, const char *message, void *arg)
+{
+  (void)message;
+  stopper *st = arg;
+  st->backwards |= complete < st->last;
+  st->last = complete;
+  return ++st->calls < st->stop_at;
+}
+
+/* The progress callback sees fractions that never go back; returning 0
+ * stops the run with TT_ERR_INTERRUPTED and no TIN. */
+static void test_interrupt(void)
+{
+  tt_grid *g = terrain(80, 80, 9, 1.0, 0);
+  tt_decimate_options o;
+  tt_decimate_options_init(&o);
+  o.percent = 5;
+  o.importance = TT_IMPORTANCE_HDH;
+  stopper st = {0, 1 << 30, 0, false};
+  o.progress = stop_progress;
+  o.progress_arg = &st;
+  tt_tin *tin = NULL;
+  CHECK_OK(ctx, tt_decimate_run(ctx, g, &o, &tin));
+  CHECK(tin != NULL);
+  CHECK(st.calls >= 3);
+  CHECK(!st.backwards);
+  CHECK_DBL_NEAR(st.last, 1.0, 0);
+  tt_tin_destroy(tin);
+  for (int at = 1; at <= 3; at++) {
+    stopper s2 = {0, at, 0, false};
+    o.progress_arg = &s2;
+    tin = NULL;
+    CHECK_INT_EQ(tt_decimate_run(ctx, g, &o, &tin), TT_ERR_INTERRUPTED);
+    CHECK(tin == NULL);
+  }
+  tt_grid_destroy(g);
+}
+
 static void test_options(void)
 {
   tt_grid *g = terrain(10, 10, 1, 0, 0);
@@ -403,6 +448,7 @@ int main(void)
   test_final_importance();
   test_determinism();
   test_double_heights();
+  test_interrupt();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
