@@ -5,7 +5,8 @@
  *    a valid mesh with two triangles fewer, and re-inserting the vertex
  *    leaves a valid mesh again;
  *  - dp holes are optimal: compared with the best of every triangulation
- *    of small random star-shaped polygons, enumerated;
+ *    of small random star-shaped polygons, enumerated, for each measure
+ *    (max-min angle, min-max angle, least 3-D area);
  *  - each importance against a direct computation by hand;
  *  - a vertex on a straight border run may go, a corner may not. */
 #include "decimate/decimate.h"
@@ -200,17 +201,57 @@ static void test_hard_stars(void)
       TT_FAIL_("only %d stars of kind %d", tested[k], k);
 }
 
-/* A triangulation's value by enumeration: the best over every
- * triangulation of polygon[i..j] closed by (i, j), for max-min angle. */
-static double enum_best(const tt__dhole *h, const tt__mesh *m, int i, int j)
+/* The measure of triangle (a, b, c) of mesh vertices, computed here from
+ * scratch: mode 0 its smallest angle, 1 its largest, 2 its 3-D area (the
+ * ground frame is (c, -r): angles and areas as in pixel space). */
+static double tri_measure(const tt__mesh *m, const int32_t c[3], int mode)
 {
+  if (mode == 2) {
+    double ux = m->v[c[1]].c - m->v[c[0]].c, uy = m->v[c[1]].r - m->v[c[0]].r;
+    double vx = m->v[c[2]].c - m->v[c[0]].c, vy = m->v[c[2]].r - m->v[c[0]].r;
+    double uz = (double)m->v[c[1]].z - m->v[c[0]].z;
+    double vz = (double)m->v[c[2]].z - m->v[c[0]].z;
+    double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz,
+           nz = ux * vy - uy * vx;
+    return 0.5 * sqrt(nx * nx + ny * ny + nz * nz);
+  }
+  double a[3];
+  for (int e = 0; e < 3; e++) {
+    const tt__mesh_vertex *P = &m->v[c[e]], *Q = &m->v[c[(e + 1) % 3]],
+                          *R = &m->v[c[(e + 2) % 3]];
+    double ux = Q->c - P->c, uy = Q->r - P->r, vx = R->c - P->c,
+           vy = R->r - P->r;
+    a[e] = atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy);
+  }
+  return mode == 0 ? fmin(a[0], fmin(a[1], a[2]))
+                   : fmax(a[0], fmax(a[1], a[2]));
+}
+
+/* Combines a value with a part's: mode 0 keeps the smallest (maximised
+ * overall), 1 the largest (minimised), 2 sums (minimised). */
+static double combine(int mode, double x, double y)
+{
+  return mode == 0 ? fmin(x, y) : mode == 1 ? fmax(x, y) : x + y;
+}
+
+static bool better(int mode, double x, double y)
+{
+  return mode == 0 ? x > y : x < y;
+}
+
+/* The best value over every triangulation of polygon[i..j] closed by
+ * (i, j), by enumeration of the apex of (i, j) and recursion. */
+static double enum_best(const tt__dhole *h, const tt__mesh *m, int i, int j,
+                        int mode)
+{
+  double none = mode == 0 ? INFINITY : mode == 1 ? -INFINITY : 0;
   if (j - i < 2)
-    return INFINITY;
-  double best = -INFINITY;
+    return none;
+  double best = mode == 0 ? -INFINITY : INFINITY;
   for (int k = i + 1; k < j; k++) {
     if (tt__mesh_orient(m, h->p[i], h->p[k], h->p[j]) <= 0)
       continue;
-    /* the triangle must be inside: its diagonals must be */
+    /* the triangle must be inside: no other vertex in it */
     bool inside = true;
     for (int q = 0; q < h->n && inside; q++) {
       if (q == i || q == j || q == k)
@@ -221,23 +262,25 @@ static double enum_best(const tt__dhole *h, const tt__mesh *m, int i, int j)
     }
     if (!inside)
       continue;
-    double a[3];
     int32_t c[3] = {h->p[i], h->p[k], h->p[j]};
-    for (int e = 0; e < 3; e++) {
-      const tt__mesh_vertex *P = &m->v[c[e]], *Q = &m->v[c[(e + 1) % 3]],
-                            *R = &m->v[c[(e + 2) % 3]];
-      double ux = Q->c - P->c, uy = Q->r - P->r, vx = R->c - P->c,
-             vy = R->r - P->r;
-      a[e] = atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy);
-    }
-    double mn = fmin(a[0], fmin(a[1], a[2]));
-    double l = k - i >= 2 ? enum_best(h, m, i, k) : INFINITY;
-    double r = j - k >= 2 ? enum_best(h, m, k, j) : INFINITY;
-    double v = fmin(mn, fmin(l, r));
-    if (v > best)
+    double l = enum_best(h, m, i, k, mode), r = enum_best(h, m, k, j, mode);
+    if (isinf(l) && l == (mode == 0 ? -INFINITY : INFINITY))
+      continue; /* that side has no triangulation */
+    if (isinf(r) && r == (mode == 0 ? -INFINITY : INFINITY))
+      continue;
+    double v = combine(mode, tri_measure(m, c, mode), combine(mode, l, r));
+    if (better(mode, v, best))
       best = v;
   }
   return best;
+}
+
+static double fill_value(const tt__dec *d, int mode)
+{
+  double v = mode == 0 ? INFINITY : mode == 1 ? -INFINITY : 0;
+  for (int t = 0; t < d->h.ntri; t++)
+    v = combine(mode, v, tri_measure(&d->m, d->h.tri[t], mode));
+  return v;
 }
 
 static void test_dp_optimal(void)
@@ -267,48 +310,36 @@ static void test_dp_optimal(void)
     }
     if (!fan)
       continue;
-    tt_decimate_options o;
-    tt_decimate_options_init(&o);
-    o.hole = TT_HOLE_DP;
-    o.criterion = TT_CRITERION_DELAUNAY;
-    o.importance = TT_IMPORTANCE_DROP;
-    tt__dec d;
-    star_init(&d, &o, x, y, n, true);
-    double imp;
-    if (tt__dec_evaluate(&d, 0, TT__DEC_FILL, &imp, NULL) != 1) {
-      TT_FAIL_("dp trial %d: no fill", trial);
+    static const tt_criterion crits[3] = {TT_CRITERION_DELAUNAY,
+                                          TT_CRITERION_MINMAX_ANGLE,
+                                          TT_CRITERION_MIN_AREA};
+    for (int mode = 0; mode < 3; mode++) {
+      tt_decimate_options o;
+      tt_decimate_options_init(&o);
+      o.hole = TT_HOLE_DP;
+      o.criterion = crits[mode];
+      o.importance = TT_IMPORTANCE_DROP;
+      tt__dec d;
+      star_init(&d, &o, x, y, n, true);
+      double imp;
+      if (tt__dec_evaluate(&d, 0, TT__DEC_FILL, &imp, NULL) != 1) {
+        TT_FAIL_("dp trial %d (%s): no fill", trial,
+                 tt_criterion_name(crits[mode]));
+        star_free(&d);
+        continue;
+      }
+      double got = fill_value(&d, mode);
+      double best = enum_best(&d.h, &d.m, 0, n - 1, mode);
+      CHECK_DBL_NEAR(got, best, 1e-9 * (1 + fabs(best)));
+      /* ear cutting never beats the optimum */
+      d.hole = TT_HOLE_MINANGLE;
+      (void)tt__dec_evaluate(&d, 0, TT__DEC_FILL, &imp, NULL);
+      double ear = fill_value(&d, mode);
+      CHECK(!better(mode, ear, best + (mode == 0 ? 1e-12 : -1e-12) *
+                                          (1 + fabs(best))));
       star_free(&d);
-      continue;
     }
-    double got = INFINITY;
-    for (int t = 0; t < d.h.ntri; t++) {
-      for (int e = 0; e < 3; e++) {
-        const tt__mesh_vertex *P = &d.m.v[d.h.tri[t][e]],
-                              *Q = &d.m.v[d.h.tri[t][(e + 1) % 3]],
-                              *R = &d.m.v[d.h.tri[t][(e + 2) % 3]];
-        double ux = Q->c - P->c, uy = Q->r - P->r, vx = R->c - P->c,
-               vy = R->r - P->r;
-        got = fmin(got, atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy));
-      }
-    }
-    double best = enum_best(&d.h, &d.m, 0, n - 1);
-    CHECK_DBL_NEAR(got, best, 1e-12);
-    /* ear cutting never beats the optimum */
-    d.hole = TT_HOLE_MINANGLE;
-    (void)tt__dec_evaluate(&d, 0, TT__DEC_FILL, &imp, NULL);
-    double ear = INFINITY;
-    for (int t = 0; t < d.h.ntri; t++)
-      for (int e = 0; e < 3; e++) {
-        const tt__mesh_vertex *P = &d.m.v[d.h.tri[t][e]],
-                              *Q = &d.m.v[d.h.tri[t][(e + 1) % 3]],
-                              *R = &d.m.v[d.h.tri[t][(e + 2) % 3]];
-        double ux = Q->c - P->c, uy = Q->r - P->r, vx = R->c - P->c,
-               vy = R->r - P->r;
-        ear = fmin(ear, atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy));
-      }
-    CHECK_DBL_LE(ear, best + 1e-12);
     checked++;
-    star_free(&d);
   }
   CHECK(checked > 100);
 }
