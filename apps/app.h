@@ -170,7 +170,8 @@ typedef struct app_simplify_report {
   const char *driver;
   size_t cells, valid;
   double zmin, zmax;
-  const tt_refine_options *ropt;
+  const tt_refine_options *ropt;  /* the limits, for either method */
+  const tt_decimate_options *dopt; /* -method decimate; else NULL */
   int default_error;            /* max_error came from the 0.5% rule */
   tt_tin_summary sum;
   double t_read, t_simplify, t_write, t_total;

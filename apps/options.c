@@ -142,7 +142,8 @@ enum opt_id {
   O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE,
   O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
   O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
-  O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R
+  O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START,
+  O_IMPORTANCE, O_SELECTION, O_ONEPASS, O_HOLE
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -193,6 +194,12 @@ static const struct opt_def {
     {"-anneal_swaps", O_ANNEAL_SWAPS, 1, FOR_S | FOR_O},
     {"-anneal_good", O_ANNEAL_GOOD, 1, FOR_S | FOR_O},
     {"-anneal_r", O_ANNEAL_R, 1, FOR_S | FOR_O},
+    {"-method", O_METHOD, 1, FOR_S},
+    {"-start", O_START, 1, FOR_S},
+    {"-importance", O_IMPORTANCE, 1, FOR_S},
+    {"-selection", O_SELECTION, 1, FOR_S},
+    {"-onepass", O_ONEPASS, 0, FOR_S},
+    {"-hole", O_HOLE, 1, FOR_S},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -275,6 +282,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
   const char *pos[3] = {NULL, NULL, NULL};
   size_t npos = 0;
   synth_flags sf;
+  const char *decimate_only = NULL; /* the first decimation-only option */
   const char *cmdname = "";
   char hint[64] = "";
   memset(&sf, 0, sizeof sf);
@@ -636,6 +644,44 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
                 keep(o, v)))
         NOMEM();
       break;
+    case O_METHOD:
+      if (tt__app_str_ieq(v, "insert"))
+        o->s.decimate = 0;
+      else if (tt__app_str_ieq(v, "decimate"))
+        o->s.decimate = 1;
+      else
+        USAGE("%s: unknown -method '%s'; known: insert, decimate", cmdname,
+              v);
+      break;
+    case O_START:
+      if (tt_decimate_start_parse(ctx, v, &o->s.start, &o->s.start_points) !=
+          TT_OK)
+        USAGE("%s: unknown -start '%s'; known: all, greedy, greedy:N (N >= "
+              "3)", cmdname, v);
+      decimate_only = decimate_only ? decimate_only : "-start";
+      break;
+    case O_IMPORTANCE:
+      if (tt_importance_parse(ctx, v, &o->s.importance) != TT_OK)
+        USAGE("%s: unknown -importance '%s'; known: degree, hdh, abh, "
+              "volume, drop, error, auto", cmdname, v);
+      decimate_only = decimate_only ? decimate_only : "-importance";
+      break;
+    case O_SELECTION:
+      if (tt_selection_parse(ctx, v, &o->s.selection) != TT_OK)
+        USAGE("%s: unknown -selection '%s'; known: independent, sequential",
+              cmdname, v);
+      decimate_only = decimate_only ? decimate_only : "-selection";
+      break;
+    case O_ONEPASS:
+      o->s.onepass = 1;
+      decimate_only = decimate_only ? decimate_only : "-onepass";
+      break;
+    case O_HOLE:
+      if (tt_hole_parse(ctx, v, &o->s.hole) != TT_OK)
+        USAGE("%s: unknown -hole '%s'; known: minangle, circumradius, dp, "
+              "auto", cmdname, v);
+      decimate_only = decimate_only ? decimate_only : "-hole";
+      break;
     case O_A_SRS:
       if (!*v)
         USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);
@@ -661,6 +707,18 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       USAGE("simplify: missing OUTPUT after '%s'%s", pos[0], hint);
     if (!(o->s.input = keep(o, pos[0])) || !(o->s.output = keep(o, pos[1])))
       NOMEM();
+    if (decimate_only && !o->s.decimate)
+      USAGE("simplify: %s applies to -method decimate only", decimate_only);
+    if (o->s.onepass && o->s.selection != TT_SELECTION_INDEPENDENT)
+      USAGE("simplify: -onepass applies to -selection independent only");
+    if (o->s.decimate && o->s.hole == TT_HOLE_DP &&
+        o->s.criterion != TT_CRITERION_DELAUNAY &&
+        o->s.criterion != TT_CRITERION_MINMAX_ANGLE &&
+        o->s.criterion != TT_CRITERION_MINMAX_ANGLE_LEX &&
+        o->s.criterion != TT_CRITERION_MIN_AREA)
+      USAGE("simplify: -hole dp needs a decomposable criterion (delaunay, "
+            "minmax_angle, minmax_angle_lex, min_area), not %s",
+            tt_criterion_name(o->s.criterion));
     break;
   case TT_APP_EVAL:
     if (npos < 1)

@@ -171,6 +171,7 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_size(&j, "band", (size_t)r->s->band);
   tt__json_str(&j, "output", r->s->output);
   tt__json_str(&j, "format", p->driver);
+  tt__json_str(&j, "method", p->dopt ? "decimate" : "insert");
   tt__json_str(&j, "criterion", tt_criterion_name(p->sum.criterion));
   tt_repair rep = tt_repair_resolve(r->s->repair, p->sum.criterion);
   tt__json_str(&j, "repair", tt_repair_name(rep));
@@ -194,6 +195,33 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   if (ro->percent > 0) tt__json_num(&j, "percent", ro->percent);
   else tt__json_null(&j, "percent");
   tt__json_close(&j);
+  if (p->dopt) {
+    const tt_decimate_options *d = p->dopt;
+    tt__json_open(&j, "decimation");
+    if (d->start == TT_DSTART_GREEDY_N) {
+      char sn[48];
+      snprintf(sn, sizeof sn, "greedy:%zu", d->start_points);
+      tt__json_str(&j, "start", sn);
+    } else {
+      tt__json_str(&j, "start", tt_decimate_start_name(d->start));
+    }
+    tt_importance imp = d->importance != TT_IMPORTANCE_AUTO ? d->importance
+                        : d->max_error >= 0 ? TT_IMPORTANCE_ERROR
+                                            : TT_IMPORTANCE_HDH;
+    tt__json_str(&j, "importance", tt_importance_name(imp));
+    tt__json_str(&j, "selection", tt_selection_name(d->selection));
+    tt__json_bool(&j, "onepass", d->onepass);
+    tt_hole hole = d->hole != TT_HOLE_AUTO ? d->hole
+                   : d->criterion == TT_CRITERION_DELAUNAY
+                       ? TT_HOLE_CIRCUMRADIUS
+                       : TT_HOLE_MINANGLE;
+    tt__json_str(&j, "hole", tt_hole_name(hole));
+    tt__json_size(&j, "start_vertices", p->sum.start_vertices);
+    tt__json_size(&j, "removed_vertices", p->sum.removed_vertices);
+    tt__json_size(&j, "rounds", p->sum.rounds);
+    tt__json_size(&j, "refused_for_bound", p->sum.refused_bound);
+    tt__json_close(&j);
+  }
   tt__json_str(&j, "stop_reason", tt_stop_reason_name(p->sum.stop_reason));
   tt__json_size(&j, "vertices", p->sum.vertices);
   tt__json_size(&j, "triangles", p->sum.triangles);
@@ -289,6 +317,13 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
           in->crs_name && *in->crs_name ? in->crs_name : "none",
           r->s->t_srs ? ", written in " : "", r->s->t_srs ? r->s->t_srs : "",
           in->frame_name, zu, p->t_total);
+  if (p->dopt)
+    fprintf(r->out,
+            "%s: decimated from %zu vertices: %zu removed in %zu %s\n",
+            r->s->output, p->sum.start_vertices, p->sum.removed_vertices,
+            p->sum.rounds,
+            p->dopt->selection == TT_SELECTION_SEQUENTIAL ? "steps"
+                                                          : "rounds");
   /* nodata outlines: what the TIN could not carry is said, not dropped */
   size_t lone = p->sum.errors.samples - p->sum.errors.covered;
   if (lone || p->sum.components > 1)

@@ -349,6 +349,7 @@ done:
 void tt__app_height_range(const tt_grid *grid, double *out_min,
                          double *out_max)
 {
+  /* a grid of doubles has no float view (tt_grid_heights_const is NULL) */
   const float *z = tt_grid_heights_const(grid);
   const double *zd = tt_grid_heights_f64_const(grid);
   size_t n = tt_grid_width(grid) * tt_grid_height(grid);

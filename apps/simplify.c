@@ -1,6 +1,7 @@
 /*
  * simplify.c -- `terratin simplify INPUT OUTPUT`: open the DEM, read the
- * band into a grid, run the refinement, write the TIN's layers under a
+ * band into a grid, run the refinement (-method insert) or the decimation
+ * (-method decimate), write the TIN's layers under a
  * temporary name and commit it, then print the summary or JSON.
  *
  * Invariants: the input is never written; an existing output is replaced
@@ -147,6 +148,7 @@ tt_status tt__app_simplify(app_run *r)
   ro.percent = s->percent;
   ro.criterion = s->criterion;
   ro.optimize = s->optimize;
+  ro.anneal = s->anneal;
   ro.repair = s->repair;
   if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
       !(s->percent > 0)) {
@@ -157,8 +159,30 @@ tt_status tt__app_simplify(app_run *r)
   ro.progress = tt__app_phase_fn;
   ro.progress_arg = &r->prog;
   rep.ropt = &ro;
+  tt_decimate_options dopt;
+  tt_decimate_options_init(&dopt);
+  if (s->decimate) {
+    dopt.max_error = ro.max_error;
+    dopt.max_points = ro.max_points;
+    dopt.max_triangles = ro.max_triangles;
+    dopt.percent = ro.percent;
+    dopt.criterion = ro.criterion;
+    dopt.optimize = ro.optimize;
+    dopt.anneal = ro.anneal;
+    dopt.repair = ro.repair;
+    dopt.start = s->start;
+    dopt.start_points = s->start_points;
+    dopt.importance = s->importance;
+    dopt.selection = s->selection;
+    dopt.onepass = s->onepass;
+    dopt.hole = s->hole;
+    dopt.progress = ro.progress;
+    dopt.progress_arg = ro.progress_arg;
+    rep.dopt = &dopt;
+  }
   double t = tt__app_now();
-  st = tt_refine_run(r->ctx, grid, &ro, &tin);
+  st = s->decimate ? tt_decimate_run(r->ctx, grid, &dopt, &tin)
+                   : tt_refine_run(r->ctx, grid, &ro, &tin);
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, st == TT_ERR_INTERRUPTED ? s->output : s->input);
     goto done;
@@ -203,6 +227,8 @@ tt_status tt__app_simplify(app_run *r)
       {"input", TT_FIELD_STRING, s->input, 0, 0},
       {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
       {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
+      {"method", TT_FIELD_STRING, s->decimate ? "decimate" : "insert", 0,
+       0},
       {"criterion", TT_FIELD_STRING, tt_criterion_name(ro.criterion), 0, 0},
       {"repair", TT_FIELD_STRING,
        tt_repair_name(tt_repair_resolve(ro.repair, ro.criterion)), 0, 0},
@@ -244,6 +270,42 @@ tt_status tt__app_simplify(app_run *r)
       {"t_stats", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_statistics},
       {"created", TT_FIELD_STRING, created, 0, 0},
   };
+  /* Decimation adds what it ran with: start, importance, selection, hole
+   * rule (resolved), rounds, and the vertex counts. */
+  char start_name[48];
+  snprintf(start_name, sizeof start_name, "greedy:%zu", s->start_points);
+  tt_importance imp_used = s->importance != TT_IMPORTANCE_AUTO ? s->importance
+                           : ro.max_error >= 0 ? TT_IMPORTANCE_ERROR
+                                               : TT_IMPORTANCE_HDH;
+  tt_hole hole_used = s->hole != TT_HOLE_AUTO ? s->hole
+                      : ro.criterion == TT_CRITERION_DELAUNAY
+                          ? TT_HOLE_CIRCUMRADIUS
+                          : TT_HOLE_MINANGLE;
+  const tt_run_field dfields[] = {
+      {"start", TT_FIELD_STRING,
+       s->start == TT_DSTART_GREEDY_N ? start_name
+                                      : tt_decimate_start_name(s->start),
+       0, 0},
+      {"importance", TT_FIELD_STRING, tt_importance_name(imp_used), 0, 0},
+      {"selection", TT_FIELD_STRING,
+       s->selection == TT_SELECTION_SEQUENTIAL ? "sequential"
+       : s->onepass                           ? "independent onepass"
+                                              : "independent multipass",
+       0, 0},
+      {"hole", TT_FIELD_STRING, tt_hole_name(hole_used), 0, 0},
+      {"rounds", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.rounds, 0},
+      {"start_vtx", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.start_vertices,
+       0},
+      {"removed", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.removed_vertices,
+       0},
+      {"refused", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.refused_bound, 0},
+  };
+  enum { NF = sizeof fields / sizeof fields[0],
+         ND = sizeof dfields / sizeof dfields[0] };
+  tt_run_field allf[NF + ND];
+  memcpy(allf, fields, sizeof fields);
+  memcpy(allf + NF, dfields, sizeof dfields);
+  size_t nallf = NF + (s->decimate ? ND : 0);
   /* Shapefile outputs name their files "<name>_<layer>": the planned
    * prefix comes first, then the user's -nln. */
   char *prefix = CPLStrdup(CPLSPrintf("%s%s", tt_output_layer_prefix(outp),
@@ -271,8 +333,7 @@ tt_status tt__app_simplify(app_run *r)
                  "for 3,600); GPKG writes them in a second",
                  s->output, nfeatures);
   r->msg.last[0] = '\0';
-  st = tt_ogr_write_tin(r->ctx, dst, tin, srs, fields,
-                        sizeof fields / sizeof fields[0], wopts,
+  st = tt_ogr_write_tin(r->ctx, dst, tin, srs, allf, nallf, wopts,
                         tt__app_phase_fn, &r->prog);
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, s->output);

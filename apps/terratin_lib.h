@@ -104,6 +104,15 @@ typedef struct tt_app_settings {
   const char *const *lco;    /* -lco NAME=VALUE, in order */
   const char *const *dsco;   /* -dsco NAME=VALUE, in order */
   const char *nln;           /* -nln layer name prefix; "" by default */
+  /* simplify -method decimate (docs/decimation.md); the options below
+   * apply to it only */
+  int decimate;              /* -method: 0 insert (default), 1 decimate */
+  tt_decimate_start start;   /* -start all | greedy | greedy:N */
+  size_t start_points;       /* the N of greedy:N */
+  tt_importance importance;  /* -importance; default auto */
+  tt_selection selection;    /* -selection; default independent */
+  int onepass;               /* -onepass */
+  tt_hole hole;              /* -hole; default auto */
 
   /* eval, optimize (which reads the TIN from tin and writes output) */
   const char *layer;         /* -layer; NULL: the triangles layer */

@@ -399,6 +399,13 @@ typedef struct tt_tin_summary {
   size_t components;      /* separate pieces of the TIN (islands) */
   size_t forced_vertices; /* inserted to follow nodata outlines, whatever
                              their error */
+  /* Decimation only (0 after refinement): vertices of the starting TIN,
+   * vertices removed, rounds (independent sets; removals for sequential),
+   * and removals refused because they would break the error bound. */
+  size_t start_vertices;
+  size_t removed_vertices;
+  size_t rounds;
+  size_t refused_bound;
   /* Wall-clock seconds tt_refine_run spent building the mesh (from the
    * call to the end of the final optimisation pass) and then measuring it
    * (`errors` above and the per-triangle and per-vertex statistics: one
@@ -422,6 +429,11 @@ typedef struct tt_vertex_info {
   double star_max_error;  /* max |H - H'| over the samples of its star */
   double star_rmse;       /* RMS of the same samples */
   size_t star_samples;
+  /* Decimation: the importance the vertex had when the run stopped (with
+   * importance error, the largest error its removal would now leave); NaN
+   * after refinement and for a vertex that may not go (a grid or outline
+   * corner, a pinch of the outline). */
+  double importance;
 } tt_vertex_info;
 
 typedef struct tt_triangle_info {
@@ -444,6 +456,95 @@ tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
                         tt_vertex_info *out_vertex);
 tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
                           tt_triangle_info *out_triangle);
+
+/* ---------------------------------------------------------------------------
+ * Decimation (SPEC section 3.6, docs/decimation.md): start from a fine TIN
+ * and delete the least important vertices.
+ * ------------------------------------------------------------------------- */
+typedef enum tt_decimate_start {
+  TT_DSTART_ALL = 0,     /* every valid sample, over the valid domain */
+  TT_DSTART_GREEDY,      /* greedy Delaunay insertion to zero error */
+  TT_DSTART_GREEDY_N     /* greedy Delaunay insertion of start_points */
+} tt_decimate_start;
+
+typedef enum tt_importance {
+  TT_IMPORTANCE_AUTO = 0, /* error with a max error, else hdh */
+  TT_IMPORTANCE_DEGREE,   /* number of neighbours */
+  TT_IMPORTANCE_HDH,      /* |sum (z(v) - z(v_i))| over the neighbours */
+  TT_IMPORTANCE_ABH,      /* |neighbours below - neighbours above| */
+  TT_IMPORTANCE_VOLUME,   /* |volume under the star - under the hole| */
+  TT_IMPORTANCE_DROP,     /* |z(v) - the hole's height at v| */
+  TT_IMPORTANCE_ERROR     /* largest |H - H'| the removal would leave over
+                             the valid samples under the hole */
+} tt_importance;
+
+typedef enum tt_selection {
+  TT_SELECTION_INDEPENDENT = 0, /* rounds of independent sets */
+  TT_SELECTION_SEQUENTIAL       /* least important first, from a heap */
+} tt_selection;
+
+typedef enum tt_hole {
+  TT_HOLE_AUTO = 0,       /* circumradius for delaunay, minangle else */
+  TT_HOLE_MINANGLE,       /* ear cutting, largest smallest angle first */
+  TT_HOLE_CIRCUMRADIUS,   /* ear cutting, smallest circumradius first */
+  TT_HOLE_DP              /* exact optimum of the criterion's decomposable
+                             measure (delaunay, minmax_angle[_lex],
+                             min_area only) */
+} tt_hole;
+
+/* Names: "all", "greedy", "greedy:N" (tt_decimate_start_parse also sets
+ * the N); "auto", "degree", "hdh", "abh", "volume", "drop", "error";
+ * "independent", "sequential"; "auto", "minangle", "circumradius", "dp".
+ * NULL for an unknown value; parsing an unknown name is TT_ERR_ARG. */
+const char *tt_importance_name(tt_importance importance);
+tt_status tt_importance_parse(tt_context *ctx, const char *name,
+                              tt_importance *out_importance);
+const char *tt_selection_name(tt_selection selection);
+tt_status tt_selection_parse(tt_context *ctx, const char *name,
+                             tt_selection *out_selection);
+const char *tt_hole_name(tt_hole hole);
+tt_status tt_hole_parse(tt_context *ctx, const char *name,
+                        tt_hole *out_hole);
+const char *tt_decimate_start_name(tt_decimate_start start);
+tt_status tt_decimate_start_parse(tt_context *ctx, const char *name,
+                                  tt_decimate_start *out_start,
+                                  size_t *out_points);
+
+typedef struct tt_decimate_options {
+  /* No removal may leave a valid sample more than max_error away (z
+   * units); negative: no error limit. */
+  double max_error;
+  /* Stop as soon as the TIN has at most max_points vertices (percent:
+   * floor(percent/100 * valid samples)) or at most max_triangles
+   * triangles; 0: none. The first reached wins. */
+  size_t max_points;
+  size_t max_triangles;
+  double percent;
+  tt_criterion criterion;
+  tt_decimate_start start;
+  size_t start_points;     /* N of TT_DSTART_GREEDY_N */
+  tt_importance importance;
+  tt_selection selection;
+  int onepass;             /* independent sets: score once at the start
+                              (non-zero) */
+  tt_hole hole;
+  tt_repair repair;        /* the criterion restored around each hole */
+  tt_optimize optimize;    /* the final whole-mesh pass */
+  tt_anneal_options anneal; /* its schedule with TT_OPTIMIZE_ANNEAL */
+  int threads;             /* as in tt_refine_options */
+  tt_progress_fn progress;
+  void *progress_arg;
+} tt_decimate_options;
+
+/* Default: no limit at all (set one), Delaunay, start all, importance
+ * auto, independent multi-pass, hole auto, repair and optimize auto. */
+void tt_decimate_options_init(tt_decimate_options *opt);
+
+/* Vertex decimation of the grid under the criterion until the first stop
+ * condition is met; at least one must be set. The caller owns *out_tin
+ * and frees it with tt_tin_destroy(). */
+tt_status tt_decimate_run(tt_context *ctx, const tt_grid *grid,
+                          const tt_decimate_options *opt, tt_tin **out_tin);
 
 /* ---------------------------------------------------------------------------
  * Evaluation of any triangle soup (ours or another tool's) against a grid.

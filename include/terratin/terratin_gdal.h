@@ -108,7 +108,8 @@ typedef struct tt_run_field {
  * (POLYGON Z; fields v0 v1 v2 max_err rmse n_samples area_2d area_3d slope
  * aspect min_angle max_angle; ring v0 v1 v2 v0, counter-clockwise in map
  * space) and <prefix>vertices (POINT Z; fields vertex_id col row ins_err
- * ins_rank star_max star_rmse star_n), and a one-row table
+ * ins_rank star_max star_rmse star_n; a decimated TIN adds importance and
+ * leaves ins_err and ins_rank NULL), and a one-row table
  * <prefix>run_parameters from fields (names of at most 10 characters for a
  * shapefile). NaN reals are written as NULL. The rows go in one transaction
  * when the driver has them; on any failure or interruption nothing is

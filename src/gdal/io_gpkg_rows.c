@@ -475,8 +475,9 @@ static tt_status write_triangles(rows_state *w, const tt__records *rec,
 static tt_status write_vertices(rows_state *w, const tt__records *rec,
                                 layer_table *t)
 {
-  batch b = {w, t, tt__vertex_fields, TT__VF_COUNT, TT__VF_COUNT + 1, NULL,
-             NULL};
+  const int nf = tt__records_vertex_fields(rec->tin);
+  const int decimated = tt__records_decimated(rec->tin);
+  batch b = {w, t, tt__vertex_fields, nf, nf + 1, NULL, NULL};
   unsigned char blobs[BATCH_ROWS][PT_BLOB_BYTES];
   tt_status s = TT_OK;
   const size_t nv = tt_tin_vertex_count(rec->tin);
@@ -508,11 +509,16 @@ static tt_status write_vertices(rows_state *w, const tt__records *rec,
       sqlite3_bind_int64(st, c + TT__VF_COL, v.col);
       sqlite3_bind_int64(st, c + TT__VF_ROW, v.row);
       bind_real(st, c + TT__VF_INS_ERR, v.insert_error);
-      sqlite3_bind_int64(st, c + TT__VF_INS_RANK, (sqlite3_int64)v.rank);
+      if (decimated)
+        sqlite3_bind_null(st, c + TT__VF_INS_RANK);
+      else
+        sqlite3_bind_int64(st, c + TT__VF_INS_RANK, (sqlite3_int64)v.rank);
       bind_real(st, c + TT__VF_STAR_MAX, v.star_max_error);
       bind_real(st, c + TT__VF_STAR_RMSE, v.star_rmse);
       sqlite3_bind_int64(st, c + TT__VF_STAR_N,
                          (sqlite3_int64)v.star_samples);
+      if (decimated)
+        bind_real(st, c + TT__VF_IMPORTANCE, v.importance);
     }
     if (s == TT_OK)
       s = batch_step(&b, st, first, n);

@@ -296,6 +296,7 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
   OGRGeometryH pt = OGR_G_CreateGeometry(wkbPoint25D);
   OGR_G_Set3D(pt, TRUE);
   const size_t nv = tt_tin_vertex_count(tin);
+  const int decimated = tt__records_decimated(tin);
   for (size_t i = 0; i < nv && s == TT_OK; i++) {
     tt_vertex_info v;
     double x, y;
@@ -308,10 +309,15 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
     OGR_F_SetFieldInteger(f, idx[TT__VF_COL], v.col);
     OGR_F_SetFieldInteger(f, idx[TT__VF_ROW], v.row);
     set_real(f, idx[TT__VF_INS_ERR], v.insert_error);
-    OGR_F_SetFieldInteger64(f, idx[TT__VF_INS_RANK], (GIntBig)v.rank);
+    if (decimated)
+      OGR_F_SetFieldNull(f, idx[TT__VF_INS_RANK]);
+    else
+      OGR_F_SetFieldInteger64(f, idx[TT__VF_INS_RANK], (GIntBig)v.rank);
     set_real(f, idx[TT__VF_STAR_MAX], v.star_max_error);
     set_real(f, idx[TT__VF_STAR_RMSE], v.star_rmse);
     OGR_F_SetFieldInteger64(f, idx[TT__VF_STAR_N], (GIntBig)v.star_samples);
+    if (decimated)
+      set_real(f, idx[TT__VF_IMPORTANCE], v.importance);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(pt);
@@ -517,7 +523,8 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   if (s == TT_OK)
     s = create_fields(&w, w.tri_layer, tt__triangle_fields, TT__TF_COUNT, w.tri_idx);
   if (s == TT_OK)
-    s = create_fields(&w, w.vtx_layer, tt__vertex_fields, TT__VF_COUNT, w.vtx_idx);
+    s = create_fields(&w, w.vtx_layer, tt__vertex_fields,
+                      tt__records_vertex_fields(tin), w.vtx_idx);
   if (s == TT_OK)
     s = create_run_fields(&w, fields, nfields);
   if (s != TT_OK)

@@ -46,7 +46,20 @@ const tt__field_spec tt__vertex_fields[TT__VF_COUNT] = {
     {"vertex_id", OFTInteger},  {"col", OFTInteger},
     {"row", OFTInteger},        {"ins_err", OFTReal},
     {"ins_rank", OFTInteger64}, {"star_max", OFTReal},
-    {"star_rmse", OFTReal},     {"star_n", OFTInteger64}};
+    {"star_rmse", OFTReal},     {"star_n", OFTInteger64},
+    {"importance", OFTReal}};
+
+int tt__records_decimated(const tt_tin *tin)
+{
+  tt_tin_summary s;
+  tt_tin_get_summary(tin, &s);
+  return s.start_vertices > 0;
+}
+
+int tt__records_vertex_fields(const tt_tin *tin)
+{
+  return tt__records_decimated(tin) ? TT__VF_COUNT : TT__VF_COUNT - 1;
+}
 
 /* The driver's last message, or a generic one. */
 static const char *ogr_msg(void)

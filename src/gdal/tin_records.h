@@ -27,11 +27,20 @@ typedef struct tt__field_spec {
 enum { TT__TF_V0, TT__TF_V1, TT__TF_V2, TT__TF_MAX_ERR, TT__TF_RMSE,
        TT__TF_N_SAMPLES, TT__TF_AREA_2D, TT__TF_AREA_3D, TT__TF_SLOPE,
        TT__TF_ASPECT, TT__TF_MIN_ANGLE, TT__TF_MAX_ANGLE, TT__TF_COUNT };
+/* The last vertex field, importance, exists for decimated TINs only
+ * (they also leave ins_err and ins_rank NULL: there was no insertion):
+ * tt__records_vertex_fields() says how many fields a TIN's layer has. */
 enum { TT__VF_ID, TT__VF_COL, TT__VF_ROW, TT__VF_INS_ERR, TT__VF_INS_RANK,
-       TT__VF_STAR_MAX, TT__VF_STAR_RMSE, TT__VF_STAR_N, TT__VF_COUNT };
+       TT__VF_STAR_MAX, TT__VF_STAR_RMSE, TT__VF_STAR_N, TT__VF_IMPORTANCE,
+       TT__VF_COUNT };
 
 TT_HIDDEN extern const tt__field_spec tt__triangle_fields[TT__TF_COUNT];
 TT_HIDDEN extern const tt__field_spec tt__vertex_fields[TT__VF_COUNT];
+
+/* Whether the TIN was decimated (tt_decimate_run), and the number of
+ * fields of its vertices layer: TT__VF_COUNT then, one fewer otherwise. */
+TT_HIDDEN int tt__records_decimated(const tt_tin *tin);
+TT_HIDDEN int tt__records_vertex_fields(const tt_tin *tin);
 
 /* The layers' CRS and the transformed vertices. */
 typedef struct tt__records {

@@ -246,4 +246,28 @@ TT_HIDDEN bool tt__mesh_snapshot_restore(tt__mesh *m,
                                          const tt__mesh_snapshot *s);
 TT_HIDDEN void tt__mesh_snapshot_free(tt__mesh_snapshot *s);
 
+/* The star of vertex v: its triangles in counter-clockwise order around
+ * it and the link, the other ends of its edges (ring) in the same order. An
+ * interior vertex (a closed fan) has n neighbours and n triangles;
+ * a vertex on the boundary has n neighbours and n - 1 triangles,
+ * ring[0] the end of its outgoing boundary edge, ring[n - 1] the start
+ * of its incoming one. Writes at most max entries into each array; returns
+ * n (> max: the arrays hold only the first max), -1 when v is in no
+ * triangle. slots may be NULL. *out_closed tells which kind. O(degree). */
+TT_HIDDEN int tt__mesh_star(const tt__mesh *m, int32_t v, int32_t *ring,
+                            int32_t *slots, int max, bool *out_closed);
+
+/* Removes vertex v and fills its star with the ntri triangles tris
+ * (vertex triples of link vertices, counter-clockwise in the ground frame)
+ * that triangulate the link polygon: for an interior v, the closed link;
+ * for a boundary v, the link closed by the new boundary edge from its last
+ * to its first vertex, which keeps the constraint flag of v's outgoing
+ * boundary edge. Every star slot is reused or freed, twins are set to the
+ * outside neighbours, v's edge becomes -1, written slots are logged.
+ * False, with the mesh unchanged, when tris does not fit the hole that
+ * way, has a triangle that is not strictly counter-clockwise, or when out
+ * of memory. O(degree^2) (holes are small; large ones are rare). */
+TT_HIDDEN bool tt__mesh_remove_vertex(tt__mesh *m, int32_t v,
+                                      const int32_t (*tris)[3], int ntri);
+
 #endif /* TT_MESH_H */

@@ -23,6 +23,7 @@ void tt_tin_destroy(tt_tin *tin)
   free(tin->v_star_max);
   free(tin->v_star_rmse);
   free(tin->v_star_n);
+  free(tin->v_importance);
   free(tin->tv);
   free(tin->t_max);
   free(tin->t_rmse);
@@ -68,6 +69,7 @@ tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
   o->star_max_error = tin->v_star_max[index];
   o->star_rmse = tin->v_star_rmse[index];
   o->star_samples = (size_t)tin->v_star_n[index];
+  o->importance = tin->v_importance ? tin->v_importance[index] : NAN;
   return TT_OK;
 }
 

@@ -22,6 +22,7 @@ struct tt_tin {
   double *v_ins_err;     /* NaN for starting vertices */
   double *v_star_max, *v_star_rmse;
   uint64_t *v_star_n;
+  double *v_importance;  /* decimation (NULL after refinement: NaN) */
   /* triangles */
   int32_t *tv;           /* 3 per triangle */
   double *t_max;

@@ -180,6 +180,34 @@ expect_failure "existing output" 1 "exists" nothing.gpkg \
   optimize dem.tif square.geojson sq.gpkg
 check "existing output untouched" [ "$(md5sum sq.gpkg)" = "$before" ]
 
+# --- simplify passes the annealing schedule on, for both methods -----------
+# (the -anneal_* options and -seed reach the final pass: the same seed gives
+# the same triangles, another seed another TIN; mean curvature, since under
+# L2 annealing seldom climbs back above its start and returns it)
+for method in insert decimate; do
+  anneal() { # anneal NAME OPTIONS...
+    local name=$1
+    shift
+    run simplify -q -percent 4 -method "$method" -criterion mean_curvature \
+        -optimize anneal "$@" dem.tif "an-$method-$name.gpkg"
+    check "simplify -method $method -optimize anneal $*" [ "$rc" -eq 0 ]
+  }
+  anneal a -seed 7
+  anneal b -seed 7
+  anneal c -seed 8
+  run simplify -q -percent 4 -method "$method" -criterion mean_curvature \
+      -optimize none dem.tif "an-$method-none.gpkg"
+  check "simplify -method $method: one seed, the same triangles" \
+    [ "$(triangles_md5 "an-$method-a.gpkg")" = "$(triangles_md5 "an-$method-b.gpkg")" ]
+  check "simplify -method $method: the seed is used" \
+    [ "$(triangles_md5 "an-$method-a.gpkg")" != "$(triangles_md5 "an-$method-c.gpkg")" ]
+  check "simplify -method $method: annealing changed the TIN" \
+    [ "$(triangles_md5 "an-$method-a.gpkg")" != "$(triangles_md5 "an-$method-none.gpkg")" ]
+done
+expect_failure "decimate: edge insertion under l2" 2 "Min-Max angle only" \
+  bad.gpkg simplify -method decimate -percent 4 -criterion l2 \
+  -optimize edge_insertion dem.tif bad.gpkg
+
 # --- Crater Lake, when the shared data is there ----------------------------
 CRATER=${TT_SHARED_TESTDATA:-}/garland_heckbert_terra_scape/crater.stm.vrt
 if [ -n "${TT_SHARED_TESTDATA:-}" ] && [ -e "$CRATER" ]; then
