@@ -50,6 +50,8 @@ typedef enum tt_app_command {
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
+/* The most threads -threads and GDAL_NUM_THREADS may ask for. */
+#define TT_APP_MAX_THREADS 1024
 
 /* The outcome of parsing or running: the exit code and, on failure, one line
  * without a trailing newline ("" on success). */
@@ -100,6 +102,10 @@ typedef struct tt_app_settings {
   const char *const *lco;    /* -lco NAME=VALUE, in order */
   const char *const *dsco;   /* -dsco NAME=VALUE, in order */
   const char *nln;           /* -nln layer name prefix; "" by default */
+  int threads;               /* -threads N (>= 1), -1 for ALL_CPUS; 0: not
+                                given (GDAL_NUM_THREADS, else automatic) */
+  size_t max_memory;         /* -max_memory in bytes (simplify, eval); 0:
+                                not given (the system's limit) */
 
   /* eval */
   const char *layer;         /* -layer; NULL: the triangles layer */

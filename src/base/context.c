@@ -122,6 +122,25 @@ bool tt__grow(void **ptr, size_t *cap, size_t need, size_t elem)
   return true;
 }
 
+bool tt__name_equal(const char *a, const char *b)
+{
+  for (;; a++, b++) {
+    char ca = *a, cb = *b;
+    if (ca >= 'A' && ca <= 'Z')
+      ca = (char)(ca - 'A' + 'a');
+    if (cb >= 'A' && cb <= 'Z')
+      cb = (char)(cb - 'A' + 'a');
+    if (ca == '-')
+      ca = '_';
+    if (cb == '-')
+      cb = '_';
+    if (ca != cb)
+      return false;
+    if (ca == '\0')
+      return true;
+  }
+}
+
 double tt__now(void)
 {
   struct timespec ts;

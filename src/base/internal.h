@@ -65,6 +65,11 @@ typedef struct tt__metric {
 
 TT_HIDDEN void tt__metric_from_frame(const double a[4], tt__metric *out);
 
+/* Whether two option words name the same thing: ASCII case-insensitive,
+ * '-' matching '_' ("Min-Area" is "min_area"), as the command's option
+ * names are matched. */
+TT_HIDDEN bool tt__name_equal(const char *a, const char *b);
+
 /* Seconds of a monotonic clock. */
 TT_HIDDEN double tt__now(void);
 
