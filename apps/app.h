@@ -137,6 +137,11 @@ const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
 const char *tt__app_nonempty_or_null(const char *s);
 /* "2026-11-22T10:38:55Z" */
 void tt__app_iso8601_utc(char *buf, size_t size);
+/* The engine's thread count (tt_refine_options.threads): -threads, else
+ * GDAL_NUM_THREADS (a number or ALL_CPUS, from the environment or
+ * --config), else 0 (automatic). A GDAL_NUM_THREADS that is neither is
+ * warned about and ignored. */
+int tt__app_threads(app_run *r);
 /* The output driver of simplify: -of, else OUTPUT's extension, else GPKG. */
 GDALDriverH tt__app_output_driver(app_run *r);
 /* Whether two paths name the same existing file. */

@@ -16,6 +16,7 @@
 #include <cpl_vsi.h>
 #include <ogr_srs_api.h>
 
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -23,6 +24,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 /* Seconds of a monotonic clock (the app's own; the engine keeps its own). */
 double tt__app_now(void)
@@ -180,8 +182,13 @@ tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file)
   if (st == TT_ERR_INTERRUPTED)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file,
                     "interrupted; nothing written");
-  if (st == TT_ERR_NOMEM)
-    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "out of memory");
+  if (st == TT_ERR_NOMEM) {
+    /* the engine's and glue's messages name the phase and the size */
+    const char *m = tt_context_errmsg(r->ctx);
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s",
+                        m && strstr(m, "memory") ? tt__app_why(r, st, file)
+                                                 : "out of memory");
+  }
   return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s",
                       tt__app_why(r, st, file));
 }
@@ -315,6 +322,9 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
     ropts = CSLSetNameValue(ropts, "Z_UNIT", r->s->z_unit);
   if (r->s->work_srs)
     ropts = CSLSetNameValue(ropts, "WORK_SRS", r->s->work_srs);
+  if (r->s->max_memory)
+    ropts = CSLSetNameValue(ropts, "MAX_MEMORY",
+                            CPLSPrintf("%zu", r->s->max_memory));
   r->msg.last[0] = '\0';
   tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
                                    progress_arg, &grid, &info);
@@ -486,6 +496,35 @@ GDALDriverH tt__app_output_driver(app_run *r)
                   "writing a GeoPackage (use -of to choose)",
          r->s->output, ext);
   return drv;
+}
+
+static int online_cpus(void)
+{
+  long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n < 1 ? 1 : n > TT_APP_MAX_THREADS ? TT_APP_MAX_THREADS : (int)n;
+}
+
+int tt__app_threads(app_run *r)
+{
+  if (r->s->threads > 0)
+    return r->s->threads;
+  if (r->s->threads < 0)
+    return online_cpus();
+  const char *v = CPLGetConfigOption("GDAL_NUM_THREADS", NULL);
+  if (!v || !*v)
+    return 0;
+  if (tt__app_str_ieq(v, "ALL_CPUS"))
+    return online_cpus();
+  char *end = NULL;
+  errno = 0;
+  long n = strtol(v, &end, 10);
+  if (end != v && *end == '\0' && errno == 0 && n >= 1 &&
+      n <= TT_APP_MAX_THREADS && v[0] >= '0' && v[0] <= '9')
+    return (int)n;
+  tt__app_warn(&r->msg, "GDAL_NUM_THREADS='%s' is neither a number of "
+               "threads from 1 to %d nor ALL_CPUS; ignored", v,
+               TT_APP_MAX_THREADS);
+  return 0;
 }
 
 /* Whether two paths name the same existing file. */

@@ -108,6 +108,12 @@ tt_status tt__app_simplify(app_run *r)
     goto done;
   }
 
+  /* The memory the run may hold: -max_memory, else what the system allows,
+   * asked before the DEM is read (the heights count against it). */
+  const char *mem_source = "-max_memory";
+  size_t mem_limit = s->max_memory ? s->max_memory
+                                   : tt_memory_limit(&mem_source);
+
   /* Read: 0 - 10%. */
   tt__app_phase_set(&r->prog, 0.0, 0.10);
   src = tt__app_open_raster(r, s->input, s->band, &band);
@@ -141,6 +147,8 @@ tt_status tt__app_simplify(app_run *r)
   ro.criterion = s->criterion;
   ro.optimize = s->optimize;
   ro.repair = s->repair;
+  ro.threads = tt__app_threads(r);
+  ro.max_memory = mem_limit == SIZE_MAX ? 0 : mem_limit;
   if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
       !(s->percent > 0)) {
     ro.max_error = 0.005 * (rep.zmax - rep.zmin);
@@ -152,6 +160,17 @@ tt_status tt__app_simplify(app_run *r)
   rep.ropt = &ro;
   double t = tt__app_now();
   st = tt_refine_run(r->ctx, grid, &ro, &tin);
+  if (st == TT_ERR_NOMEM && ro.max_memory &&
+      strstr(tt_context_errmsg(r->ctx), "memory limit")) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, st, s->input, "%s (%s); nothing "
+                 "written", tt_context_errmsg(r->ctx), mem_source);
+    goto done;
+  }
+  if (st == TT_ERR_LIMIT) { /* a budget below the start's vertices */
+    tt__app_fail(r, TT_APP_EXIT_USAGE, st, s->input, "%s",
+                 tt_context_errmsg(r->ctx));
+    goto done;
+  }
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, st == TT_ERR_INTERRUPTED ? s->output : s->input);
     goto done;

@@ -46,7 +46,8 @@ typedef struct read_options {
   int srcnodata_is_nan;
   float srcnodata;       /* compared with the raw value read as Float32 */
   size_t max_memory;     /* bytes */
-  int max_memory_default; /* not given: 3/4 of physical memory */
+  int max_memory_default; /* not given: the system's limit */
+  const char *max_memory_source; /* which limit that is (tt_memory_limit) */
 } read_options;
 
 static char *dup_str(const char *s)
@@ -77,15 +78,12 @@ void tt_raster_info_destroy(tt_raster_info *info)
   free(info);
 }
 
-/* Three quarters of physical memory; SIZE_MAX when the system cannot say. */
-static size_t default_max_memory(void)
+/* The smallest of 3/4 of physical memory, the cgroup's room and the
+ * address-space room (tt_memory_limit); SIZE_MAX when the system cannot
+ * say. */
+static size_t default_max_memory(const char **out_source)
 {
-  long pages = sysconf(_SC_PHYS_PAGES);
-  long page_size = sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page_size <= 0)
-    return SIZE_MAX;
-  double bytes = (double)pages * (double)page_size * 0.75;
-  return bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)bytes;
+  return tt_memory_limit(out_source);
 }
 
 /* Parses a whole string as a finite double. */
@@ -174,7 +172,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   }
   opt->max_memory_default = !has_max_memory;
   if (!has_max_memory)
-    opt->max_memory = default_max_memory();
+    opt->max_memory = default_max_memory(&opt->max_memory_source);
   return TT_OK;
 }
 
@@ -431,8 +429,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %s, "
                   "more than %s (%s); refused before reading", path, nx, ny,
                   fmt_bytes(need_s, sizeof need_s, need),
-                  opt.max_memory_default ? "3/4 of this machine's physical "
-                                           "memory"
+                  opt.max_memory_default ? opt.max_memory_source
                                          : "MAX_MEMORY",
                   fmt_bytes(max_s, sizeof max_s, opt.max_memory));
     goto done;

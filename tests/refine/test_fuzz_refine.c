@@ -52,8 +52,10 @@ static int check_input(const uint8_t *data, size_t size)
   opt.threads = (mode & 4) ? 2 : 1;
   tt_status s = tt_refine_run(ctx, g, &opt, &tin);
   if (s != TT_OK) {
-    /* only data errors are acceptable: too few or collinear valid samples */
-    if (s != TT_ERR_DATA)
+    /* only data errors are acceptable: too few or collinear valid
+     * samples; and a point budget below the start's vertices (the
+     * corners, the hull, the nodata outline), refused since issue 11 */
+    if (s != TT_ERR_DATA && !(s == TT_ERR_LIMIT && max_points))
       TT_FAIL_("refine failed with %s: %s", tt_status_name(s),
                tt_context_errmsg(ctx));
     goto out;
