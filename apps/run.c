@@ -301,6 +301,89 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
   return ds;
 }
 
+/* Undeclared fill values. Many DEMs mark their voids with a classic value
+ * (-9999, -32767, -32768, -32000, -99999, -3.4e38, or 32767 and 65535 at
+ * the top of integer types) without declaring it as the band's nodata, and
+ * a TIN then dives to the void. A value from that list is suspect when it
+ * lies farther from the band's other heights than their whole range, and
+ * either forms runs along a row (FILL_RUN samples in a row) or a share of
+ * FILL_SHARE of the valid samples: a warning then names it, its count and
+ * the -srcnodata that would mask it. One pass; heights far below 9999 are
+ * skipped by a single comparison. */
+#define FILL_RUN 4
+#define FILL_SHARE 0.001
+
+static void warn_fill_values(app_run *r, const tt_grid *grid,
+                             const tt_raster_info *info, const char *path,
+                             size_t valid)
+{
+  static const double fills[] = {-9999.0, -32767.0, -32768.0, -32000.0,
+                                 -99999.0, -3.4028234663852886e38, -3.4e38,
+                                 32767.0, 65535.0};
+  enum { NF = sizeof fills / sizeof fills[0] };
+  float t[NF];
+  size_t count[NF] = {0}, run[NF] = {0}, best_run[NF] = {0};
+  double k = (info ? info->z_unit_factor * info->z_factor : 1.0);
+  double scale = info ? info->scale : 1.0, offset = info ? info->offset : 0.0;
+  float thr = INFINITY;
+  for (size_t i = 0; i < NF; i++) {
+    t[i] = (float)((fills[i] * scale + offset) * k);
+    if (fabsf(t[i]) < thr)
+      thr = fabsf(t[i]);
+  }
+  const float *z = tt_grid_heights_const(grid);
+  size_t nx = tt_grid_width(grid), ny = tt_grid_height(grid);
+  double lo = INFINITY, hi = -INFINITY;
+  for (size_t row = 0; row < ny; row++) {
+    for (size_t i = 0; i < NF; i++)
+      run[i] = 0;
+    for (size_t c = 0; c < nx; c++) {
+      float h = z[row * nx + c];
+      if (isnan(h))
+        continue;
+      int which = -1;
+      if (fabsf(h) >= thr)
+        for (int i = 0; i < (int)NF; i++)
+          if (h == t[i]) {
+            which = i;
+            break;
+          }
+      for (int i = 0; i < (int)NF; i++)
+        if (i != which)
+          run[i] = 0;
+      if (which < 0) {
+        if (h < lo) lo = h;
+        if (h > hi) hi = h;
+        continue;
+      }
+      count[which]++;
+      if (++run[which] > best_run[which])
+        best_run[which] = run[which];
+    }
+  }
+  if (!(lo <= hi))
+    return; /* nothing else to compare with */
+  double span = hi - lo > 1.0 ? hi - lo : 1.0;
+  for (size_t i = 0; i < NF; i++) {
+    if (!count[i])
+      continue;
+    double gap = t[i] < lo ? lo - t[i] : t[i] > hi ? t[i] - hi : 0.0;
+    if (gap <= span)
+      continue;
+    if (best_run[i] < FILL_RUN && (double)count[i] < FILL_SHARE * valid)
+      continue;
+    char raw[40];
+    tt__app_format_double(raw, sizeof raw, fills[i]);
+    tt__app_warn(&r->msg, "%s: band %d: %zu sample%s (%.2g%%) %s %s, in "
+                 "runs of up to %zu, far from the other heights (%.10g .. "
+                 "%.10g): an undeclared nodata value? -srcnodata %s treats "
+                 "%s as nodata", path, r->s->band, count[i],
+                 count[i] == 1 ? "" : "s", 100.0 * count[i] / valid,
+                 count[i] == 1 ? "is" : "are", raw, best_run[i], lo, hi,
+                 raw, count[i] == 1 ? "it" : "them");
+  }
+}
+
 /* Reads the band into a grid and checks it has usable samples. */
 tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
                           tt_progress_fn progress, void *progress_arg,
@@ -329,6 +412,11 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
   tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
                                    progress_arg, &grid, &info);
   CSLDestroy(ropts);
+  if (st == TT_ERR_ARG) { /* -srcnodata the band cannot hold, ... */
+    tt__app_fail(r, TT_APP_EXIT_USAGE, st, path, "%s",
+                 tt__app_why(r, st, path));
+    goto done;
+  }
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, path);
     goto done;
@@ -343,6 +431,8 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
                   "band %d has no valid samples (all nodata)", r->s->band);
     goto done;
   }
+  if (!r->s->srcnodata)
+    warn_fill_values(r, grid, info, path, valid);
 done:
   if (st != TT_OK) {
     tt_grid_destroy(grid);

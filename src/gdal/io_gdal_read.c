@@ -45,6 +45,8 @@ typedef struct read_options {
   int has_srcnodata;
   int srcnodata_is_nan;
   float srcnodata;       /* compared with the raw value read as Float32 */
+  double srcnodata_given; /* the value as written, checked against the
+                             band's type */
   size_t max_memory;     /* bytes */
   int max_memory_default; /* not given: the system's limit */
   const char *max_memory_source; /* which limit that is (tt_memory_limit) */
@@ -112,6 +114,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->has_srcnodata = 0;
   opt->srcnodata_is_nan = 0;
   opt->srcnodata = 0.0f;
+  opt->srcnodata_given = 0.0;
   opt->max_memory = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
@@ -152,6 +155,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
                       "got \"%s\"", value);
       } else {
         opt->srcnodata = (float)v;
+        opt->srcnodata_given = v;
       }
     } else if (strcasecmp(key, "MAX_MEMORY") == 0) {
       if (!parse_double(value, &v) || v <= 0)
@@ -408,6 +412,26 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                   "(%s), not heights", path, GDALGetBandNumber(band),
                   GDALGetDataTypeName(dtype));
     goto done;
+  }
+
+  /* A SRCNODATA the band's type cannot hold can never match a sample:
+   * refuse it rather than mask nothing (1e39 in a Float32 band, -1 in a
+   * Byte band, 0.5 in an Int16 band, nan in an integer band). */
+  if (opt.has_srcnodata) {
+    int clamped = 0, rounded = 0;
+    if (opt.srcnodata_is_nan)
+      clamped = !GDALDataTypeIsFloating(dtype);
+    else
+      GDALAdjustValueToDataType(dtype, opt.srcnodata_given, &clamped,
+                                &rounded);
+    if (clamped || rounded) {
+      s = tt__error(ctx, TT_ERR_ARG, "%s: SRCNODATA (-srcnodata) %.15g "
+                    "cannot occur in band %d, whose type %s %s", path,
+                    opt.srcnodata_is_nan ? NAN : opt.srcnodata_given,
+                    GDALGetBandNumber(band), GDALGetDataTypeName(dtype),
+                    clamped ? "cannot hold it" : "holds whole numbers only");
+      goto done;
+    }
   }
 
   const int xsize = GDALGetRasterBandXSize(band);
