@@ -226,6 +226,53 @@ static void apply_config(const tt_app_settings *s)
     CPLSetConfigOption(s->config[i], s->config[i + 1]);
 }
 
+/* A path into an archive (/vsizip/, /vsitar/, /vsi7z/, /vsirar/, /vsigzip/,
+ * possibly chained) that does not exist: which part is missing, the
+ * archive or the member in it. Writes the reason to why; 0 when path is
+ * not such a path. Only local archive file systems are probed (a /vsicurl/
+ * prefix would cost a request per level). */
+static int explain_missing_vsi(const char *path, char *why, size_t size)
+{
+  static const char *const fs[] = {"/vsizip/", "/vsitar/", "/vsi7z/",
+                                   "/vsirar/", "/vsigzip/"};
+  size_t skip = 0;
+  for (size_t i = 0; i < sizeof fs / sizeof fs[0] && !skip; i++)
+    if (strncmp(path, fs[i], strlen(fs[i])) == 0)
+      skip = strlen(fs[i]);
+  if (!skip)
+    return 0;
+  char *buf = CPLStrdup(path);
+  VSIStatBufL sb;
+  int found = 0;
+  for (char *slash = strrchr(buf, '/'); slash && slash > buf + skip;
+       slash = strrchr(buf, '/')) {
+    *slash = '\0';
+    const char *member = path + strlen(buf) + 1;
+    const char *real = buf + skip; /* the same name outside the archive */
+    int in_archive = VSIStatL(buf, &sb) == 0;
+    if (in_archive && VSI_ISDIR(sb.st_mode) && VSIStatL(real, &sb) != 0) {
+      snprintf(why, size, "no such file or directory: the folder %s of the "
+               "archive holds no '%s'", buf, member);
+      found = 1;
+    } else if (VSIStatL(real, &sb) == 0 && VSI_ISREG(sb.st_mode)) {
+      if (in_archive)
+        snprintf(why, size, "no such file or directory: the archive %s "
+                 "holds no '%s'", real, member);
+      else
+        snprintf(why, size, "%s is not an archive %.*s can read (or is "
+                 "damaged)", real, (int)(skip - 2), path + 1);
+      found = 1;
+    }
+    if (found)
+      break;
+  }
+  if (!found)
+    snprintf(why, size, "no such file or directory (the archive in %s does "
+             "not exist)", path + skip);
+  CPLFree(buf);
+  return 1;
+}
+
 /* Opens a raster for reading and checks the band; on failure explains in
  * one line why: missing, a folder, empty, a vector dataset, unreadable. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
@@ -244,6 +291,11 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
     if (!stat_ok && !strchr(path, ':') && strncmp(path, "/vsi", 4) != 0) {
       tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path,
                "no such file or directory");
+      return NULL;
+    }
+    char why[TT_APP_MESSAGE_MAX];
+    if (!stat_ok && explain_missing_vsi(path, why, sizeof why)) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s", why);
       return NULL;
     }
     if (stat_ok && VSI_ISDIR(sb.st_mode)) {

@@ -50,6 +50,7 @@ typedef struct read_options {
   size_t max_memory;     /* bytes */
   int max_memory_default; /* not given: the system's limit */
   const char *max_memory_source; /* which limit that is (tt_memory_limit) */
+  GDALRasterBandH band;  /* to read a sample back at its own precision */
 } read_options;
 
 static char *dup_str(const char *s)
@@ -115,6 +116,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->srcnodata_is_nan = 0;
   opt->srcnodata = 0.0f;
   opt->srcnodata_given = 0.0;
+  opt->band = NULL;
   opt->max_memory = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
@@ -359,6 +361,19 @@ static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                            "%zu is NaN but not marked nodata (use "
                            "-srcnodata nan)", path, r0 + r, c);
+        /* A finite Float64 (or Int64) beyond 3.4e38 reads as an infinite
+         * float: read it back as a double to say which it is. */
+        double exact = raw;
+        if (isinf(raw) && opt->band &&
+            GDALRasterIO(opt->band, GF_Read, (int)c, (int)(r0 + r), 1, 1,
+                         &exact, 1, 1, GDT_Float64, 0, 0) != CE_None)
+          exact = raw;
+        if (isinf(raw) && isfinite(exact))
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is %.15g, beyond the range of the 32-bit "
+                           "floats heights are kept in (+-3.4e38); mark it "
+                           "nodata (-srcnodata) if it is a fill value", path,
+                           r0 + r, c, exact);
         if (isinf(raw))
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                            "%zu is infinite but not marked nodata", path,
@@ -525,6 +540,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     unit_out = "m";
   }
   read_options conv = opt; /* what convert_rows() multiplies by */
+  conv.band = band;
   conv.z_factor = opt.z_factor * unit_factor;
 
   s = tt_grid_create(ctx, nx, ny, &grid);
