@@ -38,6 +38,25 @@ double tt__app_now(void)
 void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
                        const char *fmt, ...) TT_APP_PRINTF_(4, 5);
 
+/* vsnprintf that keeps the cause: a message that would not fit is made
+ * whole on the heap and its long words (100 kB names) shortened in the
+ * middle by tt_text_fit, instead of being cut at the end. */
+static void vformat_fit(char *buf, size_t size, const char *fmt, va_list ap)
+{
+  va_list ap2;
+  va_copy(ap2, ap);
+  int n = vsnprintf(buf, size, fmt, ap);
+  if (n >= 0 && (size_t)n >= size) {
+    char *whole = malloc((size_t)n + 1);
+    if (whole) {
+      vsnprintf(whole, (size_t)n + 1, fmt, ap2);
+      tt_text_fit(buf, size, whole);
+      free(whole);
+    }
+  }
+  va_end(ap2);
+}
+
 /* Fills a result, keeping the first failure: later ones are consequences. */
 void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
                        const char *fmt, ...)
@@ -48,7 +67,7 @@ void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
   res->status = status;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(res->message, sizeof res->message, fmt, ap);
+  vformat_fit(res->message, sizeof res->message, fmt, ap);
   va_end(ap);
   /* One line: fold any newline GDAL or a driver put into a message. */
   for (char *p = res->message; *p; p++)
@@ -103,7 +122,7 @@ void tt__app_warn(app_messages *m, const char *fmt, ...)
     return;
   }
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
   one_line(buf);
   fprintf(m->err, "terratin: warning: %s\n", buf);
@@ -122,7 +141,7 @@ static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
     tt__app_warn(m, "%s", msg);
   } else if (cls != CE_None) {
     m->failures++;
-    snprintf(m->last, sizeof m->last, "%s", msg);
+    tt_text_fit(m->last, sizeof m->last, msg);
     one_line(m->last);
   }
 }
@@ -144,13 +163,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
 tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
 {
-  char buf[TT_APP_MESSAGE_MAX];
+  char buf[TT_APP_MESSAGE_MAX], name[TT_TEXT_WORD_MAX + 1];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
   if (file)
-    tt__app_result_set(r->res, exit_code, st, "%s: %s", file, buf);
+    tt__app_result_set(r->res, exit_code, st, "%s: %s",
+                       tt_text_fit(name, sizeof name, file), buf);
   else
     tt__app_result_set(r->res, exit_code, st, "%s", buf);
   return st;
@@ -168,11 +188,16 @@ const char *tt__app_why(app_run *r, tt_status st, const char *file)
     m = r->msg.last;
   if (!m || !*m)
     m = tt_status_message(st);
-  size_t n = file ? strlen(file) : 0;
-  if (n && strncmp(m, file, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
-    m += n + 2;
-  else if (n && strncmp(m, file, n) == 0 && m[n] == ' ' && m[n + 1])
-    m += n + 1;
+  /* the file as it was named, or shortened as tt_text_fit does it */
+  char fit[TT_TEXT_WORD_MAX + 1];
+  for (int pass = 0; pass < 2 && file; pass++) {
+    const char *f = pass ? tt_text_fit(fit, sizeof fit, file) : file;
+    size_t n = strlen(f);
+    if (n && strncmp(m, f, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
+      return m + n + 2;
+    if (n && strncmp(m, f, n) == 0 && m[n] == ' ' && m[n + 1])
+      return m + n + 1;
+  }
   return m;
 }
 
@@ -289,8 +314,13 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
     snprintf(gdal_msg, sizeof gdal_msg, "%s", r->msg.last);
     int stat_ok = VSIStatL(path, &sb) == 0;
     if (!stat_ok && !strchr(path, ':') && strncmp(path, "/vsi", 4) != 0) {
-      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path,
-               "no such file or directory");
+      struct stat st;
+      int too_long = stat(path, &st) != 0 && errno == ENAMETOOLONG;
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s",
+                   too_long ? "the name is too long for the file system "
+                              "(a folder or file name of more than 255 "
+                              "bytes, or a path of more than 4096)"
+                            : "no such file or directory");
       return NULL;
     }
     char why[TT_APP_MESSAGE_MAX];

@@ -268,6 +268,14 @@ void tt_refine_options_init(tt_refine_options *opt);
  * system says nothing. */
 size_t tt_memory_limit(const char **out_source);
 
+/* Copies text into buf (size bytes, always terminated), shortening every
+ * run of more than TT_TEXT_WORD_MAX bytes without a blank (a path, a
+ * layer name) in the middle to its first and last parts around "...", so
+ * that a message about a 100 kB name still fits and still says its cause.
+ * Returns buf. */
+#define TT_TEXT_WORD_MAX 200
+const char *tt_text_fit(char *buf, size_t size, const char *text);
+
 /* ---------------------------------------------------------------------------
  * The TIN: the result of a run, with its bookkeeping.
  * ------------------------------------------------------------------------- */
