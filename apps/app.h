@@ -115,6 +115,13 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
 const char *tt__app_why(app_run *r, tt_status st, const char *file);
 /* Fails with the glue's or engine's message about file. */
 tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file);
+/* Fails a write of output (the file being written: written) with the
+ * device's cause when there is one (the file system full, ulimit -f
+ * reached; the driver's message follows in parentheses), else with the
+ * driver's or engine's message; what ("cannot create GPKG dataset") may be
+ * NULL. */
+tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
+                             const char *written, const char *what);
 /* An output refused because something exists in its way. */
 tt_status tt__app_fail_exists(app_run *r, const char *output);
 /* Polls the progress callback between phases: 0 means stop. */

@@ -22,7 +22,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -216,6 +218,59 @@ tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file)
   }
   return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s",
                       tt__app_why(r, st, file));
+}
+
+/* Why a write failed when the cause is the device rather than the data:
+ * the folder's file system (almost) full, or the file size limit (ulimit
+ * -f) reached by the file being written. SQLite and the drivers report
+ * these as whatever failed next ("no such table: gpkg_contents", "disk I/O
+ * error"). Writes the cause to buf and returns 1, else 0. */
+static int device_cause(const char *written, char *buf, size_t size)
+{
+  char folder[4096];
+  snprintf(folder, sizeof folder, "%s", written);
+  char *slash = strrchr(folder, '/');
+  if (slash)
+    *(slash == folder ? slash + 1 : slash) = '\0';
+  else
+    snprintf(folder, sizeof folder, ".");
+  struct rlimit rl;
+  struct stat st;
+  if (getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+      stat(written, &st) == 0 && (uint64_t)st.st_size + 65536 >=
+                                     (uint64_t)rl.rlim_cur) {
+    snprintf(buf, size, "the file size limit (ulimit -f) of %llu bytes was "
+             "reached", (unsigned long long)rl.rlim_cur);
+    return 1;
+  }
+  struct statvfs vfs;
+  if (statvfs(folder, &vfs) == 0) {
+    uint64_t avail = (uint64_t)vfs.f_bavail * vfs.f_frsize;
+    if (avail < ((uint64_t)1 << 20) || (vfs.f_favail == 0 && vfs.f_files)) {
+      char fit[TT_TEXT_WORD_MAX + 1];
+      snprintf(buf, size, "no space left on the device of %s (%llu bytes "
+               "free%s)", tt_text_fit(fit, sizeof fit, folder),
+               (unsigned long long)avail,
+               vfs.f_favail == 0 && vfs.f_files ? ", no free inode" : "");
+      return 1;
+    }
+  }
+  return 0;
+}
+
+tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
+                             const char *written, const char *what)
+{
+  char cause[512];
+  if (st != TT_ERR_INTERRUPTED && st != TT_ERR_NOMEM && written &&
+      device_cause(written, cause, sizeof cause))
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, output,
+                        "%s%s%s (the driver said: %s)", what ? what : "",
+                        what ? ": " : "", cause, tt__app_why(r, st, output));
+  if (what)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, output, "%s: %s", what,
+                        tt__app_why(r, st, output));
+  return tt__app_fail_tt(r, st, output);
 }
 
 /* An output refused because something exists: name the file that is in

@@ -279,15 +279,15 @@ tt_status tt__app_simplify(app_run *r)
                         sizeof fields / sizeof fields[0], wopts,
                         tt__app_phase_fn, &r->prog);
   if (st != TT_OK) {
-    tt__app_fail_tt(r, st, s->output);
+    tt__app_fail_write(r, st, s->output, tt_output_temp_path(outp), NULL);
     goto done;
   }
   unsigned failures = r->msg.failures;
   GDALClose(dst);
   dst = NULL;
   if (r->msg.failures != failures) {
-    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
-                  "error while closing: %s", r->msg.last);
+    st = tt__app_fail_write(r, TT_ERR_IO, s->output,
+                            tt_output_temp_path(outp), "error while closing");
     goto done;
   }
   for (int k = 0; rtree && k < 2; k++) {
