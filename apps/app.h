@@ -118,8 +118,9 @@ tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file);
 /* Fails a write of output (the file being written: written) with the
  * device's cause when there is one (the file system full, ulimit -f
  * reached; the driver's message follows in parentheses), else with the
- * driver's or engine's message; what ("cannot create GPKG dataset") may be
- * NULL. */
+ * driver's or engine's message. what ("error while closing") names a
+ * failure of GDAL's own, whose last message is then the detail; NULL: the
+ * failure of an engine or glue call (its message). */
 tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
                              const char *written, const char *what);
 /* An output refused because something exists in its way. */

@@ -262,14 +262,16 @@ tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
                              const char *written, const char *what)
 {
   char cause[512];
+  /* with `what`, the failure is GDAL's own (a close): its last message */
+  const char *detail = what ? r->msg.last : tt__app_why(r, st, output);
   if (st != TT_ERR_INTERRUPTED && st != TT_ERR_NOMEM && written &&
       device_cause(written, cause, sizeof cause))
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, output,
                         "%s%s%s (the driver said: %s)", what ? what : "",
-                        what ? ": " : "", cause, tt__app_why(r, st, output));
+                        what ? ": " : "", cause, detail);
   if (what)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, output, "%s: %s", what,
-                        tt__app_why(r, st, output));
+                        detail);
   return tt__app_fail_tt(r, st, output);
 }
 

@@ -3,10 +3,16 @@
  * cliffs) and refinement options; every result must satisfy the oracle
  * (tt_eval_triangles: bound, cover, no overlap) and the mesh must be valid.
  *
- * Built with -DTT_FUZZ_LIBFUZZER it is a libFuzzer target; otherwise its
- * main() replays every file of $TT_CORPUS/refine (past crashes and seeds,
- * named after the issue that found them) and 400 inputs from a seeded
- * generator, so ctest runs them all without clang. */
+ * Built with -DTT_FUZZ_LIBFUZZER it is a libFuzzer target, in which a
+ * failed check aborts (tt_test.h) so that libFuzzer sees the oracle's
+ * failures as crashes and keeps their inputs:
+ *   cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DTT_FUZZ=ON
+ *   cmake --build build-fuzz -j2 --target fuzz_refine
+ *   build-fuzz/tests/fuzz_refine -max_total_time=60 RUN_DIR tests/corpus/refine
+ * (docs/fuzzing.md). Otherwise its main() replays every file of
+ * $TT_CORPUS/refine (past crashes and seeds, named after the issue that
+ * found them) and 400 inputs from a seeded generator, so ctest runs them
+ * all without clang. */
 #include "terratin/terratin.h"
 #include "tt_test.h"
 #include "tt_tin_oracle.h"
