@@ -95,7 +95,7 @@ static int parse_double(const char *s, double *out)
   char *end = NULL;
   errno = 0;
   double v = strtod(s, &end);
-  if (end == s || errno == ERANGE)
+  if (end == s || (errno == ERANGE && fabs(v) > 1.0)) /* subnormals pass */
     return 0;
   while (*end == ' ')
     end++;
