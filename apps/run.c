@@ -470,14 +470,18 @@ static void warn_fill_values(app_run *r, const tt_grid *grid,
     if (fabsf(t[i]) < thr)
       thr = fabsf(t[i]);
   }
+  /* one of the two is set, as the grid's precision says */
   const float *z = tt_grid_heights_const(grid);
+  const double *zd = tt_grid_heights_f64_const(grid);
   size_t nx = tt_grid_width(grid), ny = tt_grid_height(grid);
   double lo = INFINITY, hi = -INFINITY;
   for (size_t row = 0; row < ny; row++) {
     for (size_t i = 0; i < NF; i++)
       run[i] = 0;
     for (size_t c = 0; c < nx; c++) {
-      float h = z[row * nx + c];
+      /* a double grid's value compared as a float: the fill values are
+       * whole numbers or float limits, exact either way */
+      float h = zd ? (float)zd[row * nx + c] : z[row * nx + c];
       if (isnan(h))
         continue;
       int which = -1;
@@ -589,13 +593,15 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
                          double *out_max)
 {
   const float *z = tt_grid_heights_const(grid);
+  const double *zd = tt_grid_heights_f64_const(grid); /* one of the two */
   size_t n = tt_grid_width(grid) * tt_grid_height(grid);
   double lo = INFINITY, hi = -INFINITY;
   for (size_t i = 0; i < n; i++) {
-    if (isnan(z[i]))
+    double h = zd ? zd[i] : (double)z[i];
+    if (isnan(h))
       continue;
-    if (z[i] < lo) lo = z[i];
-    if (z[i] > hi) hi = z[i];
+    if (h < lo) lo = h;
+    if (h > hi) hi = h;
   }
   *out_min = lo;
   *out_max = hi;

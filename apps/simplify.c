@@ -266,13 +266,13 @@ tt_status tt__app_simplify(app_run *r)
     wopts = CSLAddNameValue(wopts, "LCO", s->lco[i]);
   if (s->t_srs)
     wopts = CSLSetNameValue(wopts, "T_SRS", s->t_srs);
-  /* GPKG R-trees: bulk-loaded on the closed file by tt_gpkg_build_rtree()
-   * (GDAL 3.6 inserts them one by one); -lco SPATIAL_INDEX=NO: none. */
-  const char *si = CSLFetchNameValue((CSLConstList)s->lco, "SPATIAL_INDEX");
-  int rtree = tt__app_str_ieq(drvname, "GPKG") && (!si || CPLTestBool(si));
-  if (rtree) {
-    wopts = CSLSetNameValue(wopts, "RTREE", "DEFERRED");
-    tt__app_phase_set(&r->prog, 0.85, 0.95);
+  /* GPKG: the layers through OGR, then their rows and R-trees straight
+   * into the closed file by tt_gpkg_write_rows() (OGR writes a feature at a
+   * time and GDAL 3.6 inserts R-tree entries one by one). */
+  int direct_rows = tt__app_str_ieq(drvname, "GPKG");
+  if (direct_rows) {
+    wopts = CSLSetNameValue(wopts, "ROWS", "DEFERRED");
+    tt__app_phase_set(&r->prog, 0.85, 0.86);
   }
   r->msg.last[0] = '\0';
   st = tt_ogr_write_tin(r->ctx, dst, tin, srs, fields,
@@ -290,22 +290,17 @@ tt_status tt__app_simplify(app_run *r)
                             tt_output_temp_path(outp), "error while closing");
     goto done;
   }
-  for (int k = 0; rtree && k < 2; k++) {
-    const char *geom = CSLFetchNameValueDef((CSLConstList)s->lco,
-                                            "GEOMETRY_NAME", "geom");
-    char *layer = CPLStrdup(CPLSPrintf("%s%s", s->nln,
-                                       k ? "vertices" : "triangles"));
-    tt__app_phase_set(&r->prog, k ? 0.98 : 0.95, k ? 0.99 : 0.98);
-    st = tt_gpkg_build_rtree(r->ctx, tt_output_temp_path(outp), layer, geom,
-                             tt__app_phase_fn, &r->prog);
-    CPLFree(layer);
+  if (direct_rows) {
+    tt__app_phase_set(&r->prog, 0.86, 0.99);
+    st = tt_gpkg_write_rows(r->ctx, tt_output_temp_path(outp), tin, srs,
+                            wopts, tt__app_phase_fn, &r->prog);
     if (st == TT_ERR_INTERRUPTED || st == TT_ERR_NOMEM) {
       tt__app_fail_tt(r, st, s->output);
       goto done;
     }
     if (st != TT_OK) {
       tt__app_fail(r, TT_APP_EXIT_FAILURE, st, s->output, "%s",
-               tt__app_why(r, st, tt_output_temp_path(outp)));
+                   tt__app_why(r, st, tt_output_temp_path(outp)));
       goto done;
     }
   }

@@ -1,59 +1,59 @@
 #!/usr/bin/env bash
-# bench/run.sh -- terratin against delatin on fractal DEMs, side by side.
+# bench/run.sh -- terratin against hmm and delatin, DEM file to TIN file.
 #
-#   bench/run.sh            # 1025 x 1025 and 4097 x 4097 (make bench)
-#   bench/run.sh --quick    # 1025 x 1025 only
+#   bench/run.sh            # every DEM below (make bench)
+#   bench/run.sh --quick    # the 1025 x 1025 fractal only
+#   HMM=/path/to/hmm bench/run.sh
 #
-# For each DEM: generate it with `terratin generate diamond_square`, mesh it
-# with `terratin simplify -json` and with the npm package delatin at the same
-# max error, measure both TINs with `terratin eval -json`, and print one
-# table (bench/report.mjs). Everything lands in bench/out/ (git-ignored):
-# the DEMs, both TINs, every JSON, and report.txt.
+# DEMs and max errors (override E_* in the environment):
+#   ds1025  1025 x 1025 diamond-square fractal, seed 1, E_1025=8 (~2 % of
+#           the samples become vertices)
+#   ds4097  4097 x 4097 fractal, seed 1, E_4097=10
+#   crater  Crater Lake of the 1995 and 2004 papers, E_CRATER=0.945
+#           (../shared/testdata; skipped with a message when absent)
+#   hood    Mt Hood, LANDFIRE 30 m, E_HOOD=10 (../shared/testdata; nodata
+#           collar)
+# For each DEM the three tools run REPEAT times (default 3) in alternation
+# (a slow spell of this shared machine then slows all three), and for each
+# tool the run with the fastest meshing counts for its whole column.
 #
-# Measures:
-#  - meshing s: terratin's `seconds.mesh` from -json (refinement up to the
-#    finished mesh); delatin's `new Delatin(...)` + `run(E)`, timed with
-#    process.hrtime. The row below it adds terratin's error statistics
-#    (`seconds.simplify` = mesh + statistics: max, RMS, mean and L2 error
-#    and the per-triangle and per-vertex attributes, one more pass over
-#    every sample), work that delatin's run() does not do. Each tool
-#    runs REPEAT times (default 3), the two in alternation, and the run
-#    with the fastest meshing counts for everything in its column: on a
-#    shared machine a single pair of runs can be off by 2x.
-#  - end-to-end s: wall clock of the whole process (start-up, read, mesh,
-#    write), from date +%s%N around it. terratin reads the GeoTIFF and writes
-#    a GeoPackage with per-triangle and per-vertex attributes; delatin reads
-#    a raw Float32 copy (made beforehand by gdal_translate -of ENVI, not
-#    timed: node cannot read GeoTIFF) and writes a GeoJSON text sequence.
-#  - peak MiB: maximum resident set of the process, /usr/bin/time -f %M.
-#    A baseline (terratin simplifying a 9x9 DEM, `node -e 0`) is measured
-#    too, so that memory per sample is reported net of the loaded libraries.
-#  - vertices, triangles: as each tool reports them; max error and RMS:
-#    `terratin eval DEM TIN -json` over every sample, the same code for both.
-#
-# Max error per DEM, in the DEM's z units, chosen so that about 2 % of the
-# samples become vertices -- a realistic simplification. The generator's
-# defaults (amplitude 100, roughness 0.7) give heights of about -48 .. 99
-# with seed 1; delatin keeps, at seed 1:
-#   1025 x 1025: E =  7 -> 2.9 %, E = 8 -> 2.0 %, E = 10 -> 1.0 %   (E_1025=8)
-#   4097 x 4097: E =  3 -> 4.2 %, E = 4 -> 1.9 %, E =  5 -> 1.0 %   (E_4097=4)
-# The big DEM needs the smaller E: the random term of its finest level is
-# half as large (100 * 0.7^12 = 1.4 against 100 * 0.7^10 = 2.8).
-# Override with E_1025=... E_4097=... in the environment; the seeds with
-# SEED_1025 / SEED_4097; the binary with TERRATIN=path; the runs per tool
-# with REPEAT=n.
+# What each tool does and what is timed:
+#  - terratin: `simplify -json` from the DEM file to a GeoPackage with every
+#    per-triangle and per-vertex attribute, run_parameters and both R-trees.
+#    read / mesh / statistics / write seconds from its -json.
+#  - hmm (fogleman/hmm, the C++ peer): from a 16-bit PNG of the DEM to a
+#    binary STL, with -z the height range and -e E over that range, as hmm
+#    reads heights; its read / mesh / write seconds as it prints them. hmm
+#    is not built here: set HMM to a binary built from fogleman/hmm at
+#    commit 5ea6114 with its own Makefile (Debian's libglm-dev); without it
+#    the table has no hmm column.
+#  - delatin (npm, the JavaScript port of the same algorithm): from a raw
+#    Float32 copy of the DEM to a GeoJSON text sequence, timed inside node.
+#  - wall s: the whole process (start-up included) from date +%s%N; peak
+#    MiB: /usr/bin/time -f %M.
+#  - max error, RMSE: `terratin eval DEM TIN -json` over every valid
+#    sample, the same code for the three TINs (hmm's STL is put back on the
+#    DEM by bench/stl_to_geojsonl.py; its heights are 16-bit, so its error
+#    includes up to half a quantum of the PNG).
+# The peers' inputs (PNG, raw) come from bench/peer_input.py, untimed;
+# neither peer knows nodata, which is filled with the DEM's minimum for
+# them. Everything lands in bench/out/ (git-ignored); report.txt is the
+# table, with the goals of issue 16 checked at its foot.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 cd "$ROOT"
 OUT=bench/out
 TT=${TERRATIN:-build/terratin}
+HMM=${HMM:-}
 DELATIN_VERSION=0.2.0
 E_1025=${E_1025:-8}
-E_4097=${E_4097:-4}
-SEED_1025=${SEED_1025:-1}
-SEED_4097=${SEED_4097:-1}
+E_4097=${E_4097:-10}
+E_CRATER=${E_CRATER:-0.945}
+E_HOOD=${E_HOOD:-10}
 REPEAT=${REPEAT:-3}
+SHARED=${TT_SHARED_TESTDATA:-$ROOT/../shared/testdata}
+PY=/usr/bin/python3
 
 quick=0
 for arg in "$@"; do
@@ -83,13 +83,19 @@ need_pkgs() {
   fi
 }
 
-need_pkgs time gdal-bin
+need_pkgs time gdal-bin python3-gdal python3-numpy
 command -v node >/dev/null && command -v npm >/dev/null || need_pkgs nodejs npm
 
 if [ ! -x "$TT" ]; then
   echo "bench: $TT not found; run 'make build' first (make bench does)" >&2
   exit 1
 fi
+if [ -n "$HMM" ] && [ ! -x "$HMM" ]; then
+  echo "bench: HMM=$HMM is not an executable" >&2
+  exit 1
+fi
+[ -n "$HMM" ] || echo "bench: hmm not given (HMM=/path/to/hmm, built from" \
+  "fogleman/hmm at 5ea6114); running without it"
 mkdir -p "$OUT"
 
 say "installing delatin $DELATIN_VERSION into $OUT (npm install --prefix)"
@@ -103,13 +109,13 @@ else
 fi
 [ -f "$DELATIN_JS" ] || { echo "bench: npm did not install $DELATIN_JS" >&2; exit 1; }
 
-# measure NAME CMD...: runs CMD with stdout to NAME.json, stderr to NAME.err,
+# measure NAME CMD...: runs CMD with stdout to NAME.out, stderr to NAME.err,
 # wall time (ns) to NAME.ns and peak RSS (KiB) to NAME.rss.
 measure() {
   local name=$1; shift
   local t0 t1
   t0=$(date +%s%N)
-  if ! /usr/bin/time -f %M -o "$OUT/$name.rss" "$@" >"$OUT/$name.json" 2>"$OUT/$name.err"; then
+  if ! /usr/bin/time -f %M -o "$OUT/$name.rss" "$@" >"$OUT/$name.out" 2>"$OUT/$name.err"; then
     echo "bench: failed: $*" >&2
     tail -n 20 "$OUT/$name.err" >&2
     exit 1
@@ -118,18 +124,21 @@ measure() {
   echo $((t1 - t0)) >"$OUT/$name.ns"
 }
 
-say "baselines: peak RSS of the processes doing nothing heavy"
-# terratin's baseline is a whole simplify run on a 9x9 DEM: the same code
-# path as the real runs (GDAL drivers registered, GeoTIFF read, GeoPackage
-# written) with no data to speak of. --version is shown beside it.
-measure base_terratin_version "$TT" --version
-rm -f "$OUT/tiny.tif" "$OUT/tiny.gpkg"
-"$TT" generate diamond_square "$OUT/tiny.tif" -size 9 -seed 1 -q
-measure base_terratin "$TT" simplify -q -max_error 1 "$OUT/tiny.tif" "$OUT/tiny.gpkg"
-measure base_node node -e 0
-echo "terratin simplify 9x9: $(cat $OUT/base_terratin.rss) KiB;" \
-  "terratin --version: $(cat $OUT/base_terratin_version.rss) KiB;" \
-  "node -e 0: $(cat $OUT/base_node.rss) KiB"
+# hmm prints "loading heightmap... 0.015s", "triangulating... 0.26s",
+# "points = N", "triangles = N", "writing output... 0.017s", then the total.
+hmm_json() {
+  awk '
+    /^loading heightmap/ { r = $NF }
+    /^triangulating/     { m = $NF }
+    /^writing output/    { w = $NF }
+    /points = /          { v = $NF }
+    /triangles = /       { t = $NF }
+    /^[0-9.e-]+s$/       { tot = $1 }
+    END {
+      gsub("s$", "", r); gsub("s$", "", m); gsub("s$", "", w); gsub("s$", "", tot)
+      printf "{\"tool\":\"hmm\",\"vertices\":%s,\"triangles\":%s,\"seconds\":{\"read\":%s,\"mesh\":%s,\"write\":%s,\"total\":%s}}\n", v, t, r, m, w, tot
+    }' "$1"
+}
 
 # fastest NAME PATTERN: the run r (1..REPEAT) of NAME.r<r>.json whose
 # number matched by PATTERN is the smallest.
@@ -146,63 +155,77 @@ fastest() {
   echo "$best"
 }
 
+# run_case NAME DEM E
 run_case() {
-  local n=$1 seed=$2 e=$3
-  local c=ds$n
-  local dem=$OUT/$c.tif
+  local c=$1 dem=$2 e=$3
+  say "[$c] peer inputs (bench/peer_input.py, not timed)"
+  $PY bench/peer_input.py "$dem" "$OUT/$c"
+  local zr he
+  zr=$($PY -c "import json;i=json.load(open('$OUT/$c.info.json'));print(max(i['zmax']-i['zmin'],1e-300))")
+  he=$($PY -c "print(repr($e / $zr))")
+  echo "{\"name\":\"$c\",\"dem\":\"$dem\",\"max_error\":$e,\"hmm_z\":$zr,\"hmm_e\":$he}" >"$OUT/$c.case.json"
 
-  say "[$c] generating a ${n}x$n diamond-square DEM (seed $seed)"
-  rm -f "$dem"
-  "$TT" generate diamond_square "$dem" -size "$n" -seed "$seed"
-  gdalinfo -json "$dem" >"$OUT/$c.info.json"
-  echo "{\"name\":\"$c\",\"size\":$n,\"seed\":$seed,\"max_error\":$e}" >"$OUT/$c.case.json"
-
-  say "[$c] exporting raw Float32 for delatin (gdal_translate -of ENVI, not timed)"
-  rm -f "$OUT/$c.raw" "$OUT/$c.hdr"
-  GDAL_PAM_ENABLED=NO gdal_translate -q -of ENVI -ot Float32 "$dem" "$OUT/$c.raw"
-
-  # REPEAT runs of each tool, in alternation, so that a slow spell of the
-  # machine slows both; the run of the fastest meshing counts (its JSON,
-  # wall time and peak RSS become $c.terratin.* and $c.delatin.*).
-  local r tt_best="" dl_best=""
+  local tools="terratin delatin" r t
+  [ -n "$HMM" ] && tools="terratin hmm delatin"
   for r in $(seq 1 "$REPEAT"); do
-    say "[$c] terratin simplify -max_error $e (run $r of $REPEAT)"
+    say "[$c] run $r of $REPEAT: $tools at E = $e"
     rm -f "$OUT/$c.terratin.gpkg"
     measure "$c.terratin.r$r" "$TT" simplify -json -overwrite -max_error "$e" "$dem" "$OUT/$c.terratin.gpkg"
-    grep -o '"mesh": [0-9.e-]*' "$OUT/$c.terratin.r$r.json"
-
-    say "[$c] delatin run($e) (run $r of $REPEAT)"
+    cp "$OUT/$c.terratin.r$r.out" "$OUT/$c.terratin.r$r.json"
+    if [ -n "$HMM" ]; then
+      rm -f "$OUT/$c.hmm.stl"
+      measure "$c.hmm.r$r" "$HMM" -z "$zr" -e "$he" "$OUT/$c.png" "$OUT/$c.hmm.stl"
+      hmm_json "$OUT/$c.hmm.r$r.out" >"$OUT/$c.hmm.r$r.json"
+    fi
     rm -f "$OUT/$c.delatin.geojsonl"
     measure "$c.delatin.r$r" node bench/delatin_run.mjs --delatin "$DELATIN_JS" \
       --raw "$OUT/$c.raw" --info "$OUT/$c.info.json" --max-error "$e" \
       --out "$OUT/$c.delatin.geojsonl"
-    grep -o '"mesh":[0-9.e-]*' "$OUT/$c.delatin.r$r.json"
+    cp "$OUT/$c.delatin.r$r.out" "$OUT/$c.delatin.r$r.json"
+    for t in $tools; do
+      printf '  %-9s mesh %s  wall %.3f s\n' "$t" \
+        "$(grep -o '"mesh": *[0-9.e-]*' "$OUT/$c.$t.r$r.json" | sed 's/.*: *//')" \
+        "$(awk '{print $1 / 1e9}' "$OUT/$c.$t.r$r.ns")"
+    done
   done
-  tt_best=$(fastest "$c.terratin" '"mesh": *[0-9.e-]*')
-  dl_best=$(fastest "$c.delatin" '"mesh": *[0-9.e-]*')
-  for x in json ns rss err; do
-    cp "$OUT/$c.terratin.r$tt_best.$x" "$OUT/$c.terratin.$x"
-    cp "$OUT/$c.delatin.r$dl_best.$x" "$OUT/$c.delatin.$x"
+  for t in $tools; do
+    local best
+    best=$(fastest "$c.$t" '"mesh": *[0-9.e-]*')
+    for x in json ns rss; do cp "$OUT/$c.$t.r$best.$x" "$OUT/$c.$t.$x"; done
   done
-  echo "fastest meshing: terratin run $tt_best, delatin run $dl_best"
-  cat "$OUT/$c.terratin.json"
-  cat "$OUT/$c.delatin.json"
 
-  say "[$c] terratin eval of both TINs"
+  say "[$c] terratin eval of the TINs"
   "$TT" eval "$dem" "$OUT/$c.terratin.gpkg" -json >"$OUT/$c.terratin.eval.json"
-  cat "$OUT/$c.terratin.eval.json"
   "$TT" eval "$dem" "$OUT/$c.delatin.geojsonl" -json >"$OUT/$c.delatin.eval.json"
-  cat "$OUT/$c.delatin.eval.json"
+  if [ -n "$HMM" ]; then
+    $PY bench/stl_to_geojsonl.py "$OUT/$c.hmm.stl" "$OUT/$c.info.json" "$OUT/$c.hmm.geojsonl"
+    "$TT" eval "$dem" "$OUT/$c.hmm.geojsonl" -json >"$OUT/$c.hmm.eval.json"
+  fi
 }
 
-cases=(ds1025)
-run_case 1025 "$SEED_1025" "$E_1025"
+cases=()
+rm -f "$OUT/ds1025.tif"
+"$TT" generate diamond_square "$OUT/ds1025.tif" -size 1025 -seed 1 -q
+run_case ds1025 "$OUT/ds1025.tif" "$E_1025"; cases+=(ds1025)
 if [ "$quick" = 0 ]; then
-  run_case 4097 "$SEED_4097" "$E_4097"
-  cases+=(ds4097)
+  if [ -f "$SHARED/garland_heckbert_terra_scape/crater.stm.vrt" ]; then
+    run_case crater "$SHARED/garland_heckbert_terra_scape/crater.stm.vrt" "$E_CRATER"
+    cases+=(crater)
+  else
+    echo "bench: $SHARED has no Crater Lake; skipping it"
+  fi
+  if [ -f "$SHARED/gdalraster/lf_elev_220_mt_hood_utm.tif" ]; then
+    run_case hood "$SHARED/gdalraster/lf_elev_220_mt_hood_utm.tif" "$E_HOOD"
+    cases+=(hood)
+  else
+    echo "bench: $SHARED has no Mt Hood; skipping it"
+  fi
+  rm -f "$OUT/ds4097.tif"
+  "$TT" generate diamond_square "$OUT/ds4097.tif" -size 4097 -seed 1 -q
+  run_case ds4097 "$OUT/ds4097.tif" "$E_4097"; cases+=(ds4097)
 fi
 
 say "results ($(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores, $("$TT" --version 2>&1 | head -n 1))"
 echo "terratin scans with all online CPUs on grids of a million samples or more;"
-echo "delatin runs on one thread. Load average now: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "hmm and delatin run on one thread. Load average now: $(cut -d' ' -f1-3 /proc/loadavg)"
 node bench/report.mjs "$OUT" "${cases[@]}" | tee "$OUT/report.txt"

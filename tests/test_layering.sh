@@ -14,10 +14,11 @@ if [ -n "$bad" ]; then
   echo "$bad"
   exit 1
 fi
-# The glue folder holds only files that need those libraries.
-for f in src/gdal/*.c; do
+# The glue folder holds only files that need those libraries (directly, or
+# through the glue's public header or one of its own headers).
+for f in src/gdal/*.c src/gdal/*.h; do
   grep -qE "$pattern" "$f" ||
-    grep -q '#include "terratin/terratin_gdal.h"' "$f" || {
+    grep -qE '#include "(terratin/terratin_gdal\.h|gdal/[a-z_]+\.h)"' "$f" || {
       echo "test_layering: $f includes no GDAL-family header: it belongs to the engine"
       exit 1; }
 done

@@ -2,7 +2,8 @@
  * tt_tin_oracle.h -- independent checks of a TIN against its grid, shared
  * by the engine and GDAL tests. Nothing here uses raster_scan.c: the
  * triangles go through tt_eval_triangles (its own rasteriser) or through
- * plain integer edge tests.
+ * plain integer edge tests. Heights are read through tt_grid_sample, at
+ * the grid's own precision.
  */
 #ifndef TT_TIN_ORACLE_H
 #define TT_TIN_ORACLE_H
@@ -40,8 +41,7 @@ static inline double *tt_oracle_pixel_triangles(const tt_tin *tin)
 static inline size_t tt_oracle_nodata_inside(const tt_grid *g,
                                              const tt_tin *tin)
 {
-  const float *z = tt_grid_heights_const(g);
-  size_t nx = tt_grid_width(g), bad = 0;
+  size_t bad = 0;
   for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {
     tt_triangle_info ti;
     tt_tin_triangle(tin, t, &ti);
@@ -69,7 +69,8 @@ static inline size_t tt_oracle_nodata_inside(const tt_grid *g,
           pos += o > 0;
           neg += o < 0;
         }
-        if ((pos == 3 || neg == 3) && isnan(z[(size_t)r * nx + (size_t)c]))
+        if ((pos == 3 || neg == 3) &&
+            isnan(tt_grid_sample(g, (size_t)c, (size_t)r)))
           bad++;
       }
   }
@@ -81,13 +82,13 @@ static inline size_t tt_oracle_nodata_inside(const tt_grid *g,
  * domain cannot cover. */
 static inline size_t tt_oracle_uncarriable(const tt_grid *g)
 {
-  const float *z = tt_grid_heights_const(g);
   long long nx = (long long)tt_grid_width(g);
   long long ny = (long long)tt_grid_height(g);
   size_t n = 0;
+#define TT_ORACLE_Z_(c, r) tt_grid_sample(g, (size_t)(c), (size_t)(r))
   for (long long r = 0; r < ny; r++)
     for (long long c = 0; c < nx; c++) {
-      if (isnan(z[r * nx + c]))
+      if (isnan(TT_ORACLE_Z_(c, r)))
         continue;
       bool carried = false;
       for (long long cy = r - 1; cy <= r && !carried; cy++)
@@ -96,11 +97,12 @@ static inline size_t tt_oracle_uncarriable(const tt_grid *g)
             continue;
           int nv = 0;
           for (int k = 0; k < 4; k++)
-            nv += !isnan(z[(cy + (k >> 1)) * nx + cx + (k & 1)]);
+            nv += !isnan(TT_ORACLE_Z_(cx + (k & 1), cy + (k >> 1)));
           carried = nv >= 3;
         }
       n += !carried;
     }
+#undef TT_ORACLE_Z_
   return n;
 }
 

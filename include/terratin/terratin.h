@@ -18,8 +18,11 @@
  *  - Samples stand at pixel centres. Column c, row r of the grid is the point
  *    (c, r) in pixel space and (gt0 + (c+0.5)gt1 + (r+0.5)gt2,
  *    gt3 + (c+0.5)gt4 + (r+0.5)gt5) in map space (GDAL geotransform).
- *  - Heights are floats; NaN marks nodata. Counts are size_t; mesh indices
- *    are int32_t, so a TIN holds at most TT_MAX_VERTICES vertices.
+ *  - Heights are floats, or doubles where floats cannot hold a DEM's
+ *    values exactly (tt_precision); NaN marks nodata. Every computation on
+ *    them is in doubles, so a grid of doubles and one of floats holding the
+ *    same values give the same TIN bit for bit. Counts are size_t; mesh
+ *    indices are int32_t, so a TIN holds at most TT_MAX_VERTICES vertices.
  *  - No global mutable state: everything lives in the context.
  *
  * The header compiles alone, in C11 and in C++.
@@ -43,6 +46,10 @@ extern "C" {
 #define TT_MAX_VERTICES ((size_t)0x3fffffff)
 /* The largest grid side accepted (columns or rows). */
 #define TT_MAX_GRID_SIDE ((size_t)0x0fffffff)
+/* The largest height magnitude accepted: the largest float (FLT_MAX), so
+ * that no difference, square or sum of squares of heights overflows a
+ * double, in a grid of doubles too. */
+#define TT_MAX_HEIGHT 3.4028234663852886e38
 
 /* ---------------------------------------------------------------------------
  * Status codes: one table makes the enum, the names and the messages.
@@ -104,22 +111,50 @@ size_t tt_context_warning_count(const tt_context *ctx);
  * ------------------------------------------------------------------------- */
 typedef struct tt_grid tt_grid;
 
-/* Makes an nx x ny grid, every sample NaN (nodata), geotransform
+/* How a grid holds its heights: 4-byte floats, or 8-byte doubles for
+ * values a float cannot hold exactly (32- and 64-bit integers beyond 2^24,
+ * Float64 rasters, heights scaled by a factor; docs/cli.md lists which
+ * band types get which). Doubles cost twice the memory of the heights and
+ * some time in refinement (docs/architecture.md gives the figures). */
+typedef enum tt_precision {
+  TT_PRECISION_FLOAT32 = 0,
+  TT_PRECISION_FLOAT64
+} tt_precision;
+
+/* Makes an nx x ny grid of floats, every sample NaN (nodata), geotransform
  * (0,1,0,0,0,1). nx and ny must be >= 2 and <= TT_MAX_GRID_SIDE.
  * The caller owns *out_grid and frees it with tt_grid_destroy(). */
 tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
                          tt_grid **out_grid);
-/* Same, filled from a row-major array of nx*ny heights (NaN = nodata). */
+/* The same, holding doubles. The caller owns *out_grid and frees it with
+ * tt_grid_destroy(). */
+tt_status tt_grid_create_f64(tt_context *ctx, size_t nx, size_t ny,
+                             tt_grid **out_grid);
+/* A grid of floats filled from a row-major array of nx*ny heights (NaN =
+ * nodata). The caller owns *out_grid and frees it with tt_grid_destroy(). */
 tt_status tt_grid_create_from_floats(tt_context *ctx, size_t nx, size_t ny,
                                      const float *z, tt_grid **out_grid);
+/* A grid of doubles filled from a row-major array of nx*ny heights (NaN =
+ * nodata), whatever the values. The caller owns *out_grid and frees it
+ * with tt_grid_destroy(). */
+tt_status tt_grid_create_from_doubles(tt_context *ctx, size_t nx, size_t ny,
+                                      const double *z, tt_grid **out_grid);
 void tt_grid_destroy(tt_grid *grid);
 
 size_t tt_grid_width(const tt_grid *grid);
 size_t tt_grid_height(const tt_grid *grid);
+tt_precision tt_grid_precision(const tt_grid *grid);
 /* Row-major heights, nx*ny floats; write them before the first run.
- * NaN marks nodata; infinities are refused by tt_grid_check(). */
+ * NaN marks nodata; infinities are refused by tt_grid_check(). NULL for a
+ * grid of doubles (use tt_grid_heights_f64). */
 float *tt_grid_heights(tt_grid *grid);
 const float *tt_grid_heights_const(const tt_grid *grid);
+/* The same as doubles, for a grid of doubles; NULL for a grid of floats. */
+double *tt_grid_heights_f64(tt_grid *grid);
+const double *tt_grid_heights_f64_const(const tt_grid *grid);
+/* The height at column col, row row (both in range), at the grid's own
+ * precision, whichever it is; NaN for nodata. */
+double tt_grid_sample(const tt_grid *grid, size_t col, size_t row);
 
 /* GDAL geotransform: map x = gt[0] + px*gt[1] + py*gt[2],
  * y = gt[3] + px*gt[4] + py*gt[5], px/py in pixel-edge units. Sets the ground
@@ -139,8 +174,9 @@ tt_status tt_grid_set_ground_frame(tt_context *ctx, tt_grid *grid,
                                    const double a[4]);
 void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4]);
 
-/* Checks the heights: refuses infinities (naming the first row/column) and
- * counts the valid (non-NaN) samples. out_valid may be NULL. */
+/* Checks the heights: refuses infinities and heights beyond
+ * +-TT_MAX_HEIGHT (naming the first row/column) and counts the valid
+ * (non-NaN) samples. out_valid may be NULL. */
 tt_status tt_grid_check(tt_context *ctx, const tt_grid *grid,
                         size_t *out_valid);
 

@@ -69,14 +69,21 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * which frame). Heights are never changed by the frame. Unless the user set
  * GDAL_CACHEMAX, GDAL's block cache limit (process-wide) is lowered to a
  * few MiB during the read and restored after.
+ * No height is rounded: the grid holds floats when every valid height is
+ * exactly a float (always for Byte, Int8, Int16, UInt16 and Float32 bands
+ * without scale, offset or factor), else doubles (tt_grid_precision; the
+ * heights computed as above in doubles); Int64 and UInt64 values beyond
+ * +-2^53, which doubles cannot all hold, and heights beyond TT_MAX_HEIGHT
+ * are refused.
  * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> or SRCNODATA=nan
  * (replaces the mask; compared with the raw values), MAX_MEMORY=<bytes>
  * (refuse grids whose samples need more; default 3/4 of physical memory),
  * Z_UNIT=m (heights declared in ft or us-ft -- band unit type, else the
- * vertical CRS -- are converted to metres: height = ((raw * scale + offset)
- * * unit factor) * Z_FACTOR; an unknown unit is refused unless Z_FACTOR is
- * given, which then does the whole conversion), WORK_SRS=<CRS> (any
- * OSRSetFromUserInput form, projected: the working frame).
+ * vertical CRS -- are converted to metres: height = (raw * scale + offset)
+ * * (unit factor * Z_FACTOR), in doubles in that order; an unknown unit is
+ * refused unless Z_FACTOR is given, which then does the whole
+ * conversion), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
+ * the working frame).
  * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
  * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
 tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
@@ -126,6 +133,21 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            char **options, tt_progress_fn progress,
                            void *progress_arg);
 
+/* Writes the rows of the <prefix>triangles and <prefix>vertices layers of
+ * tin straight into the closed GeoPackage gpkg_path, whose two layers
+ * tt_ogr_write_tin() made with ROWS=DEFERRED (empty, with their fields),
+ * in one SQLite transaction: the same features, values and geometry blobs
+ * as tt_ogr_write_tin() without ROWS=DEFERRED writes through OGR, and the
+ * layers' extents and feature counts. srs and the options NLN_PREFIX and
+ * T_SRS must be those given to tt_ogr_write_tin() (LCO, ROWS and RTREE are
+ * accepted and ignored, so the same list can be passed). Any failure or an
+ * interruption (progress returns 0: TT_ERR_INTERRUPTED) rolls back and
+ * leaves the layers empty. */
+tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
+                             const tt_tin *tin, OGRSpatialReferenceH srs,
+                             char **options, tt_progress_fn progress,
+                             void *progress_arg);
+
 /* Builds the GeoPackage R-tree spatial index (extension gpkg_rtree_index)
  * of geom_column in table, on a closed GeoPackage file whose table has no
  * index yet, in one SQLite transaction: the boxes are read from the
@@ -156,12 +178,12 @@ tt_status tt_ogr_read_triangles(tt_context *ctx, OGRLayerH layer,
                                 const double gt[6], double **out_xyz,
                                 size_t *out_ntriangles, size_t *out_rejected);
 
-/* Writes a grid as a single-band Float32 GeoTIFF (TILED=YES,
- * COMPRESS=DEFLATE; nodata NaN only when the grid has NaN), with the grid's
- * geotransform and srs_wkt ("" or NULL for none). Written to a temporary
- * name beside path and renamed on success (see tt_output); an existing
- * path is refused with TT_ERR_EXISTS unless overwrite. Needs the GTiff
- * driver registered. */
+/* Writes a grid as a single-band Float32 GeoTIFF (Float64 for a grid of
+ * doubles; TILED=YES, COMPRESS=DEFLATE; nodata NaN only when the grid has
+ * NaN), with the grid's geotransform and srs_wkt ("" or NULL for none).
+ * Written to a temporary name beside path and renamed on success (see
+ * tt_output); an existing path is refused with TT_ERR_EXISTS unless
+ * overwrite. Needs the GTiff driver registered. */
 tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
                              const char *path, const char *srs_wkt,
                              int overwrite);

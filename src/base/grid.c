@@ -1,8 +1,11 @@
 /*
- * grid.c -- the height grid: nx*ny float samples, row-major, NaN for nodata,
- * a GDAL geotransform and the ground frame (see terratin.h). A grid is
+ * grid.c -- the height grid: nx*ny samples, row-major, NaN for nodata, a
+ * GDAL geotransform and the ground frame (see terratin.h). The samples are
+ * floats, or doubles where floats cannot hold the values exactly
+ * (tt_precision; internal.h: exactly one of z and zd is set). A grid is
  * written once by its producer (reader, generator, caller) and then only
- * read: the engine never modifies heights. Memory: 4 bytes per sample.
+ * read: the engine never modifies heights. Memory: 4 bytes per sample, 8
+ * for a grid of doubles.
  */
 /* madvise() and MADV_HUGEPAGE are outside ISO C and POSIX. */
 #define _DEFAULT_SOURCE 1
@@ -23,13 +26,13 @@
  * the kernel does not give huge pages, nothing changes. */
 #define HUGE_ALIGN ((size_t)2 << 20)
 
-/* Every grid has TT__GRID_PAD floats after its last sample, so that the
+/* Every grid has TT__GRID_PAD samples after its last one, so that the
  * vector kernels may read a whole group past a row's end (the extra lanes
  * are masked out) even on the last row. */
-static float *alloc_heights(size_t n)
+static void *alloc_heights(size_t n, size_t elem)
 {
   n += TT__GRID_PAD;
-  size_t bytes = n * sizeof(float);
+  size_t bytes = n * elem;
   if (bytes < 4 * HUGE_ALIGN)
     return malloc(bytes);
   void *p = NULL;
@@ -42,8 +45,8 @@ static float *alloc_heights(size_t n)
   return p;
 }
 
-tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
-                         tt_grid **out_grid)
+static tt_status grid_create(tt_context *ctx, size_t nx, size_t ny,
+                             tt_precision precision, tt_grid **out_grid)
 {
   if (!out_grid)
     return tt__error(ctx, TT_ERR_ARG, "out_grid must not be NULL");
@@ -56,21 +59,31 @@ tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
     return tt__error(ctx, TT_ERR_LIMIT,
                      "grid is %zu x %zu samples: a side may have at most %zu",
                      nx, ny, (size_t)TT_MAX_GRID_SIDE);
-  if (nx > (SIZE_MAX / sizeof(float) - TT__GRID_PAD) / ny)
+  size_t elem = precision == TT_PRECISION_FLOAT64 ? sizeof(double)
+                                                  : sizeof(float);
+  if (nx > (SIZE_MAX / elem - TT__GRID_PAD) / ny)
     return tt__error(ctx, TT_ERR_LIMIT, "grid of %zu x %zu samples is too "
                      "large for this machine's address space", nx, ny);
   tt_grid *g = calloc(1, sizeof *g);
   if (!g)
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory for a grid");
-  g->z = alloc_heights(nx * ny);
-  if (!g->z) {
+  void *z = alloc_heights(nx * ny, elem);
+  if (!z) {
     free(g);
     return tt__error(ctx, TT_ERR_NOMEM,
-                     "out of memory: a %zu x %zu grid needs %.1f MiB", nx, ny,
-                     (double)(nx * ny * sizeof(float)) / 1048576.0);
+                     "out of memory: a %zu x %zu grid of %s needs %.1f MiB",
+                     nx, ny, elem == sizeof(float) ? "floats" : "doubles",
+                     (double)(nx * ny * elem) / 1048576.0);
   }
-  for (size_t i = 0; i < nx * ny + TT__GRID_PAD; i++)
-    g->z[i] = NAN;
+  if (elem == sizeof(float)) {
+    g->z = z;
+    for (size_t i = 0; i < nx * ny + TT__GRID_PAD; i++)
+      g->z[i] = NAN;
+  } else {
+    g->zd = z;
+    for (size_t i = 0; i < nx * ny + TT__GRID_PAD; i++)
+      g->zd[i] = NAN;
+  }
   g->nx = nx;
   g->ny = ny;
   const double gt[6] = {0, 1, 0, 0, 0, 1};
@@ -79,6 +92,18 @@ tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
   memcpy(g->frame, frame, sizeof frame);
   *out_grid = g;
   return TT_OK;
+}
+
+tt_status tt_grid_create(tt_context *ctx, size_t nx, size_t ny,
+                         tt_grid **out_grid)
+{
+  return grid_create(ctx, nx, ny, TT_PRECISION_FLOAT32, out_grid);
+}
+
+tt_status tt_grid_create_f64(tt_context *ctx, size_t nx, size_t ny,
+                             tt_grid **out_grid)
+{
+  return grid_create(ctx, nx, ny, TT_PRECISION_FLOAT64, out_grid);
 }
 
 tt_status tt_grid_create_from_floats(tt_context *ctx, size_t nx, size_t ny,
@@ -93,18 +118,61 @@ tt_status tt_grid_create_from_floats(tt_context *ctx, size_t nx, size_t ny,
   return TT_OK;
 }
 
+tt_status tt_grid_create_from_doubles(tt_context *ctx, size_t nx, size_t ny,
+                                      const double *z, tt_grid **out_grid)
+{
+  if (!z)
+    return tt__error(ctx, TT_ERR_ARG, "heights must not be NULL");
+  tt_status s = tt_grid_create_f64(ctx, nx, ny, out_grid);
+  if (s != TT_OK)
+    return s;
+  memcpy((*out_grid)->zd, z, nx * ny * sizeof(double));
+  return TT_OK;
+}
+
+bool tt__grid_widen(tt_grid *g)
+{
+  if (g->zd)
+    return true;
+  size_t n = g->nx * g->ny + TT__GRID_PAD;
+  double *zd = alloc_heights(g->nx * g->ny, sizeof(double));
+  if (!zd)
+    return false;
+  for (size_t i = 0; i < n; i++)
+    zd[i] = (double)g->z[i];
+  free(g->z);
+  g->z = NULL;
+  g->zd = zd;
+  return true;
+}
+
 void tt_grid_destroy(tt_grid *grid)
 {
   if (!grid)
     return;
   free(grid->z);
+  free(grid->zd);
   free(grid);
 }
 
 size_t tt_grid_width(const tt_grid *grid) { return grid->nx; }
 size_t tt_grid_height(const tt_grid *grid) { return grid->ny; }
+tt_precision tt_grid_precision(const tt_grid *grid)
+{
+  return grid->zd ? TT_PRECISION_FLOAT64 : TT_PRECISION_FLOAT32;
+}
 float *tt_grid_heights(tt_grid *grid) { return grid->z; }
 const float *tt_grid_heights_const(const tt_grid *grid) { return grid->z; }
+double *tt_grid_heights_f64(tt_grid *grid) { return grid->zd; }
+const double *tt_grid_heights_f64_const(const tt_grid *grid)
+{
+  return grid->zd;
+}
+
+double tt_grid_sample(const tt_grid *grid, size_t col, size_t row)
+{
+  return tt__grid_z(grid, row * grid->nx + col);
+}
 
 tt_status tt_grid_set_geotransform(tt_context *ctx, tt_grid *grid,
                                    const double gt[6])
@@ -154,21 +222,52 @@ void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4])
   memcpy(out_a, grid->frame, 4 * sizeof(double));
 }
 
+/* The first sample of row r that is infinite or beyond TT_MAX_HEIGHT, or
+ * -1; counts the row's valid samples into *valid. One loop per precision:
+ * the float one is as it always was. */
+static int64_t check_row_f32(const float *z, size_t nx, size_t *valid)
+{
+  for (size_t c = 0; c < nx; c++) {
+    float v = z[c];
+    if (isnan(v))
+      continue;
+    if (isinf(v))
+      return (int64_t)c;
+    (*valid)++;
+  }
+  return -1;
+}
+
+static int64_t check_row_f64(const double *z, size_t nx, size_t *valid)
+{
+  for (size_t c = 0; c < nx; c++) {
+    double v = z[c];
+    if (isnan(v))
+      continue;
+    if (!(fabs(v) <= TT_MAX_HEIGHT))
+      return (int64_t)c;
+    (*valid)++;
+  }
+  return -1;
+}
+
 tt_status tt_grid_check(tt_context *ctx, const tt_grid *grid,
                         size_t *out_valid)
 {
   size_t valid = 0;
   for (size_t r = 0; r < grid->ny; r++) {
-    const float *row = grid->z + r * grid->nx;
-    for (size_t c = 0; c < grid->nx; c++) {
-      float v = row[c];
-      if (isnan(v))
-        continue;
-      if (isinf(v))
-        return tt__error(ctx, TT_ERR_DATA, "height at row %zu, column %zu "
-                         "is infinite", r, c);
-      valid++;
-    }
+    size_t i = r * grid->nx;
+    int64_t c = grid->zd ? check_row_f64(grid->zd + i, grid->nx, &valid)
+                         : check_row_f32(grid->z + i, grid->nx, &valid);
+    if (c < 0)
+      continue;
+    double v = tt__grid_z(grid, i + (size_t)c);
+    if (isinf(v))
+      return tt__error(ctx, TT_ERR_DATA, "height at row %zu, column %lld "
+                       "is infinite", r, (long long)c);
+    return tt__error(ctx, TT_ERR_DATA, "height at row %zu, column %lld is "
+                     "%g, beyond the +-%g the engine measures", r,
+                     (long long)c, v, TT_MAX_HEIGHT);
   }
   if (out_valid)
     *out_valid = valid;

@@ -31,15 +31,30 @@ struct tt_context {
   size_t warnings;
 };
 
-/* Floats of padding after a grid's last sample (see grid.c). */
+/* Samples of padding after a grid's last sample (see grid.c). */
 #define TT__GRID_PAD 16
 
+/* Exactly one of z and zd holds the heights: z for a grid of floats, zd
+ * for one of doubles (tt_precision); the other is NULL. */
 struct tt_grid {
   size_t nx, ny;
   float *z;          /* nx*ny, row-major, NaN = nodata */
+  double *zd;        /* the same, as doubles */
   double gt[6];      /* GDAL geotransform */
   double frame[4];   /* ground frame: pixel step -> ground units */
 };
+
+/* Sample i (row-major) of a grid, at its own precision. */
+static inline double tt__grid_z(const tt_grid *g, size_t i)
+{
+  return g->zd ? g->zd[i] : (double)g->z[i];
+}
+
+/* Turns a grid of floats into one of doubles with the same values (for a
+ * reader that meets a height a float cannot hold); a grid of doubles stays
+ * as it is. False when out of memory (the grid is unchanged). For a
+ * moment both arrays exist: 12 bytes per sample. */
+TT_HIDDEN bool tt__grid_widen(tt_grid *g);
 
 /* Sets the context's status and message and returns the status, so a
  * failure reads `return tt__error(ctx, TT_ERR_ARG, "...", ...);`. A NULL

@@ -20,9 +20,11 @@
  * (column, row, height), whose 2x2 minors are exact integers; it is
  * evaluated in doubles with Shewchuk's orient3d error bound (loosened to
  * one bound per pair of rays, see pair_make) and, when the bound does not
- * decide (slivers, coplanar rays), exactly, as a sum of twelve exactly
- * representable products (float height x 21-bit slice of a minor) added
- * by expansion arithmetic. With integer heights (most DEMs) within 2^16
+ * decide (slivers, coplanar rays), exactly, as a sum of exactly
+ * representable products (a height, or each 26-bit half of a double
+ * height, times a 21-bit slice of a minor: twelve for float heights, up
+ * to twenty-four for doubles) added by expansion arithmetic. With integer
+ * heights (most DEMs) within 2^16
  * of each other the double products are exact and the bound is 0: no
  * exact sums at all. The common factor det(frame) does not change which
  * side the rays are on, so it is never needed.
@@ -209,8 +211,8 @@ typedef struct rays {
   double c[TT__STAR_MAX + 1], d[TT__STAR_MAX + 1]; /* |g_i x g_i+1|,
                                                       g_i . g_i+1 */
   int64_t dc[TT__STAR_MAX + 1], dr[TT__STAR_MAX + 1];
-  float zk[TT__STAR_MAX + 1];
-  float zv;
+  double zk[TT__STAR_MAX + 1];         /* heights as the mesh has them */
+  double zv;
   double maxc;                          /* largest |x|, |y|, |z| */
   bool ints;                            /* x, y, z are integers of at most
                                            2^16: every triple product is
@@ -229,18 +231,35 @@ static inline void two_sum(double a, double b, double *x, double *y)
   *y = (a - av) + (b - bv);
 }
 
-/* Adds the exact products sign * z * |m| (|m| < 2^63) to expansion h. */
-static int add_products(double *h, int len, float z, int64_t m)
+/* Adds the exact products z * s * 2^(21 k) of the 21-bit slices s of
+ * |m| (|m| < 2^63), z of at most 32 significant bits, to expansion h. */
+static int add_slices(double *h, int len, double z, uint64_t u)
 {
-  double sz = m < 0 ? -(double)z : (double)z;
-  uint64_t u = m < 0 ? (uint64_t)0 - (uint64_t)m : (uint64_t)m;
   const double scale[3] = {1.0, 2097152.0, 4398046511104.0}; /* 2^0,21,42 */
   for (int k = 0; k < 3; k++) {
-    double b = sz * (double)((u >> (21 * k)) & 0x1fffffu) * scale[k];
+    double b = z * (double)((u >> (21 * k)) & 0x1fffffu) * scale[k];
     for (int i = 0; i < len; i++)
       two_sum(b, h[i], &b, &h[i]);
     h[len++] = b;
   }
+  return len;
+}
+
+/* Adds the exact product sign * z * |m| (|m| < 2^63) to expansion h. A
+ * height of a grid of floats has 24 significant bits, so z times a slice
+ * is exact; a double is first split into two halves of at most 26 bits
+ * (Veltkamp: hi + lo == z exactly, for |z| between 2^-969 and 2^996,
+ * which TT_MAX_HEIGHT bounds from above), each times a slice exact. A
+ * float's lo is 0 and adds nothing. */
+static int add_products(double *h, int len, double z, int64_t m)
+{
+  double sz = m < 0 ? -z : z;
+  uint64_t u = m < 0 ? (uint64_t)0 - (uint64_t)m : (uint64_t)m;
+  double c = 134217729.0 * sz; /* 2^27 + 1 */
+  double hi = c - (c - sz), lo = sz - hi;
+  len = add_slices(h, len, hi, u);
+  if (lo != 0)
+    len = add_slices(h, len, lo, u);
   return len;
 }
 
@@ -250,7 +269,7 @@ static int exact_sign(const rays *r, int i, int j, int k)
   int64_t mi = r->dc[j] * r->dr[k] - r->dr[j] * r->dc[k];
   int64_t mj = r->dc[k] * r->dr[i] - r->dr[k] * r->dc[i];
   int64_t mk = r->dc[i] * r->dr[j] - r->dr[i] * r->dc[j];
-  double h[12];
+  double h[24];
   int len = 0;
   len = add_products(h, len, r->zk[i], mi);
   len = add_products(h, len, r->zk[j], mj);
@@ -326,7 +345,7 @@ static inline int small_int(double z)
 }
 
 int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
-                        const float z[3], float zv)
+                        const double z[3], double zv)
 {
   rays r;
   double mx = 0;
@@ -338,7 +357,7 @@ int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
     r.zk[i] = z[i];
     r.x[i] = (double)dc[i];
     r.y[i] = (double)dr[i];
-    r.z[i] = (double)z[i] - (double)zv;
+    r.z[i] = z[i] - zv;
     mx = max3abs(mx, r.x[i], r.y[i], r.z[i]);
     ints &= small_int(r.z[i]);
   }
@@ -354,7 +373,7 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
 {
   const tt__mesh_vertex *o = &m->v[v];
   int n = s->n;
-  r->zv = o->z;
+  r->zv = tt__mesh_z(m, v);
   double mx = 0;
   int ints = 1;
   for (int i = 0; i < n; i++) {
@@ -362,9 +381,9 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
     int64_t dci = (int64_t)w->c - o->c, dri = (int64_t)w->r - o->r;
     r->dc[i] = dci;
     r->dr[i] = dri;
-    r->zk[i] = w->z;
+    r->zk[i] = tt__mesh_z(m, s->nb[i]);
     double dc = (double)dci, dr = (double)dri;
-    double dz = (double)w->z - (double)r->zv;
+    double dz = r->zk[i] - r->zv;
     double gx = fr[0] * dc + fr[1] * dr, gy = fr[2] * dc + fr[3] * dr;
     r->x[i] = r->x[i + n] = dc;
     r->y[i] = r->y[i + n] = dr;

@@ -61,7 +61,7 @@ static inline tt__gvec tt__geo_vec(const double a[4], const tt__mesh *m,
   double dc = (double)((int64_t)m->v[to].c - m->v[from].c);
   double dr = (double)((int64_t)m->v[to].r - m->v[from].r);
   tt__gvec g = {a[0] * dc + a[1] * dr, a[2] * dc + a[3] * dr,
-                (double)m->v[to].z - (double)m->v[from].z};
+                tt__mesh_z(m, to) - tt__mesh_z(m, from)};
   return g;
 }
 
@@ -284,7 +284,7 @@ TT_HIDDEN double tt__gaussian_vertex(const tt__crit_env *env, int32_t v,
  * in pixel space (|dc|, |dr| < 2^28), as the Gaussian criterion's
  * supporting-plane tests take it (gaussian.c). For tests. */
 TT_HIDDEN int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
-                                  const float z[3], float zv);
+                                  const double z[3], double zv);
 
 /* The criteria defined beside Delaunay, one file each (registry.c lists
  * them). */

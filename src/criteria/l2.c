@@ -167,7 +167,7 @@ static double tri_sse(const tt__crit_env *env, int32_t p0, int32_t p1,
   for (int k = 0; k < 3; k++) {
     st.x[k] = m->v[v[k]].c;
     st.y[k] = m->v[v[k]].r;
-    st.z[k] = (double)m->v[v[k]].z;
+    st.z[k] = tt__mesh_z(m, v[k]);
     st.own[k] = (own >> k) & 1u;
   }
   tt__scan_stats s;

@@ -2,17 +2,29 @@
  * io_gdal_read.c -- reading one raster band into a tt_grid.
  *
  * The band is read block by block in its natural block size, one row of
- * blocks at a time, with RasterIO converting straight to Float32 into the
- * grid's own array (no full-size temporary). Validity comes from GDAL's mask
- * band (nodata value, NaN nodata, alpha, .msk) unless SRCNODATA overrides it;
- * masked samples become NaN. Then scale/offset and Z_FACTOR are applied, and
- * every valid sample must be finite. The heights' memory is checked against
- * MAX_MEMORY before anything is allocated.
+ * blocks at a time. Validity comes from GDAL's mask band (nodata value, NaN
+ * nodata, alpha, .msk) unless SRCNODATA overrides it; masked samples
+ * become NaN. Then scale/offset and Z_FACTOR are applied in doubles, and
+ * every valid height must be finite and within TT_MAX_HEIGHT.
  *
- * Memory: the grid (4 bytes per sample) plus one block of mask bytes plus
+ * Precision: no height is rounded. The grid holds floats while every valid
+ * height met is exactly a float, and turns into doubles (tt__grid_widen)
+ * at the first that is not. Bands whose raw values are floats (Byte, Int8,
+ * Int16, UInt16, Float32) are read by RasterIO straight into the grid's
+ * own array, with no temporary, and with no scale, offset or factor stay
+ * floats: the common case reads as it always did. The others (Int32,
+ * UInt32, Float64, Int64, UInt64) go through a buffer of one band of rows
+ * as doubles (64-bit integers as themselves, refused beyond 2^53, where
+ * doubles no longer hold every integer); an Int32 DEM of heights in
+ * centimetres, all below 2^24, still ends as floats.
+ *
+ * Memory: the grid (4 bytes per sample, 8 once it holds doubles; 12 for
+ * the moment of widening, checked against MAX_MEMORY then) plus one band
+ * of rows of mask bytes and, for the buffered types, of doubles, plus
  * GDAL's block cache, which is held to a few blocks for the duration of the
  * read unless the user set GDAL_CACHEMAX (the cache limit is process-wide
- * state of GDAL's: it is restored afterwards).
+ * state of GDAL's: it is restored afterwards). The heights' memory as
+ * floats is checked against MAX_MEMORY before anything is allocated.
  */
 #include "gdal/georef.h"
 #include "base/internal.h"
@@ -33,6 +45,10 @@
 /* Largest mask buffer used at once; taller blocks are read in bands of rows
  * (the block itself then stays in GDAL's cache between the bands). */
 #define TT_READ_MASK_BYTES ((size_t)1 << 20)
+/* Largest buffer of raw values (doubles) used at once, likewise. */
+#define TT_READ_STAGE_BYTES ((size_t)8 << 20)
+/* The largest integer magnitude up to which doubles hold every integer. */
+#define TT_READ_MAX_EXACT_INT ((uint64_t)1 << 53)
 /* Block-cache limit during the read when the user has not chosen one. */
 #define TT_READ_CACHE_BYTES ((GIntBig)2 << 20)
 
@@ -44,13 +60,14 @@ typedef struct read_options {
                             options list) */
   int has_srcnodata;
   int srcnodata_is_nan;
-  float srcnodata;       /* compared with the raw value read as Float32 */
-  double srcnodata_given; /* the value as written, checked against the
-                             band's type */
+  float srcnodata;       /* compared with raw values that are floats */
+  double srcnodata_d;    /* compared with the other raw values */
+  int srcnodata_is_int;  /* an integer literal, kept exactly for 64-bit */
+  int srcnodata_neg;     /* integer bands: sign and magnitude */
+  uint64_t srcnodata_mag;
   size_t max_memory;     /* bytes */
   int max_memory_default; /* not given: the system's limit */
   const char *max_memory_source; /* which limit that is (tt_memory_limit) */
-  GDALRasterBandH band;  /* to read a sample back at its own precision */
 } read_options;
 
 static char *dup_str(const char *s)
@@ -105,6 +122,31 @@ static int parse_double(const char *s, double *out)
   return 1;
 }
 
+/* Parses a whole string as an integer of magnitude below 2^64 (sign and
+ * magnitude, so that every Int64 and UInt64 value is one). */
+static int parse_integer(const char *s, int *out_neg, uint64_t *out_mag)
+{
+  while (*s == ' ')
+    s++;
+  int neg = *s == '-';
+  if (*s == '-' || *s == '+')
+    s++;
+  if (*s < '0' || *s > '9')
+    return 0;
+  char *end = NULL;
+  errno = 0;
+  unsigned long long m = strtoull(s, &end, 10);
+  if (errno == ERANGE)
+    return 0;
+  while (*end == ' ')
+    end++;
+  if (*end != '\0')
+    return 0;
+  *out_neg = neg && m != 0;
+  *out_mag = (uint64_t)m;
+  return 1;
+}
+
 static tt_status parse_options(tt_context *ctx, char **options,
                                read_options *opt)
 {
@@ -115,8 +157,10 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->has_srcnodata = 0;
   opt->srcnodata_is_nan = 0;
   opt->srcnodata = 0.0f;
-  opt->srcnodata_given = 0.0;
-  opt->band = NULL;
+  opt->srcnodata_d = 0.0;
+  opt->srcnodata_is_int = 0;
+  opt->srcnodata_neg = 0;
+  opt->srcnodata_mag = 0;
   opt->max_memory = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
@@ -157,7 +201,9 @@ static tt_status parse_options(tt_context *ctx, char **options,
                       "got \"%s\"", value);
       } else {
         opt->srcnodata = (float)v;
-        opt->srcnodata_given = v;
+        opt->srcnodata_d = v;
+        opt->srcnodata_is_int = parse_integer(value, &opt->srcnodata_neg,
+                                              &opt->srcnodata_mag);
       }
     } else if (strcasecmp(key, "MAX_MEMORY") == 0) {
       if (!parse_double(value, &v) || v <= 0)
@@ -324,16 +370,16 @@ static const char *declared_z_unit(GDALRasterBandH band,
   return "";
 }
 
-/* Converts a band of rows [r0, r0+nrows) in place: mask, scale/offset,
- * Z_FACTOR, finiteness. mask (nx*nrows bytes, 0 = invalid) may be NULL. */
+/* Converts a band of rows [r0, r0+nrows) of a grid of floats in place, for
+ * bands whose raw values are floats and with no scale, offset or factor
+ * (the heights are the raw values, so they stay floats): mask or
+ * SRCNODATA, finiteness. Every other case goes through convert_any().
+ * mask (nx*nrows bytes, 0 = invalid) may be NULL. */
 static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
                               size_t nx, size_t r0, size_t nrows,
                               const unsigned char *mask,
-                              const read_options *opt, double scale,
-                              double offset, size_t *valid_count)
+                              const read_options *opt, size_t *valid_count)
 {
-  const double zf = opt->z_factor;
-  const int identity = scale == 1.0 && offset == 0.0 && zf == 1.0;
   for (size_t r = 0; r < nrows; r++) {
     float *row = z + (r0 + r) * nx;
     const unsigned char *mrow = mask ? mask + r * nx : NULL;
@@ -348,10 +394,7 @@ static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
         row[c] = NAN;
         continue;
       }
-      /* Scale and offset first, then Z_FACTOR, as documented. */
-      double hd = ((double)raw * scale + offset) * zf;
-      float h = identity ? raw : (float)hd;
-      if (!isfinite(h)) {
+      if (!isfinite(raw)) {
         if (isnan(raw) && opt->has_srcnodata)
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                            "%zu is NaN, which SRCNODATA %g does not cover "
@@ -361,29 +404,165 @@ static tt_status convert_rows(tt_context *ctx, const char *path, float *z,
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                            "%zu is NaN but not marked nodata (use "
                            "-srcnodata nan)", path, r0 + r, c);
-        /* A finite Float64 (or Int64) beyond 3.4e38 reads as an infinite
-         * float: read it back as a double to say which it is. */
-        double exact = raw;
-        if (isinf(raw) && opt->band &&
-            GDALRasterIO(opt->band, GF_Read, (int)c, (int)(r0 + r), 1, 1,
-                         &exact, 1, 1, GDT_Float64, 0, 0) != CE_None)
-          exact = raw;
-        if (isinf(raw) && isfinite(exact))
+        return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                         "%zu is infinite but not marked nodata", path,
+                         r0 + r, c);
+      }
+      (*valid_count)++;
+    }
+  }
+  return TT_OK;
+}
+
+/* Where the raw values of a band of rows are: in the grid itself (bands
+ * whose raw values are floats), or in the buffer, as doubles or as 64-bit
+ * integers. */
+typedef enum raw_source {
+  RAW_IN_GRID = 0, RAW_F64, RAW_I64, RAW_U64
+} raw_source;
+
+typedef struct raw_rows {
+  raw_source source;
+  const void *buf;       /* nrows x nx values, for RAW_F64/I64/U64 */
+} raw_rows;
+
+/* Turns the grid into doubles for the height h at row r, column c, which a
+ * float cannot hold; checks the memory of both arrays against MAX_MEMORY
+ * first. */
+static tt_status widen_grid(tt_context *ctx, const char *path, tt_grid *g,
+                            const read_options *opt, size_t r, size_t c,
+                            double h)
+{
+  size_t n = g->nx * g->ny;
+  char need_s[32], max_s[32];
+  size_t need = n <= SIZE_MAX / 12 ? n * 12 : SIZE_MAX;
+  if (need > opt->max_memory)
+    return tt__error(ctx, TT_ERR_LIMIT, "%s: the height at row %zu, column "
+                     "%zu (%.17g) is not exactly a float, so the %zu x %zu "
+                     "heights are kept as doubles, which needs %s while they "
+                     "are converted, more than %s (%s)", path, r, c, h,
+                     g->nx, g->ny, fmt_bytes(need_s, sizeof need_s, need),
+                     opt->max_memory_default ? "3/4 of this machine's "
+                                               "physical memory"
+                                             : "MAX_MEMORY",
+                     fmt_bytes(max_s, sizeof max_s, opt->max_memory));
+  if (!tt__grid_widen(g))
+    return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory: the height at "
+                     "row %zu, column %zu (%.17g) is not exactly a float, "
+                     "and the %zu x %zu heights as doubles need %s", path, r,
+                     c, h, g->nx, g->ny,
+                     fmt_bytes(need_s, sizeof need_s, n * 8));
+  return TT_OK;
+}
+
+/* Whether a 64-bit integer raw value (sign and magnitude) equals SRCNODATA
+ * exactly: compared as integers when SRCNODATA is an integer literal (a
+ * double near 2^63 would match its neighbours too), else as doubles. */
+static int int_is_srcnodata(const read_options *opt, int neg, uint64_t mag)
+{
+  if (opt->srcnodata_is_nan)
+    return 0;
+  if (opt->srcnodata_is_int)
+    return neg == opt->srcnodata_neg && mag == opt->srcnodata_mag;
+  return (neg ? -(double)mag : (double)mag) == opt->srcnodata_d;
+}
+
+/* Converts a band of rows [r0, r0+nrows) into the grid, in every case but
+ * convert_rows()'s: raw values from raw (see raw_rows), then mask or
+ * SRCNODATA, scale/offset and Z_FACTOR in doubles, finiteness and the
+ * magnitude limits; each height is stored as a float while it is one, and
+ * the first that is not turns the grid into doubles. */
+static tt_status convert_any(tt_context *ctx, const char *path, tt_grid *g,
+                             const raw_rows *raw, size_t r0, size_t nrows,
+                             const unsigned char *mask,
+                             const read_options *opt, double scale,
+                             double offset, size_t *valid_count)
+{
+  const size_t nx = g->nx;
+  const double zf = opt->z_factor;
+  const int identity = scale == 1.0 && offset == 0.0 && zf == 1.0;
+  for (size_t r = 0; r < nrows; r++) {
+    const unsigned char *mrow = mask ? mask + r * nx : NULL;
+    for (size_t c = 0; c < nx; c++) {
+      const size_t i = (r0 + r) * nx + c, k = r * nx + c;
+      double rawd;
+      int ok;
+      if (raw->source == RAW_I64 || raw->source == RAW_U64) {
+        uint64_t mag;
+        int neg = 0;
+        if (raw->source == RAW_I64) {
+          int64_t v = ((const int64_t *)raw->buf)[k];
+          neg = v < 0;
+          mag = neg ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+        } else {
+          mag = ((const uint64_t *)raw->buf)[k];
+        }
+        ok = opt->has_srcnodata ? !int_is_srcnodata(opt, neg, mag)
+                                : (mrow ? mrow[c] != 0 : 1);
+        if (ok && mag > TT_READ_MAX_EXACT_INT)
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
-                           "%zu is %.15g, beyond the range of the 32-bit "
-                           "floats heights are kept in (+-3.4e38); mark it "
-                           "nodata (-srcnodata) if it is a fill value", path,
-                           r0 + r, c, exact);
-        if (isinf(raw))
+                           "%zu is %s%llu, beyond 2^53, where doubles no "
+                           "longer hold every integer: %s band values must "
+                           "lie within +-2^53", path, r0 + r, c,
+                           neg ? "-" : "", (unsigned long long)mag,
+                           raw->source == RAW_I64 ? "Int64" : "UInt64");
+        rawd = neg ? -(double)mag : (double)mag; /* exact: <= 2^53 */
+      } else {
+        rawd = raw->source == RAW_F64 ? ((const double *)raw->buf)[k]
+                                      : tt__grid_z(g, i);
+        if (!opt->has_srcnodata)
+          ok = mrow ? mrow[c] != 0 : 1;
+        else if (opt->srcnodata_is_nan)
+          ok = !isnan(rawd);
+        else if (raw->source == RAW_IN_GRID)
+          ok = (float)rawd != opt->srcnodata; /* raw floats, as before */
+        else
+          ok = rawd != opt->srcnodata_d;
+      }
+      if (!ok) {
+        if (g->zd)
+          g->zd[i] = NAN;
+        else
+          g->z[i] = NAN;
+        continue;
+      }
+      /* Scale and offset first, then Z_FACTOR, as documented. */
+      double h = identity ? rawd : (rawd * scale + offset) * zf;
+      if (!(fabs(h) <= TT_MAX_HEIGHT)) {
+        if (isnan(rawd) && opt->has_srcnodata)
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is NaN, which SRCNODATA %g does not cover "
+                           "(use -srcnodata nan)", path, r0 + r, c,
+                           opt->srcnodata_d);
+        if (isnan(rawd))
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is NaN but not marked nodata (use "
+                           "-srcnodata nan)", path, r0 + r, c);
+        if (isinf(rawd))
           return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                            "%zu is infinite but not marked nodata", path,
                            r0 + r, c);
+        if (identity)
+          return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
+                           "%zu is %g, beyond the +-%g terratin measures",
+                           path, r0 + r, c, h, TT_MAX_HEIGHT);
         return tt__error(ctx, TT_ERR_DATA, "%s: height at row %zu, column "
                          "%zu is %g after scale %g, offset %g and Z_FACTOR "
-                         "%g: too large for a 32-bit float", path, r0 + r, c,
-                         hd, scale, offset, zf);
+                         "%g: beyond the +-%g terratin measures", path,
+                         r0 + r, c, h, scale, offset, zf, TT_MAX_HEIGHT);
       }
-      row[c] = h;
+      if (!g->zd) {
+        float f = (float)h;
+        if ((double)f == h) {
+          g->z[i] = f;
+          (*valid_count)++;
+          continue;
+        }
+        tt_status s = widen_grid(ctx, path, g, opt, r0 + r, c, h);
+        if (s != TT_OK)
+          return s;
+      }
+      g->zd[i] = h;
       (*valid_count)++;
     }
   }
@@ -407,6 +586,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   tt_grid *grid = NULL;
   tt_raster_info *info = NULL;
   unsigned char *mask = NULL;
+  void *stage = NULL;
   GDALRasterBandH mask_band = NULL;
   int cache_changed = 0;
   GIntBig old_cache_max = 0;
@@ -428,6 +608,27 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                   GDALGetDataTypeName(dtype));
     goto done;
   }
+  /* Raw values that are all floats are read straight into the grid; the
+   * others through the buffer (see the top of the file). */
+  raw_rows raw = {RAW_IN_GRID, NULL};
+  GDALDataType stage_type = GDT_Float64;
+  if (dtype == GDT_Byte || dtype == GDT_Int16 || dtype == GDT_UInt16 ||
+#if GDAL_VERSION_NUM >= GDAL_COMPUTE_VERSION(3, 7, 0)
+      dtype == GDT_Int8 ||
+#endif
+      dtype == GDT_Float32) {
+    raw.source = RAW_IN_GRID;
+#if GDAL_VERSION_NUM >= GDAL_COMPUTE_VERSION(3, 5, 0)
+  } else if (dtype == GDT_Int64) {
+    raw.source = RAW_I64;
+    stage_type = GDT_Int64;
+  } else if (dtype == GDT_UInt64) {
+    raw.source = RAW_U64;
+    stage_type = GDT_UInt64;
+#endif
+  } else {
+    raw.source = RAW_F64;
+  }
 
   /* A SRCNODATA the band's type cannot hold can never match a sample:
    * refuse it rather than mask nothing (1e39 in a Float32 band, -1 in a
@@ -437,12 +638,12 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     if (opt.srcnodata_is_nan)
       clamped = !GDALDataTypeIsFloating(dtype);
     else
-      GDALAdjustValueToDataType(dtype, opt.srcnodata_given, &clamped,
+      GDALAdjustValueToDataType(dtype, opt.srcnodata_d, &clamped,
                                 &rounded);
     if (clamped || rounded) {
       s = tt__error(ctx, TT_ERR_ARG, "%s: SRCNODATA (-srcnodata) %.15g "
                     "cannot occur in band %d, whose type %s %s", path,
-                    opt.srcnodata_is_nan ? NAN : opt.srcnodata_given,
+                    opt.srcnodata_is_nan ? NAN : opt.srcnodata_d,
                     GDALGetBandNumber(band), GDALGetDataTypeName(dtype),
                     clamped ? "cannot hold it" : "holds whole numbers only");
       goto done;
@@ -540,7 +741,6 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     unit_out = "m";
   }
   read_options conv = opt; /* what convert_rows() multiplies by */
-  conv.band = band;
   conv.z_factor = opt.z_factor * unit_factor;
 
   s = tt_grid_create(ctx, nx, ny, &grid);
@@ -587,11 +787,14 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     bw = xsize;
   if (bh <= 0 || bh > ysize)
     bh = ysize;
-  /* Rows per step: a block's height, fewer if the mask buffer of a row of
-   * blocks would be large (single-strip files). */
+  /* Rows per step: a block's height, fewer if the mask buffer or the raw
+   * buffer of a row of blocks would be large (single-strip files). */
   size_t step = (size_t)bh;
   if (mask_band && step * nx > TT_READ_MASK_BYTES)
     step = TT_READ_MASK_BYTES / nx > 0 ? TT_READ_MASK_BYTES / nx : 1;
+  if (raw.source != RAW_IN_GRID && step * nx * 8 > TT_READ_STAGE_BYTES)
+    step = TT_READ_STAGE_BYTES / (nx * 8) > 0 ? TT_READ_STAGE_BYTES / (nx * 8)
+                                              : 1;
   if (mask_band) {
     mask = malloc(step * nx);
     if (!mask) {
@@ -599,6 +802,16 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       goto done;
     }
   }
+  if (raw.source != RAW_IN_GRID) {
+    stage = malloc(step * nx * 8); /* doubles or 64-bit integers */
+    if (!stage) {
+      s = tt__error(ctx, TT_ERR_NOMEM, "out of memory for a buffer of %zu "
+                    "rows", step);
+      goto done;
+    }
+    raw.buf = stage;
+  }
+  const int identity = scale == 1.0 && offset == 0.0 && conv.z_factor == 1.0;
 
   /* Hold GDAL's block cache to a few blocks unless the user chose a size. */
   if (!CPLGetConfigOption("GDAL_CACHEMAX", NULL)) {
@@ -614,7 +827,6 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     }
   }
 
-  float *z = tt_grid_heights(grid);
   size_t valid = 0;
   if (progress && !progress(0.0, "reading", progress_arg)) {
     s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: read interrupted",
@@ -625,12 +837,26 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     const size_t nrows = ny - r0 < step ? ny - r0 : step;
     for (size_t c0 = 0; c0 < nx; c0 += (size_t)bw) {
       const size_t ncols = nx - c0 < (size_t)bw ? nx - c0 : (size_t)bw;
+      /* into the buffer, or into the grid as it now is */
+      void *dst = NULL;
+      GDALDataType type = GDT_Float32;
+      size_t es = sizeof(float);
+      if (stage) {
+        dst = (char *)stage + c0 * 8;
+        type = stage_type;
+        es = 8;
+      } else if (grid->zd) {
+        dst = grid->zd + r0 * nx + c0;
+        type = GDT_Float64;
+        es = sizeof(double);
+      } else {
+        dst = grid->z + r0 * nx + c0;
+      }
       CPLErrorReset();
       CPLErr err = GDALRasterIOEx(band, GF_Read, (int)c0, (int)r0,
-                                  (int)ncols, (int)nrows, z + r0 * nx + c0,
-                                  (int)ncols, (int)nrows, GDT_Float32,
-                                  (GSpacing)sizeof(float),
-                                  (GSpacing)(nx * sizeof(float)), NULL);
+                                  (int)ncols, (int)nrows, dst, (int)ncols,
+                                  (int)nrows, type, (GSpacing)es,
+                                  (GSpacing)(nx * es), NULL);
       if (err == CE_None && mask_band)
         err = GDALRasterIOEx(mask_band, GF_Read, (int)c0, (int)r0,
                              (int)ncols, (int)nrows, mask + c0, (int)ncols,
@@ -642,8 +868,12 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
         goto done;
       }
     }
-    s = convert_rows(ctx, path, z, nx, r0, nrows, mask, &conv, scale,
-                     offset, &valid);
+    if (raw.source == RAW_IN_GRID && identity && !grid->zd)
+      s = convert_rows(ctx, path, grid->z, nx, r0, nrows, mask, &conv,
+                       &valid);
+    else
+      s = convert_any(ctx, path, grid, &raw, r0, nrows, mask, &conv, scale,
+                      offset, &valid);
     if (s != TT_OK)
       goto done;
     if (progress &&
@@ -698,6 +928,7 @@ done:
     GDALSetCacheMax64(old_cache_max);
   }
   free(mask);
+  free(stage);
   if (s != TT_OK) {
     tt_grid_destroy(grid);
     tt_raster_info_destroy(info);

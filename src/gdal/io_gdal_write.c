@@ -2,7 +2,8 @@
  * io_gdal_write.c -- writing a grid as a GeoTIFF (synthetic terrains,
  * residual or reconstructed grids).
  *
- * Single band, Float32, tiled and DEFLATE-compressed (BIGTIFF when it may
+ * Single band, Float32 (Float64 for a grid of doubles, so no height is
+ * rounded), tiled and DEFLATE-compressed (BIGTIFF when it may
  * be needed), the grid's geotransform, the given CRS, and nodata = NaN only
  * when the grid holds NaN. The file is made under a temporary name beside
  * the final one (tt_output) and renamed when GDAL has closed it without
@@ -23,10 +24,9 @@
 
 static int has_nan(const tt_grid *grid)
 {
-  const float *z = tt_grid_heights_const(grid);
   const size_t n = tt_grid_width(grid) * tt_grid_height(grid);
   for (size_t i = 0; i < n; i++)
-    if (isnan(z[i]))
+    if (isnan(tt__grid_z(grid, i)))
       return 1;
   return 0;
 }
@@ -48,6 +48,11 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
     return tt__error(ctx, TT_ERR_FORMAT, "the GTiff driver is not "
                      "registered (call GDALAllRegister() first)");
   const size_t nx = tt_grid_width(grid), ny = tt_grid_height(grid);
+  const int f64 = tt_grid_precision(grid) == TT_PRECISION_FLOAT64;
+  const GDALDataType type = f64 ? GDT_Float64 : GDT_Float32;
+  const size_t elem = f64 ? sizeof(double) : sizeof(float);
+  const void *heights = f64 ? (const void *)tt_grid_heights_f64_const(grid)
+                            : (const void *)tt_grid_heights_const(grid);
 
   tt_output *out = NULL;
   tt_status s = tt_output_begin(ctx, path, "GTiff", overwrite, &out);
@@ -58,7 +63,7 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
                                         "BIGTIFF=IF_SAFER", NULL};
   CPLErrorReset();
   GDALDatasetH ds = GDALCreate(drv, tt_output_temp_path(out), (int)nx,
-                               (int)ny, 1, GDT_Float32,
+                               (int)ny, 1, type,
                                (char **)create_options);
   if (!ds) {
     s = tt__error(ctx, TT_ERR_IO, "cannot create %s: %s", path, gdal_msg());
@@ -77,9 +82,8 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
    * signature, nothing is modified. */
   if (s == TT_OK &&
       GDALRasterIOEx(band, GF_Write, 0, 0, (int)nx, (int)ny,
-                     (void *)tt_grid_heights_const(grid), (int)nx, (int)ny,
-                     GDT_Float32, (GSpacing)sizeof(float),
-                     (GSpacing)(nx * sizeof(float)), NULL) != CE_None)
+                     (void *)heights, (int)nx, (int)ny, type,
+                     (GSpacing)elem, (GSpacing)(nx * elem), NULL) != CE_None)
     s = tt__error(ctx, TT_ERR_IO, "cannot write %s: %s", path, gdal_msg());
   CPLErrorReset();
   GDALClose(ds); /* flushes the tiles: errors show up here */

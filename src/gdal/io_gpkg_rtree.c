@@ -28,21 +28,21 @@
  * vertical slices sorted by x centre, each slice sorted by y centre. Ties
  * break on the rowid: the same table gives the same file.
  *
- * Everything happens in one IMMEDIATE transaction: the virtual table, its
- * nodes, the triggers of the standard (the seven of GeoPackage 1.4 in a 1.4
- * file, the six of 1.2.1-1.3 otherwise; see trigger_sql()), the
- * gpkg_extensions row, then SQLite's rtreecheck() on the result; only then
- * COMMIT. Any failure or interruption rolls back and leaves the file as it
- * was.
+ * tt_gpkg_build_rtree() does everything in one IMMEDIATE transaction: the
+ * virtual table, its nodes, the triggers of the standard (the seven of
+ * GeoPackage 1.4 in a 1.4 file, the six of 1.2.1-1.3 otherwise; see
+ * trigger_sql()), the gpkg_extensions row, then SQLite's rtreecheck() on
+ * the result; only then COMMIT. Any failure or interruption rolls back and
+ * leaves the file as it was. tt__gpkg_rtree_from_boxes() (gpkg_rtree.h)
+ * does the same inside a transaction of its caller's, from boxes its caller
+ * knows, with rtreecheck() only on request: the row writer builds the
+ * indexes of its own rows that way, and the tests run the check.
  *
  * Workload: one sequential scan of the table, an O(n log n) sort, one blob
  * per 51 features and one %_rowid row per feature; memory about 40 bytes per
  * feature.
  */
-#include "base/internal.h"
-#include "terratin/terratin_gdal.h"
-
-#include <sqlite3.h>
+#include "gdal/gpkg_rtree.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -52,6 +52,7 @@
 #define RT_CELL_BYTES 24 /* 8-byte id + 4 floats */
 #define RT_MAX_DEPTH 40  /* far beyond any table SQLite can hold */
 #define WKB_MAX_NESTING 32
+#define LINK_BATCH 128   /* %_rowid rows per INSERT statement */
 
 /* One cell: a feature (leaves) or a child node (inner levels). */
 typedef struct rt_item {
@@ -78,7 +79,7 @@ typedef struct rt_build {
   size_t node_size, node_cap; /* bytes per node blob, cells per node */
   int64_t next_nodeno;
   unsigned char *blob;
-  sqlite3_stmt *ins_node, *ins_parent, *ins_rowid;
+  sqlite3_stmt *ins_node, *ins_parent, *ins_rowid, *ins_rowid_batch;
   size_t nodes_written, nodes_total;
   int gpkg_version; /* PRAGMA user_version: 10400 for 1.4.0 */
 } rt_build;
@@ -496,30 +497,82 @@ done:
 
 /* --- packing -------------------------------------------------------------- */
 
-static int cmp_x(const void *pa, const void *pb)
+/* a before b along axis (0: x, 1: y): by the box's centre (the sum of its
+ * two floats, exact in a double), ties by id. */
+static inline int item_before(const rt_item *a, const rt_item *b, int axis)
 {
-  const rt_item *a = pa, *b = pb;
-  double ca = (double)a->box[0] + (double)a->box[1];
-  double cb = (double)b->box[0] + (double)b->box[1];
-  if (ca != cb)
-    return ca < cb ? -1 : 1;
-  return (a->id > b->id) - (a->id < b->id);
+  double ca = (double)a->box[2 * axis] + (double)a->box[2 * axis + 1];
+  double cb = (double)b->box[2 * axis] + (double)b->box[2 * axis + 1];
+  return ca < cb || (ca == cb && a->id < b->id);
 }
 
-static int cmp_y(const void *pa, const void *pb)
+/* Sorts items along axis: a merge sort with the comparison inlined (qsort's
+ * callback per comparison cost the loader more than its SQL), runs of 16
+ * by insertion first. tmp holds n items. The order is total (ids are
+ * unique), so any correct sort gives the same result. */
+static void sort_items(rt_item *items, size_t n, int axis, rt_item *tmp)
 {
-  const rt_item *a = pa, *b = pb;
-  double ca = (double)a->box[2] + (double)a->box[3];
-  double cb = (double)b->box[2] + (double)b->box[3];
-  if (ca != cb)
-    return ca < cb ? -1 : 1;
-  return (a->id > b->id) - (a->id < b->id);
+  enum { RUN = 16 };
+  for (size_t r0 = 0; r0 < n; r0 += RUN) {
+    size_t r1 = r0 + RUN < n ? r0 + RUN : n;
+    for (size_t i = r0 + 1; i < r1; i++) {
+      rt_item x = items[i];
+      size_t j = i;
+      for (; j > r0 && item_before(&x, &items[j - 1], axis); j--)
+        items[j] = items[j - 1];
+      items[j] = x;
+    }
+  }
+  rt_item *src = items, *dst = tmp;
+  for (size_t width = RUN; width < n; width *= 2) {
+    for (size_t lo = 0; lo < n; lo += 2 * width) {
+      size_t mid = lo + width < n ? lo + width : n;
+      size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
+      size_t i = lo, j = mid, k = lo;
+      while (i < mid && j < hi)
+        dst[k++] = item_before(&src[j], &src[i], axis) ? src[j++] : src[i++];
+      while (i < mid)
+        dst[k++] = src[i++];
+      while (j < hi)
+        dst[k++] = src[j++];
+    }
+    rt_item *t = src;
+    src = dst;
+    dst = t;
+  }
+  if (src != items)
+    memcpy(items, src, n * sizeof *items);
 }
 
 static int cmp_link(const void *pa, const void *pb)
 {
   const rt_link *a = pa, *b = pb;
   return (a->rowid > b->rowid) - (a->rowid < b->rowid);
+}
+
+/* Links in rowid order. Rowids are unique; when they are dense (a table
+ * whose fids run 1..n, as the row writer's do) each goes straight to its
+ * place, else qsort. */
+static void sort_links(rt_link *links, size_t n)
+{
+  if (n < 2)
+    return;
+  int64_t lo = links[0].rowid, hi = links[0].rowid;
+  for (size_t i = 1; i < n; i++) {
+    if (links[i].rowid < lo) lo = links[i].rowid;
+    if (links[i].rowid > hi) hi = links[i].rowid;
+  }
+  if ((uint64_t)(hi - lo) == n - 1) {
+    rt_link *tmp = malloc(n * sizeof *tmp);
+    if (tmp) {
+      for (size_t i = 0; i < n; i++)
+        tmp[links[i].rowid - lo] = links[i];
+      memcpy(links, tmp, n * sizeof *tmp);
+      free(tmp);
+      return;
+    }
+  }
+  qsort(links, n, sizeof *links, cmp_link);
 }
 
 /* First item of group g when n items make ngroups groups of near-equal
@@ -529,18 +582,19 @@ static size_t group_start(size_t g, size_t n, size_t ngroups)
   return (size_t)((uint64_t)g * n / ngroups);
 }
 
-/* Orders items for ngroups consecutive groups: STR slices by x, then y. */
-static void str_order(rt_item *items, size_t n, size_t ngroups)
+/* Orders items for ngroups consecutive groups: STR slices by x, then y.
+ * tmp holds n items. */
+static void str_order(rt_item *items, size_t n, size_t ngroups, rt_item *tmp)
 {
   size_t nslices = (size_t)ceil(sqrt((double)ngroups));
   if (nslices < 1)
     nslices = 1;
-  qsort(items, n, sizeof *items, cmp_x);
+  sort_items(items, n, 0, tmp);
   for (size_t sl = 0; sl < nslices; sl++) {
     size_t g0 = sl * ngroups / nslices, g1 = (sl + 1) * ngroups / nslices;
     size_t e0 = group_start(g0, n, ngroups), e1 = group_start(g1, n, ngroups);
     if (e1 > e0)
-      qsort(items + e0, e1 - e0, sizeof *items, cmp_y);
+      sort_items(items + e0, e1 - e0, 1, tmp);
   }
 }
 
@@ -609,7 +663,7 @@ static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
 /* Packs b->items level by level into nodes and writes them. */
 static tt_status pack_and_write(rt_build *b)
 {
-  rt_item *level = b->items, *next = NULL;
+  rt_item *level = b->items, *next = NULL, *tmp = NULL;
   size_t n = b->nitems;
   tt_status s = TT_OK;
   b->links = n ? malloc(n * sizeof *b->links) : NULL;
@@ -633,7 +687,12 @@ static tt_status pack_and_write(rt_build *b)
       goto done;
     }
     size_t ngroups = (n + b->node_cap - 1) / b->node_cap;
-    str_order(level, n, ngroups);
+    if (!tmp && !(tmp = malloc(n * sizeof *tmp))) {
+      s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
+                    b->path, b->table);
+      goto done;
+    }
+    str_order(level, n, ngroups, tmp);
     next = malloc(ngroups * sizeof *next);
     if (!next) {
       s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
@@ -667,12 +726,22 @@ done:
   if (level != b->items)
     free(level);
   free(next);
+  free(tmp);
   if (s != TT_OK)
     return s;
   /* %_rowid rows in rowid order: appends to its B-tree. */
-  if (b->nlinks)
-    qsort(b->links, b->nlinks, sizeof *b->links, cmp_link);
-  for (size_t i = 0; i < b->nlinks && s == TT_OK; i++) {
+  sort_links(b->links, b->nlinks);
+  size_t i = 0;
+  for (; i + LINK_BATCH <= b->nlinks && s == TT_OK; i += LINK_BATCH) {
+    for (int k = 0; k < LINK_BATCH; k++) {
+      const rt_link *l = &b->links[i + (size_t)k];
+      sqlite3_bind_int64(b->ins_rowid_batch, 2 * k + 1, l->rowid);
+      sqlite3_bind_int64(b->ins_rowid_batch, 2 * k + 2, l->nodeno);
+    }
+    s = step_reset(b, b->ins_rowid_batch,
+                   "cannot write the index rowid map");
+  }
+  for (; i < b->nlinks && s == TT_OK; i++) {
     sqlite3_bind_int64(b->ins_rowid, 1, b->links[i].rowid);
     sqlite3_bind_int64(b->ins_rowid, 2, b->links[i].nodeno);
     s = step_reset(b, b->ins_rowid, "cannot write the index rowid map");
@@ -886,6 +955,16 @@ static tt_status create_schema(rt_build *b)
                                       "nodeno) VALUES (?, ?)",
                                       b->rtree),
                       &b->ins_rowid, "cannot write the R-tree");
+  if (s == TT_OK) {
+    char *sql = sqlite3_mprintf("INSERT INTO \"%w_rowid\" (rowid, nodeno) "
+                                "VALUES (?, ?)", b->rtree);
+    for (int k = 1; sql && k < LINK_BATCH; k++) {
+      char *more = sqlite3_mprintf("%s, (?, ?)", sql);
+      sqlite3_free(sql);
+      sql = more;
+    }
+    s = prepare_owned(b, sql, &b->ins_rowid_batch, "cannot write the R-tree");
+  }
   return s;
 }
 
@@ -913,6 +992,94 @@ static tt_status check_tree(rt_build *b)
     }
   }
   sqlite3_finalize(st);
+  return s;
+}
+
+/* The index of b->table's column from b->items (read from the table when
+ * from_table), in the open transaction of b->db. */
+static tt_status build_in_transaction(rt_build *b, const char *table,
+                                      const char *column, int from_table,
+                                      int check)
+{
+  sqlite3_stmt *uv = NULL;
+  if (sqlite3_prepare_v2(b->db, "PRAGMA user_version", -1, &uv, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(uv) == SQLITE_ROW)
+    b->gpkg_version = sqlite3_column_int(uv, 0);
+  sqlite3_finalize(uv);
+  tt_status s = describe(b, table, column);
+  if (s == TT_OK && from_table)
+    s = read_boxes(b);
+  if (s == TT_OK)
+    s = report(b, 0.6);
+  if (s == TT_OK)
+    s = create_schema(b);
+  if (s == TT_OK)
+    s = pack_and_write(b);
+  if (s == TT_OK)
+    s = report(b, 0.9);
+  if (s == TT_OK && check)
+    s = check_tree(b);
+  if (s == TT_OK)
+    s = report(b, 0.99);
+  sqlite3_finalize(b->ins_node);
+  sqlite3_finalize(b->ins_parent);
+  sqlite3_finalize(b->ins_rowid);
+  sqlite3_finalize(b->ins_rowid_batch);
+  b->ins_node = b->ins_parent = b->ins_rowid = b->ins_rowid_batch = NULL;
+  return s;
+}
+
+static void build_free(rt_build *b)
+{
+  sqlite3_finalize(b->ins_node);
+  sqlite3_finalize(b->ins_parent);
+  sqlite3_finalize(b->ins_rowid);
+  sqlite3_finalize(b->ins_rowid_batch);
+  free(b->table);
+  free(b->column);
+  free(b->fid);
+  sqlite3_free(b->rtree);
+  free(b->items);
+  free(b->links);
+  free(b->blob);
+}
+
+tt_status tt__gpkg_rtree_from_boxes(tt_context *ctx, sqlite3 *db,
+                                    const char *gpkg_path, const char *table,
+                                    const char *geom_column,
+                                    const tt__rtree_box *boxes, size_t n,
+                                    int check, tt_progress_fn progress,
+                                    void *progress_arg)
+{
+  rt_build b;
+  memset(&b, 0, sizeof b);
+  b.ctx = ctx;
+  b.db = db;
+  b.path = gpkg_path;
+  b.progress = progress;
+  b.progress_arg = progress_arg;
+  tt_status s = TT_OK;
+  b.table = malloc(strlen(table) + 1);
+  b.items = malloc((n ? n : 1) * sizeof *b.items);
+  if (!b.table || !b.items) {
+    s = tt__error(ctx, TT_ERR_NOMEM, "%s: table %s: out of memory for %zu "
+                  "index entries", gpkg_path, table, n);
+    goto done;
+  }
+  memcpy(b.table, table, strlen(table) + 1);
+  b.cap_items = n ? n : 1;
+  for (size_t i = 0; i < n; i++) {
+    rt_item *it = &b.items[b.nitems++];
+    it->id = boxes[i].id;
+    it->box[0] = round_down(boxes[i].minx);
+    it->box[1] = round_up(boxes[i].maxx);
+    it->box[2] = round_down(boxes[i].miny);
+    it->box[3] = round_up(boxes[i].maxy);
+  }
+  s = build_in_transaction(&b, table, geom_column, 0, check);
+done:
+  build_free(&b);
   return s;
 }
 
@@ -952,33 +1119,9 @@ tt_status tt_gpkg_build_rtree(tt_context *ctx, const char *gpkg_path,
   }
   in_transaction = 1;
 
-  sqlite3_stmt *uv = NULL;
-  if (sqlite3_prepare_v2(b.db, "PRAGMA user_version", -1, &uv, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(uv) == SQLITE_ROW)
-    b.gpkg_version = sqlite3_column_int(uv, 0);
-  sqlite3_finalize(uv);
-  s = describe(&b, table, geom_column);
-  if (s == TT_OK)
-    s = read_boxes(&b);
-  if (s == TT_OK)
-    s = report(&b, 0.6);
-  if (s == TT_OK)
-    s = create_schema(&b);
-  if (s == TT_OK)
-    s = pack_and_write(&b);
-  if (s == TT_OK)
-    s = report(&b, 0.9);
-  if (s == TT_OK)
-    s = check_tree(&b);
-  if (s == TT_OK)
-    s = report(&b, 0.99);
+  s = build_in_transaction(&b, table, geom_column, 1, 1);
   if (s != TT_OK)
     goto done;
-  sqlite3_finalize(b.ins_node);
-  sqlite3_finalize(b.ins_parent);
-  sqlite3_finalize(b.ins_rowid);
-  b.ins_node = b.ins_parent = b.ins_rowid = NULL;
   if (sqlite3_exec(b.db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) {
     s = db_error(&b, TT_ERR_IO, "cannot commit the spatial index");
     goto done;
@@ -988,19 +1131,10 @@ tt_status tt_gpkg_build_rtree(tt_context *ctx, const char *gpkg_path,
     progress(1.0, "indexing", progress_arg); /* done: too late to stop */
 
 done:
-  sqlite3_finalize(b.ins_node);
-  sqlite3_finalize(b.ins_parent);
-  sqlite3_finalize(b.ins_rowid);
   if (in_transaction)
     sqlite3_exec(b.db, "ROLLBACK", NULL, NULL, NULL);
   if (b.db && sqlite3_close(b.db) != SQLITE_OK && s == TT_OK)
     s = db_error(&b, TT_ERR_IO, "cannot close");
-  free(b.table);
-  free(b.column);
-  free(b.fid);
-  sqlite3_free(b.rtree);
-  free(b.items);
-  free(b.links);
-  free(b.blob);
+  build_free(&b);
   return s;
 }

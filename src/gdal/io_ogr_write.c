@@ -32,21 +32,13 @@
  * drivers index as their own options say (Shapefile: .qix at close with
  * LCO=SPATIAL_INDEX=YES). Shapefile layers default to ENCODING=UTF-8 (.cpg).
  *
- * Output CRS: the layers get srs (the input CRS) unless T_SRS names
- * another; then every vertex is transformed once, up front, from srs to
- * T_SRS with OGR/PROJ (traditional GIS axis order on both sides, so x is
- * easting or longitude) and the triangles' rings are made of the
- * transformed vertices: the triangles themselves (which vertices, which
- * order) do not change.
+ * Output CRS and areas: tin_records.c (the layers get srs, or T_SRS with
+ * every vertex transformed once; geodesic areas for a geographic output).
  *
- * Areas: per-triangle area_2d and area_3d come from the TIN (the ground
- * frame, metres) when the output CRS is projected or absent. When it is
- * geographic, area_2d is the geodesic area of the triangle whose corners
- * are the output longitudes and latitudes, on the output CRS's ellipsoid
- * (GeographicLib's geod_polygonarea, shipped with PROJ), and area_3d keeps
- * the TIN's ratio area_3d / area_2d, which is 1 / cos(slope) of the
- * triangle's plane: area_3d = geodesic area_2d * (frame area_3d / frame
- * area_2d). Slope, aspect and angles stay those of the ground frame.
+ * ROWS=DEFERRED (GPKG only): the layers, their fields and the
+ * run_parameters row are written here, the triangles and vertices rows
+ * later by tt_gpkg_write_rows() on the closed file, straight through
+ * SQLite (several times faster than a feature at a time through OGR).
  *
  * Each layer's feature and geometry are made once and reused: per feature
  * only field values and coordinates change. Progress is reported about
@@ -55,14 +47,11 @@
  * Workload: O(vertices + triangles) feature inserts (about 16 us each into
  * GPKG, R-tree included); memory O(1) beyond what the driver buffers.
  */
-#include "base/internal.h"
-#include "terratin/terratin_gdal.h"
+#include "gdal/tin_records.h"
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
-
-#include <geodesic.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -72,32 +61,6 @@
 
 #define TT_SHP_FIELD_NAME_MAX 10
 #define TT_DBF_STRING_MAX 254
-
-typedef struct field_spec {
-  const char *name;
-  OGRFieldType type;
-} field_spec;
-
-/* Column order of the two geometry layers; the writers below index these
- * tables by the enum values. */
-enum { TF_V0, TF_V1, TF_V2, TF_MAX_ERR, TF_RMSE, TF_N_SAMPLES, TF_AREA_2D,
-       TF_AREA_3D, TF_SLOPE, TF_ASPECT, TF_MIN_ANGLE, TF_MAX_ANGLE,
-       TF_COUNT };
-static const field_spec triangle_fields[TF_COUNT] = {
-    {"v0", OFTInteger},         {"v1", OFTInteger},
-    {"v2", OFTInteger},         {"max_err", OFTReal},
-    {"rmse", OFTReal},          {"n_samples", OFTInteger64},
-    {"area_2d", OFTReal},       {"area_3d", OFTReal},
-    {"slope", OFTReal},         {"aspect", OFTReal},
-    {"min_angle", OFTReal},     {"max_angle", OFTReal}};
-
-enum { VF_ID, VF_COL, VF_ROW, VF_INS_ERR, VF_INS_RANK, VF_STAR_MAX,
-       VF_STAR_RMSE, VF_STAR_N, VF_COUNT };
-static const field_spec vertex_fields[VF_COUNT] = {
-    {"vertex_id", OFTInteger},  {"col", OFTInteger},
-    {"row", OFTInteger},        {"ins_err", OFTReal},
-    {"ins_rank", OFTInteger64}, {"star_max", OFTReal},
-    {"star_rmse", OFTReal},     {"star_n", OFTInteger64}};
 
 typedef struct write_state {
   tt_context *ctx;
@@ -110,17 +73,15 @@ typedef struct write_state {
   int gpkg;
   int build_rtree;         /* GPKG: bulk-build the R-trees before commit */
   int rtree_deferred;      /* RTREE=DEFERRED: the caller builds them */
+  int rows_deferred;       /* ROWS=DEFERRED: tt_gpkg_write_rows() writes
+                              the triangles and vertices */
   OGRLayerH tri_layer, vtx_layer, run_layer;
-  int tri_idx[TF_COUNT], vtx_idx[VF_COUNT];
+  int tri_idx[TT__TF_COUNT], vtx_idx[TT__VF_COUNT];
   int *run_idx;
   tt_progress_fn progress;
   void *progress_arg;
   char *t_srs;             /* T_SRS as given, NULL: none */
-  OGRSpatialReferenceH out_srs; /* the layers' CRS (owned), NULL: none */
-  double *xy;              /* T_SRS: the transformed vertices, 2 per vertex */
-  int geodesic;            /* the output CRS is geographic */
-  struct geod_geodesic geod;
-  double deg_per_unit;     /* output angular unit in degrees */
+  tt__records rec;         /* the layers' CRS, transformed vertices */
   size_t done, total, next_report, step;
   double scale;            /* share of the progress range the rows take */
 } write_state;
@@ -158,6 +119,14 @@ static tt_status parse_options(write_state *w, char **options)
     } else if (strcasecmp(key, "T_SRS") == 0) {
       CPLFree(w->t_srs);
       w->t_srs = *value ? CPLStrdup(value) : NULL;
+    } else if (strcasecmp(key, "ROWS") == 0) {
+      if (strcasecmp(value, "DEFERRED") == 0)
+        w->rows_deferred = 1;
+      else if (strcasecmp(value, "NOW") == 0)
+        w->rows_deferred = 0;
+      else
+        s = tt__error(w->ctx, TT_ERR_ARG, "ROWS=%s: expected NOW or "
+                      "DEFERRED", value);
     } else if (strcasecmp(key, "RTREE") == 0) {
       if (strcasecmp(value, "DEFERRED") == 0)
         w->rtree_deferred = 1;
@@ -168,7 +137,7 @@ static tt_status parse_options(write_state *w, char **options)
                       "DEFERRED", value);
     } else {
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
-                    "(known: NLN_PREFIX, LCO, RTREE, T_SRS)", key);
+                    "(known: NLN_PREFIX, LCO, ROWS, RTREE, T_SRS)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -176,13 +145,18 @@ static tt_status parse_options(write_state *w, char **options)
   }
   if (!w->prefix)
     w->prefix = CPLStrdup("");
+  if (w->rows_deferred && !w->gpkg)
+    return tt__error(w->ctx, TT_ERR_ARG, "ROWS=DEFERRED is for GPKG "
+                     "datasets only");
   /* GPKG: no R-tree at creation (its triggers would update it per insert);
    * it is built in bulk after the inserts, inside the transaction, unless
    * the user asked for none. */
   if (w->gpkg) {
     const char *si = CSLFetchNameValue(w->lco, "SPATIAL_INDEX");
-    /* RTREE=DEFERRED: tt_gpkg_build_rtree() on the closed file instead. */
-    w->build_rtree = (!si || CPLTestBool(si)) && !w->rtree_deferred;
+    /* RTREE=DEFERRED: tt_gpkg_build_rtree() on the closed file instead;
+     * ROWS=DEFERRED: tt_gpkg_write_rows() builds them with the rows. */
+    w->build_rtree = (!si || CPLTestBool(si)) && !w->rtree_deferred &&
+                     !w->rows_deferred;
     w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "NO");
   }
   /* DBF strings are Latin-1 unless told otherwise; CRS names and paths may
@@ -228,7 +202,7 @@ static tt_status create_layer(write_state *w, const char *suffix,
 
 /* Creates the fields and returns their indices in the layer definition. */
 static tt_status create_fields(write_state *w, OGRLayerH layer,
-                               const field_spec *spec, int n, int *out_index)
+                               const tt__field_spec *spec, int n, int *out_index)
 {
   for (int i = 0; i < n; i++) {
     OGRFieldDefnH fd = OGR_Fld_Create(spec[i].name, spec[i].type);
@@ -282,46 +256,26 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
   for (size_t i = 0; i < nt && s == TT_OK; i++) {
     tt_triangle_info t;
     tt_vertex_info v[3];
-    if (tt_tin_triangle(tin, i, &t) != TT_OK ||
-        tt_tin_vertex(tin, (size_t)t.v[0], &v[0]) != TT_OK ||
-        tt_tin_vertex(tin, (size_t)t.v[1], &v[1]) != TT_OK ||
-        tt_tin_vertex(tin, (size_t)t.v[2], &v[2]) != TT_OK) {
-      s = tt__error(w->ctx, TT_ERR_INTERNAL, "triangle %zu of %zu could not "
-                    "be read from the TIN", i, nt);
-      break;
-    }
     double px[3], py[3];
-    for (int k = 0; k < 3; k++) {
-      px[k] = w->xy ? w->xy[2 * (size_t)t.v[k]] : v[k].x;
-      py[k] = w->xy ? w->xy[2 * (size_t)t.v[k] + 1] : v[k].y;
-    }
-    if (w->geodesic) {
-      double lats[3], lons[3], area = 0, perimeter = 0;
-      for (int k = 0; k < 3; k++) {
-        lons[k] = px[k] * w->deg_per_unit;
-        lats[k] = py[k] * w->deg_per_unit;
-      }
-      geod_polygonarea(&w->geod, lats, lons, 3, &area, &perimeter);
-      area = fabs(area);
-      t.area_3d = t.area_2d > 0 ? t.area_3d * (area / t.area_2d) : area;
-      t.area_2d = area;
-    }
+    s = tt__records_triangle(&w->rec, w->ctx, i, &t, v, px, py);
+    if (s != TT_OK)
+      break;
     ring = OGR_G_GetGeometryRef(poly, 0);
     for (int k = 0; k < 4; k++)
       OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], v[k % 3].z);
     OGR_F_SetGeometry(f, poly);
-    OGR_F_SetFieldInteger(f, idx[TF_V0], t.v[0]);
-    OGR_F_SetFieldInteger(f, idx[TF_V1], t.v[1]);
-    OGR_F_SetFieldInteger(f, idx[TF_V2], t.v[2]);
-    set_real(f, idx[TF_MAX_ERR], t.max_error);
-    set_real(f, idx[TF_RMSE], t.rmse);
-    OGR_F_SetFieldInteger64(f, idx[TF_N_SAMPLES], (GIntBig)t.samples);
-    set_real(f, idx[TF_AREA_2D], t.area_2d);
-    set_real(f, idx[TF_AREA_3D], t.area_3d);
-    set_real(f, idx[TF_SLOPE], t.slope_deg);
-    set_real(f, idx[TF_ASPECT], t.aspect_deg);
-    set_real(f, idx[TF_MIN_ANGLE], t.min_angle_deg);
-    set_real(f, idx[TF_MAX_ANGLE], t.max_angle_deg);
+    OGR_F_SetFieldInteger(f, idx[TT__TF_V0], t.v[0]);
+    OGR_F_SetFieldInteger(f, idx[TT__TF_V1], t.v[1]);
+    OGR_F_SetFieldInteger(f, idx[TT__TF_V2], t.v[2]);
+    set_real(f, idx[TT__TF_MAX_ERR], t.max_error);
+    set_real(f, idx[TT__TF_RMSE], t.rmse);
+    OGR_F_SetFieldInteger64(f, idx[TT__TF_N_SAMPLES], (GIntBig)t.samples);
+    set_real(f, idx[TT__TF_AREA_2D], t.area_2d);
+    set_real(f, idx[TT__TF_AREA_3D], t.area_3d);
+    set_real(f, idx[TT__TF_SLOPE], t.slope_deg);
+    set_real(f, idx[TT__TF_ASPECT], t.aspect_deg);
+    set_real(f, idx[TT__TF_MIN_ANGLE], t.min_angle_deg);
+    set_real(f, idx[TT__TF_MAX_ANGLE], t.max_angle_deg);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(poly);
@@ -340,22 +294,20 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
   const size_t nv = tt_tin_vertex_count(tin);
   for (size_t i = 0; i < nv && s == TT_OK; i++) {
     tt_vertex_info v;
-    if (tt_tin_vertex(tin, i, &v) != TT_OK) {
-      s = tt__error(w->ctx, TT_ERR_INTERNAL, "vertex %zu of %zu could not "
-                    "be read from the TIN", i, nv);
+    double x, y;
+    s = tt__records_vertex(&w->rec, w->ctx, i, &v, &x, &y);
+    if (s != TT_OK)
       break;
-    }
-    OGR_G_SetPoint(pt, 0, w->xy ? w->xy[2 * i] : v.x,
-                   w->xy ? w->xy[2 * i + 1] : v.y, v.z);
+    OGR_G_SetPoint(pt, 0, x, y, v.z);
     OGR_F_SetGeometry(f, pt);
-    OGR_F_SetFieldInteger(f, idx[VF_ID], (int)i);
-    OGR_F_SetFieldInteger(f, idx[VF_COL], v.col);
-    OGR_F_SetFieldInteger(f, idx[VF_ROW], v.row);
-    set_real(f, idx[VF_INS_ERR], v.insert_error);
-    OGR_F_SetFieldInteger64(f, idx[VF_INS_RANK], (GIntBig)v.rank);
-    set_real(f, idx[VF_STAR_MAX], v.star_max_error);
-    set_real(f, idx[VF_STAR_RMSE], v.star_rmse);
-    OGR_F_SetFieldInteger64(f, idx[VF_STAR_N], (GIntBig)v.star_samples);
+    OGR_F_SetFieldInteger(f, idx[TT__VF_ID], (int)i);
+    OGR_F_SetFieldInteger(f, idx[TT__VF_COL], v.col);
+    OGR_F_SetFieldInteger(f, idx[TT__VF_ROW], v.row);
+    set_real(f, idx[TT__VF_INS_ERR], v.insert_error);
+    OGR_F_SetFieldInteger64(f, idx[TT__VF_INS_RANK], (GIntBig)v.rank);
+    set_real(f, idx[TT__VF_STAR_MAX], v.star_max_error);
+    set_real(f, idx[TT__VF_STAR_RMSE], v.star_rmse);
+    OGR_F_SetFieldInteger64(f, idx[TT__VF_STAR_N], (GIntBig)v.star_samples);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(pt);
@@ -488,109 +440,6 @@ static tt_status check_run_fields(write_state *w, const tt_run_field *fields,
   return TT_OK;
 }
 
-/* The layers' CRS: srs, or T_SRS with every vertex transformed to it; and
- * the ellipsoid for geodesic areas when that CRS is geographic. */
-static tt_status prepare_crs(write_state *w, const tt_tin *tin,
-                             OGRSpatialReferenceH srs)
-{
-  tt_status s = TT_OK;
-  OGRSpatialReferenceH src = NULL;
-  OGRCoordinateTransformationH ct = NULL;
-  if (w->t_srs) {
-    if (!srs)
-      return tt__error(w->ctx, TT_ERR_ARG, "T_SRS=%s: the TIN has no CRS "
-                       "to transform from", w->t_srs);
-    w->out_srs = OSRNewSpatialReference(NULL);
-    CPLPushErrorHandler(CPLQuietErrorHandler);
-    OGRErr e = w->out_srs ? OSRSetFromUserInput(w->out_srs, w->t_srs)
-                          : OGRERR_FAILURE;
-    CPLPopErrorHandler();
-    if (e != OGRERR_NONE)
-      return tt__error(w->ctx, TT_ERR_ARG, "T_SRS '%s' is not a CRS GDAL "
-                       "understands", w->t_srs);
-    OSRSetAxisMappingStrategy(w->out_srs, OAMS_TRADITIONAL_GIS_ORDER);
-    src = OSRClone(srs);
-    if (src)
-      OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
-    CPLErrorReset();
-    ct = src ? OCTNewCoordinateTransformation(src, w->out_srs) : NULL;
-    if (!ct) {
-      s = tt__error(w->ctx, TT_ERR_ARG, "PROJ cannot transform the TIN's "
-                    "CRS to T_SRS '%s': %s", w->t_srs, ogr_msg());
-      goto done;
-    }
-    const size_t nv = tt_tin_vertex_count(tin);
-    w->xy = malloc((nv ? nv : 1) * 2 * sizeof *w->xy);
-    double *bx = malloc(4096 * sizeof *bx), *by = malloc(4096 * sizeof *by);
-    int *ok = malloc(4096 * sizeof *ok);
-    if (!w->xy || !bx || !by || !ok) {
-      s = tt__error(w->ctx, TT_ERR_NOMEM, "out of memory for %zu "
-                    "transformed vertices", nv);
-    }
-    for (size_t i0 = 0; s == TT_OK && i0 < nv; i0 += 4096) {
-      size_t n = nv - i0 < 4096 ? nv - i0 : 4096;
-      for (size_t k = 0; k < n; k++) {
-        tt_vertex_info v;
-        tt_tin_vertex(tin, i0 + k, &v);
-        bx[k] = v.x;
-        by[k] = v.y;
-      }
-      if (!OCTTransformEx(ct, (int)n, bx, by, NULL, ok)) {
-        for (size_t k = 0; k < n; k++)
-          if (!ok[k]) {
-            s = tt__error(w->ctx, TT_ERR_DATA, "vertex %zu cannot be "
-                          "transformed to T_SRS '%s': %s", i0 + k, w->t_srs,
-                          ogr_msg());
-            break;
-          }
-        if (s == TT_OK)
-          s = tt__error(w->ctx, TT_ERR_DATA, "the vertices cannot be "
-                        "transformed to T_SRS '%s': %s", w->t_srs,
-                        ogr_msg());
-      }
-      for (size_t k = 0; s == TT_OK && k < n; k++) {
-        if (!isfinite(bx[k]) || !isfinite(by[k])) {
-          s = tt__error(w->ctx, TT_ERR_DATA, "vertex %zu has no finite "
-                        "coordinates in T_SRS '%s'", i0 + k, w->t_srs);
-          break;
-        }
-        w->xy[2 * (i0 + k)] = bx[k];
-        w->xy[2 * (i0 + k) + 1] = by[k];
-      }
-    }
-    free(bx);
-    free(by);
-    free(ok);
-    if (s != TT_OK)
-      goto done;
-  } else if (srs) {
-    w->out_srs = OSRClone(srs);
-    if (!w->out_srs)
-      return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
-  }
-  if (w->out_srs && OSRIsGeographic(w->out_srs)) {
-    OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
-    double a = OSRGetSemiMajor(w->out_srs, &e1);
-    double invf = OSRGetInvFlattening(w->out_srs, &e2);
-    double deg = OSRGetAngularUnits(w->out_srs, NULL) * 180.0 /
-                 3.14159265358979323846;
-    if (e1 == OGRERR_NONE && e2 == OGRERR_NONE && a > 0 && isfinite(a) &&
-        invf >= 0 && isfinite(invf) && deg > 0 && isfinite(deg)) {
-      geod_init(&w->geod, a, invf > 0 ? 1.0 / invf : 0.0);
-      w->deg_per_unit = deg;
-      w->geodesic = 1;
-    } else {
-      tt__warn(w->ctx, "the output CRS is geographic but has no usable "
-               "ellipsoid: triangle areas are those of the ground frame");
-    }
-  }
-done:
-  if (ct)
-    OCTDestroyCoordinateTransformation(ct);
-  OSRDestroySpatialReference(src);
-  return s;
-}
-
 /* After a failure without a transaction: drop the layers this call made. */
 static void delete_created_layers(write_state *w)
 {
@@ -642,10 +491,10 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                   "is too large for 32-bit feature fields", nv, nt);
     goto done;
   }
-  s = prepare_crs(&w, tin, srs);
+  s = tt__records_init(&w.rec, ctx, tin, srs, w.t_srs);
   if (s != TT_OK)
     goto done;
-  w.total = nv + nt + 1;
+  w.total = w.rows_deferred ? 1 : nv + nt + 1;
   w.step = (w.total + 99) / 100; /* at most 100 reports for the rows */
   w.next_report = w.step;
   w.scale = w.build_rtree ? 0.75 : 1.0; /* the R-trees take about a quarter */
@@ -658,15 +507,15 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   /* The layers and their fields first, outside the transaction: GDAL 3.6's
    * GPKG driver keeps the layer objects of a rolled-back CREATE TABLE and
    * then breaks the file at close. On failure they are deleted instead. */
-  s = create_layer(&w, "triangles", w.out_srs, wkbPolygon25D, &w.tri_layer);
+  s = create_layer(&w, "triangles", w.rec.out_srs, wkbPolygon25D, &w.tri_layer);
   if (s == TT_OK)
-    s = create_layer(&w, "vertices", w.out_srs, wkbPoint25D, &w.vtx_layer);
+    s = create_layer(&w, "vertices", w.rec.out_srs, wkbPoint25D, &w.vtx_layer);
   if (s == TT_OK)
     s = create_layer(&w, "run_parameters", NULL, wkbNone, &w.run_layer);
   if (s == TT_OK)
-    s = create_fields(&w, w.tri_layer, triangle_fields, TF_COUNT, w.tri_idx);
+    s = create_fields(&w, w.tri_layer, tt__triangle_fields, TT__TF_COUNT, w.tri_idx);
   if (s == TT_OK)
-    s = create_fields(&w, w.vtx_layer, vertex_fields, VF_COUNT, w.vtx_idx);
+    s = create_fields(&w, w.vtx_layer, tt__vertex_fields, TT__VF_COUNT, w.vtx_idx);
   if (s == TT_OK)
     s = create_run_fields(&w, fields, nfields);
   if (s != TT_OK)
@@ -690,8 +539,9 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
     in_transaction = 1;
   }
 
-  s = write_triangles(&w, tin);
-  if (s == TT_OK)
+  if (!w.rows_deferred)
+    s = write_triangles(&w, tin);
+  if (s == TT_OK && !w.rows_deferred)
     s = write_vertices(&w, tin);
   if (s == TT_OK)
     s = write_run_parameters(&w, fields, nfields);
@@ -732,10 +582,8 @@ done:
   for (int k = 0; k < w.ncreated; k++)
     CPLFree(w.created[k]);
   free(w.run_idx);
-  free(w.xy);
+  tt__records_free(&w.rec);
   CPLFree(w.t_srs);
-  if (w.out_srs)
-    OSRDestroySpatialReference(w.out_srs);
   CPLFree(w.prefix);
   CSLDestroy(w.lco);
   return s;

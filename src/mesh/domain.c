@@ -36,7 +36,7 @@ static const int DY[8] = {0, 1, 1, 1, 0, -1, -1, -1};
 static inline bool ok_at(const tt_grid *g, int64_t x, int64_t y)
 {
   return x >= 0 && y >= 0 && (size_t)x < g->nx && (size_t)y < g->ny &&
-         !isnan(g->z[(size_t)y * g->nx + (size_t)x]);
+         !isnan(tt__grid_z(g, (size_t)y * g->nx + (size_t)x));
 }
 
 /* valid corners of cell (x, y): corners (x..x+1, y..y+1); 0 off the grid */

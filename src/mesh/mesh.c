@@ -53,9 +53,25 @@ bool tt__mesh_track_stars(tt__mesh *m)
   return true;
 }
 
+bool tt__mesh_keep_f64(tt__mesh *m)
+{
+  if (m->vz)
+    return true;
+  size_t cap = 0;
+  double *p = NULL;
+  if (!tt__grow((void **)&p, &cap, m->vcap > 16 ? m->vcap : 16, sizeof *p))
+    return false;
+  for (size_t i = 0; i < m->nv; i++)
+    p[i] = (double)m->v[i].z;
+  m->vz = p;
+  m->vzcap = cap;
+  return true;
+}
+
 void tt__mesh_free(tt__mesh *m)
 {
   free(m->v);
+  free(m->vz);
   free(m->hv);
   free(m->twin);
   free(m->eflag);
@@ -73,6 +89,9 @@ static bool grow_vertices(tt__mesh *m, size_t need)
       return false;
     memset(m->vver + old, 0, (m->vvercap - old) * sizeof(uint32_t));
   }
+  if (m->vz && need > m->vzcap &&
+      !tt__grow((void **)&m->vz, &m->vzcap, need, sizeof(double)))
+    return false;
   return tt__grow((void **)&m->v, &m->vcap, need, sizeof(tt__mesh_vertex));
 }
 
@@ -101,14 +120,16 @@ bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt)
   return grow_vertices(m, nv) && grow_triangles(m, nt);
 }
 
-int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row, float z)
+int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row, double z)
 {
   if (m->nv >= TT_MAX_VERTICES || !grow_vertices(m, m->nv + 1))
     return -1;
   int32_t v = (int32_t)m->nv++;
   m->v[v].c = col;
   m->v[v].r = row;
-  m->v[v].z = z;
+  m->v[v].z = (float)z;
+  if (m->vz)
+    m->vz[v] = z;
   m->v[v].edge = -1;
   return v;
 }

@@ -28,11 +28,14 @@
 #define TT__EDGE_CONSTRAINED 1u
 
 /* A vertex: one 16-byte record, so a triangle's corners cost three cache
- * lines, not twelve. */
+ * lines, not twelve. Its height is read through tt__mesh_z(): the record's
+ * float, or for a mesh of a grid of doubles (tt__mesh_keep_f64) the exact
+ * double kept beside it. */
 typedef struct tt__mesh_vertex {
   int32_t c, r;          /* pixel column, row */
   float z;               /* height (kept here so scans need not fetch it
-                            from the grid at a random place) */
+                            from the grid at a random place); only rounded
+                            when the mesh keeps doubles */
   int32_t edge;          /* a half-edge leaving the vertex, or -1 */
 } tt__mesh_vertex;
 
@@ -40,6 +43,8 @@ typedef struct tt__mesh {
   /* vertices */
   tt__mesh_vertex *v;
   size_t nv, vcap;
+  double *vz;            /* exact heights (tt__mesh_keep_f64), else NULL */
+  size_t vzcap;
   /* triangles (3 half-edges each) */
   int32_t *hv;           /* start vertex; hv[3t] == -1: free slot */
   int32_t *twin;         /* opposite half-edge or -1 */
@@ -69,6 +74,11 @@ static inline bool tt__mesh_live(const tt__mesh *m, int32_t t)
 {
   return m->hv[3 * (size_t)t] >= 0;
 }
+/* The height of vertex v, exact: the only way to read it. */
+static inline double tt__mesh_z(const tt__mesh *m, int32_t v)
+{
+  return m->vz ? m->vz[v] : (double)m->v[v].z;
+}
 
 TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
 /* Starts tracking star versions (vver above, all 0 from here on); call it
@@ -80,14 +90,19 @@ TT_HIDDEN void tt__mesh_init(tt__mesh *m, const tt__metric *metric);
  * one to each of its quad's four vertices (a criterion's cache may rely on
  * it, criterion.h). A version wraps after 2^32 changes of one star. */
 TT_HIDDEN bool tt__mesh_track_stars(tt__mesh *m);
+/* Keeps every vertex height as a double (vz above, 8 bytes per vertex), for
+ * the mesh of a grid of doubles; call it before adding vertices. False
+ * when out of memory (the mesh keeps floats only). */
+TT_HIDDEN bool tt__mesh_keep_f64(tt__mesh *m);
 TT_HIDDEN void tt__mesh_free(tt__mesh *m);
 /* Reserves room for about nv vertices and nt triangles (a hint). */
 TT_HIDDEN bool tt__mesh_reserve(tt__mesh *m, size_t nv, size_t nt);
 
 /* Adds an unconnected vertex; returns its index, or -1 when out of memory
- * or past TT_MAX_VERTICES. */
+ * or past TT_MAX_VERTICES. z is kept exactly when the mesh keeps doubles,
+ * else as a float (it must be one: a sample of a grid of floats). */
 TT_HIDDEN int32_t tt__mesh_add_vertex(tt__mesh *m, int32_t col, int32_t row,
-                                      float z);
+                                      double z);
 
 /* Adds triangle (a, b, c), which must be counter-clockwise in the ground
  * frame, with no twins; returns its slot or -1 when out of memory. */

@@ -84,13 +84,16 @@ TT_HIDDEN void tt__scan_candidate(const tt_grid *g, const tt__scan_tri *st,
  * found so far, and still finds exactly the same sample. The floats are
  * the stored plane itself (h is measured from them, rounded up), so their
  * rounding costs tightness, never validity. Memory: 16 bytes per tile,
- * 0.25 bytes per sample. */
+ * 0.25 bytes per sample (for a grid of doubles the tiles hold doubles:
+ * 32 bytes per tile, 0.5 per sample). */
 #define TT__TILE_SHIFT 3
 #define TT__TILE (1 << TT__TILE_SHIFT)
 
 typedef struct tt__scan_tiles {
   size_t ntx, nty;     /* tiles per row and per column */
   float *t;            /* 4 per tile, row-major: c, bx, by, h */
+  double *td;          /* the same as doubles, for a grid of doubles (0.5
+                          bytes per sample); the other one is NULL */
 } tt__scan_tiles;
 
 /* Builds the bounds of g into *out (its own array); false when out of

@@ -451,7 +451,7 @@ static bool build_hole(const tt__mesh *m, int32_t v, hole *h)
     h->id[i] = w;
     h->c[i] = m->v[w].c;
     h->r[i] = m->v[w].r;
-    h->z[i] = (double)m->v[w].z;
+    h->z[i] = tt__mesh_z(m, w);
   }
   int nt = tri_index(h->n - 2, h->n - 1, h->n) + 1;
   for (int i = 0; i < nt; i++)

@@ -97,7 +97,8 @@ typedef struct mem_use {
 static void mem_count(const refine *r, size_t nv, size_t nt, mem_use *u)
 {
   const tt__mesh *m = &r->m;
-  u->grid = (uint64_t)r->g->nx * r->g->ny * sizeof(float) +
+  u->grid = (uint64_t)r->g->nx * r->g->ny *
+                (sizeof(float) + (r->g->zd ? sizeof(double) : 0)) +
             (uint64_t)r->tiles.ntx * r->tiles.nty * 4 * sizeof(float);
   uint64_t per_v = sizeof(tt__mesh_vertex) + sizeof(double) +
                    (m->vver ? sizeof(uint32_t) : 0);
@@ -176,8 +177,8 @@ static bool fit_slots(refine *r)
 static bool add_vertex(refine *r, int32_t col, int32_t row, double err,
                        int32_t *out_v)
 {
-  int32_t v = tt__mesh_add_vertex(
-      &r->m, col, row, r->g->z[(size_t)row * r->g->nx + (size_t)col]);
+  size_t at = (size_t)row * r->g->nx + (size_t)col;
+  int32_t v = tt__mesh_add_vertex(&r->m, col, row, tt__grid_z(r->g, at));
   if (v < 0 || !tt__grow((void **)&r->ins_err, &r->inscap, (size_t)v + 1,
                          sizeof(double)))
     return false;
@@ -367,7 +368,7 @@ static tt_status start_hull(refine *r, size_t valid)
   for (size_t row = 0; row < g->ny; row++) {
     size_t lo = SIZE_MAX, hi = 0;
     for (size_t c = 0; c < g->nx; c++)
-      if (!isnan(g->z[row * g->nx + c])) {
+      if (!isnan(tt__grid_z(g, row * g->nx + c))) {
         if (lo == SIZE_MAX)
           lo = c;
         hi = c;
@@ -517,12 +518,15 @@ static void prefetch_next(const refine *r, int32_t *ahead)
       int64_t col = s % nx, row = s / nx;
       int64_t x0 = col >= 16 ? col - 16 : 0, x1 = col + 16 < nx ? col + 16
                                                                 : nx - 1;
+      const tt_grid *g = r->g;
+      size_t es = g->zd ? sizeof(double) : sizeof(float);
+      const char *z0 = g->zd ? (const char *)g->zd : (const char *)g->z;
       for (int64_t y = row >= 4 ? row - 4 : 0; y <= row + 4 && y < ny; y++) {
-        const float *z = r->g->z + (size_t)(y * nx);
-        __builtin_prefetch(z + x0);
-        __builtin_prefetch(z + x1);
+        const char *z = z0 + (size_t)(y * nx) * es;
+        __builtin_prefetch(z + (size_t)x0 * es);
+        __builtin_prefetch(z + (size_t)x1 * es);
         if (x1 - x0 > 16)
-          __builtin_prefetch(z + (x0 + x1) / 2);
+          __builtin_prefetch(z + (size_t)((x0 + x1) / 2) * es);
       }
     }
   }
@@ -605,6 +609,11 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   tt__heap_init(&r.heap);
   r.env.mesh = &r.m;
   r.env.grid = grid;
+  /* the vertices of a grid of doubles keep their exact heights */
+  if (grid->zd && !tt__mesh_keep_f64(&r.m)) {
+    status = oom(&r);
+    goto done;
+  }
   /* a criterion's cache may key its values by star versions (mesh.h);
    * without them (out of memory) it proves its entries by other means */
   if (r.crit->star_versions)

@@ -26,8 +26,10 @@
  * distance to the triangle is <= EVAL_TOL (inside, or within EVAL_TOL of an
  * edge segment). The ends move inward past samples that fail and outward
  * past neighbours that pass; by convexity every sample between the two ends
- * is covered. Workload: O(triangles + rows of the clipped bounding boxes +
- * covered samples) time; memory 2 bits per sample.
+ * is covered. Heights are read at the grid's own precision (floats, or
+ * doubles: tt_precision), and every error is computed in doubles. Workload:
+ * O(triangles + rows of the clipped bounding boxes + covered samples)
+ * time; memory 2 bits per sample.
  */
 #include "base/internal.h"
 
@@ -129,7 +131,7 @@ static bool eval_tri_init(eval_tri *t, const double *p)
 
 /* The running sums of one evaluation. */
 typedef struct eval_acc {
-  const float *z;
+  const tt_grid *g;
   size_t nx;
   uint64_t *cov, *mark;   /* the 2-bit sample states, see the header */
   size_t covered, overlapped;
@@ -141,7 +143,7 @@ typedef struct eval_acc {
 static void eval_visit(eval_acc *acc, const eval_tri *t, size_t c, size_t r)
 {
   const size_t idx = r * acc->nx + c;
-  const float h = acc->z[idx];
+  const double h = tt__grid_z(acc->g, idx);
   if (isnan(h))
     return;
   const size_t w = idx >> 6;
@@ -174,7 +176,7 @@ static void eval_visit(eval_acc *acc, const eval_tri *t, size_t c, size_t r)
     acc->mark[w] |= bit;
   acc->covered++;
   const double hp = (f1 * t->z[0] + f2 * t->z[1] + f0 * t->z[2]) / t->a2;
-  const double d = (double)h - hp;
+  const double d = h - hp;
   const double ad = fabs(d);
   acc->sum_abs += ad;
   acc->sum_sq += d * d;
@@ -298,7 +300,7 @@ tt_status tt_eval_triangles(tt_context *ctx, const tt_grid *grid,
 
   const size_t nx = grid->nx, ny = grid->ny;
   const size_t words = nx * ny / 64 + 1;
-  acc.z = grid->z;
+  acc.g = grid;
   acc.nx = nx;
   acc.cov = calloc(words, sizeof(uint64_t));
   acc.mark = calloc(words, sizeof(uint64_t));

@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static tt_status alloc_tin(tt_context *ctx, size_t nv, size_t nt,
+static tt_status alloc_tin(tt_context *ctx, size_t nv, size_t nt, bool f64,
                            tt_tin **out)
 {
   tt_tin *tin = calloc(1, sizeof *tin);
@@ -25,7 +25,10 @@ static tt_status alloc_tin(tt_context *ctx, size_t nv, size_t nt,
   size_t v1 = nv ? nv : 1, t1 = nt ? nt : 1;
   tin->vc = malloc(v1 * sizeof *tin->vc);
   tin->vr = malloc(v1 * sizeof *tin->vr);
-  tin->vz = malloc(v1 * sizeof *tin->vz);
+  if (f64)
+    tin->vzd = malloc(v1 * sizeof *tin->vzd);
+  else
+    tin->vz = malloc(v1 * sizeof *tin->vz);
   tin->v_star_max = calloc(v1, sizeof *tin->v_star_max);
   tin->v_star_rmse = calloc(v1, sizeof *tin->v_star_rmse);
   tin->v_star_n = calloc(v1, sizeof *tin->v_star_n);
@@ -33,7 +36,7 @@ static tt_status alloc_tin(tt_context *ctx, size_t nv, size_t nt,
   tin->t_max = malloc(t1 * sizeof *tin->t_max);
   tin->t_rmse = malloc(t1 * sizeof *tin->t_rmse);
   tin->t_n = malloc(t1 * sizeof *tin->t_n);
-  if (!tin->vc || !tin->vr || !tin->vz || !tin->v_star_max ||
+  if (!tin->vc || !tin->vr || !(tin->vz || tin->vzd) || !tin->v_star_max ||
       !tin->v_star_rmse || !tin->v_star_n || !tin->tv || !tin->t_max ||
       !tin->t_rmse || !tin->t_n) {
     tt_tin_destroy(tin);
@@ -142,7 +145,7 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   double *t_sq = NULL;
   *out_tin = NULL;
 
-  status = alloc_tin(ctx, m->nv, m->nlive, &tin);
+  status = alloc_tin(ctx, m->nv, m->nlive, m->vz != NULL, &tin);
   if (status != TT_OK) {
     free(ins_err);
     return status;
@@ -161,7 +164,10 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   for (size_t v = 0; v < m->nv; v++) {
     tin->vc[v] = m->v[v].c;
     tin->vr[v] = m->v[v].r;
-    tin->vz[v] = m->v[v].z;
+    if (tin->vzd)
+      tin->vzd[v] = tt__mesh_z(m, (int32_t)v);
+    else
+      tin->vz[v] = m->v[v].z;
   }
 
   tt_error_stats *es = &tin->summary.errors;

@@ -18,6 +18,7 @@ void tt_tin_destroy(tt_tin *tin)
   free(tin->vc);
   free(tin->vr);
   free(tin->vz);
+  free(tin->vzd);
   free(tin->v_ins_err);
   free(tin->v_star_max);
   free(tin->v_star_rmse);
@@ -61,7 +62,7 @@ tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
   o->row = tin->vr[index];
   o->x = gt[0] + px * gt[1] + py * gt[2];
   o->y = gt[3] + px * gt[4] + py * gt[5];
-  o->z = tin->vz[index];
+  o->z = tt__tin_z(tin, index);
   o->insert_error = tin->v_ins_err[index];
   o->rank = index;
   o->star_max_error = tin->v_star_max[index];
@@ -94,7 +95,7 @@ tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
     double dr = (double)(tin->vr[v] - tin->vr[tin->tv[3 * index]]);
     p[k][0] = a[0] * dc + a[1] * dr;
     p[k][1] = a[2] * dc + a[3] * dr;
-    z[k] = tin->vz[v];
+    z[k] = tt__tin_z(tin, (size_t)v);
   }
   o->max_error = tin->t_max[index];
   o->rmse = tin->t_rmse[index];

@@ -16,7 +16,8 @@ struct tt_tin {
   size_t nv, nt;
   /* vertices */
   int32_t *vc, *vr;
-  float *vz;
+  float *vz;             /* heights; NULL when vzd holds them */
+  double *vzd;           /* heights of a TIN of a grid of doubles */
   double *v_ins_err;     /* NaN for starting vertices */
   double *v_star_max, *v_star_rmse;
   uint64_t *v_star_n;
@@ -30,6 +31,12 @@ struct tt_tin {
   double frame[4];
   tt_tin_summary summary;
 };
+
+/* Vertex v's height. */
+static inline double tt__tin_z(const tt_tin *tin, size_t v)
+{
+  return tin->vzd ? tin->vzd[v] : (double)tin->vz[v];
+}
 
 /* Builds a tin from the mesh's live triangles (in spatial order) with the
  * error statistics of every sample (metrics.c). ins_err: per mesh vertex

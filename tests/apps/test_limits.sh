@@ -182,6 +182,10 @@ for f in m9999:-9999 m32000:-32000 m32767:-32767; do
   run simplify -q -overwrite -srcnodata "$val" -max_error 5 in/$name.tif out/$name.gpkg
   check "fill $val with -srcnodata: no warning ($(cat err.txt))" [ ! -s err.txt ]
 done
+# a grid of doubles (Float64 band) is scanned as well
+gdal_translate -q -ot Float64 in/m9999.asc in/m9999_f64.tif
+run simplify -q -max_error 5 in/m9999_f64.tif out/f64fill.gpkg
+check "fill -9999 in a Float64 band: warned ($(cat err.txt))" has "srcnodata -9999 treats"
 run simplify -q -max_error 5 in/f.tif out/nofill.gpkg
 check "no fill value: no warning ($(cat err.txt))" [ ! -s err.txt ]
 rm -f out/*
@@ -199,7 +203,7 @@ done
 
 # --- messages that say the true cause ---
 gdal_create -q -ot Float64 -outsize 4 4 -burn 1e300 in/f64.tif
-expect_failure "Float64 1e300" 1 "is 1e+300, beyond the range" simplify -q in/f64.tif out/x.gpkg
+expect_failure "Float64 1e300" 1 "is 1e+300, beyond the" simplify -q in/f64.tif out/x.gpkg
 check "Float64 1e300: not called infinite" bash -c '! grep -q infinite err.txt'
 expect_failure "-srcnodata 1e39 on Float32" 2 "type Float32 cannot hold it" simplify -q -srcnodata 1e39 in/f.tif out/x.gpkg
 gdal_translate -q -ot Int16 in/f.tif in/i16.tif

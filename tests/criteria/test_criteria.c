@@ -833,10 +833,67 @@ static void gaussian_exact_orient(uint64_t seed)
     for (int i = 0; i < 3; i++)
       det += (__int128)(int64_t)ldexp(z[i] - (double)zv, 20) * m[i];
     int want = det > 0 ? 1 : det < 0 ? -1 : 0;
-    int got = tt__gaussian_orient(dc, dr, z, zv);
+    const double zd[3] = {z[0], z[1], z[2]};
+    int got = tt__gaussian_orient(dc, dr, zd, zv);
     seen[want + 1]++;
     if (got != want) {
       TT_FAIL_("seed %#llx case %d: sign %d, exact %d",
+               (unsigned long long)seed, it, got, want);
+      return;
+    }
+  }
+  CHECK(seen[0] > 100 && seen[1] > 100 && seen[2] > 100);
+}
+
+/* The same for heights of a grid of doubles (53 significant bits, which
+ * the exact sum splits into two halves): heights in [8, 2^23), multiples
+ * of 2^-49, so that 2^49 z is an exact integer. Every other case has its
+ * third ray in the plane of the first two exactly (e2 = a e0 + b e1 in
+ * all three coordinates, heights multiples of 2^-30 so that no step
+ * rounds), then moved by a few ulps: signs -1, 0 and +1 all occur. */
+static void gaussian_exact_orient_f64(uint64_t seed)
+{
+  uint64_t rng = seed;
+  int seen[3] = {0, 0, 0};
+  for (int it = 0; it < 20000; it++) {
+    int64_t dc[3], dr[3];
+    for (int i = 0; i < 2; i++) {
+      dc[i] = (int64_t)(tt_test_rand(&rng) % 201) - 100;
+      dr[i] = (int64_t)(tt_test_rand(&rng) % 201) - 100;
+    }
+    double z[3], zv = 8 + ldexp(floor(tt_test_uniform(&rng) * 0x1p49), -30);
+    for (int i = 0; i < 2; i++)
+      z[i] = 8 + ldexp(floor(tt_test_uniform(&rng) * 0x1p49), -30);
+    if (it % 2 == 0) {
+      int64_t a = (int64_t)(tt_test_rand(&rng) % 7) - 3;
+      int64_t b = (int64_t)(tt_test_rand(&rng) % 7) - 3;
+      dc[2] = a * dc[0] + b * dc[1];
+      dr[2] = a * dr[0] + b * dr[1];
+      z[2] = zv + (double)a * (z[0] - zv) + (double)b * (z[1] - zv);
+    } else {
+      dc[2] = (int64_t)(tt_test_rand(&rng) % 201) - 100;
+      dr[2] = (int64_t)(tt_test_rand(&rng) % 201) - 100;
+      z[2] = 8 + tt_test_uniform(&rng) * 0x1p20;
+    }
+    int steps = (int)(tt_test_rand(&rng) % 7) - 3;
+    for (; steps > 0; steps--)
+      z[2] = nextafter(z[2], INFINITY);
+    for (; steps < 0; steps++)
+      z[2] = nextafter(z[2], -INFINITY);
+    if (!(z[2] >= 8 && z[2] < 0x1p23))
+      continue;
+    int64_t mi = dc[1] * dr[2] - dr[1] * dc[2];
+    int64_t mj = dc[2] * dr[0] - dr[2] * dc[0];
+    int64_t mk = dc[0] * dr[1] - dr[0] * dc[1];
+    __int128 det = 0, zvi = (__int128)ldexp(zv, 49);
+    int64_t m[3] = {mi, mj, mk};
+    for (int i = 0; i < 3; i++)
+      det += ((__int128)ldexp(z[i], 49) - zvi) * m[i];
+    int want = det > 0 ? 1 : det < 0 ? -1 : 0;
+    int got = tt__gaussian_orient(dc, dr, z, zv);
+    seen[want + 1]++;
+    if (got != want) {
+      TT_FAIL_("doubles, seed %#llx case %d: sign %d, exact %d",
                (unsigned long long)seed, it, got, want);
       return;
     }
@@ -1175,6 +1232,7 @@ int main(void)
   hand_quads(ctx);
   gaussian_stars();
   gaussian_exact_orient(0x5eed0001u);
+  gaussian_exact_orient_f64(0x5eed0002u);
   gaussian_paraboloid(ctx);
   gaussian_cache(ctx, 0xcac4e000u);
   random_tests(ctx);

@@ -7,6 +7,14 @@
  * series, GDAL's block cache held small during the read, and the shared real
  * DEMs when TT_SHARED_TESTDATA is present (skipped otherwise). Also
  * tt_gdal_write_grid(): written, refused, overwritten and read back.
+ * Band types (issue 11): every GDAL type up to UInt64, with values chosen
+ * to break float rounding where the type allows, read exactly (floats kept
+ * where every height is one, doubles otherwise, widened in mid-read),
+ * 64-bit integers beyond 2^53 refused, SRCNODATA and masks on the buffered
+ * path, scales that floats hold and that they do not, MAX_MEMORY counted
+ * at the widening; then refined at a limit and at 0 and checked by a brute
+ * force in long double against the values written, and by
+ * tt_eval_triangles.
  */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
@@ -16,6 +24,7 @@
 #include <cpl_vsi.h>
 #include <gdal_utils.h>
 
+#include <float.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -102,21 +111,21 @@ static tt_status read_path(tt_context *ctx, const char *path,
   return s;
 }
 
-/* Every sample of grid equals expect(c,r) (NaN where expected NaN). */
+/* Every sample of grid equals expect(c,r) exactly (NaN where expected
+ * NaN), whichever precision the grid holds. */
 static int compare_grid(const tt_grid *g, const double *expect, int nx,
                         int ny)
 {
   int bad = 0;
   CHECK_INT_EQ(tt_grid_width(g), nx);
   CHECK_INT_EQ(tt_grid_height(g), ny);
-  const float *z = tt_grid_heights_const(g);
   for (int r = 0; r < ny; r++)
     for (int c = 0; c < nx; c++) {
       double e = expect[(size_t)r * nx + c];
-      float v = z[(size_t)r * nx + c];
-      int same = isnan(e) ? isnan(v) : (float)e == v;
+      double v = tt_grid_sample(g, (size_t)c, (size_t)r);
+      int same = isnan(e) ? isnan(v) : e == v;
       if (!same && bad++ < 5)
-        TT_FAIL_("sample (%d,%d): got %.9g, want %.9g", c, r, (double)v, e);
+        TT_FAIL_("sample (%d,%d): got %.17g, want %.17g", c, r, v, e);
     }
   return bad;
 }
@@ -265,7 +274,8 @@ static void test_float32_nan_nodata(tt_context *ctx)
   CHECK_INT_EQ(read_path(ctx, tmp_path("f32big.tif"), o3, &g, NULL),
                TT_ERR_DATA);
   CHECK(strstr(tt_context_errmsg(ctx), "row 2, column 3 is 3e+39 after "
-               "scale 1, offset 0 and Z_FACTOR 10: too large") != NULL);
+               "scale 1, offset 0 and Z_FACTOR 10: beyond the +-3.40282e+38 "
+               "terratin measures") != NULL);
   free(v);
 }
 
@@ -283,8 +293,10 @@ static void test_scale_offset_z_factor(tt_context *ctx)
   tt_raster_info *info = NULL;
   CHECK_OK(ctx, read_path(ctx, tmp_path("scaled.tif"), o, &g, &info));
   for (int i = 0; i < nx * ny; i++)
-    want[i] = i == 7 ? NAN : (float)((v[i] * 0.5 - 20) * 0.3048);
+    want[i] = i == 7 ? NAN : (v[i] * 0.5 - 20) * 0.3048;
   if (g) {
+    /* computed in doubles and kept so, not rounded to floats */
+    CHECK_INT_EQ(tt_grid_precision(g), TT_PRECISION_FLOAT64);
     compare_grid(g, want, nx, ny);
     CHECK_DBL_NEAR(info->scale, 0.5, 0);
     CHECK_DBL_NEAR(info->offset, -20, 0);
@@ -523,6 +535,343 @@ static void test_refusals(tt_context *ctx)
   CHECK_INT_EQ(read_path(ctx, tmp_path("gcp.tif"), NULL, &g, NULL),
                TT_ERR_FORMAT);
   CHECK(strstr(tt_context_errmsg(ctx), "ground control points") != NULL);
+}
+
+/* --- band types -------------------------------------------------------- */
+
+/* A GeoTIFF of one band of type `type` holding raw[] (nx*ny values of the
+ * C type of `type`, written as themselves, not through doubles). */
+static void make_typed(const char *path, GDALDataType type, int nx, int ny,
+                       const void *raw, const char *const *options,
+                       int has_nodata, double nodata)
+{
+  GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GTiff"), path, nx, ny, 1,
+                               type, (char **)options);
+  if (!ds) {
+    fprintf(stderr, "cannot create %s\n", path);
+    exit(1);
+  }
+  GDALRasterBandH b = GDALGetRasterBand(ds, 1);
+  if (has_nodata && type == GDT_Int64)
+    GDALSetRasterNoDataValueAsInt64(b, (int64_t)nodata);
+  else if (has_nodata)
+    GDALSetRasterNoDataValue(b, nodata);
+  CHECK(GDALRasterIO(b, GF_Write, 0, 0, nx, ny, (void *)raw, nx, ny, type, 0,
+                     0) == CE_None);
+  GDALClose(ds);
+}
+
+/* The brute force: every sample in or on every triangle of the TIN (exact
+ * integer edge tests), its error from the plane in long double against
+ * truth[] (NaN: nodata, must not be inside). Returns the largest error. */
+static long double oracle_max_error(const tt_tin *tin, const double *truth,
+                                    int nx, size_t *out_bad)
+{
+  long double worst = 0;
+  *out_bad = 0;
+  for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {
+    tt_triangle_info ti;
+    tt_tin_triangle(tin, t, &ti);
+    long long x[3], y[3];
+    long double z[3];
+    for (int k = 0; k < 3; k++) {
+      tt_vertex_info vi;
+      tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
+      x[k] = vi.col;
+      y[k] = vi.row;
+      z[k] = vi.z;
+      if (vi.z != truth[(size_t)vi.row * nx + vi.col])
+        (*out_bad)++;
+    }
+    long long det =
+        (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    long long xa = x[0], xb = x[0], ya = y[0], yb = y[0];
+    for (int k = 1; k < 3; k++) {
+      xa = x[k] < xa ? x[k] : xa;
+      xb = x[k] > xb ? x[k] : xb;
+      ya = y[k] < ya ? y[k] : ya;
+      yb = y[k] > yb ? y[k] : yb;
+    }
+    for (long long r = ya; r <= yb; r++)
+      for (long long c = xa; c <= xb; c++) {
+        long long w1 = (c - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (r - y[0]);
+        long long w2 = (x[1] - x[0]) * (r - y[0]) - (c - x[0]) * (y[1] - y[0]);
+        long long w0 = det - w1 - w2;
+        if (det < 0)
+          w0 = -w0, w1 = -w1, w2 = -w2;
+        if (w0 < 0 || w1 < 0 || w2 < 0)
+          continue;
+        double h = truth[(size_t)r * nx + (size_t)c];
+        if (isnan(h)) {
+          (*out_bad)++;
+          continue;
+        }
+        long double p = ((long double)w0 * z[0] + (long double)w1 * z[1] +
+                         (long double)w2 * z[2]) / (long double)llabs(det);
+        long double e = fabsl((long double)h - p);
+        worst = e > worst ? e : worst;
+      }
+  }
+  return worst;
+}
+
+/* Refines g at `limit` and at 0 and checks the TINs against truth. */
+static void check_refined(tt_context *ctx, const char *what, const tt_grid *g,
+                          const double *truth, int nx, double limit)
+{
+  double zmax = 0;
+  for (size_t i = 0; i < tt_grid_width(g) * tt_grid_height(g); i++)
+    if (!isnan(truth[i]))
+      zmax = fmax(zmax, fabs(truth[i]));
+  const double tol = 64 * DBL_EPSILON * zmax;
+  for (int pass = 0; pass < 2; pass++) {
+    tt_refine_options opt;
+    tt_refine_options_init(&opt);
+    opt.max_error = pass ? 0 : limit;
+    tt_tin *tin = NULL;
+    CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
+    if (!tin)
+      return;
+    size_t bad = 0;
+    double worst = (double)oracle_max_error(tin, truth, nx, &bad);
+    if (bad || !(worst <= opt.max_error + tol))
+      TT_FAIL_("%s, -max_error %g: the TIN is %.17g off the values written "
+               "(%zu vertices off their sample or nodata inside)", what,
+               opt.max_error, worst, bad);
+    tt_tin_summary s;
+    tt_tin_get_summary(tin, &s);
+    if (!(fabs(s.errors.max_error - worst) <= tol))
+      TT_FAIL_("%s: the run reports max error %.17g, the oracle %.17g", what,
+               s.errors.max_error, worst);
+    size_t nt = tt_tin_triangle_count(tin);
+    double *xyz = malloc((nt ? nt : 1) * 9 * sizeof *xyz);
+    for (size_t t = 0; t < nt; t++) {
+      tt_triangle_info ti;
+      tt_tin_triangle(tin, t, &ti);
+      for (int k = 0; k < 3; k++) {
+        tt_vertex_info vi;
+        tt_tin_vertex(tin, (size_t)ti.v[k], &vi);
+        xyz[9 * t + 3 * k] = vi.col;
+        xyz[9 * t + 3 * k + 1] = vi.row;
+        xyz[9 * t + 3 * k + 2] = vi.z;
+      }
+    }
+    tt_eval_result ev;
+    CHECK_OK(ctx, tt_eval_triangles(ctx, g, nt, xyz, &ev));
+    if (!(fabs(ev.errors.max_error - worst) <= tol))
+      TT_FAIL_("%s: eval reports max error %.17g, the oracle %.17g", what,
+               ev.errors.max_error, worst);
+    free(xyz);
+    tt_tin_destroy(tin);
+  }
+}
+
+enum { BT_NX = 37, BT_NY = 29 };
+
+/* A smooth terrain in [0, 1] with noise, for sample i. */
+static double bt_shape(int i, uint64_t *rng)
+{
+  int c = i % BT_NX, r = i / BT_NX;
+  return 0.45 + 0.45 * sin(0.23 * c) * cos(0.19 * r) +
+         0.1 * tt_test_uniform(rng);
+}
+
+static void test_band_types(tt_context *ctx)
+{
+  const int n = BT_NX * BT_NY;
+  double *truth = malloc(n * sizeof *truth);
+  void *raw = malloc(n * 8);
+  const char *striped[] = {"BLOCKYSIZE=2", NULL};
+  /* type, kind of values, precision expected, -max_error */
+  static const struct {
+    GDALDataType type;
+    const char *what;
+    tt_precision want;
+    double limit;
+  } cases[] = {
+      {GDT_Byte, "Byte 0..255", TT_PRECISION_FLOAT32, 3},
+      {GDT_Int16, "Int16 -32768..32767", TT_PRECISION_FLOAT32, 50},
+      {GDT_UInt16, "UInt16 0..65535", TT_PRECISION_FLOAT32, 50},
+      {GDT_Int32, "Int32 below 2^24", TT_PRECISION_FLOAT32, 10},
+      {GDT_Int32, "Int32 2^30 + [0, 1000)", TT_PRECISION_FLOAT64, 10},
+      {GDT_Int32, "Int32 floats, then 2^30 + ...", TT_PRECISION_FLOAT64, 10},
+      {GDT_UInt32, "UInt32 3 2^30 + [0, 1000)", TT_PRECISION_FLOAT64, 10},
+      {GDT_Float32, "Float32 of 24 bits", TT_PRECISION_FLOAT32, 0.5},
+      {GDT_Float64, "Float64 that are floats", TT_PRECISION_FLOAT32, 0.5},
+      {GDT_Float64, "Float64 1e6 + k / 1000", TT_PRECISION_FLOAT64, 0.01},
+      {GDT_Int64, "Int64 -2^40 - [0, 1000)", TT_PRECISION_FLOAT64, 10},
+      {GDT_UInt64, "UInt64 2^53 - [0, 1000)", TT_PRECISION_FLOAT64, 10},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    uint64_t rng = 1000 + k;
+    for (int i = 0; i < n; i++) {
+      double s = bt_shape(i, &rng), v = 0;
+      switch (k) {
+      case 0: v = floor(255 * s); ((uint8_t *)raw)[i] = (uint8_t)v; break;
+      case 1: v = floor(65535 * s) - 32768; ((int16_t *)raw)[i] = (int16_t)v;
+        break;
+      case 2: v = floor(65535 * s); ((uint16_t *)raw)[i] = (uint16_t)v;
+        break;
+      case 3: v = 12345678 + floor(1000 * s); ((int32_t *)raw)[i] =
+                                                  (int32_t)v;
+        break;
+      case 4: v = 1073741824.0 + floor(1000 * s);
+        ((int32_t *)raw)[i] = (int32_t)v;
+        break;
+      case 5: /* the first rows are floats: the grid widens in mid-read */
+        v = (i < n / 2 ? 0 : 1073741824.0) + floor(1000 * s);
+        ((int32_t *)raw)[i] = (int32_t)v;
+        break;
+      case 6: v = 3221225472.0 + floor(1000 * s);
+        ((uint32_t *)raw)[i] = (uint32_t)v;
+        break;
+      case 7: v = (float)(8848 + 40 * s); ((float *)raw)[i] = (float)v;
+        break;
+      case 8: v = 0.25 * floor(4000 * s); ((double *)raw)[i] = v; break;
+      case 9: v = 1e6 + 0.001 * floor(1000 * s); ((double *)raw)[i] = v;
+        break;
+      case 10: {
+        int64_t iv = -((int64_t)1 << 40) - (int64_t)floor(1000 * s);
+        ((int64_t *)raw)[i] = iv;
+        v = (double)iv;
+        break;
+      }
+      default: {
+        uint64_t uv = ((uint64_t)1 << 53) - (uint64_t)floor(1000 * s);
+        ((uint64_t *)raw)[i] = uv;
+        v = (double)uv;
+        break;
+      }
+      }
+      truth[i] = v;
+    }
+    make_typed(tmp_path("bt.tif"), cases[k].type, BT_NX, BT_NY, raw,
+               k == 5 ? striped : NULL, 0, 0);
+    tt_grid *g = NULL;
+    CHECK_OK(ctx, read_path(ctx, tmp_path("bt.tif"), NULL, &g, NULL));
+    if (!g)
+      continue;
+    if (tt_grid_precision(g) != cases[k].want)
+      TT_FAIL_("%s: precision %d, want %d", cases[k].what,
+               (int)tt_grid_precision(g), (int)cases[k].want);
+    if (compare_grid(g, truth, BT_NX, BT_NY))
+      TT_FAIL_("%s: heights not read exactly", cases[k].what);
+    check_refined(ctx, cases[k].what, g, truth, BT_NX, cases[k].limit);
+    tt_grid_destroy(g);
+  }
+
+  /* beyond 2^53: refused, naming the sample; 2^53 itself and -2^53 are
+   * doubles */
+  int64_t *i64 = raw;
+  for (int i = 0; i < n; i++)
+    i64[i] = i % 2 ? -((int64_t)1 << 53) : ((int64_t)1 << 53);
+  make_typed(tmp_path("i64.tif"), GDT_Int64, BT_NX, BT_NY, raw, NULL, 0, 0);
+  tt_grid *g = NULL;
+  CHECK_OK(ctx, read_path(ctx, tmp_path("i64.tif"), NULL, &g, NULL));
+  if (g)
+    CHECK(tt_grid_sample(g, 1, 0) == -9007199254740992.0);
+  tt_grid_destroy(g);
+  i64[BT_NX * 3 + 5] = ((int64_t)1 << 53) + 1;
+  make_typed(tmp_path("i64.tif"), GDT_Int64, BT_NX, BT_NY, raw, NULL, 0, 0);
+  CHECK_INT_EQ(read_path(ctx, tmp_path("i64.tif"), NULL, &g, NULL),
+               TT_ERR_DATA);
+  CHECK(strstr(tt_context_errmsg(ctx), "height at row 3, column 5 is "
+               "9007199254740993, beyond 2^53") != NULL);
+  i64[BT_NX * 3 + 5] = INT64_MIN; /* declared nodata: not a height */
+  make_typed(tmp_path("i64.tif"), GDT_Int64, BT_NX, BT_NY, raw, NULL, 1,
+             -9223372036854775808.0);
+  CHECK_OK(ctx, read_path(ctx, tmp_path("i64.tif"), NULL, &g, NULL));
+  if (g)
+    CHECK(isnan(tt_grid_sample(g, 5, 3)));
+  tt_grid_destroy(g);
+  uint64_t *u64 = raw;
+  for (int i = 0; i < n; i++)
+    u64[i] = i == 7 ? UINT64_MAX : 5;
+  make_typed(tmp_path("u64.tif"), GDT_UInt64, BT_NX, BT_NY, raw, NULL, 0, 0);
+  CHECK_INT_EQ(read_path(ctx, tmp_path("u64.tif"), NULL, &g, NULL),
+               TT_ERR_DATA);
+  CHECK(strstr(tt_context_errmsg(ctx), "column 7 is 18446744073709551615, "
+               "beyond 2^53") != NULL);
+  const char *o_nd[] = {"SRCNODATA=18446744073709551615", NULL};
+  CHECK_OK(ctx, read_path(ctx, tmp_path("u64.tif"), o_nd, &g, NULL));
+  if (g) {
+    CHECK(isnan(tt_grid_sample(g, 7, 0)));
+    CHECK(tt_grid_sample(g, 8, 0) == 5);
+    CHECK_INT_EQ(tt_grid_precision(g), TT_PRECISION_FLOAT32);
+  }
+  tt_grid_destroy(g);
+
+  /* Int32 nodata through the mask, and SRCNODATA compared exactly with
+   * Float64 raw values (10^6 + 0.001 is not 10^6 + 0.002, as floats would
+   * have it) */
+  int32_t *i32 = raw;
+  for (int i = 0; i < n; i++)
+    i32[i] = i % 13 == 0 ? INT32_MIN : 1073741824 + i;
+  make_typed(tmp_path("i32nd.tif"), GDT_Int32, BT_NX, BT_NY, raw, NULL, 1,
+             (double)INT32_MIN);
+  CHECK_OK(ctx, read_path(ctx, tmp_path("i32nd.tif"), NULL, &g, NULL));
+  if (g) {
+    CHECK(isnan(tt_grid_sample(g, 0, 0)) && isnan(tt_grid_sample(g, 13, 0)));
+    CHECK(tt_grid_sample(g, 1, 0) == 1073741825.0);
+    CHECK_INT_EQ(tt_grid_precision(g), TT_PRECISION_FLOAT64);
+  }
+  tt_grid_destroy(g);
+  double *f64 = raw;
+  for (int i = 0; i < n; i++)
+    f64[i] = 1e6 + 0.001 * (i % 3);
+  make_typed(tmp_path("f64nd.tif"), GDT_Float64, BT_NX, BT_NY, raw, NULL, 0,
+             0);
+  const char *o_f[] = {"SRCNODATA=1000000.001", NULL};
+  CHECK_OK(ctx, read_path(ctx, tmp_path("f64nd.tif"), o_f, &g, NULL));
+  if (g) {
+    CHECK(tt_grid_sample(g, 0, 0) == 1e6);
+    CHECK(isnan(tt_grid_sample(g, 1, 0)));
+    CHECK(tt_grid_sample(g, 2, 0) == 1e6 + 0.002);
+  }
+  tt_grid_destroy(g);
+
+  /* Scales: 0.5 and an offset of 100 keep Int16 heights floats; 0.1 does
+   * not, and the heights are raw * 0.1 + offset computed in doubles */
+  int16_t *i16 = raw;
+  for (int i = 0; i < n; i++)
+    i16[i] = (int16_t)(i * 37 % 20000 - 10000);
+  const double scales[2][2] = {{0.5, 100}, {0.1, -3.7}};
+  for (int k = 0; k < 2; k++) {
+    make_typed(tmp_path("i16s.tif"), GDT_Int16, BT_NX, BT_NY, raw, NULL, 0,
+               0);
+    GDALDatasetH ds = GDALOpen(tmp_path("i16s.tif"), GA_Update);
+    GDALSetRasterScale(GDALGetRasterBand(ds, 1), scales[k][0]);
+    GDALSetRasterOffset(GDALGetRasterBand(ds, 1), scales[k][1]);
+    GDALClose(ds);
+    for (int i = 0; i < n; i++)
+      truth[i] = ((double)i16[i] * scales[k][0] + scales[k][1]) * 1.0;
+    CHECK_OK(ctx, read_path(ctx, tmp_path("i16s.tif"), NULL, &g, NULL));
+    if (g) {
+      CHECK_INT_EQ(tt_grid_precision(g), k == 0 ? TT_PRECISION_FLOAT32
+                                                : TT_PRECISION_FLOAT64);
+      CHECK_INT_EQ(compare_grid(g, truth, BT_NX, BT_NY), 0);
+    }
+    tt_grid_destroy(g);
+  }
+
+  /* MAX_MEMORY: floats fit, the widening to doubles (12 bytes a sample
+   * for a moment) does not */
+  for (int i = 0; i < n; i++)
+    i32[i] = 1073741824 + i;
+  make_typed(tmp_path("i32m.tif"), GDT_Int32, BT_NX, BT_NY, raw, NULL, 0, 0);
+  char mm[64];
+  snprintf(mm, sizeof mm, "MAX_MEMORY=%d", n * 12 - 1);
+  const char *o_m[] = {mm, NULL};
+  CHECK_INT_EQ(read_path(ctx, tmp_path("i32m.tif"), o_m, &g, NULL),
+               TT_ERR_LIMIT);
+  CHECK(strstr(tt_context_errmsg(ctx), "row 0, column 1 (1073741825) is not "
+               "exactly a float, so the 37 x 29 heights are kept as doubles")
+        != NULL);
+  snprintf(mm, sizeof mm, "MAX_MEMORY=%d", n * 12);
+  CHECK_OK(ctx, read_path(ctx, tmp_path("i32m.tif"), o_m, &g, NULL));
+  tt_grid_destroy(g);
+  free(raw);
+  free(truth);
 }
 
 typedef struct cache_watch {
@@ -767,6 +1116,7 @@ int main(void)
   test_other_formats(ctx);
   test_geographic_frame(ctx);
   test_refusals(ctx);
+  test_band_types(ctx);
   test_cache_and_progress(ctx);
   test_write_grid(ctx);
   int shared = test_shared_data(ctx);

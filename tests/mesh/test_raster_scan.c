@@ -17,6 +17,11 @@
  * stepping the edges) are most of the small ones here. Everything runs
  * twice: with the SSE2 row search and with the AVX-512 one (where the
  * processor has it; else SSE2 again).
+ * Grids of doubles (tt_precision) run the same checks, and two more kinds
+ * whose heights floats cannot hold (2^30 + integers, 10^6 + thousandths:
+ * a float plane in the tiles would be looser than the errors sought);
+ * each float grid is also copied into a grid of doubles, which must give
+ * the same candidates and statistics bit for bit.
  */
 #include "mesh/raster_scan.h"
 #include "tt_test.h"
@@ -39,17 +44,26 @@ static int64_t rnd_in(int64_t lo, int64_t hi)
   return lo + (int64_t)(rnd() % (uint64_t)(hi - lo + 1));
 }
 
-enum { G_NOISE, G_PLATEAU, G_HOLES, G_FAR, G_STEEP, G_FLAT, G_COUNT };
+enum { G_NOISE, G_PLATEAU, G_HOLES, G_FAR, G_STEEP, G_FLAT, G_FLOATS,
+       G_INT30 = G_FLOATS, G_MICRO, G_COUNT };
 
 static const char *grid_name[G_COUNT] = {"noise", "plateau", "holes",
-                                         "far", "steep", "flat"};
+                                         "far", "steep", "flat",
+                                         "2^30 + integers (doubles)",
+                                         "1e6 + thousandths (doubles)"};
 
-static tt_grid *make_grid(tt_context *ctx, int kind, size_t nx, size_t ny)
+/* Kinds below G_FLOATS are grids of floats (as doubles when f64); the
+ * others hold doubles that no float holds. */
+static tt_grid *make_grid(tt_context *ctx, int kind, size_t nx, size_t ny,
+                          bool f64)
 {
   tt_grid *g = NULL;
-  if (tt_grid_create(ctx, nx, ny, &g) != TT_OK)
+  f64 = f64 || kind >= G_FLOATS;
+  if ((f64 ? tt_grid_create_f64(ctx, nx, ny, &g)
+           : tt_grid_create(ctx, nx, ny, &g)) != TT_OK)
     return NULL;
   float *z = tt_grid_heights(g);
+  double *zd = tt_grid_heights_f64(g);
   for (size_t y = 0; y < ny; y++)
     for (size_t x = 0; x < nx; x++) {
       double v = 0;
@@ -75,8 +89,23 @@ static tt_grid *make_grid(tt_context *ctx, int kind, size_t nx, size_t ny)
       case G_FLAT:
         v = 5.0;
         break;
+      case G_INT30: /* plateaus and noise of integers far above 2^24 */
+        v = 1073741824.0 + (double)((x / 9 + y / 7) % 5) * 40 +
+            floor(30 * rnd_unit());
+        break;
+      case G_MICRO:
+        v = 1e6 + 0.001 * floor(400 * sin(sx * 0.05) * cos(sy * 0.04) +
+                                100 * rnd_unit());
+        if (rnd() % 17 == 0)
+          v = NAN;
+        break;
       }
-      z[y * nx + x] = (float)v;
+      if (kind < G_FLOATS)
+        v = (float)v;
+      if (zd)
+        zd[y * nx + x] = v;
+      else
+        z[y * nx + x] = (float)v;
     }
   return g;
 }
@@ -114,14 +143,13 @@ static void brute(const tt_grid *g, const tt__scan_tri *st, int64_t ylo,
   plane_of(st, &p);
   double best = 0;
   int64_t bi = -1;
-  const float *z = tt_grid_heights_const(g);
   size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
   for (int64_t y = ylo < 0 ? 0 : ylo; y <= yhi && y < (int64_t)ny; y++) {
     double rowbase = p.z0 + p.gy * (double)(y - p.y0);
     for (int64_t x = 0; x < (int64_t)nx; x++) {
       if (!owned(st, x, y))
         continue;
-      double e = fabs((double)z[(size_t)y * nx + (size_t)x] -
+      double e = fabs(tt_grid_sample(g, (size_t)x, (size_t)y) -
                       (rowbase + p.gx * (double)(x - p.x0)));
       if (e > best) { /* NaN compares false */
         best = e;
@@ -139,15 +167,14 @@ static void brute_stats(const tt_grid *g, const tt__scan_tri *st,
 {
   plane p;
   plane_of(st, &p);
-  const float *z = tt_grid_heights_const(g);
   size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
   for (int64_t y = 0; y < (int64_t)ny; y++) {
     double rowbase = p.z0 + p.gy * (double)(y - p.y0);
     for (int64_t x = 0; x < (int64_t)nx; x++) {
-      float h = z[(size_t)y * nx + (size_t)x];
+      double h = tt_grid_sample(g, (size_t)x, (size_t)y);
       if (h != h || !owned(st, x, y))
         continue;
-      double e = fabs((double)h - (rowbase + p.gx * (double)(x - p.x0)));
+      double e = fabs(h - (rowbase + p.gx * (double)(x - p.x0)));
       (*out_n)++;
       *out_max = e > *out_max ? e : *out_max;
       *out_abs += e;
@@ -176,26 +203,79 @@ static bool random_tri(const tt_grid *g, int64_t span, tt__scan_tri *st)
                (st->x[2] - st->x[0]) * (st->y[1] - st->y[0]);
   if (a2 == 0)
     return false;
-  const float *z = tt_grid_heights_const(g);
   for (int k = 0; k < 3; k++) {
-    float h = z[(size_t)st->y[k] * (size_t)nx + (size_t)st->x[k]];
-    st->z[k] = h == h && rnd() % 8 ? (double)h : 40 * rnd_unit() - 20;
+    double h = tt_grid_sample(g, (size_t)st->x[k], (size_t)st->y[k]);
+    st->z[k] = h == h && rnd() % 8 ? h : 40 * rnd_unit() - 20;
     st->own[k] = rnd() % 2;
   }
   return true;
 }
 
+/* The same values as a grid of doubles. */
+static tt_grid *copy_f64(tt_context *ctx, const tt_grid *g)
+{
+  size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
+  tt_grid *d = NULL;
+  if (tt_grid_create_f64(ctx, nx, ny, &d) != TT_OK)
+    return NULL;
+  double *zd = tt_grid_heights_f64(d);
+  for (size_t i = 0; i < nx * ny; i++)
+    zd[i] = tt_grid_sample(g, i % nx, i / nx);
+  return d;
+}
+
+/* The scans of triangle st (rows [ylo, yhi]) on grid d, with and without
+ * tiles, and its statistics, must be those found on g, bit for bit. */
+static int same_as(const tt_grid *g, const tt_grid *d,
+                   const tt__scan_tiles *tg, const tt__scan_tiles *td,
+                   const tt__scan_tri *st, int64_t ylo, int64_t yhi)
+{
+  double e[4];
+  int64_t i[4];
+  tt__scan_candidate_rows(g, NULL, st, ylo, yhi, &e[0], &i[0]);
+  tt__scan_candidate_rows(d, NULL, st, ylo, yhi, &e[1], &i[1]);
+  tt__scan_candidate_rows(g, tg, st, ylo, yhi, &e[2], &i[2]);
+  tt__scan_candidate_rows(d, td, st, ylo, yhi, &e[3], &i[3]);
+  for (int k = 1; k < 4; k++)
+    if (memcmp(&e[0], &e[k], sizeof e[0]) != 0 || i[0] != i[k]) {
+      TT_FAIL_("floats and doubles differ: %.17g at %lld, %.17g at %lld "
+               "(scan %d)", e[0], (long long)i[0], e[k], (long long)i[k], k);
+      return 1;
+    }
+  tt__scan_stats a, b;
+  tt__scan_stats_run(g, st, &a);
+  tt__scan_stats_run(d, st, &b);
+  if (a.count != b.count || a.max_index != b.max_index ||
+      memcmp(&a.max_err, &b.max_err, sizeof a.max_err) != 0 ||
+      memcmp(&a.sum_abs, &b.sum_abs, sizeof a.sum_abs) != 0 ||
+      memcmp(&a.sum_sq, &b.sum_sq, sizeof a.sum_sq) != 0) {
+    TT_FAIL_("floats and doubles: other statistics (%zu, %.17g; %zu, %.17g)",
+             a.count, a.max_err, b.count, b.max_err);
+    return 1;
+  }
+  return 0;
+}
+
 static void test_grid(tt_context *ctx, int kind, size_t nx, size_t ny,
                       int ntri, size_t *tiled_count)
 {
-  tt_grid *g = make_grid(ctx, kind, nx, ny);
+  tt_grid *g = make_grid(ctx, kind, nx, ny, false);
   CHECK(g != NULL);
   if (!g)
     return;
+  CHECK_INT_EQ(tt_grid_precision(g), kind < G_FLOATS ? TT_PRECISION_FLOAT32
+                                                     : TT_PRECISION_FLOAT64);
   tt__scan_tiles tiles;
   CHECK(tt__scan_tiles_build(g, NULL, &tiles));
   CHECK_INT_EQ(tiles.ntx, (nx + TT__TILE - 1) / TT__TILE);
   CHECK_INT_EQ(tiles.nty, (ny + TT__TILE - 1) / TT__TILE);
+  CHECK((tiles.t != NULL) == (kind < G_FLOATS));
+  CHECK((tiles.td != NULL) == (kind >= G_FLOATS));
+  /* a float grid's values as doubles, and their tiles */
+  tt_grid *d = kind < G_FLOATS ? copy_f64(ctx, g) : NULL;
+  tt__scan_tiles dtiles = {0, 0, NULL, NULL};
+  if (d)
+    CHECK(tt__scan_tiles_build(d, NULL, &dtiles));
   int bad = 0;
   for (int i = 0; i < ntri && bad < 5; i++) {
     tt__scan_tri st;
@@ -250,7 +330,12 @@ static void test_grid(tt_context *ctx, int kind, size_t nx, size_t ny,
       brute(g, &st, ylo, yhi, &e2, &i2);
       CHECK(memcmp(&e0, &e2, sizeof e0) == 0 && i0 == i2);
     }
+    if (d && (same_as(g, d, &tiles, &dtiles, &st, INT64_MIN, INT64_MAX) ||
+              same_as(g, d, &tiles, &dtiles, &st, ylo, yhi)))
+      bad++;
   }
+  tt__scan_tiles_free(&dtiles);
+  tt_grid_destroy(d);
   tt__scan_tiles_free(&tiles);
   CHECK(tiles.t == NULL);
   tt_grid_destroy(g);

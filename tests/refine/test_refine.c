@@ -5,12 +5,17 @@
  *  - every interior edge passes the exact incircle test in the ground frame;
  *  - stop conditions are honoured exactly; two runs give identical TINs;
  *  - the reported statistics equal the oracle's;
- *  - nodata, bad options and interruption behave. */
+ *  - nodata, bad options and interruption behave;
+ *  - a grid of doubles gives the TIN of a grid of floats holding the same
+ *    values, bit for bit, under every criterion; with heights no float
+ *    holds (2^30 + integers, 10^6 + thousandths) the bound holds on the
+ *    exact heights, -max_error 0 reproduces every sample. */
 #include "base/predicates.h"
 #include "terratin/terratin.h"
 #include "tt_test.h"
 #include "tt_tin_oracle.h"
 
+#include <float.h>
 #include <stdbool.h>
 
 static tt_context *ctx;
@@ -42,13 +47,12 @@ typedef struct oracle {
 static void brute_force(const tt_grid *g, const tt_tin *tin, oracle *o)
 {
   size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
-  const float *z = tt_grid_heights_const(g);
   size_t nt = tt_tin_triangle_count(tin);
   double *tri = tt_oracle_pixel_triangles(tin);
   memset(o, 0, sizeof *o);
   for (size_t r = 0; r < ny; r++)
     for (size_t c = 0; c < nx; c++) {
-      double h = z[r * nx + c];
+      double h = tt_grid_sample(g, c, r);
       if (isnan(h))
         continue;
       o->valid++;
@@ -124,7 +128,8 @@ static bool same_tin(const tt_tin *a, const tt_tin *b)
     tt_vertex_info x, y;
     tt_tin_vertex(a, v, &x);
     tt_tin_vertex(b, v, &y);
-    if (x.col != y.col || x.row != y.row)
+    if (x.col != y.col || x.row != y.row || x.z != y.z ||
+        memcmp(&x.insert_error, &y.insert_error, sizeof x.insert_error) != 0)
       return false;
   }
   for (size_t t = 0; t < tt_tin_triangle_count(a); t++) {
@@ -506,9 +511,136 @@ static void test_threads(void)
   tt_grid_destroy(g);
 }
 
+/* The grid's values as a grid of doubles. */
+static tt_grid *as_doubles(const tt_grid *g)
+{
+  size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
+  double *z = malloc(nx * ny * sizeof *z);
+  for (size_t i = 0; i < nx * ny; i++)
+    z[i] = tt_grid_sample(g, i % nx, i / nx);
+  tt_grid *d = NULL;
+  CHECK_OK(ctx, tt_grid_create_from_doubles(ctx, nx, ny, z, &d));
+  double gt[6], a[4];
+  tt_grid_get_geotransform(g, gt);
+  tt_grid_get_ground_frame(g, a);
+  if (d) {
+    CHECK_OK(ctx, tt_grid_set_geotransform(ctx, d, gt));
+    CHECK_OK(ctx, tt_grid_set_ground_frame(ctx, d, a));
+  }
+  free(z);
+  return d;
+}
+
+/* Floats or doubles, the same values: the same TIN, bit for bit, under
+ * every criterion (with nodata holes and a tilted frame too). */
+static void test_doubles_same_tin(void)
+{
+  tt_grid *g = terrain(53, 41, 5, 6.0);
+  float *z = tt_grid_heights(g);
+  for (size_t i = 0; i < 53 * 41; i += 29)
+    z[i] = NAN;
+  const double gt[6] = {500000, 0.7, -0.2, 4000000, 0.3, -1.1};
+  const double frame[4] = {0.9, -0.1, 0.2, -1.3};
+  CHECK_OK(ctx, tt_grid_set_geotransform(ctx, g, gt));
+  CHECK_OK(ctx, tt_grid_set_ground_frame(ctx, g, frame));
+  tt_grid *d = as_doubles(g);
+  CHECK_INT_EQ(tt_grid_precision(g), TT_PRECISION_FLOAT32);
+  CHECK_INT_EQ(tt_grid_precision(d), TT_PRECISION_FLOAT64);
+  for (int c = TT_CRITERION_DELAUNAY; c <= TT_CRITERION_L2 && d; c++) {
+    tt_refine_options opt;
+    tt_refine_options_init(&opt);
+    opt.max_error = 4;
+    opt.criterion = (tt_criterion)c;
+    tt_tin *a = NULL, *b = NULL;
+    CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &a));
+    CHECK_OK(ctx, tt_refine_run(ctx, d, &opt, &b));
+    if (a && b && !same_tin(a, b))
+      TT_FAIL_("%s: a grid of doubles gives another TIN than a grid of "
+               "floats with the same values", tt_criterion_name(opt.criterion));
+    if (a && b) {
+      tt_tin_summary sa, sb;
+      tt_tin_get_summary(a, &sa);
+      tt_tin_get_summary(b, &sb);
+      CHECK(sa.errors.max_error == sb.errors.max_error);
+      CHECK(sa.errors.total_abs == sb.errors.total_abs);
+      CHECK(sa.errors.l2 == sb.errors.l2);
+    }
+    tt_tin_destroy(a);
+    tt_tin_destroy(b);
+  }
+  tt_grid_destroy(g);
+  tt_grid_destroy(d);
+}
+
+/* Heights no float holds: the bound, and -max_error 0, on the exact
+ * values, by the brute force (in doubles; its rounding is far below the
+ * floats' 64 or 0.03) and by tt_eval_triangles. */
+static void test_doubles_exact(void)
+{
+  const size_t nx = 61, ny = 47;
+  for (int kind = 0; kind < 2; kind++) {
+    /* Int32-like: 2^30 + [0, 1000); Float64-like: 10^6 + k / 1000 */
+    double base = kind == 0 ? 1073741824.0 : 1e6;
+    double unit = kind == 0 ? 1.0 : 0.001;
+    double limit = kind == 0 ? 10 : 0.01;
+    double *z = malloc(nx * ny * sizeof *z);
+    uint64_t rng = 77 + (uint64_t)kind;
+    for (size_t r = 0; r < ny; r++)
+      for (size_t c = 0; c < nx; c++) {
+        double s = 0.5 + 0.5 * sin(0.2 * (double)c) * cos(0.15 * (double)r);
+        z[r * nx + c] = base + unit * floor(900 * s +
+                                            100 * tt_test_uniform(&rng));
+      }
+    z[7] = z[nx * ny - 9] = NAN;
+    tt_grid *g = NULL;
+    CHECK_OK(ctx, tt_grid_create_from_doubles(ctx, nx, ny, z, &g));
+    const double tol = 64 * DBL_EPSILON * (base + 1000 * unit);
+    for (int pass = 0; pass < 2 && g; pass++) {
+      tt_refine_options opt;
+      tt_refine_options_init(&opt);
+      opt.max_error = pass ? 0 : limit;
+      opt.criterion = pass ? TT_CRITERION_L2 : TT_CRITERION_DELAUNAY;
+      tt_tin *tin = NULL;
+      CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
+      if (!tin)
+        continue;
+      oracle o;
+      brute_force(g, tin, &o);
+      if (!(o.max_err <= opt.max_error + tol))
+        TT_FAIL_("kind %d, -max_error %g: the exact heights are %.17g off",
+                 kind, opt.max_error, o.max_err);
+      tt_tin_summary s;
+      tt_tin_get_summary(tin, &s);
+      CHECK_DBL_NEAR(s.errors.max_error, o.max_err, tol);
+      CHECK_INT_EQ(o.uncovered, tt_oracle_uncarriable(g));
+      CHECK_INT_EQ(tt_oracle_nodata_inside(g, tin), 0);
+      for (size_t v = 0; v < tt_tin_vertex_count(tin); v++) {
+        tt_vertex_info vi;
+        tt_tin_vertex(tin, v, &vi);
+        if (vi.z != z[(size_t)vi.row * nx + (size_t)vi.col]) {
+          TT_FAIL_("vertex %zu: z %.17g, the sample is %.17g", v, vi.z,
+                   z[(size_t)vi.row * nx + (size_t)vi.col]);
+          break;
+        }
+      }
+      double *xyz = tt_oracle_pixel_triangles(tin);
+      tt_eval_result ev;
+      CHECK_OK(ctx, tt_eval_triangles(ctx, g, tt_tin_triangle_count(tin), xyz,
+                                      &ev));
+      CHECK_DBL_NEAR(ev.errors.max_error, o.max_err, tol);
+      free(xyz);
+      tt_tin_destroy(tin);
+    }
+    tt_grid_destroy(g);
+    free(z);
+  }
+}
+
 int main(void)
 {
   ctx = tt_context_create();
+  test_doubles_same_tin();
+  test_doubles_exact();
   test_threads();
   test_bounds_and_frames();
   test_stop_conditions();

@@ -4,6 +4,9 @@
  * pixel tolerance, nodata, refusals, and random soups on random grids
  * against a brute-force oracle that tests every sample against every
  * triangle. Set TT_TEST_SEED to replay a random case; the seed is printed.
+ * Grids of doubles are read at their own precision: a plane of heights
+ * 2^30 + c + 2 r and 10^6 + (c + 2 r) / 1000 is reproduced exactly, and a
+ * spike of one unit on it is measured as one.
  */
 #include "tt_test.h"
 
@@ -567,6 +570,44 @@ static void test_large(tt_context *ctx)
   free(s.v);
 }
 
+/* Heights no float holds (2^30 + integers, 10^6 + thousandths): a plane
+ * through them measures 0 everywhere, one sample raised by one unit
+ * measures exactly one unit (floats would give errors of up to 64 and
+ * 0.03 everywhere). */
+static void test_doubles(tt_context *ctx)
+{
+  const size_t nx = 41, ny = 33;
+  const double base[2] = {1073741824.0, 1e6}, unit[2] = {1, 0.001};
+  for (int k = 0; k < 2; k++) {
+    tt_grid *g = NULL;
+    CHECK_OK(ctx, tt_grid_create_f64(ctx, nx, ny, &g));
+    if (!g)
+      return;
+    CHECK(tt_grid_heights(g) == NULL);
+    double *z = tt_grid_heights_f64(g);
+    for (size_t r = 0; r < ny; r++)
+      for (size_t c = 0; c < nx; c++)
+        z[r * nx + c] = base[k] + unit[k] * (double)(c + 2 * r);
+    soup s = {0};
+    double X = (double)(nx - 1), Y = (double)(ny - 1);
+    double z00 = z[0], zx0 = z[nx - 1], zxy = z[nx * ny - 1],
+           z0y = z[(ny - 1) * nx];
+    soup_add(&s, 0, 0, z00, X, 0, zx0, X, Y, zxy);
+    soup_add(&s, 0, 0, z00, X, Y, zxy, 0, Y, z0y);
+    tt_eval_result res;
+    CHECK_OK(ctx, tt_eval_triangles(ctx, g, s.n, s.v, &res));
+    CHECK_INT_EQ(res.errors.covered, nx * ny);
+    CHECK_DBL_LE(res.errors.max_error, 64 * DBL_EPSILON * base[k]);
+    z[5 * nx + 9] += unit[k];
+    CHECK_OK(ctx, tt_eval_triangles(ctx, g, s.n, s.v, &res));
+    CHECK_DBL_NEAR(res.errors.max_error, unit[k], 64 * DBL_EPSILON * base[k]);
+    CHECK_INT_EQ(res.errors.max_col, 9);
+    CHECK_INT_EQ(res.errors.max_row, 5);
+    tt_grid_destroy(g);
+    free(s.v);
+  }
+}
+
 int main(void)
 {
   tt_context *ctx = tt_context_create();
@@ -581,6 +622,7 @@ int main(void)
   test_degenerate(ctx);
   test_nodata(ctx);
   test_refusals(ctx);
+  test_doubles(ctx);
   test_random(ctx);
   test_large(ctx);
   tt_context_destroy(ctx);

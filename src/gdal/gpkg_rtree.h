@@ -1,0 +1,33 @@
+/*
+ * gpkg_rtree.h -- the R-tree bulk loader of io_gpkg_rtree.c as the row
+ * writer (io_gpkg_rows.c) uses it: inside the writer's own transaction,
+ * fed with the boxes it has just written, so nothing is read back.
+ */
+#ifndef TERRATIN_GPKG_RTREE_H
+#define TERRATIN_GPKG_RTREE_H
+
+#include "base/internal.h"
+#include "terratin/terratin_gdal.h"
+
+#include <sqlite3.h>
+
+/* A feature's id (its fid) and the 2-D box of its geometry, in doubles:
+ * the loader rounds them outward to floats as SQLite's R*Tree does. */
+typedef struct tt__rtree_box {
+  int64_t id;
+  double minx, maxx, miny, maxy;
+} tt__rtree_box;
+
+/* Builds the gpkg_rtree_index of table.geom_column in db, whose caller
+ * holds an open write transaction, from the n boxes (every feature with a
+ * non-empty geometry, each once), exactly as tt_gpkg_build_rtree() would
+ * from the table: the virtual table, its nodes, the standard's triggers and
+ * the gpkg_extensions row. check: run SQLite's rtreecheck() on the result
+ * too (about a fifth of the build's time; the tests do). gpkg_path names
+ * the file in messages. The caller commits or rolls back. */
+TT_HIDDEN tt_status tt__gpkg_rtree_from_boxes(
+    tt_context *ctx, sqlite3 *db, const char *gpkg_path, const char *table,
+    const char *geom_column, const tt__rtree_box *boxes, size_t n, int check,
+    tt_progress_fn progress, void *progress_arg);
+
+#endif /* TERRATIN_GPKG_RTREE_H */

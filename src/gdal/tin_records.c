@@ -1,0 +1,220 @@
+/*
+ * tin_records.c -- the fields of the TIN layers and the values of each
+ * feature in the layers' CRS (see tin_records.h).
+ *
+ * Output CRS: the layers get srs (the input CRS) unless T_SRS names
+ * another; then every vertex is transformed once, up front, from srs to
+ * T_SRS with OGR/PROJ (traditional GIS axis order on both sides, so x is
+ * easting or longitude) and the triangles are made of the transformed
+ * vertices: the triangles themselves (which vertices, which order) do not
+ * change.
+ *
+ * Areas: per-triangle area_2d and area_3d come from the TIN (the ground
+ * frame, metres) when the output CRS is projected or absent. When it is
+ * geographic, area_2d is the geodesic area of the triangle whose corners
+ * are the output longitudes and latitudes, on the output CRS's ellipsoid
+ * (GeographicLib's geod_polygonarea, shipped with PROJ), and area_3d keeps
+ * the TIN's ratio area_3d / area_2d, which is 1 / cos(slope) of the
+ * triangle's plane. Slope, aspect and angles stay those of the ground
+ * frame.
+ *
+ * Workload: one batched PROJ transformation of every vertex with T_SRS
+ * (16 bytes a vertex), then O(1) per feature.
+ */
+#include "gdal/tin_records.h"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <ogr_srs_api.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const tt__field_spec tt__triangle_fields[TT__TF_COUNT] = {
+    {"v0", OFTInteger},         {"v1", OFTInteger},
+    {"v2", OFTInteger},         {"max_err", OFTReal},
+    {"rmse", OFTReal},          {"n_samples", OFTInteger64},
+    {"area_2d", OFTReal},       {"area_3d", OFTReal},
+    {"slope", OFTReal},         {"aspect", OFTReal},
+    {"min_angle", OFTReal},     {"max_angle", OFTReal}};
+
+const tt__field_spec tt__vertex_fields[TT__VF_COUNT] = {
+    {"vertex_id", OFTInteger},  {"col", OFTInteger},
+    {"row", OFTInteger},        {"ins_err", OFTReal},
+    {"ins_rank", OFTInteger64}, {"star_max", OFTReal},
+    {"star_rmse", OFTReal},     {"star_n", OFTInteger64}};
+
+/* The driver's last message, or a generic one. */
+static const char *ogr_msg(void)
+{
+  const char *m = CPLGetLastErrorMsg();
+  return m && *m ? m : "no details from GDAL";
+}
+
+/* The layers' CRS: srs, or T_SRS with every vertex transformed to it; and
+ * the ellipsoid for geodesic areas when that CRS is geographic. */
+static tt_status prepare_crs(tt__records *w, tt_context *ctx,
+                             const tt_tin *tin, OGRSpatialReferenceH srs,
+                             const char *t_srs)
+{
+  tt_status s = TT_OK;
+  OGRSpatialReferenceH src = NULL;
+  OGRCoordinateTransformationH ct = NULL;
+  if (t_srs) {
+    if (!srs)
+      return tt__error(ctx, TT_ERR_ARG, "T_SRS=%s: the TIN has no CRS "
+                       "to transform from", t_srs);
+    w->out_srs = OSRNewSpatialReference(NULL);
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRErr e = w->out_srs ? OSRSetFromUserInput(w->out_srs, t_srs)
+                          : OGRERR_FAILURE;
+    CPLPopErrorHandler();
+    if (e != OGRERR_NONE)
+      return tt__error(ctx, TT_ERR_ARG, "T_SRS '%s' is not a CRS GDAL "
+                       "understands", t_srs);
+    OSRSetAxisMappingStrategy(w->out_srs, OAMS_TRADITIONAL_GIS_ORDER);
+    src = OSRClone(srs);
+    if (src)
+      OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+    CPLErrorReset();
+    ct = src ? OCTNewCoordinateTransformation(src, w->out_srs) : NULL;
+    if (!ct) {
+      s = tt__error(ctx, TT_ERR_ARG, "PROJ cannot transform the TIN's "
+                    "CRS to T_SRS '%s': %s", t_srs, ogr_msg());
+      goto done;
+    }
+    const size_t nv = tt_tin_vertex_count(tin);
+    w->xy = malloc((nv ? nv : 1) * 2 * sizeof *w->xy);
+    double *bx = malloc(4096 * sizeof *bx), *by = malloc(4096 * sizeof *by);
+    int *ok = malloc(4096 * sizeof *ok);
+    if (!w->xy || !bx || !by || !ok) {
+      s = tt__error(ctx, TT_ERR_NOMEM, "out of memory for %zu "
+                    "transformed vertices", nv);
+    }
+    for (size_t i0 = 0; s == TT_OK && i0 < nv; i0 += 4096) {
+      size_t n = nv - i0 < 4096 ? nv - i0 : 4096;
+      for (size_t k = 0; k < n; k++) {
+        tt_vertex_info v;
+        tt_tin_vertex(tin, i0 + k, &v);
+        bx[k] = v.x;
+        by[k] = v.y;
+      }
+      if (!OCTTransformEx(ct, (int)n, bx, by, NULL, ok)) {
+        for (size_t k = 0; k < n; k++)
+          if (!ok[k]) {
+            s = tt__error(ctx, TT_ERR_DATA, "vertex %zu cannot be "
+                          "transformed to T_SRS '%s': %s", i0 + k, t_srs,
+                          ogr_msg());
+            break;
+          }
+        if (s == TT_OK)
+          s = tt__error(ctx, TT_ERR_DATA, "the vertices cannot be "
+                        "transformed to T_SRS '%s': %s", t_srs,
+                        ogr_msg());
+      }
+      for (size_t k = 0; s == TT_OK && k < n; k++) {
+        if (!isfinite(bx[k]) || !isfinite(by[k])) {
+          s = tt__error(ctx, TT_ERR_DATA, "vertex %zu has no finite "
+                        "coordinates in T_SRS '%s'", i0 + k, t_srs);
+          break;
+        }
+        w->xy[2 * (i0 + k)] = bx[k];
+        w->xy[2 * (i0 + k) + 1] = by[k];
+      }
+    }
+    free(bx);
+    free(by);
+    free(ok);
+    if (s != TT_OK)
+      goto done;
+  } else if (srs) {
+    w->out_srs = OSRClone(srs);
+    if (!w->out_srs)
+      return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  }
+  if (w->out_srs && OSRIsGeographic(w->out_srs)) {
+    OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
+    double a = OSRGetSemiMajor(w->out_srs, &e1);
+    double invf = OSRGetInvFlattening(w->out_srs, &e2);
+    double deg = OSRGetAngularUnits(w->out_srs, NULL) * 180.0 /
+                 3.14159265358979323846;
+    if (e1 == OGRERR_NONE && e2 == OGRERR_NONE && a > 0 && isfinite(a) &&
+        invf >= 0 && isfinite(invf) && deg > 0 && isfinite(deg)) {
+      geod_init(&w->geod, a, invf > 0 ? 1.0 / invf : 0.0);
+      w->deg_per_unit = deg;
+      w->geodesic = 1;
+    } else {
+      tt__warn(ctx, "the output CRS is geographic but has no usable "
+               "ellipsoid: triangle areas are those of the ground frame");
+    }
+  }
+done:
+  if (ct)
+    OCTDestroyCoordinateTransformation(ct);
+  OSRDestroySpatialReference(src);
+  return s;
+}
+
+tt_status tt__records_init(tt__records *r, tt_context *ctx, const tt_tin *tin,
+                           OGRSpatialReferenceH srs, const char *t_srs)
+{
+  memset(r, 0, sizeof *r);
+  r->tin = tin;
+  return prepare_crs(r, ctx, tin, srs, t_srs && *t_srs ? t_srs : NULL);
+}
+
+void tt__records_free(tt__records *r)
+{
+  if (!r)
+    return;
+  free(r->xy);
+  if (r->out_srs)
+    OSRDestroySpatialReference(r->out_srs);
+  r->xy = NULL;
+  r->out_srs = NULL;
+}
+
+tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
+                               size_t i, tt_triangle_info *out_t,
+                               tt_vertex_info out_v[3], double out_x[3],
+                               double out_y[3])
+{
+  tt_triangle_info *t = out_t;
+  if (tt_tin_triangle(r->tin, i, t) != TT_OK ||
+      tt_tin_vertex(r->tin, (size_t)t->v[0], &out_v[0]) != TT_OK ||
+      tt_tin_vertex(r->tin, (size_t)t->v[1], &out_v[1]) != TT_OK ||
+      tt_tin_vertex(r->tin, (size_t)t->v[2], &out_v[2]) != TT_OK)
+    return tt__error(ctx, TT_ERR_INTERNAL, "triangle %zu of %zu could not "
+                     "be read from the TIN", i,
+                     tt_tin_triangle_count(r->tin));
+  for (int k = 0; k < 3; k++) {
+    size_t v = (size_t)t->v[k];
+    out_x[k] = r->xy ? r->xy[2 * v] : out_v[k].x;
+    out_y[k] = r->xy ? r->xy[2 * v + 1] : out_v[k].y;
+  }
+  if (r->geodesic) {
+    double lats[3], lons[3], area = 0, perimeter = 0;
+    for (int k = 0; k < 3; k++) {
+      lons[k] = out_x[k] * r->deg_per_unit;
+      lats[k] = out_y[k] * r->deg_per_unit;
+    }
+    geod_polygonarea(&r->geod, lats, lons, 3, &area, &perimeter);
+    area = fabs(area);
+    t->area_3d = t->area_2d > 0 ? t->area_3d * (area / t->area_2d) : area;
+    t->area_2d = area;
+  }
+  return TT_OK;
+}
+
+tt_status tt__records_vertex(const tt__records *r, tt_context *ctx, size_t i,
+                             tt_vertex_info *out_v, double *out_x,
+                             double *out_y)
+{
+  if (tt_tin_vertex(r->tin, i, out_v) != TT_OK)
+    return tt__error(ctx, TT_ERR_INTERNAL, "vertex %zu of %zu could not be "
+                     "read from the TIN", i, tt_tin_vertex_count(r->tin));
+  *out_x = r->xy ? r->xy[2 * i] : out_v->x;
+  *out_y = r->xy ? r->xy[2 * i + 1] : out_v->y;
+  return TT_OK;
+}

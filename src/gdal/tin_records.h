@@ -1,0 +1,69 @@
+/*
+ * tin_records.h -- what a TIN's features hold, shared by the writers: the
+ * fields of the triangles and vertices layers, and the output coordinates
+ * and areas of each feature in the layers' CRS (the input CRS, or T_SRS
+ * with every vertex transformed once, up front; geodesic triangle areas
+ * when that CRS is geographic).
+ *
+ * The OGR writer (io_ogr_write.c) and the direct GeoPackage row writer
+ * (io_gpkg_rows.c) both take their values from here, so the two write the
+ * same content.
+ */
+#ifndef TERRATIN_TIN_RECORDS_H
+#define TERRATIN_TIN_RECORDS_H
+
+#include "base/internal.h"
+#include "terratin/terratin_gdal.h"
+
+#include <geodesic.h>
+
+typedef struct tt__field_spec {
+  const char *name;
+  OGRFieldType type;
+} tt__field_spec;
+
+/* Column order of the two geometry layers; the writers index the tables
+ * below by these values. Names have at most 10 characters (DBF). */
+enum { TT__TF_V0, TT__TF_V1, TT__TF_V2, TT__TF_MAX_ERR, TT__TF_RMSE,
+       TT__TF_N_SAMPLES, TT__TF_AREA_2D, TT__TF_AREA_3D, TT__TF_SLOPE,
+       TT__TF_ASPECT, TT__TF_MIN_ANGLE, TT__TF_MAX_ANGLE, TT__TF_COUNT };
+enum { TT__VF_ID, TT__VF_COL, TT__VF_ROW, TT__VF_INS_ERR, TT__VF_INS_RANK,
+       TT__VF_STAR_MAX, TT__VF_STAR_RMSE, TT__VF_STAR_N, TT__VF_COUNT };
+
+TT_HIDDEN extern const tt__field_spec tt__triangle_fields[TT__TF_COUNT];
+TT_HIDDEN extern const tt__field_spec tt__vertex_fields[TT__VF_COUNT];
+
+/* The layers' CRS and the transformed vertices. */
+typedef struct tt__records {
+  const tt_tin *tin;
+  OGRSpatialReferenceH out_srs; /* the layers' CRS (owned), NULL: none */
+  double *xy;                   /* T_SRS: 2 doubles per vertex, else NULL */
+  int geodesic;                 /* the output CRS is geographic */
+  struct geod_geodesic geod;
+  double deg_per_unit;          /* output angular unit in degrees */
+} tt__records;
+
+/* Sets up *r for tin: the layers' CRS is srs, or t_srs (any
+ * OSRSetFromUserInput form; NULL or "": none) with every vertex transformed
+ * from srs. On failure *r holds nothing to free but tt__records_free()
+ * accepts it. */
+TT_HIDDEN tt_status tt__records_init(tt__records *r, tt_context *ctx,
+                                     const tt_tin *tin,
+                                     OGRSpatialReferenceH srs,
+                                     const char *t_srs);
+TT_HIDDEN void tt__records_free(tt__records *r);
+
+/* Triangle i: its record (areas in the output CRS's terms), its three
+ * vertices, and their output x, y. TT_ERR_INTERNAL when the TIN cannot
+ * give them. */
+TT_HIDDEN tt_status tt__records_triangle(const tt__records *r,
+                                         tt_context *ctx, size_t i,
+                                         tt_triangle_info *out_t,
+                                         tt_vertex_info out_v[3],
+                                         double out_x[3], double out_y[3]);
+/* Vertex i and its output x, y. */
+TT_HIDDEN tt_status tt__records_vertex(const tt__records *r, tt_context *ctx,
+                                       size_t i, tt_vertex_info *out_v,
+                                       double *out_x, double *out_y);
+
+#endif /* TERRATIN_TIN_RECORDS_H */
