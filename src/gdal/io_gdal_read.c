@@ -635,11 +635,20 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
    * Byte band, 0.5 in an Int16 band, nan in an integer band). */
   if (opt.has_srcnodata) {
     int clamped = 0, rounded = 0;
-    if (opt.srcnodata_is_nan)
+    if (opt.srcnodata_is_nan) {
       clamped = !GDALDataTypeIsFloating(dtype);
-    else
+    } else if ((dtype == GDT_Int64 || dtype == GDT_UInt64) &&
+               opt.srcnodata_is_int) {
+      /* doubles cannot say near 2^63, 2^64: the integer literal, exactly */
+      const uint64_t top = (uint64_t)1 << 63;
+      clamped = opt.srcnodata_mag &&
+                (dtype == GDT_UInt64 ? opt.srcnodata_neg
+                 : opt.srcnodata_neg ? opt.srcnodata_mag > top
+                                     : opt.srcnodata_mag >= top);
+    } else {
       GDALAdjustValueToDataType(dtype, opt.srcnodata_d, &clamped,
                                 &rounded);
+    }
     if (clamped || rounded) {
       s = tt__error(ctx, TT_ERR_ARG, "%s: SRCNODATA (-srcnodata) %.15g "
                     "cannot occur in band %d, whose type %s %s", path,
