@@ -115,6 +115,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
 const char *tt__app_why(app_run *r, tt_status st, const char *file);
 /* Fails with the glue's or engine's message about file. */
 tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file);
+/* Fails a write of output (the file being written: written) with the
+ * device's cause when there is one (the file system full, ulimit -f
+ * reached; the driver's message follows in parentheses), else with the
+ * driver's or engine's message. what ("error while closing") names a
+ * failure of GDAL's own, whose last message is then the detail; NULL: the
+ * failure of an engine or glue call (its message). */
+tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
+                             const char *written, const char *what);
 /* An output refused because something exists in its way. */
 tt_status tt__app_fail_exists(app_run *r, const char *output);
 /* Polls the progress callback between phases: 0 means stop. */
@@ -137,6 +145,11 @@ const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
 const char *tt__app_nonempty_or_null(const char *s);
 /* "2026-11-22T10:38:55Z" */
 void tt__app_iso8601_utc(char *buf, size_t size);
+/* The engine's thread count (tt_refine_options.threads): -threads, else
+ * GDAL_NUM_THREADS (a number or ALL_CPUS, from the environment or
+ * --config), else 0 (automatic). A GDAL_NUM_THREADS that is neither is
+ * warned about and ignored. */
+int tt__app_threads(app_run *r);
 /* The output driver of simplify: -of, else OUTPUT's extension, else GPKG. */
 GDALDriverH tt__app_output_driver(app_run *r);
 /* Whether two paths name the same existing file. */

@@ -93,45 +93,131 @@ int tt_app_options_wants_progress_bar(const tt_app_options *o)
  * Parsing
  * ========================================================================= */
 
-/* A finite double, the whole word. */
+/* A finite decimal number, the whole word: [+-]digits[.digits][e[+-]digits].
+ * strtod alone would also take hex ("0x10" is 16), "inf", "nan" and
+ * leading blanks, none of which is meant where a height or a limit goes.
+ * A value too small for a double (1e-320 is subnormal, 1e-400 rounds to
+ * 0) is taken as strtod rounds it: it is still the number written. */
 static int parse_double(const char *w, double *out)
 {
-  char *end = NULL;
-  if (!*w || strchr(" \t\n", w[0]))
+  const char *p = w;
+  int digits = 0;
+  if (*p == '+' || *p == '-')
+    p++;
+  for (; *p >= '0' && *p <= '9'; p++)
+    digits++;
+  if (*p == '.')
+    for (p++; *p >= '0' && *p <= '9'; p++)
+      digits++;
+  if (!digits)
     return 0;
+  if (*p == 'e' || *p == 'E') {
+    p++;
+    if (*p == '+' || *p == '-')
+      p++;
+    if (!(*p >= '0' && *p <= '9'))
+      return 0;
+    while (*p >= '0' && *p <= '9')
+      p++;
+  }
+  if (*p != '\0')
+    return 0;
+  char *end = NULL;
   errno = 0;
   double d = strtod(w, &end);
-  if (end == w || *end != '\0' || errno == ERANGE || !isfinite(d))
+  if (end == w || *end != '\0' || !isfinite(d))
     return 0;
+  if (errno == ERANGE && fabs(d) > 1.0)
+    return 0; /* overflow: strtod gave HUGE_VAL */
   *out = d;
   return 1;
 }
 
-/* An unsigned decimal integer, the whole word, no sign, no overflow. */
+/* What parse_u64 found: a number, not a number, or one too large. */
+enum { NUM_BAD = 0, NUM_OK = 1, NUM_TOO_LARGE = 2 };
+
+/* An unsigned decimal integer, the whole word, no sign. NUM_TOO_LARGE for
+ * digits beyond 2^64 - 1, so the message can say "above the limit" as it
+ * does for 18446744073709551615. */
 static int parse_u64(const char *w, uint64_t *out)
 {
   uint64_t v = 0;
+  int over = 0;
   if (!*w)
-    return 0;
+    return NUM_BAD;
   for (const char *p = w; *p; p++) {
     if (*p < '0' || *p > '9')
-      return 0;
+      return NUM_BAD;
     unsigned d = (unsigned)(*p - '0');
     if (v > (UINT64_MAX - d) / 10)
-      return 0;
-    v = v * 10 + d;
+      over = 1;
+    else
+      v = v * 10 + d;
   }
+  if (over)
+    return NUM_TOO_LARGE;
   *out = v;
-  return 1;
+  return NUM_OK;
 }
 
 static int parse_size(const char *w, size_t *out)
 {
-  uint64_t v;
-  if (!parse_u64(w, &v) || v > (uint64_t)SIZE_MAX)
-    return 0;
-  *out = (size_t)v;
-  return 1;
+  uint64_t v = 0;
+  int k = parse_u64(w, &v);
+  if (k == NUM_OK && v > (uint64_t)SIZE_MAX)
+    k = NUM_TOO_LARGE;
+  if (k == NUM_OK)
+    *out = (size_t)v;
+  return k;
+}
+
+/* A memory size as GDAL's utilities write them: bytes, or a decimal number
+ * with K, M, G or T (powers of 1024, optionally followed by B or iB:
+ * "500M", "1.5GB", "2GiB", "1048576"). NUM_TOO_LARGE beyond SIZE_MAX. */
+static int parse_mem_size(const char *w, size_t *out)
+{
+  char num[64];
+  size_t n = strspn(w, "0123456789.");
+  if (n == 0 || n >= sizeof num)
+    return n >= sizeof num ? NUM_TOO_LARGE : NUM_BAD;
+  memcpy(num, w, n);
+  num[n] = '\0';
+  double v;
+  if (!parse_double(num, &v))
+    return NUM_BAD;
+  const char *u = w + n;
+  double mult = 1;
+  static const char units[] = "KMGT";
+  const char *k = *u ? strchr(units, *u >= 'a' ? *u - 'a' + 'A' : *u) : NULL;
+  if (k && *u) {
+    for (const char *q = units; q <= k; q++)
+      mult *= 1024;
+    u++;
+    if (tt__app_str_ieq(u, "iB"))
+      u += 2;
+    else if (*u == 'B' || *u == 'b')
+      u++;
+  } else if (*u == 'B' || *u == 'b') {
+    u++;
+  }
+  if (*u)
+    return NUM_BAD;
+  double bytes = floor(v * mult);
+  if (bytes >= 18446744073709551616.0 || bytes >= (double)SIZE_MAX)
+    return NUM_TOO_LARGE;
+  *out = (size_t)bytes;
+  return NUM_OK;
+}
+
+/* GDAL's booleans for --debug: the words CPLTestBool reads as such. */
+static int is_gdal_bool(const char *w)
+{
+  static const char *const words[] = {"on", "off", "yes", "no", "true",
+                                      "false", "1", "0"};
+  for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
+    if (tt__app_str_ieq(w, words[i]))
+      return 1;
+  return 0;
 }
 
 /* Which option applies to which command: one table, so the parser, the
@@ -143,7 +229,7 @@ enum opt_id {
   O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
   O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
   O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START,
-  O_IMPORTANCE, O_SELECTION, O_ONEPASS, O_HOLE
+  O_IMPORTANCE, O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -200,6 +286,8 @@ static const struct opt_def {
     {"-selection", O_SELECTION, 1, FOR_S},
     {"-onepass", O_ONEPASS, 0, FOR_S},
     {"-hole", O_HOLE, 1, FOR_S},
+    {"-threads", O_THREADS, 1, FOR_S},
+    {"-max_memory", O_MAX_MEMORY, 1, FOR_S | FOR_E},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -207,8 +295,9 @@ static const struct opt_def *find_opt(const char *w)
   for (size_t i = 0; i < sizeof opt_defs / sizeof opt_defs[0]; i++)
     if (tt__app_str_ieq(w, opt_defs[i].name))
       return &opt_defs[i];
-  /* GDAL accepts --of as well as -of for its own options: do the same. */
-  if (w[0] == '-' && w[1] == '-' && w[2] != '\0')
+  /* GDAL accepts --of as well as -of for its own options: do the same,
+   * with exactly two dashes ("---of" is a typo, not an option). */
+  if (w[0] == '-' && w[1] == '-' && w[2] != '\0' && w[2] != '-')
     return find_opt(w + 1);
   return NULL;
 }
@@ -232,10 +321,10 @@ static int parse_grid_size(const char *w, size_t *nx, size_t *ny)
   if (strlen(w) >= sizeof buf)
     return 0;
   if (!x)
-    return parse_size(w, nx) && (*ny = *nx, 1);
+    return parse_size(w, nx) == NUM_OK && (*ny = *nx, 1);
   memcpy(buf, w, (size_t)(x - w));
   buf[x - w] = '\0';
-  return parse_size(buf, nx) && parse_size(x + 1, ny);
+  return parse_size(buf, nx) == NUM_OK && parse_size(x + 1, ny) == NUM_OK;
 }
 
 static int is_pow2_plus1(size_t n)
@@ -387,6 +476,9 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (tt__app_str_ieq(w, "--debug")) {
       if (!argv[i + 1])
         USAGE("--debug needs a value: on or off");
+      if (!is_gdal_bool(argv[i + 1]))
+        USAGE("--debug must be on, off, yes, no, true, false, 1 or 0, got "
+              "'%s'", argv[i + 1]);
       if (!strlist_add(&o->config, "CPL_DEBUG") ||
           !strlist_add(&o->config, argv[i + 1]))
         NOMEM();
@@ -433,12 +525,15 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       continue;
     }
 
-    size_t z;
+    size_t z = 0;
     double x;
     uint64_t u;
+    int k; /* what parse_size or parse_mem_size found */
     switch (d->id) {
     case O_B:
-      if (!parse_size(v, &z) || z < 1 || z > INT_MAX)
+      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+        USAGE("%s: -b must be a band number >= 1, got '%s'", cmdname, v);
+      if (k != NUM_OK || z > INT_MAX)
         USAGE("%s: -b must be a band number >= 1, got '%s'", cmdname, v);
       o->s.band = (int)z;
       break;
@@ -449,19 +544,19 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.max_error = x + 0.0; /* -0 reads as "no limit" to the engine */
       break;
     case O_MAX_POINTS:
-      if (!parse_size(v, &z) || z < 1)
+      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -max_points must be an integer >= 1, got '%s'", cmdname,
               v);
-      if (z > TT_MAX_VERTICES)
+      if (k != NUM_OK || z > TT_MAX_VERTICES)
         USAGE("%s: -max_points %s is above the limit of %zu vertices",
               cmdname, v, (size_t)TT_MAX_VERTICES);
       o->s.max_points = z;
       break;
     case O_MAX_TRIANGLES:
-      if (!parse_size(v, &z) || z < 1)
+      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -max_triangles must be an integer >= 1, got '%s'",
               cmdname, v);
-      if (z > 2 * TT_MAX_VERTICES)
+      if (k != NUM_OK || z > 2 * TT_MAX_VERTICES)
         USAGE("%s: -max_triangles %s is above the limit of %zu triangles "
               "(twice the %zu vertices a TIN may have)", cmdname, v,
               2 * (size_t)TT_MAX_VERTICES, (size_t)TT_MAX_VERTICES);
@@ -501,12 +596,12 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         /* The engine's list, so new criteria show up here by themselves. */
         char known[256] = "";
         size_t n = 0;
-        for (int k = 0; k < 64 && n < sizeof known; k++) {
-          const char *name = tt_criterion_name((tt_criterion)k);
+        for (int ci = 0; ci < 64 && n < sizeof known; ci++) {
+          const char *name = tt_criterion_name((tt_criterion)ci);
           if (!name)
             break;
           n += (size_t)snprintf(known + n, sizeof known - n, "%s%s",
-                                k ? ", " : "", name);
+                                ci ? ", " : "", name);
         }
         USAGE("%s: unknown -criterion '%s'; known: %s", cmdname, v, known);
       }
@@ -541,7 +636,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       sf.size = 1;
       break;
     case O_SEED:
-      if (!parse_u64(v, &u))
+      if (parse_u64(v, &u) != NUM_OK)
         USAGE("%s: -seed must be an unsigned integer, got '%s'", cmdname, v);
       sf.seed = 1;
       sf.seed_value = u;
@@ -572,7 +667,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.anneal.r = x;
       break;
     case O_ITERATIONS:
-      if (!parse_size(v, &z) || z < 1)
+      if (parse_size(v, &z) != NUM_OK || z < 1)
         USAGE("%s: -iterations must be an integer >= 1, got '%s'", cmdname,
               v);
       sf.iterations = 1;
@@ -618,8 +713,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       break;
     case O_SRCNODATA:
       if (!tt__app_str_ieq(v, "nan") && !parse_double(v, &x))
-        USAGE("%s: -srcnodata must be a number or nan, got '%s'", cmdname,
-              v);
+        USAGE("%s: -srcnodata must be a finite decimal number or nan, got "
+              "'%s'", cmdname, v);
       if (!(o->s.srcnodata = keep(o, v)))
         NOMEM();
       break;
@@ -682,6 +777,31 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
               "auto", cmdname, v);
       decimate_only = decimate_only ? decimate_only : "-hole";
       break;
+    case O_THREADS:
+      if (tt__app_str_ieq(v, "ALL_CPUS")) {
+        o->s.threads = -1;
+        break;
+      }
+      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+        USAGE("%s: -threads must be an integer >= 1 or ALL_CPUS, got '%s'",
+              cmdname, v);
+      if (k != NUM_OK || z > TT_APP_MAX_THREADS)
+        USAGE("%s: -threads %s is above the limit of %d threads", cmdname,
+              v, TT_APP_MAX_THREADS);
+      o->s.threads = (int)z;
+      break;
+    case O_MAX_MEMORY: {
+      k = parse_mem_size(v, &z);
+      if (k == NUM_BAD || (k == NUM_OK && z < 1))
+        USAGE("%s: -max_memory must be a size of at least 1 byte: bytes, "
+              "or a number with K, M, G or T (e.g. 500M, 2G), got '%s'",
+              cmdname, v);
+      if (k != NUM_OK)
+        USAGE("%s: -max_memory %s is above the limit of %zu bytes", cmdname,
+              v, (size_t)SIZE_MAX);
+      o->s.max_memory = z;
+      break;
+    }
     case O_A_SRS:
       if (!*v)
         USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);

@@ -16,13 +16,17 @@
 #include <cpl_vsi.h>
 #include <ogr_srs_api.h>
 
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
+#include <unistd.h>
 
 /* Seconds of a monotonic clock (the app's own; the engine keeps its own). */
 double tt__app_now(void)
@@ -36,6 +40,25 @@ double tt__app_now(void)
 void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
                        const char *fmt, ...) TT_APP_PRINTF_(4, 5);
 
+/* vsnprintf that keeps the cause: a message that would not fit is made
+ * whole on the heap and its long words (100 kB names) shortened in the
+ * middle by tt_text_fit, instead of being cut at the end. */
+static void vformat_fit(char *buf, size_t size, const char *fmt, va_list ap)
+{
+  va_list ap2;
+  va_copy(ap2, ap);
+  int n = vsnprintf(buf, size, fmt, ap);
+  if (n >= 0 && (size_t)n >= size) {
+    char *whole = malloc((size_t)n + 1);
+    if (whole) {
+      vsnprintf(whole, (size_t)n + 1, fmt, ap2);
+      tt_text_fit(buf, size, whole);
+      free(whole);
+    }
+  }
+  va_end(ap2);
+}
+
 /* Fills a result, keeping the first failure: later ones are consequences. */
 void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
                        const char *fmt, ...)
@@ -46,7 +69,7 @@ void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
   res->status = status;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(res->message, sizeof res->message, fmt, ap);
+  vformat_fit(res->message, sizeof res->message, fmt, ap);
   va_end(ap);
   /* One line: fold any newline GDAL or a driver put into a message. */
   for (char *p = res->message; *p; p++)
@@ -101,7 +124,7 @@ void tt__app_warn(app_messages *m, const char *fmt, ...)
     return;
   }
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
   one_line(buf);
   fprintf(m->err, "terratin: warning: %s\n", buf);
@@ -120,7 +143,7 @@ static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
     tt__app_warn(m, "%s", msg);
   } else if (cls != CE_None) {
     m->failures++;
-    snprintf(m->last, sizeof m->last, "%s", msg);
+    tt_text_fit(m->last, sizeof m->last, msg);
     one_line(m->last);
   }
 }
@@ -142,13 +165,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
 tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
 {
-  char buf[TT_APP_MESSAGE_MAX];
+  char buf[TT_APP_MESSAGE_MAX], name[TT_TEXT_WORD_MAX + 1];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
   if (file)
-    tt__app_result_set(r->res, exit_code, st, "%s: %s", file, buf);
+    tt__app_result_set(r->res, exit_code, st, "%s: %s",
+                       tt_text_fit(name, sizeof name, file), buf);
   else
     tt__app_result_set(r->res, exit_code, st, "%s", buf);
   return st;
@@ -166,11 +190,16 @@ const char *tt__app_why(app_run *r, tt_status st, const char *file)
     m = r->msg.last;
   if (!m || !*m)
     m = tt_status_message(st);
-  size_t n = file ? strlen(file) : 0;
-  if (n && strncmp(m, file, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
-    m += n + 2;
-  else if (n && strncmp(m, file, n) == 0 && m[n] == ' ' && m[n + 1])
-    m += n + 1;
+  /* the file as it was named, or shortened as tt_text_fit does it */
+  char fit[TT_TEXT_WORD_MAX + 1];
+  for (int pass = 0; pass < 2 && file; pass++) {
+    const char *f = pass ? tt_text_fit(fit, sizeof fit, file) : file;
+    size_t n = strlen(f);
+    if (n && strncmp(m, f, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
+      return m + n + 2;
+    if (n && strncmp(m, f, n) == 0 && m[n] == ' ' && m[n + 1])
+      return m + n + 1;
+  }
   return m;
 }
 
@@ -180,10 +209,70 @@ tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file)
   if (st == TT_ERR_INTERRUPTED)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file,
                     "interrupted; nothing written");
-  if (st == TT_ERR_NOMEM)
-    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "out of memory");
+  if (st == TT_ERR_NOMEM) {
+    /* the engine's and glue's messages name the phase and the size */
+    const char *m = tt_context_errmsg(r->ctx);
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s",
+                        m && strstr(m, "memory") ? tt__app_why(r, st, file)
+                                                 : "out of memory");
+  }
   return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, file, "%s",
                       tt__app_why(r, st, file));
+}
+
+/* Why a write failed when the cause is the device rather than the data:
+ * the folder's file system (almost) full, or the file size limit (ulimit
+ * -f) reached by the file being written. SQLite and the drivers report
+ * these as whatever failed next ("no such table: gpkg_contents", "disk I/O
+ * error"). Writes the cause to buf and returns 1, else 0. */
+static int device_cause(const char *written, char *buf, size_t size)
+{
+  char folder[4096];
+  snprintf(folder, sizeof folder, "%s", written);
+  char *slash = strrchr(folder, '/');
+  if (slash)
+    *(slash == folder ? slash + 1 : slash) = '\0';
+  else
+    snprintf(folder, sizeof folder, ".");
+  struct rlimit rl;
+  struct stat st;
+  if (getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+      stat(written, &st) == 0 && (uint64_t)st.st_size + 65536 >=
+                                     (uint64_t)rl.rlim_cur) {
+    snprintf(buf, size, "the file size limit (ulimit -f) of %llu bytes was "
+             "reached", (unsigned long long)rl.rlim_cur);
+    return 1;
+  }
+  struct statvfs vfs;
+  if (statvfs(folder, &vfs) == 0) {
+    uint64_t avail = (uint64_t)vfs.f_bavail * vfs.f_frsize;
+    if (avail < ((uint64_t)1 << 20) || (vfs.f_favail == 0 && vfs.f_files)) {
+      char fit[TT_TEXT_WORD_MAX + 1];
+      snprintf(buf, size, "no space left on the device of %s (%llu bytes "
+               "free%s)", tt_text_fit(fit, sizeof fit, folder),
+               (unsigned long long)avail,
+               vfs.f_favail == 0 && vfs.f_files ? ", no free inode" : "");
+      return 1;
+    }
+  }
+  return 0;
+}
+
+tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
+                             const char *written, const char *what)
+{
+  char cause[512];
+  /* with `what`, the failure is GDAL's own (a close): its last message */
+  const char *detail = what ? r->msg.last : tt__app_why(r, st, output);
+  if (st != TT_ERR_INTERRUPTED && st != TT_ERR_NOMEM && written &&
+      device_cause(written, cause, sizeof cause))
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, output,
+                        "%s%s%s (the driver said: %s)", what ? what : "",
+                        what ? ": " : "", cause, detail);
+  if (what)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, output, "%s: %s", what,
+                        detail);
+  return tt__app_fail_tt(r, st, output);
 }
 
 /* An output refused because something exists: name the file that is in
@@ -219,6 +308,53 @@ static void apply_config(const tt_app_settings *s)
     CPLSetConfigOption(s->config[i], s->config[i + 1]);
 }
 
+/* A path into an archive (/vsizip/, /vsitar/, /vsi7z/, /vsirar/, /vsigzip/,
+ * possibly chained) that does not exist: which part is missing, the
+ * archive or the member in it. Writes the reason to why; 0 when path is
+ * not such a path. Only local archive file systems are probed (a /vsicurl/
+ * prefix would cost a request per level). */
+static int explain_missing_vsi(const char *path, char *why, size_t size)
+{
+  static const char *const fs[] = {"/vsizip/", "/vsitar/", "/vsi7z/",
+                                   "/vsirar/", "/vsigzip/"};
+  size_t skip = 0;
+  for (size_t i = 0; i < sizeof fs / sizeof fs[0] && !skip; i++)
+    if (strncmp(path, fs[i], strlen(fs[i])) == 0)
+      skip = strlen(fs[i]);
+  if (!skip)
+    return 0;
+  char *buf = CPLStrdup(path);
+  VSIStatBufL sb;
+  int found = 0;
+  for (char *slash = strrchr(buf, '/'); slash && slash > buf + skip;
+       slash = strrchr(buf, '/')) {
+    *slash = '\0';
+    const char *member = path + strlen(buf) + 1;
+    const char *real = buf + skip; /* the same name outside the archive */
+    int in_archive = VSIStatL(buf, &sb) == 0;
+    if (in_archive && VSI_ISDIR(sb.st_mode) && VSIStatL(real, &sb) != 0) {
+      snprintf(why, size, "no such file or directory: the folder %s of the "
+               "archive holds no '%s'", buf, member);
+      found = 1;
+    } else if (VSIStatL(real, &sb) == 0 && VSI_ISREG(sb.st_mode)) {
+      if (in_archive)
+        snprintf(why, size, "no such file or directory: the archive %s "
+                 "holds no '%s'", real, member);
+      else
+        snprintf(why, size, "%s is not an archive %.*s can read (or is "
+                 "damaged)", real, (int)(skip - 2), path + 1);
+      found = 1;
+    }
+    if (found)
+      break;
+  }
+  if (!found)
+    snprintf(why, size, "no such file or directory (the archive in %s does "
+             "not exist)", path + skip);
+  CPLFree(buf);
+  return 1;
+}
+
 /* Opens a raster for reading and checks the band; on failure explains in
  * one line why: missing, a folder, empty, a vector dataset, unreadable. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
@@ -235,8 +371,18 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
     snprintf(gdal_msg, sizeof gdal_msg, "%s", r->msg.last);
     int stat_ok = VSIStatL(path, &sb) == 0;
     if (!stat_ok && !strchr(path, ':') && strncmp(path, "/vsi", 4) != 0) {
-      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path,
-               "no such file or directory");
+      struct stat st;
+      int too_long = stat(path, &st) != 0 && errno == ENAMETOOLONG;
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s",
+                   too_long ? "the name is too long for the file system "
+                              "(a folder or file name of more than 255 "
+                              "bytes, or a path of more than 4096)"
+                            : "no such file or directory");
+      return NULL;
+    }
+    char why[TT_APP_MESSAGE_MAX];
+    if (!stat_ok && explain_missing_vsi(path, why, sizeof why)) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s", why);
       return NULL;
     }
     if (stat_ok && VSI_ISDIR(sb.st_mode)) {
@@ -294,6 +440,93 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
   return ds;
 }
 
+/* Undeclared fill values. Many DEMs mark their voids with a classic value
+ * (-9999, -32767, -32768, -32000, -99999, -3.4e38, or 32767 and 65535 at
+ * the top of integer types) without declaring it as the band's nodata, and
+ * a TIN then dives to the void. A value from that list is suspect when it
+ * lies farther from the band's other heights than their whole range, and
+ * either forms runs along a row (FILL_RUN samples in a row) or a share of
+ * FILL_SHARE of the valid samples: a warning then names it, its count and
+ * the -srcnodata that would mask it. One pass; heights far below 9999 are
+ * skipped by a single comparison. */
+#define FILL_RUN 4
+#define FILL_SHARE 0.001
+
+static void warn_fill_values(app_run *r, const tt_grid *grid,
+                             const tt_raster_info *info, const char *path,
+                             size_t valid)
+{
+  static const double fills[] = {-9999.0, -32767.0, -32768.0, -32000.0,
+                                 -99999.0, -3.4028234663852886e38, -3.4e38,
+                                 32767.0, 65535.0};
+  enum { NF = sizeof fills / sizeof fills[0] };
+  float t[NF];
+  size_t count[NF] = {0}, run[NF] = {0}, best_run[NF] = {0};
+  double k = (info ? info->z_unit_factor * info->z_factor : 1.0);
+  double scale = info ? info->scale : 1.0, offset = info ? info->offset : 0.0;
+  float thr = INFINITY;
+  for (size_t i = 0; i < NF; i++) {
+    t[i] = (float)((fills[i] * scale + offset) * k);
+    if (fabsf(t[i]) < thr)
+      thr = fabsf(t[i]);
+  }
+  /* one of the two is set, as the grid's precision says */
+  const float *z = tt_grid_heights_const(grid);
+  const double *zd = tt_grid_heights_f64_const(grid);
+  size_t nx = tt_grid_width(grid), ny = tt_grid_height(grid);
+  double lo = INFINITY, hi = -INFINITY;
+  for (size_t row = 0; row < ny; row++) {
+    for (size_t i = 0; i < NF; i++)
+      run[i] = 0;
+    for (size_t c = 0; c < nx; c++) {
+      /* a double grid's value compared as a float: the fill values are
+       * whole numbers or float limits, exact either way */
+      float h = zd ? (float)zd[row * nx + c] : z[row * nx + c];
+      if (isnan(h))
+        continue;
+      int which = -1;
+      if (fabsf(h) >= thr)
+        for (int i = 0; i < (int)NF; i++)
+          if (h == t[i]) {
+            which = i;
+            break;
+          }
+      for (int i = 0; i < (int)NF; i++)
+        if (i != which)
+          run[i] = 0;
+      if (which < 0) {
+        if (h < lo) lo = h;
+        if (h > hi) hi = h;
+        continue;
+      }
+      count[which]++;
+      if (++run[which] > best_run[which])
+        best_run[which] = run[which];
+    }
+  }
+  if (!(lo <= hi))
+    return; /* nothing else to compare with */
+  double span = hi - lo > 1.0 ? hi - lo : 1.0;
+  for (size_t i = 0; i < NF; i++) {
+    if (!count[i])
+      continue;
+    double gap = t[i] < lo ? lo - t[i] : t[i] > hi ? t[i] - hi : 0.0;
+    if (gap <= span)
+      continue;
+    if (best_run[i] < FILL_RUN && (double)count[i] < FILL_SHARE * valid)
+      continue;
+    char raw[40];
+    tt__app_format_double(raw, sizeof raw, fills[i]);
+    tt__app_warn(&r->msg, "%s: band %d: %zu sample%s (%.2g%%) %s %s, in "
+                 "runs of up to %zu, far from the other heights (%.10g .. "
+                 "%.10g): an undeclared nodata value? -srcnodata %s treats "
+                 "%s as nodata", path, r->s->band, count[i],
+                 count[i] == 1 ? "" : "s", 100.0 * count[i] / valid,
+                 count[i] == 1 ? "is" : "are", raw, best_run[i], lo, hi,
+                 raw, count[i] == 1 ? "it" : "them");
+  }
+}
+
 /* Reads the band into a grid and checks it has usable samples. */
 tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
                           tt_progress_fn progress, void *progress_arg,
@@ -315,10 +548,18 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
     ropts = CSLSetNameValue(ropts, "Z_UNIT", r->s->z_unit);
   if (r->s->work_srs)
     ropts = CSLSetNameValue(ropts, "WORK_SRS", r->s->work_srs);
+  if (r->s->max_memory)
+    ropts = CSLSetNameValue(ropts, "MAX_MEMORY",
+                            CPLSPrintf("%zu", r->s->max_memory));
   r->msg.last[0] = '\0';
   tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
                                    progress_arg, &grid, &info);
   CSLDestroy(ropts);
+  if (st == TT_ERR_ARG) { /* -srcnodata the band cannot hold, ... */
+    tt__app_fail(r, TT_APP_EXIT_USAGE, st, path, "%s",
+                 tt__app_why(r, st, path));
+    goto done;
+  }
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, path);
     goto done;
@@ -333,6 +574,8 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
                   "band %d has no valid samples (all nodata)", r->s->band);
     goto done;
   }
+  if (!r->s->srcnodata)
+    warn_fill_values(r, grid, info, path, valid);
 done:
   if (st != TT_OK) {
     tt_grid_destroy(grid);
@@ -489,6 +732,35 @@ GDALDriverH tt__app_output_driver(app_run *r)
                   "writing a GeoPackage (use -of to choose)",
          r->s->output, ext);
   return drv;
+}
+
+static int online_cpus(void)
+{
+  long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n < 1 ? 1 : n > TT_APP_MAX_THREADS ? TT_APP_MAX_THREADS : (int)n;
+}
+
+int tt__app_threads(app_run *r)
+{
+  if (r->s->threads > 0)
+    return r->s->threads;
+  if (r->s->threads < 0)
+    return online_cpus();
+  const char *v = CPLGetConfigOption("GDAL_NUM_THREADS", NULL);
+  if (!v || !*v)
+    return 0;
+  if (tt__app_str_ieq(v, "ALL_CPUS"))
+    return online_cpus();
+  char *end = NULL;
+  errno = 0;
+  long n = strtol(v, &end, 10);
+  if (end != v && *end == '\0' && errno == 0 && n >= 1 &&
+      n <= TT_APP_MAX_THREADS && v[0] >= '0' && v[0] <= '9')
+    return (int)n;
+  tt__app_warn(&r->msg, "GDAL_NUM_THREADS='%s' is neither a number of "
+               "threads from 1 to %d nor ALL_CPUS; ignored", v,
+               TT_APP_MAX_THREADS);
+  return 0;
 }
 
 /* Whether two paths name the same existing file. */

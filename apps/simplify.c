@@ -109,6 +109,12 @@ tt_status tt__app_simplify(app_run *r)
     goto done;
   }
 
+  /* The memory the run may hold: -max_memory, else what the system allows,
+   * asked before the DEM is read (the heights count against it). */
+  const char *mem_source = "-max_memory";
+  size_t mem_limit = s->max_memory ? s->max_memory
+                                   : tt_memory_limit(&mem_source);
+
   /* Read: 0 - 10%. */
   tt__app_phase_set(&r->prog, 0.0, 0.10);
   src = tt__app_open_raster(r, s->input, s->band, &band);
@@ -150,6 +156,8 @@ tt_status tt__app_simplify(app_run *r)
   ro.optimize = s->optimize;
   ro.anneal = s->anneal;
   ro.repair = s->repair;
+  ro.threads = tt__app_threads(r);
+  ro.max_memory = mem_limit == SIZE_MAX ? 0 : mem_limit;
   if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
       !(s->percent > 0)) {
     ro.max_error = 0.005 * (rep.zmax - rep.zmin);
@@ -178,11 +186,32 @@ tt_status tt__app_simplify(app_run *r)
     dopt.hole = s->hole;
     dopt.progress = ro.progress;
     dopt.progress_arg = ro.progress_arg;
+    dopt.threads = ro.threads;
     rep.dopt = &dopt;
+    /* Decimation does not count its memory as it goes (its start holds a
+     * triangle per half sample): an explicit limit would be a promise it
+     * cannot keep. */
+    if (s->max_memory) {
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -max_memory bounds -method insert only; "
+                        "decimation does not count its memory yet");
+      goto done;
+    }
   }
   double t = tt__app_now();
   st = s->decimate ? tt_decimate_run(r->ctx, grid, &dopt, &tin)
                    : tt_refine_run(r->ctx, grid, &ro, &tin);
+  if (st == TT_ERR_NOMEM && ro.max_memory &&
+      strstr(tt_context_errmsg(r->ctx), "memory limit")) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, st, s->input, "%s (%s); nothing "
+                 "written", tt_context_errmsg(r->ctx), mem_source);
+    goto done;
+  }
+  if (st == TT_ERR_LIMIT) { /* a budget below the start's vertices */
+    tt__app_fail(r, TT_APP_EXIT_USAGE, st, s->input, "%s",
+                 tt_context_errmsg(r->ctx));
+    goto done;
+  }
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, st == TT_ERR_INTERRUPTED ? s->output : s->input);
     goto done;
@@ -336,7 +365,7 @@ tt_status tt__app_simplify(app_run *r)
   st = tt_ogr_write_tin(r->ctx, dst, tin, srs, allf, nallf, wopts,
                         tt__app_phase_fn, &r->prog);
   if (st != TT_OK) {
-    tt__app_fail_tt(r, st, s->output);
+    tt__app_fail_write(r, st, s->output, tt_output_temp_path(outp), NULL);
     goto done;
   }
   /* Around the close, which may flush for long (a stop during it is seen
@@ -353,8 +382,8 @@ tt_status tt__app_simplify(app_run *r)
     goto done;
   }
   if (r->msg.failures != failures) {
-    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
-                  "error while closing: %s", r->msg.last);
+    st = tt__app_fail_write(r, TT_ERR_IO, s->output,
+                            tt_output_temp_path(outp), "error while closing");
     goto done;
   }
   if (direct_rows) {

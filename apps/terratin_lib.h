@@ -51,6 +51,8 @@ typedef enum tt_app_command {
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
+/* The most threads -threads and GDAL_NUM_THREADS may ask for. */
+#define TT_APP_MAX_THREADS 1024
 
 /* The outcome of parsing or running: the exit code and, on failure, one line
  * without a trailing newline ("" on success). */
@@ -113,6 +115,10 @@ typedef struct tt_app_settings {
   tt_selection selection;    /* -selection; default independent */
   int onepass;               /* -onepass */
   tt_hole hole;              /* -hole; default auto */
+  int threads;               /* -threads N (>= 1), -1 for ALL_CPUS; 0: not
+                                given (GDAL_NUM_THREADS, else automatic) */
+  size_t max_memory;         /* -max_memory in bytes (simplify, eval); 0:
+                                not given (the system's limit) */
 
   /* eval, optimize (which reads the TIN from tin and writes output) */
   const char *layer;         /* -layer; NULL: the triangles layer */

@@ -3,6 +3,11 @@
  * test/task.h): each check prints both sides and the place on failure and
  * makes the test exit non-zero. TT_SKIP() exits with 77, which ctest reports
  * as skipped (SKIP_RETURN_CODE).
+ *
+ * In a libFuzzer build (TT_FUZZ_LIBFUZZER defined, cmake -DTT_FUZZ=ON) a
+ * failed check aborts at once: libFuzzer sees crashes only, so an oracle
+ * that merely counted its failures would let every wrong result pass and
+ * never save the input that found it.
  */
 #ifndef TT_TEST_H
 #define TT_TEST_H
@@ -15,12 +20,19 @@
 
 static int tt_test_failures = 0;
 
+#ifdef TT_FUZZ_LIBFUZZER
+#define TT_FAIL_ABORT_() abort()
+#else
+#define TT_FAIL_ABORT_() ((void)0)
+#endif
+
 #define TT_FAIL_(...)                                                        \
   do {                                                                       \
     fprintf(stderr, "%s:%d: ", __FILE__, __LINE__);                          \
     fprintf(stderr, __VA_ARGS__);                                            \
     fputc('\n', stderr);                                                     \
     tt_test_failures++;                                                      \
+    TT_FAIL_ABORT_();                                                        \
   } while (0)
 
 #define CHECK(cond)                                                          \

@@ -315,10 +315,31 @@ typedef struct tt_refine_options {
   /* Called now and then with the fraction done; may be NULL. */
   tt_progress_fn progress;
   void *progress_arg;
+  /* Bytes the run may hold, the grid's heights included: the mesh, the
+   * insertion state and the TIN's records to come are counted as they
+   * grow, and a run that would pass the limit stops with TT_ERR_NOMEM and
+   * a message naming the phase and the size it needed. 0: no limit. */
+  size_t max_memory;
 } tt_refine_options;
 
 /* Default: max_error 1 z unit, no other limit, Delaunay, no progress. */
 void tt_refine_options_init(tt_refine_options *opt);
+
+/* The bytes this process may still use as the system says: the smallest
+ * of 3/4 of physical memory, its cgroup's limit less the group's use (v2
+ * memory.max, v1 memory.limit_in_bytes) and its address-space limit
+ * (ulimit -v, RLIMIT_AS) less what is mapped already. *out_source (may be
+ * NULL) names the one that decided, a static string. SIZE_MAX when the
+ * system says nothing. */
+size_t tt_memory_limit(const char **out_source);
+
+/* Copies text into buf (size bytes, always terminated), shortening every
+ * run of more than TT_TEXT_WORD_MAX bytes without a blank (a path, a
+ * layer name) in the middle to its first and last parts around "...", so
+ * that a message about a 100 kB name still fits and still says its cause.
+ * Returns buf. */
+#define TT_TEXT_WORD_MAX 200
+const char *tt_text_fit(char *buf, size_t size, const char *text);
 
 /* ---------------------------------------------------------------------------
  * The TIN: the result of a run, with its bookkeeping.

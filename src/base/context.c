@@ -78,6 +78,53 @@ size_t tt_context_warning_count(const tt_context *ctx)
   return ctx ? ctx->warnings : 0;
 }
 
+const char *tt_text_fit(char *buf, size_t size, const char *text)
+{
+  const size_t keep = (TT_TEXT_WORD_MAX - 3) / 2; /* each side of "..." */
+  size_t o = 0;
+  if (!buf || !size)
+    return buf;
+  for (const char *p = text ? text : ""; *p && o + 1 < size;) {
+    size_t word = strcspn(p, " \t");
+    if (word == 0) {
+      buf[o++] = *p++;
+      continue;
+    }
+    const char *parts[3] = {p, "...", p + word - keep};
+    size_t lens[3] = {word, 0, 0};
+    if (word > TT_TEXT_WORD_MAX) {
+      lens[0] = keep;
+      lens[1] = 3;
+      lens[2] = keep;
+    }
+    for (int k = 0; k < 3; k++)
+      for (size_t i = 0; i < lens[k] && o + 1 < size; i++)
+        buf[o++] = parts[k][i];
+    p += word;
+  }
+  buf[o] = '\0';
+  return buf;
+}
+
+/* Formats into buf; when the text would not fit, formats it whole on the
+ * heap and lets tt_text_fit shorten its long words, so the end of the
+ * message (the cause, after the name) survives. */
+static void vformat_fit(char *buf, size_t size, const char *fmt, va_list ap)
+{
+  va_list ap2;
+  va_copy(ap2, ap);
+  int n = vsnprintf(buf, size, fmt, ap);
+  if (n >= 0 && (size_t)n >= size) {
+    char *whole = malloc((size_t)n + 1);
+    if (whole) {
+      vsnprintf(whole, (size_t)n + 1, fmt, ap2);
+      tt_text_fit(buf, size, whole);
+      free(whole);
+    }
+  }
+  va_end(ap2);
+}
+
 tt_status tt__error(tt_context *ctx, tt_status status, const char *fmt, ...)
 {
   if (!ctx)
@@ -85,7 +132,7 @@ tt_status tt__error(tt_context *ctx, tt_status status, const char *fmt, ...)
   ctx->last_status = status;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(ctx->errmsg, sizeof ctx->errmsg, fmt, ap);
+  vformat_fit(ctx->errmsg, sizeof ctx->errmsg, fmt, ap);
   va_end(ap);
   return status;
 }
@@ -100,7 +147,7 @@ void tt__warn(tt_context *ctx, const char *fmt, ...)
   char buf[TT_ERRMSG_MAX];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
   ctx->log_fn(ctx->log_user, buf);
 }
@@ -120,6 +167,25 @@ bool tt__grow(void **ptr, size_t *cap, size_t need, size_t elem)
   *ptr = p;
   *cap = ncap;
   return true;
+}
+
+bool tt__name_equal(const char *a, const char *b)
+{
+  for (;; a++, b++) {
+    char ca = *a, cb = *b;
+    if (ca >= 'A' && ca <= 'Z')
+      ca = (char)(ca - 'A' + 'a');
+    if (cb >= 'A' && cb <= 'Z')
+      cb = (char)(cb - 'A' + 'a');
+    if (ca == '-')
+      ca = '_';
+    if (cb == '-')
+      cb = '_';
+    if (ca != cb)
+      return false;
+    if (ca == '\0')
+      return true;
+  }
 }
 
 double tt__now(void)

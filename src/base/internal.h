@@ -80,6 +80,22 @@ typedef struct tt__metric {
 
 TT_HIDDEN void tt__metric_from_frame(const double a[4], tt__metric *out);
 
+/* Whether two option words name the same thing: ASCII case-insensitive,
+ * '-' matching '_' ("Min-Area" is "min_area"), as the command's option
+ * names are matched. */
+TT_HIDDEN bool tt__name_equal(const char *a, const char *b);
+
+/* tt_memory_limit() with its inputs given (memory.c; the tests pass a
+ * folder holding proc/self/cgroup and sys/fs/cgroup/... as root, "" is the
+ * real system): phys_bytes of physical memory (0: unknown), an address-space
+ * limit as_limit (0: none) of which as_used is mapped already. */
+TT_HIDDEN size_t tt__memory_limit_at(const char *root, uint64_t phys_bytes,
+                                     uint64_t as_limit, uint64_t as_used,
+                                     const char **out_source);
+/* "31.2 KiB", "1.5 GiB", "12 bytes": sizes for messages; returns buf. */
+TT_HIDDEN const char *tt__format_bytes(char *buf, size_t size,
+                                       uint64_t bytes);
+
 /* Seconds of a monotonic clock. */
 TT_HIDDEN double tt__now(void);
 

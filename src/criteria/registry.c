@@ -35,7 +35,7 @@ tt_status tt_criterion_parse(tt_context *ctx, const char *name,
 {
   if (name && out_criterion)
     for (size_t i = 0; i < NCRIT; i++)
-      if (strcmp(table[i]->name, name) == 0) {
+      if (tt__name_equal(table[i]->name, name)) {
         *out_criterion = table[i]->id;
         return TT_OK;
       }

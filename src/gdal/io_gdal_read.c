@@ -66,7 +66,8 @@ typedef struct read_options {
   int srcnodata_neg;     /* integer bands: sign and magnitude */
   uint64_t srcnodata_mag;
   size_t max_memory;     /* bytes */
-  int max_memory_default; /* not given: 3/4 of physical memory */
+  int max_memory_default; /* not given: the system's limit */
+  const char *max_memory_source; /* which limit that is (tt_memory_limit) */
 } read_options;
 
 static char *dup_str(const char *s)
@@ -97,15 +98,12 @@ void tt_raster_info_destroy(tt_raster_info *info)
   free(info);
 }
 
-/* Three quarters of physical memory; SIZE_MAX when the system cannot say. */
-static size_t default_max_memory(void)
+/* The smallest of 3/4 of physical memory, the cgroup's room and the
+ * address-space room (tt_memory_limit); SIZE_MAX when the system cannot
+ * say. */
+static size_t default_max_memory(const char **out_source)
 {
-  long pages = sysconf(_SC_PHYS_PAGES);
-  long page_size = sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page_size <= 0)
-    return SIZE_MAX;
-  double bytes = (double)pages * (double)page_size * 0.75;
-  return bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)bytes;
+  return tt_memory_limit(out_source);
 }
 
 /* Parses a whole string as a finite double. */
@@ -114,7 +112,7 @@ static int parse_double(const char *s, double *out)
   char *end = NULL;
   errno = 0;
   double v = strtod(s, &end);
-  if (end == s || errno == ERANGE)
+  if (end == s || (errno == ERANGE && fabs(v) > 1.0)) /* subnormals pass */
     return 0;
   while (*end == ' ')
     end++;
@@ -226,7 +224,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   }
   opt->max_memory_default = !has_max_memory;
   if (!has_max_memory)
-    opt->max_memory = default_max_memory();
+    opt->max_memory = default_max_memory(&opt->max_memory_source);
   return TT_OK;
 }
 
@@ -632,6 +630,35 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     raw.source = RAW_F64;
   }
 
+  /* A SRCNODATA the band's type cannot hold can never match a sample:
+   * refuse it rather than mask nothing (1e39 in a Float32 band, -1 in a
+   * Byte band, 0.5 in an Int16 band, nan in an integer band). */
+  if (opt.has_srcnodata) {
+    int clamped = 0, rounded = 0;
+    if (opt.srcnodata_is_nan) {
+      clamped = !GDALDataTypeIsFloating(dtype);
+    } else if ((dtype == GDT_Int64 || dtype == GDT_UInt64) &&
+               opt.srcnodata_is_int) {
+      /* doubles cannot say near 2^63, 2^64: the integer literal, exactly */
+      const uint64_t top = (uint64_t)1 << 63;
+      clamped = opt.srcnodata_mag &&
+                (dtype == GDT_UInt64 ? opt.srcnodata_neg
+                 : opt.srcnodata_neg ? opt.srcnodata_mag > top
+                                     : opt.srcnodata_mag >= top);
+    } else {
+      GDALAdjustValueToDataType(dtype, opt.srcnodata_d, &clamped,
+                                &rounded);
+    }
+    if (clamped || rounded) {
+      s = tt__error(ctx, TT_ERR_ARG, "%s: SRCNODATA (-srcnodata) %.15g "
+                    "cannot occur in band %d, whose type %s %s", path,
+                    opt.srcnodata_is_nan ? NAN : opt.srcnodata_d,
+                    GDALGetBandNumber(band), GDALGetDataTypeName(dtype),
+                    clamped ? "cannot hold it" : "holds whole numbers only");
+      goto done;
+    }
+  }
+
   const int xsize = GDALGetRasterBandXSize(band);
   const int ysize = GDALGetRasterBandYSize(band);
   if (xsize < 2 || ysize < 2) {
@@ -651,8 +678,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %s, "
                   "more than %s (%s); refused before reading", path, nx, ny,
                   fmt_bytes(need_s, sizeof need_s, need),
-                  opt.max_memory_default ? "3/4 of this machine's physical "
-                                           "memory"
+                  opt.max_memory_default ? opt.max_memory_source
                                          : "MAX_MEMORY",
                   fmt_bytes(max_s, sizeof max_s, opt.max_memory));
     goto done;

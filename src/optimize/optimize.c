@@ -41,7 +41,7 @@ static const char *const repair_names[] = {"auto", "flip", "local",
 static int name_index(const char *const *names, size_t n, const char *name)
 {
   for (size_t i = 0; name && i < n; i++)
-    if (strcmp(names[i], name) == 0)
+    if (tt__name_equal(names[i], name))
       return (int)i;
   return -1;
 }

@@ -40,6 +40,7 @@
 #include "tin/tin.h"
 
 #include <float.h>
+#include <stdio.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -73,15 +74,90 @@ typedef struct refine {
   size_t max_points, max_tris;
   double max_error;    /* < 0: none */
   size_t forced;       /* vertices the nodata outline required */
+  const char *phase;   /* for messages: "inserting", ... */
   /* progress */
   double e0, frac;
 } refine;
 
+/* --- memory ------------------------------------------------------------
+ * What the run holds, counted from the arrays' capacities: the grid's
+ * heights, the mesh, the insertion state, and the TIN's records that the
+ * end of the run adds (tin.h: 44 bytes per vertex and 32 per triangle,
+ * with metrics.c's 12 per vertex and 4 per slot while building them).
+ * Criterion caches and the scans' jobs are small and not counted. */
+#define TIN_BYTES_PER_VERTEX 56
+#define TIN_BYTES_PER_TRIANGLE 36
+
+typedef struct mem_use {
+  uint64_t grid, mesh, tin;
+} mem_use;
+
+/* The bytes held if the vertex and triangle arrays had room for nv and
+ * nt (their capacities, or the capacities they are about to grow to). */
+static void mem_count(const refine *r, size_t nv, size_t nt, mem_use *u)
+{
+  const tt__mesh *m = &r->m;
+  u->grid = (uint64_t)r->g->nx * r->g->ny *
+                (sizeof(float) + (r->g->zd ? sizeof(double) : 0)) +
+            (uint64_t)r->tiles.ntx * r->tiles.nty * 4 * sizeof(float);
+  uint64_t per_v = sizeof(tt__mesh_vertex) + sizeof(double) +
+                   (m->vver ? sizeof(uint32_t) : 0);
+  uint64_t per_t = 6 * sizeof(int32_t) + 3 + sizeof(int64_t) +
+                   sizeof(double) + sizeof(int32_t) + sizeof(tt__heap_entry);
+  u->mesh = per_v * nv + per_t * nt +
+            (uint64_t)(m->freecap + m->touchedcap + r->stack.cap) *
+                sizeof(int32_t);
+  u->tin = (uint64_t)TIN_BYTES_PER_VERTEX * nv +
+           (uint64_t)TIN_BYTES_PER_TRIANGLE * nt;
+}
+
+/* TT_ERR_NOMEM when holding room for nv vertices and nt triangle slots
+ * would pass opt->max_memory; names the phase and the sizes. */
+static tt_status mem_check(refine *r, size_t nv, size_t nt)
+{
+  if (!r->opt->max_memory)
+    return TT_OK;
+  mem_use u;
+  mem_count(r, nv, nt, &u);
+  uint64_t total = u.grid + u.mesh + u.tin;
+  if (total <= (uint64_t)r->opt->max_memory)
+    return TT_OK;
+  char a[32], b[32], c[32], d[32], e[32];
+  return tt__error(r->ctx, TT_ERR_NOMEM, "%s, at %zu vertices and %zu "
+                   "triangles: room for %zu vertices needs %s (heights %s, "
+                   "mesh and insertion state %s, the TIN's records %s), "
+                   "more than the memory limit of %s", r->phase, r->m.nv,
+                   r->m.nlive, nv,
+                   tt__format_bytes(a, sizeof a, total),
+                   tt__format_bytes(b, sizeof b, u.grid),
+                   tt__format_bytes(c, sizeof c, u.mesh),
+                   tt__format_bytes(d, sizeof d, u.tin),
+                   tt__format_bytes(e, sizeof e, r->opt->max_memory));
+}
+
+/* Before an insertion: when the next one grows the vertex or slot arrays
+ * (by tt__grow's 1.5 steps), the room they grow to must fit. */
+static tt_status mem_check_growth(refine *r)
+{
+  const tt__mesh *m = &r->m;
+  if (!r->opt->max_memory ||
+      (m->nv + 1 <= m->vcap && m->nslots + 2 <= m->tcap &&
+       m->nslots + 2 <= r->ccap && r->heap.n + 3 <= r->heap.cap))
+    return TT_OK;
+  size_t nv = m->vcap + m->vcap / 2, nt = m->tcap + m->tcap / 2;
+  return mem_check(r, nv < m->nv + 1 ? m->nv + 1 : nv,
+                   nt < m->nslots + 2 ? m->nslots + 2 : nt);
+}
+
 static tt_status oom(refine *r)
 {
+  mem_use u;
+  char a[32];
+  mem_count(r, r->m.vcap, r->m.tcap, &u);
   return tt__error(r->ctx, TT_ERR_NOMEM,
-                   "out of memory after %zu vertices and %zu triangles",
-                   r->m.nv, r->m.nlive);
+                   "out of memory %s, at %zu vertices and %zu triangles "
+                   "(the run held about %s)", r->phase, r->m.nv, r->m.nlive,
+                   tt__format_bytes(a, sizeof a, u.grid + u.mesh));
 }
 
 /* Per-slot arrays follow the mesh's slot count. */
@@ -373,10 +449,6 @@ static tt_status start(refine *r, size_t valid)
     if (s != TT_OK)
       return s;
     r->forced = r->m.nv - before;
-    if (r->max_points && r->m.nv > r->max_points)
-      tt__warn(r->ctx, "the outline of the nodata areas needs %zu "
-               "vertices, more than the point limit %zu", r->m.nv,
-               r->max_points);
   }
   /* every slot written so far is logged: scan them all */
   if (!drain(r))
@@ -564,20 +636,44 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       r.max_points = p;
   }
   if (r.max_points == 0 && (opt->percent > 0))
-    r.max_points = 1; /* below the start: stop at once (warned below) */
+    r.max_points = 1; /* below the start: refused below */
 
   tt_stop_reason reason = TT_STOP_NONE;
+  r.phase = "while building the starting triangulation";
   status = start(&r, valid);
+  if (status == TT_OK)
+    status = mem_check(&r, r.m.vcap, r.m.tcap);
   if (status != TT_OK)
     goto done;
-  if (r.max_points && r.m.nv > r.max_points)
-    tt__warn(ctx, "the point limit %zu is below the %zu vertices of the "
-             "starting triangulation, which is returned as it is",
-             r.max_points, r.m.nv);
-  if (r.max_tris && r.m.nlive > r.max_tris)
-    tt__warn(ctx, "the triangle limit %zu is below the %zu triangles of the "
-             "starting triangulation, which is returned as it is",
-             r.max_tris, r.m.nlive);
+  /* Every limit is exact: a budget below what the start needs (the four
+   * corners, or the hull and the nodata outline's forced vertices, which
+   * the run cannot drop) is refused before any insertion, with the count
+   * to ask for instead. */
+  char why[96];
+  if (r.forced)
+    snprintf(why, sizeof why, "%zu of its %zu vertices forced by the nodata "
+             "outline", r.forced, r.m.nv);
+  else
+    snprintf(why, sizeof why, "%s", valid == grid->nx * grid->ny
+                                        ? "the grid's four corners"
+                                        : "the valid samples' convex hull");
+  if (r.max_points && r.m.nv > r.max_points) {
+    status = tt__error(ctx, TT_ERR_LIMIT, "the point limit %zu%s is below "
+                       "the %zu vertices the starting triangulation needs "
+                       "(%s); ask for at least %zu", r.max_points,
+                       opt->percent > 0 && r.max_points != opt->max_points
+                           ? " (from the percentage)" : "",
+                       r.m.nv, why, r.m.nv);
+    goto done;
+  }
+  if (r.max_tris && r.m.nlive > r.max_tris) {
+    status = tt__error(ctx, TT_ERR_LIMIT, "the triangle limit %zu is below "
+                       "the %zu triangles the starting triangulation needs "
+                       "(%s); ask for at least %zu", r.max_tris, r.m.nlive,
+                       why, r.m.nlive);
+    goto done;
+  }
+  r.phase = "while inserting";
   r.e0 = tt__heap_size(&r.heap) ? tt__heap_top(&r.heap).key : 0;
   if (opt->progress && !opt->progress(0.0, "inserting", opt->progress_arg)) {
     status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
@@ -611,6 +707,9 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       reason = TT_STOP_MAX_TRIANGLES;
       break;
     }
+    status = mem_check_growth(&r);
+    if (status != TT_OK)
+      goto done;
     int32_t v;
     if (!add_vertex(&r, (int32_t)col, (int32_t)row, err, &v)) {
       status = oom(&r);
@@ -649,6 +748,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
    * would give one of its triangles an error above the larger of max_error
    * and the worst error left is refused, so the bound the loop reached
    * still holds. */
+  r.phase = "in the final optimisation pass";
   if (!tt__optimize_final(&r.m, r.crit, &r.env, opt->optimize, r.repair,
                           fmax(r.max_error, tt__heap_size(&r.heap)
                                                 ? tt__heap_top(&r.heap).key
@@ -666,6 +766,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.cand = NULL;
   r.cerr = NULL;
   tt__edge_stack_free(&r.stack);
+  r.phase = "while building the TIN's records";
+  status = mem_check(&r, r.m.nv, r.m.nlive);
+  if (status != TT_OK)
+    goto done;
   double t_meshed = tt__now();
   status = tt__tin_build(ctx, &r.m, grid, r.ins_err, r.pool, out_tin);
   r.ins_err = NULL; /* taken over by the tin, or freed on failure */

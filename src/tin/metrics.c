@@ -181,7 +181,9 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   slot_to_tri = malloc((m->nslots ? m->nslots : 1) * sizeof *slot_to_tri);
   t_sq = malloc((m->nlive ? m->nlive : 1) * sizeof *t_sq);
   if (!slot_to_tri || !t_sq) {
-    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory while measuring "
+                       "the TIN of %zu vertices and %zu triangles",
+                       m->nv, m->nlive);
     goto done;
   }
   memcpy(tin->gt, g->gt, sizeof tin->gt);
@@ -211,7 +213,9 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   order = malloc((m->nlive ? m->nlive : 1) * sizeof *order);
   first = calloc(g->ny + 1, sizeof *first);
   if (!order || !first) {
-    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory while measuring "
+                       "the TIN of %zu vertices and %zu triangles",
+                       m->nv, m->nlive);
     goto done;
   }
   /* slot_to_tri holds each live slot's top row for the two passes of the
@@ -240,7 +244,9 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   size_t nchunks = (nt + CHUNK - 1) / CHUNK;
   chunks = calloc(nchunks ? nchunks : 1, sizeof *chunks);
   if (!chunks) {
-    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory while measuring "
+                       "the TIN of %zu vertices and %zu triangles",
+                       m->nv, m->nlive);
     goto done;
   }
   stats_job_arg ja = {m, g, order, tin, t_sq, chunks, nt};

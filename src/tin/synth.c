@@ -158,26 +158,6 @@ const char *tt_synth_kind_name(tt_synth_kind kind)
   return synth_kind_names[kind];
 }
 
-/* ASCII case-insensitive comparison where '-' matches '_'. */
-static bool synth_name_equal(const char *a, const char *b)
-{
-  for (;; a++, b++) {
-    char ca = *a, cb = *b;
-    if (ca >= 'A' && ca <= 'Z')
-      ca = (char)(ca - 'A' + 'a');
-    if (cb >= 'A' && cb <= 'Z')
-      cb = (char)(cb - 'A' + 'a');
-    if (ca == '-')
-      ca = '_';
-    if (cb == '-')
-      cb = '_';
-    if (ca != cb)
-      return false;
-    if (ca == '\0')
-      return true;
-  }
-}
-
 tt_status tt_synth_kind_parse(tt_context *ctx, const char *name,
                               tt_synth_kind *out_kind)
 {
@@ -185,7 +165,7 @@ tt_status tt_synth_kind_parse(tt_context *ctx, const char *name,
     return tt__error(ctx, TT_ERR_ARG, "synthetic terrain kind and out_kind "
                      "must not be NULL");
   for (size_t i = 0; i < SYNTH_KIND_COUNT; i++) {
-    if (synth_name_equal(name, synth_kind_names[i])) {
+    if (tt__name_equal(name, synth_kind_names[i])) {
       *out_kind = (tt_synth_kind)i;
       return TT_OK;
     }

@@ -216,6 +216,94 @@ static void test_simplify_usage_errors(void)
   CHECK_USAGE("before the command", "-max_error", "1", "simplify", "a", "b");
 }
 
+/* Issue 11, "Messages and limits": each message says the true cause, and
+ * the parser is as strict as the docs say. */
+static void test_issue11_parsing(void)
+{
+  tt_app_options *o = NULL;
+  const tt_app_settings *s;
+  /* a subnormal limit is a number >= 0, not a malformed one */
+  PARSE_OK(o, "simplify", "-max_error", "1e-320", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->max_error > 0 && s->max_error < 1e-300);
+  tt_app_options_destroy(o);
+  /* 20 digits are too many, as 2^64 - 1 is: "above the limit" for both */
+  CHECK_USAGE("above the limit", "simplify", "-max_points",
+              "99999999999999999999", "a", "b");
+  CHECK_USAGE("above the limit", "simplify", "-max_points",
+              "18446744073709551615", "a", "b");
+  CHECK_USAGE("above the limit", "simplify", "-max_triangles",
+              "99999999999999999999", "a", "b");
+  /* no hex, inf or nan where a finite decimal number is meant */
+  CHECK_USAGE("-max_error", "simplify", "-max_error", "0x10", "a", "b");
+  CHECK_USAGE("-max_error", "simplify", "-max_error", " 5", "a", "b");
+  CHECK_USAGE("-percent", "simplify", "-percent", "0x1p4", "a", "b");
+  CHECK_USAGE("-z_factor", "simplify", "-z_factor", "infinity", "a", "b");
+  CHECK_USAGE("-srcnodata", "simplify", "-srcnodata", "0x10", "a", "b");
+  CHECK_USAGE("-srcnodata", "simplify", "-srcnodata", "inf", "a", "b");
+  CHECK_USAGE("-displacement", "generate", "fault", "o.tif",
+              "-displacement", "0x10");
+  /* --opt is -opt; ---opt is no option */
+  CHECK_USAGE("unknown option '---max_error'", "simplify", "---max_error",
+              "1", "a", "b");
+  PARSE_OK(o, "simplify", "--max_error", "1", "a", "b");
+  tt_app_options_destroy(o);
+  /* names are matched without regard to case, as option names are */
+  PARSE_OK(o, "simplify", "-criterion", "DELAUNAY", "-repair", "Local",
+           "-optimize", "LOOKAHEAD", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->criterion == TT_CRITERION_DELAUNAY);
+  CHECK(s && s->repair == TT_REPAIR_LOCAL);
+  CHECK(s && s->optimize == TT_OPTIMIZE_LOOKAHEAD);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "simplify", "-criterion", "Min_Area", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->criterion == TT_CRITERION_MIN_AREA);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "generate", "FAULT", "o.tif");
+  tt_app_options_destroy(o);
+  /* --debug takes GDAL's booleans only */
+  CHECK_USAGE("--debug must be on, off", "simplify", "a", "b", "--debug",
+              "maybe");
+  PARSE_OK(o, "simplify", "a", "b", "--debug", "OFF");
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "simplify", "a", "b", "--debug", "1");
+  tt_app_options_destroy(o);
+  /* -threads and -max_memory */
+  PARSE_OK(o, "simplify", "-threads", "4", "-max_memory", "500M", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->threads == 4);
+  CHECK(s && s->max_memory == (size_t)500 << 20);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "simplify", "-threads", "all_cpus", "-max_memory", "1.5GB",
+           "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->threads == -1);
+  CHECK(s && s->max_memory == (size_t)3 << 29);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "eval", "-max_memory", "1048576", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->max_memory == 1048576);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "simplify", "-max_memory", "2GiB", "a", "b");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->max_memory == (size_t)2 << 30);
+  tt_app_options_destroy(o);
+  CHECK_USAGE("-threads must be", "simplify", "-threads", "0", "a", "b");
+  CHECK_USAGE("-threads must be", "simplify", "-threads", "two", "a", "b");
+  CHECK_USAGE("above the limit", "simplify", "-threads", "100000", "a", "b");
+  CHECK_USAGE("-max_memory must be", "simplify", "-max_memory", "0", "a",
+              "b");
+  CHECK_USAGE("-max_memory must be", "simplify", "-max_memory", "5X", "a",
+              "b");
+  CHECK_USAGE("-max_memory must be", "simplify", "-max_memory", "-1G", "a",
+              "b");
+  CHECK_USAGE("above the limit", "simplify", "-max_memory", "99999999T",
+              "a", "b");
+  CHECK_USAGE("does not apply", "generate", "fault", "o.tif", "-threads",
+              "2");
+}
+
 static void test_help_and_version(void)
 {
   tt_app_options *o = NULL;
@@ -676,6 +764,7 @@ int main(void)
   test_simplify_defaults();
   test_simplify_all_options();
   test_simplify_usage_errors();
+  test_issue11_parsing();
   test_help_and_version();
   test_generate();
   test_eval();

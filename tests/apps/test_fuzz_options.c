@@ -10,13 +10,14 @@
  *  - ctest (default): a plain main() replays every file of the checked-in
  *    corpus, $TT_CORPUS/options/ (or the files and folders named on the
  *    command line), so every past crash stays a test without clang.
- *  - libFuzzer: define TT_FUZZ_LIBFUZZER and link with -fsanitize=fuzzer,
- *    e.g. with a clang build of the libraries in /tmp/build-fuzz:
- *      clang -DTT_FUZZ_LIBFUZZER -fsanitize=fuzzer,address,undefined \
- *        -Iinclude -Iapps -I/usr/include/gdal tests/apps/test_fuzz_options.c \
- *        /tmp/build-fuzz/libterratin_app.a /tmp/build-fuzz/libterratin_gdal.a \
- *        /tmp/build-fuzz/libterratin.a -lgdal -lproj -lm -o fuzz_options
- *      ./fuzz_options tests/corpus/options
+ *  - libFuzzer (docs/fuzzing.md): TT_FUZZ_LIBFUZZER defined, linked with
+ *    -fsanitize=fuzzer; CMake does it with clang and -DTT_FUZZ=ON:
+ *      cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DTT_FUZZ=ON
+ *      cmake --build build-fuzz -j2 --target fuzz_options
+ *      build-fuzz/tests/fuzz_options -max_total_time=60 RUN_DIR \
+ *        tests/corpus/options
+ *    A failed REQUIRE aborts, which libFuzzer reports as a crash and saves
+ *    the input of.
  *    New crashes go into tests/corpus/options/ named after their issue;
  *    the cov-* files there are a coverage corpus merged from such runs
  *    (./fuzz_options -merge=1 NEW_DIR tests/corpus/options RUN_DIR).
@@ -61,6 +62,7 @@ static void check_settings(const tt_app_settings *s)
   REQUIRE(s->percent == 0 || (s->percent > 0 && s->percent <= 100));
   REQUIRE(isfinite(s->z_factor) && s->z_factor != 0);
   REQUIRE(s->max_points <= TT_MAX_VERTICES);
+  REQUIRE(s->threads >= -1 && s->threads <= TT_APP_MAX_THREADS);
   REQUIRE(valid_list(s->lco, 1) && valid_list(s->dsco, 1));
   size_t nconfig = 0;
   REQUIRE(s->config != NULL);

@@ -425,6 +425,64 @@ static void test_errors(void)
   tt_grid_destroy(g);
 }
 
+/* Issue 11: every budget is exact, so one below the starting
+ * triangulation is refused before any insertion, with the count; and
+ * max_memory stops a run that would pass it with the phase and the size,
+ * while a run that fits is unchanged by it. */
+static void test_budgets_and_memory(void)
+{
+  tt_grid *g = terrain(120, 90, 4, 3);
+  tt_refine_options opt;
+  tt_tin *tin = NULL;
+  for (size_t n = 1; n <= 3; n++) {
+    tt_refine_options_init(&opt);
+    opt.max_points = n;
+    CHECK_INT_EQ(tt_refine_run(ctx, g, &opt, &tin), TT_ERR_LIMIT);
+    CHECK(tin == NULL);
+    CHECK(strstr(tt_context_errmsg(ctx), "ask for at least 4") != NULL);
+  }
+  tt_refine_options_init(&opt);
+  opt.max_triangles = 1;
+  CHECK_INT_EQ(tt_refine_run(ctx, g, &opt, &tin), TT_ERR_LIMIT);
+  CHECK(strstr(tt_context_errmsg(ctx), "at least 2") != NULL);
+  tt_refine_options_init(&opt);
+  opt.max_error = -1;
+  opt.percent = 0.01; /* 1 of 10800 samples */
+  CHECK_INT_EQ(tt_refine_run(ctx, g, &opt, &tin), TT_ERR_LIMIT);
+  CHECK(strstr(tt_context_errmsg(ctx), "from the percentage") != NULL);
+  tt_refine_options_init(&opt);
+  opt.max_points = 4;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
+  CHECK_INT_EQ(tt_tin_vertex_count(tin), 4);
+  tt_tin_destroy(tin);
+  tin = NULL;
+
+  /* a dense TIN in 1 MiB: refused while inserting, naming the sizes */
+  tt_refine_options_init(&opt);
+  opt.max_error = 0;
+  opt.max_memory = (size_t)1 << 20;
+  CHECK_INT_EQ(tt_refine_run(ctx, g, &opt, &tin), TT_ERR_NOMEM);
+  CHECK(tin == NULL);
+  const char *m = tt_context_errmsg(ctx);
+  CHECK(strstr(m, "while inserting") != NULL);
+  CHECK(strstr(m, "more than the memory limit of 1.0 MiB") != NULL);
+  /* the heights alone pass a few KiB: refused at the start */
+  opt.max_memory = 4096;
+  CHECK_INT_EQ(tt_refine_run(ctx, g, &opt, &tin), TT_ERR_NOMEM);
+  CHECK(strstr(tt_context_errmsg(ctx), "starting triangulation") != NULL);
+  /* with room to spare: the same TIN as without a limit */
+  opt.max_memory = (size_t)1 << 30;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
+  tt_tin *ref = NULL;
+  opt.max_memory = 0;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &ref));
+  CHECK_INT_EQ(tt_tin_vertex_count(tin), tt_tin_vertex_count(ref));
+  CHECK_INT_EQ(tt_tin_triangle_count(tin), tt_tin_triangle_count(ref));
+  tt_tin_destroy(tin);
+  tt_tin_destroy(ref);
+  tt_grid_destroy(g);
+}
+
 /* The worker pool changes nothing: 1 and 3 threads give the same TIN and
  * the same statistics. */
 static void test_threads(void)
@@ -589,6 +647,7 @@ int main(void)
   test_flat_and_plane();
   test_nodata();
   test_errors();
+  test_budgets_and_memory();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
