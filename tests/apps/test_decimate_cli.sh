@@ -84,6 +84,7 @@ usage "bad method" simplify -method melt dem.tif u.gpkg
 usage "bad start" simplify -method decimate -start greedy:x dem.tif u.gpkg
 usage "bad importance" simplify -method decimate -importance size dem.tif u.gpkg
 usage "onepass sequential" simplify -method decimate -onepass -selection sequential dem.tif u.gpkg
+usage "max_memory with decimate" simplify -method decimate -percent 5 -max_memory 1G dem.tif u.gpkg
 usage "dp for l2" simplify -method decimate -hole dp -criterion l2 dem.tif u.gpkg
 [ ! -e u.gpkg ] && pass || fail "a usage error left u.gpkg"
 
