@@ -29,6 +29,10 @@ struct tt_tin {
   /* georeference */
   double gt[6];
   double frame[4];
+  /* the vertices' ground points, scale factors and convergences (struct
+   * tt_grid), NULL when the grid had none */
+  double *vgxy;
+  float *vgk, *vgconv;
   tt_tin_summary summary;
 };
 
