@@ -350,13 +350,15 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
                          double *out_max)
 {
   const float *z = tt_grid_heights_const(grid);
+  const double *zd = tt_grid_heights_f64_const(grid); /* grid of doubles */
   size_t n = tt_grid_width(grid) * tt_grid_height(grid);
   double lo = INFINITY, hi = -INFINITY;
   for (size_t i = 0; i < n; i++) {
-    if (isnan(z[i]))
+    double v = z ? (double)z[i] : zd[i];
+    if (isnan(v))
       continue;
-    if (z[i] < lo) lo = z[i];
-    if (z[i] > hi) hi = z[i];
+    if (v < lo) lo = v;
+    if (v > hi) hi = v;
   }
   *out_min = lo;
   *out_max = hi;

@@ -191,6 +191,16 @@ void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4]);
  * convergence. tt_grid_drop_ground_points() returns to the affine frame.
  * The accessors return NULL when the grid has no ground points. */
 tt_status tt_grid_alloc_ground_points(tt_context *ctx, tt_grid *grid);
+/* The area of a triangle on the ground from its corners' map coordinates
+ * (the geotransform's x, y of three pixel centres), for a frame whose
+ * plane triangles are not the ground's (the glue gives geodesic areas for
+ * a geographic CRS); params: four numbers the function reads. A TIN made
+ * from the grid then reports these areas (tt_triangle_info.area_2d, and
+ * area_3d in proportion). NULL: areas in the frame. */
+typedef double (*tt_area_fn)(const double params[4], const double x[3],
+                             const double y[3]);
+void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
+                         const double params[4]);
 void tt_grid_drop_ground_points(tt_grid *grid);
 double *tt_grid_ground_xy(tt_grid *grid);
 float *tt_grid_ground_scale(tt_grid *grid);

@@ -247,6 +247,14 @@ void tt_grid_drop_ground_points(tt_grid *grid)
   grid->gk = grid->gconv = NULL;
 }
 
+void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
+                         const double params[4])
+{
+  grid->area_fn = fn;
+  for (int k = 0; k < 4; k++)
+    grid->area_par[k] = fn ? params[k] : 0;
+}
+
 double *tt_grid_ground_xy(tt_grid *grid) { return grid->gxy; }
 float *tt_grid_ground_scale(tt_grid *grid) { return grid->gk; }
 float *tt_grid_ground_convergence(tt_grid *grid) { return grid->gconv; }

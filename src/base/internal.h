@@ -48,6 +48,8 @@ struct tt_grid {
    * the projection's +y to true north (gconv, radians clockwise). */
   double *gxy;
   float *gk, *gconv;
+  tt_area_fn area_fn;  /* tt_grid_set_area_fn, or NULL */
+  double area_par[4];
 };
 
 /* Sample i (row-major) of a grid, at its own precision. */

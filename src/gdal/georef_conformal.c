@@ -49,6 +49,7 @@
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
+#include <geodesic.h>
 #include <ogr_srs_api.h>
 
 #define TT_PI 3.14159265358979323846
@@ -146,6 +147,23 @@ done:
   return work;
 }
 
+/* Geodesic area of a triangle of longitudes x and latitudes y (in the
+ * CRS's angular unit) on the ellipsoid of params (a, f, degrees per
+ * unit): GeographicLib's geod_polygonarea. */
+static double geodesic_area(const double params[4], const double x[3],
+                            const double y[3])
+{
+  struct geod_geodesic g;
+  geod_init(&g, params[0], params[1]);
+  double lat[3], lon[3], area = 0, perimeter = 0;
+  for (int k = 0; k < 3; k++) {
+    lon[k] = x[k] * params[2];
+    lat[k] = y[k] * params[2];
+  }
+  geod_polygonarea(&g, lat, lon, 3, &area, &perimeter);
+  return fabs(area);
+}
+
 tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
                                    const char *work_srs, tt_grid *grid,
                                    char *out_name, size_t name_size,
@@ -202,7 +220,7 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     }
     CPLPopErrorHandler();
     const char *nm = OSRGetName(work);
-    snprintf(work_name, sizeof work_name, "%s (-work_srs %s)",
+    snprintf(work_name, sizeof work_name, "%s (%s)",
              nm ? nm : "unnamed", work_srs);
   } else {
     work = choose(srs, lon0, lat0, lon_min, lon_max, lat_min, lat_max,
@@ -317,14 +335,18 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   s = tt_grid_set_ground_frame(ctx, grid, centre_frame);
   if (s != TT_OK)
     goto done;
+  const double area_par[4] = {a, f, deg, 0};
+  tt_grid_set_area_fn(grid, geodesic_area, area_par);
   double err_max = fmax(fabs(kmax - 1.0), fabs(kmin - 1.0));
   *out_scale_error = err_max;
   snprintf(out_name, name_size, "%s, per vertex; scale %.6f to %.6f "
            "(%.2g%% off over the whole DEM)", work_name, kmin, kmax,
            100 * err_max);
 done:
-  if (s != TT_OK)
+  if (s != TT_OK) {
     tt_grid_drop_ground_points(grid);
+    tt_grid_set_area_fn(grid, NULL, NULL);
+  }
   free(lx);
   free(ly);
   free(ok);

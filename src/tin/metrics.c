@@ -159,6 +159,8 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   }
   memcpy(tin->gt, g->gt, sizeof tin->gt);
   memcpy(tin->frame, g->frame, sizeof tin->frame);
+  tin->area_fn = g->area_fn;
+  memcpy(tin->area_par, g->area_par, sizeof tin->area_par);
   if (g->gxy) {
     size_t v1 = m->nv ? m->nv : 1;
     tin->vgxy = malloc(2 * v1 * sizeof *tin->vgxy);

@@ -139,6 +139,20 @@ tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
   o->area_2d = 0.5 * fabs(cross2);
   double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = cross2;
   o->area_3d = 0.5 * sqrt(nx * nx + ny * ny + nz * nz);
+  if (tin->area_fn) {
+    /* the ground's own area (geodesic), area_3d in proportion */
+    const double *gt = tin->gt;
+    double mx[3], my[3];
+    for (int k = 0; k < 3; k++) {
+      int32_t v = tin->tv[3 * index + k];
+      double px = tin->vc[v] + 0.5, py = tin->vr[v] + 0.5;
+      mx[k] = gt[0] + px * gt[1] + py * gt[2];
+      my[k] = gt[3] + px * gt[4] + py * gt[5];
+    }
+    double ga = tin->area_fn(tin->area_par, mx, my);
+    o->area_3d = o->area_2d > 0 ? o->area_3d * (ga / o->area_2d) : ga;
+    o->area_2d = ga;
+  }
   /* plane z = gx X + gy Y + c: gradient (gx, gy) = -(nx, ny) / nz */
   double gx = -nx / nz, gy = -ny / nz;
   double grad = hypot(gx, gy);

@@ -33,6 +33,8 @@ struct tt_tin {
    * tt_grid), NULL when the grid had none */
   double *vgxy;
   float *vgk, *vgconv;
+  tt_area_fn area_fn;    /* the grid's, or NULL */
+  double area_par[4];
   tt_tin_summary summary;
 };
 
