@@ -410,8 +410,10 @@ tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
     snprintf(out_name, name_size, "%s, affine at the centre%s%s", work_name,
              centre, corners);
     /* An affine frame cannot follow a grid much larger than a UTM zone:
-     * say so rather than measure angles that mean little. */
-    if (isfinite(corner_error) && corner_error > 0.01)
+     * say so rather than measure angles that mean little. A geographic
+     * grid gets ground points instead (georef_conformal.c), which warns
+     * itself if it cannot. */
+    if (isfinite(corner_error) && corner_error > 0.01 && !geographic)
       tt__warn(ctx, "the grid is large for one affine frame: the ground "
                "frame strays %.2g%% from %s at the grid's corners; angles, "
                "areas and the Delaunay test are approximate there (tile "

@@ -683,7 +683,7 @@ int main(void)
   test_warped(p);
   test_vertical_crs(p);
 
-  /* Twenty degrees in one frame: said in the frame's name and warned. */
+  /* Twenty degrees: ground points in an oblique stereographic, named. */
   GDALDatasetH jd = GDALOpen(p, GA_ReadOnly);
   const char *targv[] = {"-of", "VRT", "-a_ullr", "-100", "50", "-80", "30",
                          NULL};
