@@ -386,6 +386,10 @@ typedef struct tt_tin_summary {
 void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary);
 size_t tt_tin_vertex_count(const tt_tin *tin);
 size_t tt_tin_triangle_count(const tt_tin *tin);
+/* Non-zero when the triangles' areas come from the grid's area function
+ * (tt_grid_set_area_fn: geodesic for a geographic DEM) rather than the
+ * ground frame. */
+int tt_tin_has_area_fn(const tt_tin *tin);
 
 typedef struct tt_vertex_info {
   int32_t col, row;       /* source sample */

@@ -153,8 +153,15 @@ done:
 static double geodesic_area(const double params[4], const double x[3],
                             const double y[3])
 {
-  struct geod_geodesic g;
-  geod_init(&g, params[0], params[1]);
+  /* geod_init's series coefficients, kept per thread for the last
+   * ellipsoid (the writer asks for every triangle's area) */
+  static _Thread_local struct geod_geodesic g;
+  static _Thread_local double ga = 0, gf = -1;
+  if (ga != params[0] || gf != params[1]) {
+    geod_init(&g, params[0], params[1]);
+    ga = params[0];
+    gf = params[1];
+  }
   double lat[3], lon[3], area = 0, perimeter = 0;
   for (int k = 0; k < 3; k++) {
     lon[k] = x[k] * params[2];

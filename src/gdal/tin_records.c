@@ -153,6 +153,11 @@ static tt_status prepare_crs(tt__records *w, tt_context *ctx,
       geod_init(&w->geod, a, invf > 0 ? 1.0 / invf : 0.0);
       w->deg_per_unit = deg;
       w->geodesic = geo_srs == w->out_srs ? 1 : 2;
+      /* the TIN's own areas are already geodesic on the input's
+       * ellipsoid (georef_conformal.c): no second computation */
+      if (tt_tin_has_area_fn(tin) && srs && OSRIsGeographic(srs) &&
+          (w->geodesic == 2 || OSRIsSameGeogCS(w->out_srs, srs)))
+        w->geodesic = 0;
     } else {
       tt__warn(ctx, "the output CRS is geographic but has no usable "
                "ellipsoid: triangle areas are those of the ground frame");

@@ -52,6 +52,7 @@ void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary)
 
 size_t tt_tin_vertex_count(const tt_tin *tin) { return tin->nv; }
 size_t tt_tin_triangle_count(const tt_tin *tin) { return tin->nt; }
+int tt_tin_has_area_fn(const tt_tin *tin) { return tin->area_fn != NULL; }
 
 tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
                         tt_vertex_info *out_vertex)
