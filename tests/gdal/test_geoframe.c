@@ -485,6 +485,43 @@ done:
   tt_raster_info_destroy(info);
 }
 
+/* The frame for the extent, and its scale error over the DEM. */
+static void test_frame_choice(void)
+{
+  static const struct {
+    double lon0, lat_top, step;
+    size_t nx, ny;
+    const char *want;
+    double max_error;
+  } cases[] = {
+      {-100.0, 50.0, 0.25, 80, 20, "Lambert conformal conic", 4e-3},
+      {20.0, 3.0, 0.25, 80, 24, "Mercator", 4e-3},
+      {-30.0, 90.0, 0.25, 120, 24, "polar stereographic (north pole", 1e-2},
+      {170.0, -80.5, 0.25, 40, 30, "polar stereographic (south pole", 1e-2},
+      {8.0, 48.0, 0.1, 40, 40, "UTM zone 32N (EPSG:32632)", 1e-3},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    tt_raster_info *info = NULL;
+    tt_grid *g = make_dem(cases[i].nx, cases[i].ny, cases[i].lon0,
+                          cases[i].lat_top, cases[i].step, sea_floor, &info);
+    if (!g)
+      continue;
+    if (!strstr(info->frame_name, cases[i].want))
+      TT_FAIL_("frame \"%s\" is not %s", info->frame_name, cases[i].want);
+    CHECK_DBL_LE(info->frame_scale_error, cases[i].max_error);
+    /* the TIN's slopes are finite and its triangles have area */
+    tt_tin *tin = refine(g, 50.0, NULL);
+    for (size_t t = 0; tin && t < tt_tin_triangle_count(tin); t++) {
+      tt_triangle_info ti;
+      tt_tin_triangle(tin, t, &ti);
+      CHECK(ti.area_2d > 0 && isfinite(ti.slope_deg));
+    }
+    tt_tin_destroy(tin);
+    tt_grid_destroy(g);
+    tt_raster_info_destroy(info);
+  }
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -493,6 +530,7 @@ int main(void)
   test_srtm_57n();
   test_ten_degrees();
   test_sixty_degrees();
+  test_frame_choice();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
