@@ -522,6 +522,37 @@ static void test_frame_choice(void)
   }
 }
 
+/* Over MAX_MEMORY with the ground points, the affine frame stays. */
+static void test_memory_limit(void)
+{
+  const char *td = getenv("TT_TESTDATA");
+  if (!td)
+    return;
+  char path[1024];
+  snprintf(path, sizeof path, "%s/jacksboro_fault_dem.tif", td);
+  GDALDatasetH ds = GDALOpen(path, GA_ReadOnly);
+  if (!ds) {
+    TT_FAIL_("cannot open %s", path);
+    return;
+  }
+  /* 138,632 samples: 0.55 MB of heights, 3.9 MB with ground points */
+  char *opts[] = {"MAX_MEMORY=2000000", NULL};
+  size_t warnings = tt_context_warning_count(ctx);
+  tt_grid *g = NULL;
+  tt_raster_info *info = NULL;
+  CHECK_OK(ctx, tt_gdal_read_grid(ctx, GDALGetRasterBand(ds, 1), opts, NULL,
+                                  NULL, &g, &info));
+  if (g) {
+    printf("MAX_MEMORY=2000000: frame %s\n", info->frame_name);
+    CHECK(tt_grid_ground_xy(g) == NULL);
+    CHECK(strstr(info->frame_name, "affine at the centre") != NULL);
+    CHECK_INT_EQ(tt_context_warning_count(ctx), warnings + 1);
+  }
+  tt_grid_destroy(g);
+  tt_raster_info_destroy(info);
+  GDALClose(ds);
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -531,6 +562,7 @@ int main(void)
   test_ten_degrees();
   test_sixty_degrees();
   test_frame_choice();
+  test_memory_limit();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
