@@ -292,6 +292,7 @@ tt_status tt__app_simplify(app_run *r)
       {"out_crs", TT_FIELD_STRING, s->t_srs ? s->t_srs : "", 0, 0},
       {"frame", TT_FIELD_STRING, info->frame_name ? info->frame_name : "", 0,
        0},
+      {"scale_err", TT_FIELD_REAL, NULL, 0, info->frame_scale_error},
       {"version", TT_FIELD_STRING, tt_version(), 0, 0},
       {"t_read", TT_FIELD_REAL, NULL, 0, rep.t_read},
       {"t_simplify", TT_FIELD_REAL, NULL, 0, rep.t_simplify},

@@ -174,6 +174,38 @@ tt_status tt_grid_set_ground_frame(tt_context *ctx, tt_grid *grid,
                                    const double a[4]);
 void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4]);
 
+/* Ground points: for a grid whose pixels map to the ground through no
+ * affine frame (longitude/latitude), every sample's position in a
+ * conformal working projection. tt_grid_alloc_ground_points() makes room
+ * for them (24 bytes a sample) and the caller fills, per sample i
+ * (row-major): xy[2i], xy[2i+1] the projected x, y (any origin; differences
+ * must be ground lengths times the scale), scale[i] the projection's scale
+ * factor k there (projected length / ground length) and convergence[i] the
+ * angle, radians clockwise, from the projection's +y to true north. The
+ * ground frame (tt_grid_set_ground_frame) must still be set, to the
+ * projection's Jacobian near the centre: it gives the pixel-space
+ * orientation and the fallbacks. Once filled, the Delaunay test runs on the
+ * points with exact adaptive predicates (triangle orientation stays exact
+ * in pixel space), criteria measure angles on them, and a TIN's triangle
+ * areas, slopes and aspects divide out the local scale and turn by the
+ * convergence. tt_grid_drop_ground_points() returns to the affine frame.
+ * The accessors return NULL when the grid has no ground points. */
+tt_status tt_grid_alloc_ground_points(tt_context *ctx, tt_grid *grid);
+/* The area of a triangle on the ground from its corners' map coordinates
+ * (the geotransform's x, y of three pixel centres), for a frame whose
+ * plane triangles are not the ground's (the glue gives geodesic areas for
+ * a geographic CRS); params: four numbers the function reads. A TIN made
+ * from the grid then reports these areas (tt_triangle_info.area_2d, and
+ * area_3d in proportion). NULL: areas in the frame. */
+typedef double (*tt_area_fn)(const double params[4], const double x[3],
+                             const double y[3]);
+void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
+                         const double params[4]);
+void tt_grid_drop_ground_points(tt_grid *grid);
+double *tt_grid_ground_xy(tt_grid *grid);
+float *tt_grid_ground_scale(tt_grid *grid);
+float *tt_grid_ground_convergence(tt_grid *grid);
+
 /* Checks the heights: refuses infinities and heights beyond
  * +-TT_MAX_HEIGHT (naming the first row/column) and counts the valid
  * (non-NaN) samples. out_valid may be NULL. */
@@ -438,6 +470,10 @@ typedef struct tt_tin_summary {
 void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary);
 size_t tt_tin_vertex_count(const tt_tin *tin);
 size_t tt_tin_triangle_count(const tt_tin *tin);
+/* Non-zero when the triangles' areas come from the grid's area function
+ * (tt_grid_set_area_fn: geodesic for a geographic DEM) rather than the
+ * ground frame. */
+int tt_tin_has_area_fn(const tt_tin *tin);
 
 typedef struct tt_vertex_info {
   int32_t col, row;       /* source sample */

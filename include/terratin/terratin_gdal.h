@@ -46,6 +46,9 @@ typedef struct tt_raster_info {
   double frame[4];        /* ground frame set on the grid */
   char *frame_name;       /* "geotransform", "UTM zone 17N (EPSG:32617),
                              affine at the centre (...)", ... */
+  double frame_scale_error; /* largest |k - 1| of the frame's scale factor
+                             k over the samples for a frame of ground
+                             points (geographic CRS), else NaN */
   char *z_unit_declared;  /* the height unit as the file declares it, ""
                              when it does not */
   char *z_unit_source;    /* "band unit", "vertical CRS" or "" */

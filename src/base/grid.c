@@ -152,6 +152,7 @@ void tt_grid_destroy(tt_grid *grid)
     return;
   free(grid->z);
   free(grid->zd);
+  tt_grid_drop_ground_points(grid);
   free(grid);
 }
 
@@ -221,6 +222,42 @@ void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4])
 {
   memcpy(out_a, grid->frame, 4 * sizeof(double));
 }
+
+tt_status tt_grid_alloc_ground_points(tt_context *ctx, tt_grid *grid)
+{
+  tt_grid_drop_ground_points(grid);
+  size_t n = grid->nx * grid->ny;
+  grid->gxy = malloc(2 * n * sizeof *grid->gxy);
+  grid->gk = malloc(n * sizeof *grid->gk);
+  grid->gconv = malloc(n * sizeof *grid->gconv);
+  if (!grid->gxy || !grid->gk || !grid->gconv) {
+    tt_grid_drop_ground_points(grid);
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the ground "
+                     "points of %zu samples (24 bytes each)", n);
+  }
+  return TT_OK;
+}
+
+void tt_grid_drop_ground_points(tt_grid *grid)
+{
+  free(grid->gxy);
+  free(grid->gk);
+  free(grid->gconv);
+  grid->gxy = NULL;
+  grid->gk = grid->gconv = NULL;
+}
+
+void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
+                         const double params[4])
+{
+  grid->area_fn = fn;
+  for (int k = 0; k < 4; k++)
+    grid->area_par[k] = fn ? params[k] : 0;
+}
+
+double *tt_grid_ground_xy(tt_grid *grid) { return grid->gxy; }
+float *tt_grid_ground_scale(tt_grid *grid) { return grid->gk; }
+float *tt_grid_ground_convergence(tt_grid *grid) { return grid->gconv; }
 
 /* The first sample of row r that is infinite or beyond TT_MAX_HEIGHT, or
  * -1; counts the row's valid samples into *valid. One loop per precision:

@@ -42,6 +42,14 @@ struct tt_grid {
   double *zd;        /* the same, as doubles */
   double gt[6];      /* GDAL geotransform */
   double frame[4];   /* ground frame: pixel step -> ground units */
+  /* Ground points (tt_grid_alloc_ground_points), NULL when the affine frame
+   * measures everything: per sample, x and y in a conformal working
+   * projection (gxy, 2 doubles), its scale factor (gk) and the angle from
+   * the projection's +y to true north (gconv, radians clockwise). */
+  double *gxy;
+  float *gk, *gconv;
+  tt_area_fn area_fn;  /* tt_grid_set_area_fn, or NULL */
+  double area_par[4];
 };
 
 /* Sample i (row-major) of a grid, at its own precision. */

@@ -3,7 +3,8 @@
  * vectors, normals, angles, and the quadrilateral of an edge.
  *
  * Everything is measured on the ground: a vertex at pixel (c, r) with
- * height z sits at (a0 c + a1 r, a2 c + a3 r, z), a = grid->frame (or, when
+ * height z sits at (a0 c + a1 r, a2 c + a3 r, z), a = grid->frame, or at
+ * its ground point (x, y, z) when the mesh has them (mesh.h) (or, when
  * the environment has no grid, a frame with the same metric and
  * orientation, from mesh->metric). Points are taken relative to one vertex
  * of the neighbourhood (integer pixel differences are exact), so
@@ -58,6 +59,18 @@ static inline void tt__geo_frame(const tt__crit_env *env, double out_a[4])
 static inline tt__gvec tt__geo_vec(const double a[4], const tt__mesh *m,
                                    int32_t from, int32_t to)
 {
+  if (m->gxy) {
+    /* ground points: the conformal projection's own coordinates (angles
+     * true, lengths times the local scale factor, within 1e-3 of 1 for
+     * the frames georef_conformal.c picks over a zone) */
+    const double *p = m->gxy + 2 * ((size_t)m->v[from].r * m->gnx +
+                                    (size_t)m->v[from].c);
+    const double *q = m->gxy + 2 * ((size_t)m->v[to].r * m->gnx +
+                                    (size_t)m->v[to].c);
+    tt__gvec g = {q[0] - p[0], q[1] - p[1],
+                  tt__mesh_z(m, to) - tt__mesh_z(m, from)};
+    return g;
+  }
   double dc = (double)((int64_t)m->v[to].c - m->v[from].c);
   double dr = (double)((int64_t)m->v[to].r - m->v[from].r);
   tt__gvec g = {a[0] * dc + a[1] * dr, a[2] * dc + a[3] * dr,

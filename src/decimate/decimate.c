@@ -752,6 +752,7 @@ static tt_status build_tin(run *r, tt_tin **out_tin)
   tt_status status = TT_OK;
   tt__mesh c;
   tt__mesh_init(&c, &m->metric);
+  tt__mesh_use_ground_points(&c, m->gxy, m->gnx);
   int32_t *map = malloc((m->nv ? m->nv : 1) * sizeof *map);
   double *ins = NULL, *imp = NULL;
   if (!map || !tt__mesh_reserve(&c, d->nvert, m->nlive) ||
@@ -848,6 +849,7 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
   tt__metric metric;
   tt__metric_from_frame(grid->frame, &metric);
   tt__mesh_init(&d->m, &metric);
+  tt__mesh_use_ground_points(&d->m, grid->gxy, grid->nx);
   tt__heap_init(&r.heap);
   if (grid->zd && !tt__mesh_keep_f64(&d->m)) {
     tt__mesh_free(&d->m);

@@ -30,4 +30,26 @@ TT_HIDDEN tt_status tt__georef_ground_frame(tt_context *ctx,
                                             char *out_name,
                                             size_t name_size);
 
+/* The UTM zone (UPS beyond 84 N / 80 S, WGS 84 only) of a point at
+ * (lon, lat) degrees on srs's datum; out_name gets e.g. "UTM zone 17N
+ * (EPSG:32617)". NULL when none fits. The caller destroys it. */
+TT_HIDDEN OGRSpatialReferenceH tt__georef_utm_of(OGRSpatialReferenceH srs,
+                                                 double lon, double lat,
+                                                 char *out_name,
+                                                 size_t name_size);
+
+/* Ground points for a grid in a geographic CRS (georef_conformal.c):
+ * projects every sample into a conformal working projection suited to the
+ * extent (or work_srs), fills the grid's ground points (tt_grid_alloc_
+ * ground_points) and sets its ground frame to the projection's Jacobian at
+ * the centre. out_name describes the frame; out_scale_error gets the
+ * largest |k - 1| over the samples. TT_ERR_ARG for an unusable work_srs;
+ * other failures leave the grid as it was and return the status. */
+TT_HIDDEN tt_status tt__georef_ground_points(tt_context *ctx,
+                                             OGRSpatialReferenceH srs,
+                                             const char *work_srs,
+                                             tt_grid *grid, char *out_name,
+                                             size_t name_size,
+                                             double *out_scale_error);
+
 #endif /* TT_GEOREF_H */

@@ -199,9 +199,9 @@ static void epsg_of(OGRSpatialReferenceH srs, char *buf, size_t size)
 
 /* The UTM (or UPS) working CRS of a centre at (lon, lat) on srs's datum.
  * out_name gets e.g. "UTM zone 17N (EPSG:32617)". NULL when none fits. */
-static OGRSpatialReferenceH utm_of(OGRSpatialReferenceH srs, double lon,
-                                   double lat, char *out_name,
-                                   size_t name_size)
+OGRSpatialReferenceH tt__georef_utm_of(OGRSpatialReferenceH srs,
+                                       double lon, double lat,
+                                       char *out_name, size_t name_size)
 {
   OGRSpatialReferenceH geog = OSRCloneGeogCS(srs);
   OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(NULL);
@@ -382,7 +382,7 @@ tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
   double lon = 0, lat = 0;
   int have_centre = centre_lonlat(srs, gt, nx, ny, &lon, &lat);
   if (!work && have_centre)
-    work = utm_of(srs, lon, lat, work_name, sizeof work_name);
+    work = tt__georef_utm_of(srs, lon, lat, work_name, sizeof work_name);
 
   double frame[4], corner_error = NAN;
   int ok = work && jacobian(srs, work, gt, nx, ny, frame, &corner_error) &&
@@ -410,8 +410,10 @@ tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
     snprintf(out_name, name_size, "%s, affine at the centre%s%s", work_name,
              centre, corners);
     /* An affine frame cannot follow a grid much larger than a UTM zone:
-     * say so rather than measure angles that mean little. */
-    if (isfinite(corner_error) && corner_error > 0.01)
+     * say so rather than measure angles that mean little. A geographic
+     * grid gets ground points instead (georef_conformal.c), which warns
+     * itself if it cannot. */
+    if (isfinite(corner_error) && corner_error > 0.01 && !geographic)
       tt__warn(ctx, "the grid is large for one affine frame: the ground "
                "frame strays %.2g%% from %s at the grid's corners; angles, "
                "areas and the Delaunay test are approximate there (tile "

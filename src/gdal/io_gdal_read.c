@@ -763,6 +763,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     goto done;
   }
   char frame_name[512] = "geotransform";
+  double frame_scale_error = NAN;
   if (srs || opt.work_srs) {
     double frame[4];
     s = tt__georef_ground_frame(ctx, srs, opt.work_srs, gt, nx, ny, frame,
@@ -779,6 +780,38 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       s = TT_OK;
     } else if (s == TT_OK) {
       s = tt_grid_set_ground_frame(ctx, grid, frame);
+      /* Longitude/latitude: every sample projected into a conformal
+       * frame (georef_conformal.c); the affine frame stays only when
+       * that fails. */
+      /* 24 bytes a sample beside the heights' 4: over MAX_MEMORY, the
+       * affine frame stays, with a warning */
+      size_t n = nx * ny, with_points = n <= SIZE_MAX / 28 ? n * 28
+                                                           : SIZE_MAX;
+      if (s == TT_OK && srs && OSRIsGeographic(srs) &&
+          with_points > opt.max_memory) {
+        char need_s[32], max_s[32];
+        tt__warn(ctx, "%s: the heights and ground points of %zu x %zu "
+                 "samples would need %s, more than %s (%s): keeping the "
+                 "affine frame %s", path, nx, ny,
+                 fmt_bytes(need_s, sizeof need_s, with_points),
+                 opt.max_memory_default ? "3/4 of this machine's physical "
+                                          "memory"
+                                        : "MAX_MEMORY",
+                 fmt_bytes(max_s, sizeof max_s, opt.max_memory), frame_name);
+      } else if (s == TT_OK && srs && OSRIsGeographic(srs)) {
+        char conformal_name[512];
+        s = tt__georef_ground_points(ctx, srs, opt.work_srs, grid,
+                                     conformal_name, sizeof conformal_name,
+                                     &frame_scale_error);
+        if (s == TT_OK) {
+          snprintf(frame_name, sizeof frame_name, "%s", conformal_name);
+        } else if (s != TT_ERR_ARG) {
+          tt__warn(ctx, "%s: %s; keeping the affine frame %s", path,
+                   ctx ? ctx->errmsg : "", frame_name);
+          tt_context_clear_error(ctx);
+          s = TT_OK;
+        }
+      }
     }
     if (s != TT_OK) {
       s = with_path(ctx, s, path);
@@ -921,6 +954,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   info->datatype = dup_str(GDALGetDataTypeName(dtype));
   tt_grid_get_ground_frame(grid, info->frame);
   info->frame_name = dup_str(frame_name);
+  info->frame_scale_error = frame_scale_error;
   if (!info->path || !info->driver || !info->z_unit ||
       !info->z_unit_declared || !info->z_unit_source ||
       !info->area_or_point || !info->datatype || !info->frame_name) {

@@ -13,9 +13,12 @@
  * (its corners 1 and 2 swap where T_SRS mirrors the plane).
  *
  * Areas: per-triangle area_2d and area_3d come from the TIN (the ground
- * frame, metres) when the output CRS is projected or absent. When it is
- * geographic, area_2d is the geodesic area of the triangle whose corners
- * are the output longitudes and latitudes, on the output CRS's ellipsoid
+ * frame, metres) when the output CRS and the input CRS are projected or
+ * absent. When the output CRS is geographic, area_2d is the geodesic area
+ * of the triangle whose corners are the output longitudes and latitudes,
+ * on the output CRS's ellipsoid; when only the input CRS is (T_SRS
+ * projects a geographic DEM), the same from the input's longitudes and
+ * latitudes on the input's ellipsoid
  * (GeographicLib's geod_polygonarea, shipped with PROJ), and area_3d keeps
  * the TIN's ratio area_3d / area_2d, which is 1 / cos(slope) of the
  * triangle's plane. Slope, aspect and angles stay those of the ground
@@ -149,17 +152,28 @@ static tt_status prepare_crs(tt__records *w, tt_context *ctx,
     if (!w->out_srs)
       return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
   }
-  if (w->out_srs && OSRIsGeographic(w->out_srs)) {
+  /* geodesic areas on the output's ellipsoid when it is geographic, else
+   * on the input's when that is (a projected T_SRS of a geographic DEM) */
+  OGRSpatialReferenceH geo_srs =
+      w->out_srs && OSRIsGeographic(w->out_srs) ? w->out_srs
+      : srs && OSRIsGeographic(srs)              ? srs
+                                                 : NULL;
+  if (geo_srs) {
     OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
-    double a = OSRGetSemiMajor(w->out_srs, &e1);
-    double invf = OSRGetInvFlattening(w->out_srs, &e2);
-    double deg = OSRGetAngularUnits(w->out_srs, NULL) * 180.0 /
+    double a = OSRGetSemiMajor(geo_srs, &e1);
+    double invf = OSRGetInvFlattening(geo_srs, &e2);
+    double deg = OSRGetAngularUnits(geo_srs, NULL) * 180.0 /
                  3.14159265358979323846;
     if (e1 == OGRERR_NONE && e2 == OGRERR_NONE && a > 0 && isfinite(a) &&
         invf >= 0 && isfinite(invf) && deg > 0 && isfinite(deg)) {
       geod_init(&w->geod, a, invf > 0 ? 1.0 / invf : 0.0);
       w->deg_per_unit = deg;
-      w->geodesic = 1;
+      w->geodesic = geo_srs == w->out_srs ? 1 : 2;
+      /* the TIN's own areas are already geodesic on the input's
+       * ellipsoid (georef_conformal.c): no second computation */
+      if (tt_tin_has_area_fn(tin) && srs && OSRIsGeographic(srs) &&
+          (w->geodesic == 2 || OSRIsSameGeogCS(w->out_srs, srs)))
+        w->geodesic = 0;
     } else {
       tt__warn(ctx, "the output CRS is geographic but has no usable "
                "ellipsoid: triangle areas are those of the ground frame");
@@ -224,8 +238,8 @@ tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
   if (r->geodesic) {
     double lats[3], lons[3], area = 0, perimeter = 0;
     for (int k = 0; k < 3; k++) {
-      lons[k] = out_x[k] * r->deg_per_unit;
-      lats[k] = out_y[k] * r->deg_per_unit;
+      lons[k] = (r->geodesic == 1 ? out_x[k] : out_v[k].x) * r->deg_per_unit;
+      lats[k] = (r->geodesic == 1 ? out_y[k] : out_v[k].y) * r->deg_per_unit;
     }
     geod_polygonarea(&r->geod, lats, lons, 3, &area, &perimeter);
     area = fabs(area);

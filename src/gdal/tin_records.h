@@ -47,7 +47,9 @@ typedef struct tt__records {
   const tt_tin *tin;
   OGRSpatialReferenceH out_srs; /* the layers' CRS (owned), NULL: none */
   double *xy;                   /* T_SRS: 2 doubles per vertex, else NULL */
-  int geodesic;                 /* the output CRS is geographic */
+  int geodesic;                 /* geodesic areas: 1 from the output
+                                   coordinates (geographic output CRS),
+                                   2 from the input's (geographic input) */
   struct geod_geodesic geod;
   double deg_per_unit;          /* output angular unit in degrees */
 } tt__records;

@@ -268,9 +268,27 @@ int tt__mesh_orient(const tt__mesh *m, int32_t a, int32_t b, int32_t c)
                       m->v[c].r);
 }
 
+void tt__mesh_use_ground_points(tt__mesh *m, const double *gxy, size_t nx)
+{
+  m->gxy = gxy;
+  m->gnx = nx;
+}
+
+static inline const double *ground_point(const tt__mesh *m, int32_t v)
+{
+  return m->gxy + 2 * ((size_t)m->v[v].r * m->gnx + (size_t)m->v[v].c);
+}
+
 int tt__mesh_incircle(const tt__mesh *m, int32_t a, int32_t b, int32_t c,
                       int32_t d)
 {
+  if (m->gxy) {
+    const double *pa = ground_point(m, a), *pb = ground_point(m, b),
+                 *pc = ground_point(m, c);
+    int o = tt__orient2d(pa, pb, pc);
+    if (o != 0)
+      return o * tt__incircle(pa, pb, pc, ground_point(m, d));
+  }
   return tt__incircle_metric(&m->metric, m->v[a].c, m->v[a].r, m->v[b].c,
                              m->v[b].r, m->v[c].c, m->v[c].r, m->v[d].c,
                              m->v[d].r);

@@ -56,6 +56,11 @@ typedef struct tt__mesh {
   size_t nfree, freecap;
   /* the ground frame */
   tt__metric metric;
+  /* the grid's ground points (tt__mesh_use_ground_points), or NULL: the
+   * conformal x, y of the sample at (c, r) are gxy[2 (r gnx + c)] and the
+   * next double */
+  const double *gxy;
+  size_t gnx;
   /* slots written since the caller last drained the log */
   int32_t *touched;
   size_t ntouched, touchedcap;
@@ -112,8 +117,19 @@ TT_HIDDEN int32_t tt__mesh_add_triangle(tt__mesh *m, int32_t a, int32_t b,
  * live triangles (used once after building a starting triangulation). */
 TT_HIDDEN bool tt__mesh_link_all(tt__mesh *m);
 
+/* Measures the Delaunay test on a grid's ground points (its gxy, an nx-wide
+ * grid) instead of the affine metric; NULL keeps the metric. Call it before
+ * the first triangle. */
+TT_HIDDEN void tt__mesh_use_ground_points(tt__mesh *m, const double *gxy,
+                                          size_t nx);
+
 /* Ground-frame orientation of three vertices / incircle of four (d inside
- * the circle through a, b, c given counter-clockwise: > 0). Exact. */
+ * the circle through a, b, c given counter-clockwise: > 0). Exact.
+ * Orientation is always the pixel-space one (the mesh's topology); with
+ * ground points the incircle is the adaptive exact test on them, signed by
+ * their own orientation of a, b, c (a triangle can only turn the other way
+ * there when it is a sliver long enough for the projection to bend it; its
+ * pixel-space metric test decides then if that orientation is zero). */
 TT_HIDDEN int tt__mesh_orient(const tt__mesh *m, int32_t a, int32_t b,
                               int32_t c);
 TT_HIDDEN int tt__mesh_incircle(const tt__mesh *m, int32_t a, int32_t b,

@@ -219,6 +219,7 @@ tt_status tt_optimize_run(tt_context *ctx, const tt_grid *grid,
   tt__metric metric;
   tt__metric_from_frame(grid->frame, &metric);
   tt__mesh_init(&m, &metric);
+  tt__mesh_use_ground_points(&m, grid->gxy, grid->nx);
   tt__crit_env env = {&m, grid, NULL};
   double *ins_err = NULL;
   st = rebuild(ctx, grid, ntriangles, pix_xyz, &m);

@@ -606,6 +606,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   tt__metric metric;
   tt__metric_from_frame(grid->frame, &metric);
   tt__mesh_init(&r.m, &metric);
+  tt__mesh_use_ground_points(&r.m, grid->gxy, grid->nx);
   tt__heap_init(&r.heap);
   r.env.mesh = &r.m;
   r.env.grid = grid;

@@ -188,6 +188,25 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   }
   memcpy(tin->gt, g->gt, sizeof tin->gt);
   memcpy(tin->frame, g->frame, sizeof tin->frame);
+  tin->area_fn = g->area_fn;
+  memcpy(tin->area_par, g->area_par, sizeof tin->area_par);
+  if (g->gxy) {
+    size_t v1 = m->nv ? m->nv : 1;
+    tin->vgxy = malloc(2 * v1 * sizeof *tin->vgxy);
+    tin->vgk = malloc(v1 * sizeof *tin->vgk);
+    tin->vgconv = malloc(v1 * sizeof *tin->vgconv);
+    if (!tin->vgxy || !tin->vgk || !tin->vgconv) {
+      status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+      goto done;
+    }
+    for (size_t v = 0; v < m->nv; v++) {
+      size_t i = (size_t)m->v[v].r * g->nx + (size_t)m->v[v].c;
+      tin->vgxy[2 * v] = g->gxy[2 * i];
+      tin->vgxy[2 * v + 1] = g->gxy[2 * i + 1];
+      tin->vgk[v] = g->gk[i];
+      tin->vgconv[v] = g->gconv[i];
+    }
+  }
   for (size_t v = 0; v < m->nv; v++) {
     if (vmap[v] < 0)
       continue;

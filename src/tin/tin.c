@@ -28,6 +28,9 @@ void tt_tin_destroy(tt_tin *tin)
   free(tin->t_max);
   free(tin->t_rmse);
   free(tin->t_n);
+  free(tin->vgxy);
+  free(tin->vgk);
+  free(tin->vgconv);
   free(tin);
 }
 
@@ -50,6 +53,7 @@ void tt_tin_get_summary(const tt_tin *tin, tt_tin_summary *out_summary)
 
 size_t tt_tin_vertex_count(const tt_tin *tin) { return tin->nv; }
 size_t tt_tin_triangle_count(const tt_tin *tin) { return tin->nt; }
+int tt_tin_has_area_fn(const tt_tin *tin) { return tin->area_fn != NULL; }
 
 tt_status tt_tin_vertex(const tt_tin *tin, size_t index,
                         tt_vertex_info *out_vertex)
@@ -81,6 +85,33 @@ static double angle_at(const double p[2], const double q[2], const double r[2])
   return atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy);
 }
 
+/* The corners of triangle index on the ground, relative to the first, from
+ * the ground points: the conformal coordinates divided by the mean scale
+ * factor of the corners and turned by their mean convergence, so that +y
+ * is true north and lengths are metres (to the second order in the
+ * triangle's size: the scale and the convergence vary smoothly). */
+static void ground_corners(const tt_tin *tin, size_t index, double p[3][2])
+{
+  const int32_t *tv = tin->tv + 3 * index;
+  double k = 0, sc = 0, cc = 0;
+  for (int j = 0; j < 3; j++) {
+    k += tin->vgk[tv[j]];
+    sc += sin(tin->vgconv[tv[j]]);
+    cc += cos(tin->vgconv[tv[j]]);
+  }
+  k /= 3;
+  /* a direction at grid azimuth A has true azimuth A - conv: turn the
+   * vectors counter-clockwise by conv */
+  double conv = atan2(sc, cc), cs = cos(conv) / k, sn = sin(conv) / k;
+  const double *o = tin->vgxy + 2 * (size_t)tv[0];
+  for (int j = 0; j < 3; j++) {
+    const double *q = tin->vgxy + 2 * (size_t)tv[j];
+    double x = q[0] - o[0], y = q[1] - o[1];
+    p[j][0] = cs * x - sn * y;
+    p[j][1] = sn * x + cs * y;
+  }
+}
+
 tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
                           tt_triangle_info *out_triangle)
 {
@@ -99,6 +130,8 @@ tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
     p[k][1] = a[2] * dc + a[3] * dr;
     z[k] = tt__tin_z(tin, (size_t)v);
   }
+  if (tin->vgxy)
+    ground_corners(tin, index, p);
   o->max_error = tin->t_max[index];
   o->rmse = tin->t_rmse[index];
   o->samples = (size_t)tin->t_n[index];
@@ -109,6 +142,20 @@ tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
   o->area_2d = 0.5 * fabs(cross2);
   double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = cross2;
   o->area_3d = 0.5 * sqrt(nx * nx + ny * ny + nz * nz);
+  if (tin->area_fn) {
+    /* the ground's own area (geodesic), area_3d in proportion */
+    const double *gt = tin->gt;
+    double mx[3], my[3];
+    for (int k = 0; k < 3; k++) {
+      int32_t v = tin->tv[3 * index + k];
+      double px = tin->vc[v] + 0.5, py = tin->vr[v] + 0.5;
+      mx[k] = gt[0] + px * gt[1] + py * gt[2];
+      my[k] = gt[3] + px * gt[4] + py * gt[5];
+    }
+    double ga = tin->area_fn(tin->area_par, mx, my);
+    o->area_3d = o->area_2d > 0 ? o->area_3d * (ga / o->area_2d) : ga;
+    o->area_2d = ga;
+  }
   /* plane z = gx X + gy Y + c: gradient (gx, gy) = -(nx, ny) / nz */
   double gx = -nx / nz, gy = -ny / nz;
   double grad = hypot(gx, gy);

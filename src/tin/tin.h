@@ -31,6 +31,12 @@ struct tt_tin {
   /* georeference */
   double gt[6];
   double frame[4];
+  /* the vertices' ground points, scale factors and convergences (struct
+   * tt_grid), NULL when the grid had none */
+  double *vgxy;
+  float *vgk, *vgconv;
+  tt_area_fn area_fn;    /* the grid's, or NULL */
+  double area_par[4];
   tt_tin_summary summary;
 };
 

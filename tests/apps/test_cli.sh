@@ -484,7 +484,7 @@ if [ -f "$J" ]; then
   run simplify -json -max_error 10 "$J" out/geo.gpkg
   check "geographic DEM: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
   check "-json: frame UTM zone 16N" \
-    grep -q '"frame": "UTM zone 16N (EPSG:32616), affine at the centre' out.txt
+    grep -q '"frame": "UTM zone 16N (EPSG:32616), per vertex; scale ' out.txt
   check "-json: crs, z unit, pixel_is, valid samples" python3 -c '
 import json, sys
 d = json.load(open("out.txt"))
@@ -500,7 +500,7 @@ assert d["valid_samples"] == 138632, d'
      ogrinfo -q out/geo.gpkg run_parameters | grep -q "valid (Integer64) = 138632"'
   run simplify -max_error 10 "$J" out/geo_line.gpkg
   check "summary line: CRS, frame, z unit" grep -q \
-    "138632 valid samples -> .*; CRS WGS 84 (EPSG:4326); frame UTM zone 16N (EPSG:32616), affine at the centre .*; z unit m (band unit); .* s$" out.txt
+    "138632 valid samples -> .*; CRS WGS 84 (EPSG:4326); frame UTM zone 16N (EPSG:32616), per vertex; scale .* off over the whole DEM); z unit m (band unit); .* s$" out.txt
   run simplify -q -max_error 10 -t_srs EPSG:32616 "$J" out/utm.gpkg
   check "-t_srs: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
   check "-t_srs: the layers are in UTM 16N" \
@@ -519,7 +519,7 @@ assert 700000 < x0 < 800000, eu'
   run simplify -q -max_error 10 -work_srs EPSG:32617 "$J" out/w17.gpkg
   check "-work_srs: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
   check "-work_srs: the frame names it" bash -c \
-    'ogrinfo -q out/w17.gpkg run_parameters | grep -q "frame (String) = WGS 84 / UTM zone 17N (EPSG:32617), affine"'
+    'ogrinfo -q out/w17.gpkg run_parameters | grep -q "frame (String) = WGS 84 / UTM zone 17N (EPSG:32617), per vertex"'
   rm -f out/*
   expect_failure "-work_srs geographic" 2 out simplify -work_srs EPSG:4326 "$J" out/x.gpkg
   expect_failure "-work_srs garbage" 2 out simplify -work_srs NOT_A_CRS "$J" out/x.gpkg

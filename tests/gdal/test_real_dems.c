@@ -124,9 +124,17 @@ static void test_jacksboro(void)
     snprintf(what, sizeof what, "jacksboro.tif at %g m", bounds[i]);
     if (a)
       check_against_eval(tif, a, bounds[i], what);
-    /* same heights, same grid: the AAIGrid copy gives the same TIN */
-    if (a && b)
-      CHECK(same_tin(a, b));
+    /* same heights, same grid: the AAIGrid copy gives the same TIN in
+     * the affine frame. Its origin differs in the tenth decimal of a
+     * degree (ASCII), which moves the ground points (issue 18) by 1e-5 m:
+     * enough to decide some of the grid's near-co-circular quads the
+     * other way, so with ground points only the sizes agree closely. */
+    if (a && b) {
+      size_t na = tt_tin_vertex_count(a), nb = tt_tin_vertex_count(b);
+      printf("jacksboro at %g m: %zu vertices (.tif), %zu (.asc)\n",
+             bounds[i], na, nb);
+      CHECK(na <= nb + nb / 100 && nb <= na + na / 100);
+    }
     if (a && again)
       CHECK(same_tin(a, again));
     tt_tin_destroy(a);
@@ -137,6 +145,17 @@ static void test_jacksboro(void)
     if (d)
       check_against_eval(dem, d, bounds[i], what);
     tt_tin_destroy(d);
+  }
+  /* the affine frame (ground points dropped): the same TIN exactly */
+  tt_grid_drop_ground_points(tif);
+  tt_grid_drop_ground_points(asc);
+  for (size_t i = 0; i < sizeof bounds / sizeof bounds[0]; i++) {
+    tt_tin *a = refine(tif, bounds[i], 0);
+    tt_tin *b = refine(asc, bounds[i], 0);
+    if (a && b)
+      CHECK(same_tin(a, b));
+    tt_tin_destroy(a);
+    tt_tin_destroy(b);
   }
 out:
   tt_grid_destroy(tif);
