@@ -228,24 +228,6 @@ static tt_status parse_options(tt_context *ctx, char **options,
   return TT_OK;
 }
 
-/* "31.2 KiB", "1.5 GiB": sizes for messages. */
-static const char *fmt_bytes(char *buf, size_t size, size_t bytes)
-{
-  static const char *const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB",
-                                      "PiB", "EiB"};
-  double v = (double)bytes;
-  int u = 0;
-  while (v >= 1024.0 && u < 6) {
-    v /= 1024.0;
-    u++;
-  }
-  if (u == 0)
-    snprintf(buf, size, "%zu bytes", bytes);
-  else
-    snprintf(buf, size, "%.1f %s", v, units[u]);
-  return buf;
-}
-
 /* Prefixes the context's current message with "path: ". */
 static tt_status with_path(tt_context *ctx, tt_status s, const char *path)
 {
@@ -441,17 +423,17 @@ static tt_status widen_grid(tt_context *ctx, const char *path, tt_grid *g,
                      "%zu (%.17g) is not exactly a float, so the %zu x %zu "
                      "heights are kept as doubles, which needs %s while they "
                      "are converted, more than %s (%s)", path, r, c, h,
-                     g->nx, g->ny, fmt_bytes(need_s, sizeof need_s, need),
+                     g->nx, g->ny, tt__format_bytes(need_s, sizeof need_s, need),
                      opt->max_memory_default ? "3/4 of this machine's "
                                                "physical memory"
                                              : "MAX_MEMORY",
-                     fmt_bytes(max_s, sizeof max_s, opt->max_memory));
+                     tt__format_bytes(max_s, sizeof max_s, opt->max_memory));
   if (!tt__grid_widen(g))
     return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory: the height at "
                      "row %zu, column %zu (%.17g) is not exactly a float, "
                      "and the %zu x %zu heights as doubles need %s", path, r,
                      c, h, g->nx, g->ny,
-                     fmt_bytes(need_s, sizeof need_s, n * 8));
+                     tt__format_bytes(need_s, sizeof need_s, n * 8));
   return TT_OK;
 }
 
@@ -677,10 +659,10 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     char need_s[32], max_s[32];
     s = tt__error(ctx, TT_ERR_LIMIT, "%s: the %zu x %zu heights need %s, "
                   "more than %s (%s); refused before reading", path, nx, ny,
-                  fmt_bytes(need_s, sizeof need_s, need),
+                  tt__format_bytes(need_s, sizeof need_s, need),
                   opt.max_memory_default ? opt.max_memory_source
                                          : "MAX_MEMORY",
-                  fmt_bytes(max_s, sizeof max_s, opt.max_memory));
+                  tt__format_bytes(max_s, sizeof max_s, opt.max_memory));
     goto done;
   }
 
@@ -793,11 +775,11 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
         tt__warn(ctx, "%s: the heights and ground points of %zu x %zu "
                  "samples would need %s, more than %s (%s): keeping the "
                  "affine frame %s", path, nx, ny,
-                 fmt_bytes(need_s, sizeof need_s, with_points),
+                 tt__format_bytes(need_s, sizeof need_s, with_points),
                  opt.max_memory_default ? "3/4 of this machine's physical "
                                           "memory"
                                         : "MAX_MEMORY",
-                 fmt_bytes(max_s, sizeof max_s, opt.max_memory), frame_name);
+                 tt__format_bytes(max_s, sizeof max_s, opt.max_memory), frame_name);
       } else if (s == TT_OK && srs && OSRIsGeographic(srs)) {
         char conformal_name[512];
         s = tt__georef_ground_points(ctx, srs, opt.work_srs, grid,

@@ -17,59 +17,20 @@
 #include "optimize/anneal.h"
 
 #include "base/heap.h"
+#include "base/random.h"
 #include "criteria/geometry.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* --- the generator: xoshiro256** seeded by splitmix64 ------------------- */
-
-typedef struct rng {
-  uint64_t s[4];
-} rng;
-
-static uint64_t splitmix64(uint64_t *x)
-{
-  uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
-static void rng_seed(rng *g, uint64_t seed)
-{
-  for (int i = 0; i < 4; i++)
-    g->s[i] = splitmix64(&seed);
-}
-
-static inline uint64_t rotl(uint64_t x, int k)
-{
-  return (x << k) | (x >> (64 - k));
-}
-
-static uint64_t rng_next(rng *g)
-{
-  uint64_t *s = g->s;
-  uint64_t out = rotl(s[1] * 5, 7) * 9;
-  uint64_t t = s[1] << 17;
-  s[2] ^= s[0];
-  s[3] ^= s[1];
-  s[1] ^= s[2];
-  s[0] ^= s[3];
-  s[2] ^= t;
-  s[3] = rotl(s[3], 45);
-  return out;
-}
-
-/* Uniform in [0, 1), 53 bits. */
-static double rng_unit(rng *g)
-{
-  return (double)(rng_next(g) >> 11) * 0x1.0p-53;
-}
+/* --- the generator: base/random.h (xoshiro256**) ------------------------ */
 
 /* Uniform in [0, n), n > 0 (the modulo bias is below n / 2^64). */
-static uint64_t rng_below(rng *g, uint64_t n) { return rng_next(g) % n; }
+static uint64_t rng_below(tt__rng *g, uint64_t n)
+{
+  return tt__rng_next(g) % n;
+}
 
 /* --- the run's state ----------------------------------------------------- */
 
@@ -328,7 +289,7 @@ static bool do_swap(ann *a, int32_t e, double d, bool *out_done)
 
 /* A random swappable half-edge, or -1 when none was found in a long run
  * of draws (a mesh with no swappable edge left). */
-static int32_t draw(ann *a, rng *g)
+static int32_t draw(ann *a, tt__rng *g)
 {
   const tt__mesh *m = a->m;
   uint64_t nh = 3 * (uint64_t)m->nslots;
@@ -392,8 +353,8 @@ bool tt__anneal_run_log(tt__mesh *m, const tt__criterion_vt *crit,
   a.best_tol = TT__OPT_PAIR_EPS * scale;
   long S = (long)ceil(sper * (double)a.st.edges);
   long G = (long)ceil(gper * (double)a.st.edges);
-  rng g;
-  rng_seed(&g, opt ? opt->seed : 0);
+  tt__rng g;
+  tt__rng_seed(&g, opt ? opt->seed : 0);
   ok = heap_all(&a);
   bool lex = crit->id == TT_CRITERION_MINMAX_ANGLE_LEX ||
              crit->id == TT_CRITERION_ABN;
@@ -420,7 +381,7 @@ bool tt__anneal_run_log(tt__mesh *m, const tt__criterion_vt *crit,
       double d = crit->swap_value(env, e);
       if (isnan(d))
         continue;
-      bool take = d >= -a.tol || rng_unit(&g) < exp(d / t);
+      bool take = d >= -a.tol || tt__rng_unit(&g) < exp(d / t);
       if (!take)
         continue;
       bool done;

@@ -27,6 +27,7 @@
  * allocated beyond that.
  */
 #include "base/internal.h"
+#include "base/random.h"
 
 #include <float.h>
 #include <math.h>
@@ -52,58 +53,10 @@
 
 static const double synth_pi = 3.14159265358979323846;
 
-/* ---------------------------------------------------------------------------
- * Random numbers: xoshiro256** seeded by splitmix64 (both public-domain
- * algorithms by Blackman and Vigna), written here from their description.
- * ------------------------------------------------------------------------- */
-typedef struct synth_rng {
-  uint64_t s[4];
-} synth_rng;
-
-static uint64_t splitmix64_next(uint64_t *x)
-{
-  uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
-static void rng_seed(synth_rng *rng, uint64_t seed)
-{
-  uint64_t x = seed;
-  for (int i = 0; i < 4; i++)
-    rng->s[i] = splitmix64_next(&x);
-}
-
-static uint64_t rotl64(uint64_t v, int k)
-{
-  return (v << k) | (v >> (64 - k));
-}
-
-static uint64_t rng_next(synth_rng *rng)
-{
-  uint64_t *s = rng->s;
-  uint64_t result = rotl64(s[1] * 5, 7) * 9;
-  uint64_t t = s[1] << 17;
-  s[2] ^= s[0];
-  s[3] ^= s[1];
-  s[1] ^= s[2];
-  s[0] ^= s[3];
-  s[2] ^= t;
-  s[3] = rotl64(s[3], 45);
-  return result;
-}
-
-/* Uniform in [0, 1), 53 random bits. */
-static double rng_uniform(synth_rng *rng)
-{
-  return (double)(rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
-}
-
 /* Uniform in [-1, 1). */
-static double rng_signed(synth_rng *rng)
+static double rng_signed(tt__rng *rng)
 {
-  return 2.0 * rng_uniform(rng) - 1.0;
+  return 2.0 * tt__rng_unit(rng) - 1.0;
 }
 
 /* ---------------------------------------------------------------------------
@@ -302,13 +255,13 @@ static tt_status synth_fault(tt_context *ctx, const tt_synth_options *opt,
     goto done;
   }
 
-  synth_rng rng;
-  rng_seed(&rng, opt->seed);
+  tt__rng rng;
+  tt__rng_seed(&rng, opt->seed);
   const double cx = 0.5 * (double)(nx - 1), cy = 0.5 * (double)(ny - 1);
   const double diag = sqrt(4.0 * cx * cx + 4.0 * cy * cy);
   for (size_t k = 0; k < n; k++) {
-    double t = 2.0 * synth_pi * rng_uniform(&rng);
-    double o = (rng_uniform(&rng) - 0.5) * diag;
+    double t = 2.0 * synth_pi * tt__rng_unit(&rng);
+    double o = (tt__rng_unit(&rng) - 0.5) * diag;
     lines[3 * k + 0] = cos(t);
     lines[3 * k + 1] = sin(t);
     lines[3 * k + 2] = o;
@@ -376,7 +329,7 @@ done:
 typedef struct synth_ds {
   float *z;
   size_t n;
-  synth_rng rng;
+  tt__rng rng;
   size_t peak, valley;   /* sample indices of the seeds, SIZE_MAX: none */
   double hi, lo;         /* clamp range of unseeded samples */
   double seed_height;
@@ -404,7 +357,7 @@ static void synth_diamond_square(const tt_synth_options *opt, tt_grid *grid)
   const double amp = opt->amplitude, rough = opt->roughness;
   ds.z = grid->z;
   ds.n = n;
-  rng_seed(&ds.rng, opt->seed);
+  tt__rng_seed(&ds.rng, opt->seed);
   ds.peak = ds.valley = SIZE_MAX;
   ds.hi = INFINITY;
   ds.lo = -INFINITY;
