@@ -6,8 +6,8 @@
  *
  *   options.c   the option table, parsing, the options object
  *   help.c      the help texts
- *   run.c       tt_app_run, GDAL messages, failures, opening and reading
- *               the DEM, choosing the output driver
+ *   run.c       tt_app_run, GDAL messages, failures, the output driver
+ *   dem.c       opening the DEM and reading it into a grid
  *   progress.c  the text progress bar and the phase scaling
  *   report.c    the JSON writer and simplify's summary and JSON
  *   simplify.c, generate.c, eval.c, optimize.c   one file per subcommand
