@@ -104,6 +104,15 @@ static void put_xml_text(FILE *f, const char *s)
     }
 }
 
+/* A name on one line of a text header (2DM's quoted MESHNAME, PLY's
+ * comment, OBJ's object): control characters and double quotes become
+ * '_', so an odd file name cannot break the header. */
+static void put_plain(FILE *f, const char *s)
+{
+  for (; s && *s; s++)
+    fputc((unsigned char)*s < 0x20 || *s == '"' || *s == 0x7f ? '_' : *s, f);
+}
+
 /* The centre of the output extent, rounded to whole units (so the
  * subtraction of map coordinates near it loses nothing in practice and the
  * origin reads plainly). */
@@ -144,12 +153,14 @@ static void write_header(FILE *f, tt_mesh_format fmt, const char *name,
   switch (fmt) {
   case TT_MESH_2DM:
     fputs("MESH2D\nMESHNAME \"", f);
-    fputs(name, f);
+    put_plain(f, name);
     fputs("\"\n", f);
     break;
   case TT_MESH_PLY:
     fprintf(f, "ply\nformat binary_little_endian 1.0\n"
-               "comment terratin TIN %s\n"
+               "comment terratin TIN ");
+    put_plain(f, name);
+    fprintf(f, "\n"
                "element vertex %zu\n"
                "property double x\nproperty double y\nproperty double z\n"
                "property double ins_err\nproperty double star_max\n"
@@ -158,14 +169,17 @@ static void write_header(FILE *f, tt_mesh_format fmt, const char *name,
                "property list uchar int vertex_indices\n"
                "property double max_err\nproperty double rmse\n"
                "property int n_samples\nend_header\n",
-            name, nv, nt);
+            nv, nt);
     break;
   case TT_MESH_OBJ:
-    fprintf(f, "# terratin TIN %s: %zu vertices, %zu triangles\n", name, nv,
-            nt);
+    fputs("# terratin TIN ", f);
+    put_plain(f, name);
+    fprintf(f, ": %zu vertices, %zu triangles\n", nv, nt);
     if (local)
       fprintf(f, "# origin %.17g %.17g\n", origin[0], origin[1]);
-    fprintf(f, "o %s\n", name);
+    fputs("o ", f);
+    put_plain(f, name);
+    fputc('\n', f);
     break;
   case TT_MESH_LANDXML: {
     time_t now = time(NULL);

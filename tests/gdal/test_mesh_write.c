@@ -5,7 +5,8 @@
  * the double the OGR layers get (tin_records.h), every face the same three
  * vertices in the same counter-clockwise order, PLY's attributes equal to
  * the TIN's (NaN kept), LandXML read with libxml2 (when the test was built
- * with it) in the northing, easting, elevation order. Also: -t_srs's
+ * with it) in the northing, easting, elevation order, the mesh's name
+ * escaped in LandXML and made plain in 2DM. Also: -t_srs's
  * transformed coordinates, the format names and extensions, and an
  * interruption through progress, which leaves no file.
  */
@@ -161,6 +162,8 @@ static void read_2dm(const char *path, const expected *e)
     long a, b, c, mat;
     if (strcmp(line, "MESH2D\n") == 0)
       header = 1;
+    else if (strncmp(line, "MESHNAME", 8) == 0) /* quotes made plain */
+      CHECK_STR_EQ(line, "MESHNAME \"small _tin_ <&>\"\n");
     else if (sscanf(line, "ND %zu %lf %lf %lf", &id, &x, &y, &z) == 4)
       see_vertex(&k, e, id, x, y, z);
     else if (sscanf(line, "E3T %zu %ld %ld %ld %ld", &id, &a, &b, &c,
@@ -288,7 +291,11 @@ static void walk_landxml(xmlNodePtr node, tally *k, const expected *e,
     if (n->type != XML_ELEMENT_NODE)
       continue;
     const char *name = (const char *)n->name;
-    if (strcmp(name, "Definition") == 0) {
+    if (strcmp(name, "Surface") == 0) { /* escaped, read back whole */
+      xmlChar *sn = xmlGetProp(n, (const xmlChar *)"name");
+      CHECK(sn && strcmp((char *)sn, "small \"tin\" <&>") == 0);
+      xmlFree(sn);
+    } else if (strcmp(name, "Definition") == 0) {
       xmlChar *st = xmlGetProp(n, (const xmlChar *)"surfType");
       *surface += st && strcmp((char *)st, "TIN") == 0;
       xmlFree(st);
