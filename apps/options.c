@@ -224,7 +224,7 @@ static int is_gdal_bool(const char *w)
  * error messages and the tests agree. */
 enum opt_id {
   O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
-  O_DSCO, O_NLN, O_OVERWRITE, O_Q, O_CRITERION, O_OPTIMIZE, O_REPAIR, O_JSON,
+  O_DSCO, O_NLN, O_OVERWRITE, O_OBJ_LOCAL, O_Q, O_CRITERION, O_OPTIMIZE, O_REPAIR, O_JSON,
   O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE,
   O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
   O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
@@ -254,6 +254,7 @@ static const struct opt_def {
     {"-dsco", O_DSCO, 1, FOR_S | FOR_O},
     {"-nln", O_NLN, 1, FOR_S | FOR_O},
     {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G | FOR_O},
+    {"-obj_local", O_OBJ_LOCAL, 0, FOR_S},
     {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O},
     {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O},
     {"-criterion", O_CRITERION, 1, FOR_S | FOR_O},
@@ -588,6 +589,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         NOMEM();
       break;
     case O_OVERWRITE: o->s.overwrite = 1; break;
+    case O_OBJ_LOCAL: o->s.obj_local = 1; break;
     case O_Q: o->s.quiet = 1; break;
     case O_JSON: o->s.json = 1; break;
     case O_CRITERION: {

@@ -70,10 +70,26 @@ tt_status tt__app_simplify(app_run *r)
   if (!check_srs(r, "-work_srs", s->work_srs, 1) ||
       !check_srs(r, "-t_srs", s->t_srs, 0))
     return r->res->status;
-  GDALDriverH drv = tt__app_output_driver(r);
-  if (!drv)
-    return r->res->status;
-  const char *drvname = GDALGetDriverShortName(drv);
+  /* The mesh and survey formats (2DM, PLY, OBJ, LandXML) are written by
+   * tt_mesh_write(), not by an OGR driver: -of names them, else OUTPUT's
+   * extension (.2dm, .ply, .obj, .xml), before any OGR driver is sought. */
+  tt_mesh_format mesh = s->format ? tt_mesh_format_from_name(s->format)
+                                  : tt_mesh_format_from_path(s->output);
+  GDALDriverH drv = NULL;
+  const char *drvname = tt_mesh_format_name(mesh);
+  if (mesh && ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0])))
+    return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -lco and -dsco are for OGR drivers; %s "
+                        "takes none", drvname);
+  if (s->obj_local && mesh != TT_MESH_OBJ)
+    return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -obj_local is for -of OBJ outputs");
+  if (!mesh) {
+    drv = tt__app_output_driver(r);
+    if (!drv)
+      return r->res->status;
+    drvname = GDALGetDriverShortName(drv);
+  }
 
   /* Plan the output first: a refusal costs nothing yet. */
   r->msg.last[0] = '\0';
@@ -229,15 +245,6 @@ tt_status tt__app_simplify(app_run *r)
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
     goto done;
   }
-  r->msg.last[0] = '\0';
-  dst = GDALCreate(drv, tt_output_temp_path(outp), 0, 0, 0, GDT_Unknown,
-                   (CSLConstList)s->dsco);
-  if (!dst) {
-    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
-                  "cannot create %s dataset: %s", drvname,
-                  r->msg.last[0] ? r->msg.last : "unknown reason");
-    goto done;
-  }
   if (info->crs_wkt && *info->crs_wkt) {
     srs = OSRNewSpatialReference(info->crs_wkt);
     if (srs)
@@ -247,6 +254,34 @@ tt_status tt__app_simplify(app_run *r)
                    "%s: the raster's CRS could not be parsed; the layers "
                    "have none",
                    s->input);
+  }
+  if (mesh) {
+    /* One file, no layers: the mesh named after OUTPUT's base name. */
+    r->msg.last[0] = '\0';
+    char *mname = CPLStrdup(CPLGetBasename(s->output));
+    st = tt_mesh_write(r->ctx, tt_output_temp_path(outp), mesh, mname, tin,
+                       srs, s->t_srs, s->obj_local, tt__app_phase_fn,
+                       &r->prog);
+    CPLFree(mname);
+    if (st == TT_ERR_INTERRUPTED || st == TT_ERR_NOMEM) {
+      tt__app_fail_tt(r, st, s->output);
+      goto done;
+    }
+    if (st != TT_OK) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, st, s->output, "%s",
+                   tt__app_why(r, st, tt_output_temp_path(outp)));
+      goto done;
+    }
+    goto commit;
+  }
+  r->msg.last[0] = '\0';
+  dst = GDALCreate(drv, tt_output_temp_path(outp), 0, 0, 0, GDT_Unknown,
+                   (CSLConstList)s->dsco);
+  if (!dst) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
+                  "cannot create %s dataset: %s", drvname,
+                  r->msg.last[0] ? r->msg.last : "unknown reason");
+    goto done;
   }
 
   char created[32];
@@ -401,6 +436,7 @@ tt_status tt__app_simplify(app_run *r)
       goto done;
     }
   }
+commit:
   if (!tt__app_continue(r, 0.99)) {
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
     goto done;

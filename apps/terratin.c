@@ -9,7 +9,9 @@
  * re-raises the signal with its default action so the shell sees the
  * process killed by it. A run that completed before it saw the flag exits 0
  * with its output in place. SIGPIPE is ignored: a closed stdout must not
- * kill a run halfway through writing a file.
+ * kill a run halfway through writing a file. SIGXFSZ too: a write past
+ * the file size limit (ulimit -f) then fails with EFBIG, and the run
+ * removes its temporary files instead of dying with them in place.
  *
  * A driver can keep the run from calling back for minutes (GDAL's LIBKML
  * writer, a close that flushes a large file). So the handler also wakes a
@@ -108,6 +110,7 @@ static void install_handlers(void)
     sigaction(sigs[i], &sa, NULL);
   }
   signal(SIGPIPE, SIG_IGN);
+  signal(SIGXFSZ, SIG_IGN);
 }
 
 int main(int argc, char **argv)

@@ -105,6 +105,8 @@ typedef struct tt_app_settings {
                                 extension, else GPKG */
   const char *const *lco;    /* -lco NAME=VALUE, in order */
   const char *const *dsco;   /* -dsco NAME=VALUE, in order */
+  int obj_local;             /* -obj_local: OBJ vertices around the
+                                centre of the extent */
   const char *nln;           /* -nln layer name prefix; "" by default */
   /* simplify -method decimate (docs/decimation.md); the options below
    * apply to it only */

@@ -193,6 +193,45 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
                              int overwrite);
 
 /* ---------------------------------------------------------------------------
+ * Mesh and survey files (not OGR drivers): SMS 2DM, binary little-endian
+ * PLY, Wavefront OBJ and a LandXML 1.2 TIN surface.
+ * ------------------------------------------------------------------------- */
+typedef enum tt_mesh_format {
+  TT_MESH_NONE = 0,
+  TT_MESH_2DM,     /* MESH2D, ND id x y z, E3T id n1 n2 n3 1 (1-based) */
+  TT_MESH_PLY,     /* vertex x y z ins_err star_max star_rmse (double);
+                      face vertex_indices (uchar, int) max_err rmse
+                      (double) n_samples (int); NaN kept */
+  TT_MESH_OBJ,     /* v x y z, f a b c (1-based) */
+  TT_MESH_LANDXML  /* Surface/Definition surfType="TIN": Pnts P id=
+                      "northing easting elevation", Faces F "a b c" */
+} tt_mesh_format;
+
+/* The format of an -of name ("2DM", "PLY", "OBJ", "LandXML", any case),
+ * or of a path's extension (.2dm, .ply, .obj, .xml, any case);
+ * TT_MESH_NONE for anything else. */
+tt_mesh_format tt_mesh_format_from_name(const char *name);
+tt_mesh_format tt_mesh_format_from_path(const char *path);
+/* "2DM", "PLY", "OBJ", "LandXML"; NULL for TT_MESH_NONE. */
+const char *tt_mesh_format_name(tt_mesh_format fmt);
+
+/* Writes tin to the file path (create or truncate: give it the temporary
+ * name of a tt_output and commit that) in fmt. Every vertex is written, in
+ * TIN order; triangles are counter-clockwise in the output coordinates,
+ * which are those of srs, or t_srs (as tt_ogr_write_tin's T_SRS; NULL or
+ * "": none) with every vertex transformed. Doubles are written exactly
+ * (%.17g, or binary in PLY). name labels the mesh (2DM MESHNAME, LandXML
+ * Surface name, OBJ object; NULL: "TIN"). local (OBJ only): vertices
+ * relative to the centre of the extent rounded to whole units, which a
+ * comment line `# origin X Y` gives. progress may stop the write
+ * (TT_ERR_INTERRUPTED). On any failure the file at path is removed. */
+tt_status tt_mesh_write(tt_context *ctx, const char *path,
+                        tt_mesh_format fmt, const char *name,
+                        const tt_tin *tin, OGRSpatialReferenceH srs,
+                        const char *t_srs, int local,
+                        tt_progress_fn progress, void *progress_arg);
+
+/* ---------------------------------------------------------------------------
  * Safe output: never overwrite without permission, never leave a half-written
  * file. A tt_output names the final files and the temporary ones beside them.
  * ------------------------------------------------------------------------- */

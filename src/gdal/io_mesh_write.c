@@ -1,0 +1,401 @@
+/*
+ * io_mesh_write.c -- a TIN written as one mesh or survey file, without
+ * OGR: SMS 2DM (QGIS's MDAL reads it as a mesh layer), binary PLY (vertex
+ * and face properties), Wavefront OBJ (3-D and game tools) and a LandXML
+ * 1.2 TIN surface (civil and survey software).
+ *
+ * The coordinates and the triangles come from tin_records.h, as for the
+ * OGR layers: the output CRS is the input's or T_SRS with every vertex
+ * transformed once, and each triangle's vertices are counter-clockwise in
+ * the output coordinates. Every vertex of the TIN is written, in TIN
+ * order, so a vertex's index in the file is its index in the TIN (1-based
+ * in 2DM, OBJ and LandXML, 0-based in PLY). Numbers are written with
+ * %.17g (ASCII formats) or as IEEE doubles (PLY): a reader gets back the
+ * very doubles. The caller gives the path to write (the temporary name of
+ * a tt_output); a failure or an interruption removes the partial file.
+ */
+#include "tin_records.h"
+
+#include <cpl_conv.h>
+#include <ogr_srs_api.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+
+/* Names, in -of's spelling, and the extension each format selects. */
+static const struct {
+  tt_mesh_format fmt;
+  const char *name;
+  const char *ext;
+} mesh_formats[] = {
+    {TT_MESH_2DM, "2DM", "2dm"},
+    {TT_MESH_PLY, "PLY", "ply"},
+    {TT_MESH_OBJ, "OBJ", "obj"},
+    {TT_MESH_LANDXML, "LandXML", "xml"},
+};
+enum { N_MESH_FORMATS = sizeof mesh_formats / sizeof mesh_formats[0] };
+
+tt_mesh_format tt_mesh_format_from_name(const char *name)
+{
+  for (size_t i = 0; name && i < N_MESH_FORMATS; i++)
+    if (strcasecmp(name, mesh_formats[i].name) == 0)
+      return mesh_formats[i].fmt;
+  return TT_MESH_NONE;
+}
+
+tt_mesh_format tt_mesh_format_from_path(const char *path)
+{
+  const char *base = path ? strrchr(path, '/') : NULL;
+  base = base ? base + 1 : path;
+  const char *dot = base ? strrchr(base, '.') : NULL;
+  for (size_t i = 0; dot && i < N_MESH_FORMATS; i++)
+    if (strcasecmp(dot + 1, mesh_formats[i].ext) == 0)
+      return mesh_formats[i].fmt;
+  return TT_MESH_NONE;
+}
+
+const char *tt_mesh_format_name(tt_mesh_format fmt)
+{
+  for (size_t i = 0; i < N_MESH_FORMATS; i++)
+    if (mesh_formats[i].fmt == fmt)
+      return mesh_formats[i].name;
+  return NULL;
+}
+
+/* PLY's binary_little_endian body: doubles and ints in little-endian
+ * order whatever the host's. */
+static int host_big_endian(void)
+{
+  const uint16_t one = 1;
+  unsigned char b;
+  memcpy(&b, &one, 1);
+  return b == 0;
+}
+
+static void put_le(FILE *f, const void *value, size_t size, int swap)
+{
+  unsigned char b[8];
+  memcpy(b, value, size);
+  if (swap)
+    for (size_t i = 0; i < size / 2; i++) {
+      unsigned char t = b[i];
+      b[i] = b[size - 1 - i];
+      b[size - 1 - i] = t;
+    }
+  fwrite(b, 1, size, f);
+}
+
+/* Text with XML's five special characters escaped. */
+static void put_xml_text(FILE *f, const char *s)
+{
+  for (; s && *s; s++)
+    switch (*s) {
+    case '<': fputs("&lt;", f); break;
+    case '>': fputs("&gt;", f); break;
+    case '&': fputs("&amp;", f); break;
+    case '"': fputs("&quot;", f); break;
+    case '\'': fputs("&apos;", f); break;
+    default: fputc(*s, f);
+    }
+}
+
+/* A name on one line of a text header (2DM's quoted MESHNAME, PLY's
+ * comment, OBJ's object): control characters and double quotes become
+ * '_', so an odd file name cannot break the header. */
+static void put_plain(FILE *f, const char *s)
+{
+  for (; s && *s; s++)
+    fputc((unsigned char)*s < 0x20 || *s == '"' || *s == 0x7f ? '_' : *s, f);
+}
+
+/* The centre of the output extent, rounded to whole units (so the
+ * subtraction of map coordinates near it loses nothing in practice and the
+ * origin reads plainly). */
+static tt_status extent_centre(const tt__records *rec, tt_context *ctx,
+                               size_t nv, double *cx, double *cy)
+{
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  for (size_t i = 0; i < nv; i++) {
+    tt_vertex_info v;
+    double x, y;
+    tt_status st = tt__records_vertex(rec, ctx, i, &v, &x, &y);
+    if (st != TT_OK)
+      return st;
+    x0 = fmin(x0, x);
+    x1 = fmax(x1, x);
+    y0 = fmin(y0, y);
+    y1 = fmax(y1, y);
+  }
+  *cx = nv ? floor(0.5 * (x0 + x1)) : 0.0;
+  *cy = nv ? floor(0.5 * (y0 + y1)) : 0.0;
+  return TT_OK;
+}
+
+/* Calls progress now and then: 0 when it asks to stop. */
+static int keep_going(tt_progress_fn progress, void *arg, size_t done,
+                      size_t total)
+{
+  if (!progress || (done & 4095) != 0)
+    return 1;
+  return progress(total ? (double)done / (double)total : 1.0, NULL, arg);
+}
+
+/* The header of each format, before the vertices. */
+static void write_header(FILE *f, tt_mesh_format fmt, const char *name,
+                         const tt__records *rec, size_t nv, size_t nt,
+                         const double origin[2], int local)
+{
+  switch (fmt) {
+  case TT_MESH_2DM:
+    fputs("MESH2D\nMESHNAME \"", f);
+    put_plain(f, name);
+    fputs("\"\n", f);
+    break;
+  case TT_MESH_PLY:
+    fprintf(f, "ply\nformat binary_little_endian 1.0\n"
+               "comment terratin TIN ");
+    put_plain(f, name);
+    fprintf(f, "\n"
+               "element vertex %zu\n"
+               "property double x\nproperty double y\nproperty double z\n"
+               "property double ins_err\nproperty double star_max\n"
+               "property double star_rmse\n"
+               "element face %zu\n"
+               "property list uchar int vertex_indices\n"
+               "property double max_err\nproperty double rmse\n"
+               "property int n_samples\nend_header\n",
+            nv, nt);
+    break;
+  case TT_MESH_OBJ:
+    fputs("# terratin TIN ", f);
+    put_plain(f, name);
+    fprintf(f, ": %zu vertices, %zu triangles\n", nv, nt);
+    if (local)
+      fprintf(f, "# origin %.17g %.17g\n", origin[0], origin[1]);
+    fputs("o ", f);
+    put_plain(f, name);
+    fputc('\n', f);
+    break;
+  case TT_MESH_LANDXML: {
+    time_t now = time(NULL);
+    struct tm tmv;
+    char date[16] = "1970-01-01", clock[16] = "00:00:00";
+    if (gmtime_r(&now, &tmv)) {
+      strftime(date, sizeof date, "%Y-%m-%d", &tmv);
+      strftime(clock, sizeof clock, "%H:%M:%S", &tmv);
+    }
+    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+               "<LandXML xmlns=\"http://www.landxml.org/schema/LandXML-1.2\" "
+               "xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
+               "xsi:schemaLocation=\"http://www.landxml.org/schema/"
+               "LandXML-1.2 http://www.landxml.org/schema/LandXML-1.2/"
+               "LandXML-1.2.xsd\" version=\"1.2\" date=\"%s\" "
+               "time=\"%s\">\n"
+               "  <Units>\n    <Metric areaUnit=\"squareMeter\" "
+               "linearUnit=\"meter\" volumeUnit=\"cubicMeter\" "
+               "temperatureUnit=\"celsius\" pressureUnit=\"milliBars\" "
+               "angularUnit=\"decimal degrees\" "
+               "directionUnit=\"decimal degrees\"/>\n  </Units>\n",
+            date, clock);
+    if (rec->out_srs) {
+      /* CoordinateSystem: the EPSG code when the CRS has one, and its
+       * WKT (ogcWktCode) in any case. */
+      char *wkt = NULL;
+      const char *auth = OSRGetAuthorityName(rec->out_srs, NULL);
+      const char *code = OSRGetAuthorityCode(rec->out_srs, NULL);
+      fputs("  <CoordinateSystem", f);
+      if (auth && code && strcasecmp(auth, "EPSG") == 0) {
+        fputs(" epsgCode=\"", f);
+        put_xml_text(f, code);
+        fputs("\"", f);
+      }
+      if (OSRExportToWkt(rec->out_srs, &wkt) == OGRERR_NONE && wkt) {
+        fputs(" ogcWktCode=\"", f);
+        put_xml_text(f, wkt);
+        fputs("\"", f);
+      }
+      CPLFree(wkt);
+      fputs("/>\n", f);
+    }
+    fputs("  <Application name=\"terratin\"/>\n"
+          "  <Surfaces>\n    <Surface name=\"", f);
+    put_xml_text(f, name);
+    fputs("\">\n      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
+    break;
+  }
+  default:
+    break;
+  }
+}
+
+/* One vertex: index i (0-based), output x, y. */
+static void write_vertex(FILE *f, tt_mesh_format fmt, size_t i,
+                         const tt_vertex_info *v, double x, double y,
+                         const double origin[2], int swap)
+{
+  switch (fmt) {
+  case TT_MESH_2DM:
+    fprintf(f, "ND %zu %.17g %.17g %.17g\n", i + 1, x, y, v->z);
+    break;
+  case TT_MESH_PLY: {
+    const double d[6] = {x, y, v->z, v->insert_error, v->star_max_error,
+                         v->star_rmse};
+    for (int k = 0; k < 6; k++)
+      put_le(f, &d[k], sizeof d[k], swap);
+    break;
+  }
+  case TT_MESH_OBJ:
+    fprintf(f, "v %.17g %.17g %.17g\n", x - origin[0], y - origin[1], v->z);
+    break;
+  case TT_MESH_LANDXML:
+    /* The standard's order: northing (y), easting (x), elevation. */
+    fprintf(f, "          <P id=\"%zu\">%.17g %.17g %.17g</P>\n", i + 1, y,
+            x, v->z);
+    break;
+  default:
+    break;
+  }
+}
+
+/* Between the vertices and the faces. */
+static void write_middle(FILE *f, tt_mesh_format fmt)
+{
+  if (fmt == TT_MESH_LANDXML)
+    fputs("        </Pnts>\n        <Faces>\n", f);
+}
+
+/* One triangle: index i (0-based), its record with v[] counter-clockwise
+ * in the output coordinates. */
+static void write_face(FILE *f, tt_mesh_format fmt, size_t i,
+                       const tt_triangle_info *t, int swap)
+{
+  switch (fmt) {
+  case TT_MESH_2DM:
+    fprintf(f, "E3T %zu %ld %ld %ld 1\n", i + 1, (long)t->v[0] + 1,
+            (long)t->v[1] + 1, (long)t->v[2] + 1);
+    break;
+  case TT_MESH_PLY: {
+    const unsigned char three = 3;
+    fwrite(&three, 1, 1, f);
+    for (int k = 0; k < 3; k++) {
+      const int32_t vi = t->v[k];
+      put_le(f, &vi, sizeof vi, swap);
+    }
+    const double d[2] = {t->max_error, t->rmse};
+    put_le(f, &d[0], sizeof d[0], swap);
+    put_le(f, &d[1], sizeof d[1], swap);
+    const int32_t n = t->samples > INT32_MAX ? INT32_MAX : (int32_t)t->samples;
+    put_le(f, &n, sizeof n, swap);
+    break;
+  }
+  case TT_MESH_OBJ:
+    fprintf(f, "f %ld %ld %ld\n", (long)t->v[0] + 1, (long)t->v[1] + 1,
+            (long)t->v[2] + 1);
+    break;
+  case TT_MESH_LANDXML:
+    fprintf(f, "          <F>%ld %ld %ld</F>\n", (long)t->v[0] + 1,
+            (long)t->v[1] + 1, (long)t->v[2] + 1);
+    break;
+  default:
+    break;
+  }
+}
+
+static void write_footer(FILE *f, tt_mesh_format fmt)
+{
+  if (fmt == TT_MESH_LANDXML)
+    fputs("        </Faces>\n      </Definition>\n    </Surface>\n"
+          "  </Surfaces>\n</LandXML>\n", f);
+}
+
+tt_status tt_mesh_write(tt_context *ctx, const char *path,
+                        tt_mesh_format fmt, const char *name,
+                        const tt_tin *tin, OGRSpatialReferenceH srs,
+                        const char *t_srs, int local,
+                        tt_progress_fn progress, void *progress_arg)
+{
+  tt_status st = TT_OK;
+  tt__records rec;
+  FILE *f = NULL;
+  int made = 0;
+  memset(&rec, 0, sizeof rec);
+  if (!path || !tin || !tt_mesh_format_name(fmt))
+    return tt__error(ctx, TT_ERR_ARG, "tt_mesh_write: no path, TIN or "
+                                      "mesh format");
+  if (!name || !*name)
+    name = "TIN";
+  st = tt__records_init(&rec, ctx, tin, srs, t_srs);
+  if (st != TT_OK)
+    goto done;
+  const size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
+  const size_t total = nv + nt;
+  double origin[2] = {0.0, 0.0};
+  local = local && fmt == TT_MESH_OBJ;
+  if (local) {
+    st = extent_centre(&rec, ctx, nv, &origin[0], &origin[1]);
+    if (st != TT_OK)
+      goto done;
+  }
+  f = fopen(path, "wb");
+  if (!f) {
+    st = tt__error(ctx, TT_ERR_IO, "%s: cannot create: %s", path,
+                   strerror(errno));
+    goto done;
+  }
+  made = 1;
+  const int swap = host_big_endian();
+  write_header(f, fmt, name, &rec, nv, nt, origin, local);
+  for (size_t i = 0; i < nv && st == TT_OK; i++) {
+    tt_vertex_info v;
+    double x, y;
+    st = tt__records_vertex(&rec, ctx, i, &v, &x, &y);
+    if (st == TT_OK)
+      write_vertex(f, fmt, i, &v, x, y, origin, swap);
+    if (st == TT_OK && !keep_going(progress, progress_arg, i + 1, total))
+      st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
+  }
+  if (st != TT_OK)
+    goto done;
+  write_middle(f, fmt);
+  for (size_t i = 0; i < nt && st == TT_OK; i++) {
+    tt_triangle_info t;
+    tt_vertex_info tv[3];
+    double tx[3], ty[3];
+    st = tt__records_triangle(&rec, ctx, i, &t, tv, tx, ty);
+    if (st == TT_OK)
+      write_face(f, fmt, i, &t, swap);
+    if (st == TT_OK &&
+        !keep_going(progress, progress_arg, nv + i + 1, total))
+      st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
+  }
+  if (st != TT_OK)
+    goto done;
+  write_footer(f, fmt);
+  if (ferror(f)) {
+    st = tt__error(ctx, TT_ERR_IO, "%s: write failed: %s", path,
+                   strerror(errno));
+    goto done;
+  }
+  FILE *g = f;
+  f = NULL;
+  if (fclose(g) != 0) {
+    st = tt__error(ctx, TT_ERR_IO, "%s: write failed: %s", path,
+                   strerror(errno));
+    goto done;
+  }
+  if (progress && !progress(1.0, NULL, progress_arg))
+    st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
+
+done:
+  if (f)
+    fclose(f);
+  if (st != TT_OK && made)
+    remove(path);
+  tt__records_free(&rec);
+  return st;
+}
