@@ -499,7 +499,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (o->s.command == TT_APP_NONE) {
       if (w[0] == '-' && w[1] != '\0')
         USAGE("unknown option '%s' before the command; expected simplify, "
-              "generate, eval or optimize (see 'terratin --help')", w);
+              "generate, eval, optimize or study (see 'terratin --help')", w);
       if (tt__app_str_ieq(w, "simplify")) o->s.command = TT_APP_SIMPLIFY;
       else if (tt__app_str_ieq(w, "generate")) o->s.command = TT_APP_GENERATE;
       else if (tt__app_str_ieq(w, "eval")) o->s.command = TT_APP_EVAL;
@@ -854,7 +854,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
           cmdname);
   switch (o->s.command) {
   case TT_APP_NONE:
-    USAGE("missing command: simplify, generate, eval or optimize (see "
+    USAGE("missing command: simplify, generate, eval, optimize or study (see "
           "'terratin --help')");
   case TT_APP_SIMPLIFY:
     if (npos < 1)
