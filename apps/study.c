@@ -129,6 +129,12 @@ static int add_criterion(app_run *r, study_plan *p, const char *w)
                  tt_context_errmsg(r->ctx));
     return 0;
   }
+  for (size_t k = 0; k < p->ncrit; k++)
+    if (p->crit[k] == c) {
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                   "study: -criteria names %s twice", tt_criterion_name(c));
+      return 0;
+    }
   p->crit[p->ncrit++] = c;
   return 1;
 }
@@ -155,19 +161,31 @@ static int add_optimizer(app_run *r, study_plan *p, const char *w)
                  "lookahead, anneal, edge_insertion, auto", w);
     return 0;
   }
+  for (size_t k = 0; k < p->nopt; k++)
+    if (p->opt[k] == p->opt[p->nopt]) {
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                   "study: -optimizers names %s twice", w);
+      return 0;
+    }
   p->nopt++;
   return 1;
 }
 
 static int add_percent(app_run *r, study_plan *p, const char *w)
 {
+  /* Plain decimals only (strtod would also take hex, exponents, "inf"),
+   * each checkpoint once. */
   char *end = NULL;
   double x = strtod(w, &end);
-  if (!(w[0] >= '0' && w[0] <= '9') || *end || !(x > 0 && x <= 100) ||
+  int seen = 0;
+  for (size_t k = 0; k < p->npct; k++)
+    seen |= p->pct[k] == x;
+  if (!(w[0] >= '0' && w[0] <= '9') || strspn(w, "0123456789.") != strlen(w) ||
+      *end || !(x > 0 && x <= 100) || seen ||
       strlen(w) >= sizeof p->pct_text[0]) {
     tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                 "study: -percent items must be numbers in (0, 100], got "
-                 "'%s'", w);
+                 "study: -percent items must be distinct decimal numbers in "
+                 "(0, 100], got '%s'", w);
     return 0;
   }
   strcpy(p->pct_text[p->npct], w);
@@ -666,9 +684,8 @@ tt_status tt__app_study(app_run *r)
   st = write_outputs(r, exists, ts, nterr, &plan, rows, nrows);
   if (st != TT_OK)
     goto done;
-  if (!tt__app_continue(r, 1.0)) {
-    /* Too late to stop: the outputs are complete and committed. */
-  }
+  /* Draws 100%; a stop asked now is too late: the files are committed. */
+  (void)tt__app_continue(r, 1.0);
   if (!s->quiet) {
     fprintf(r->out, "%s: %zu runs over %zu terrain%s (curves.csv, tables.md, "
             "runs.json); %.2f s\n", s->output, nrows, nterr,

@@ -195,6 +195,12 @@ expect_failure "unknown criterion" 2 "nosuch" bad4 \
 expect_failure "bad percent" 2 "-percent" bad5 \
   study -q -terrain bump -percent 10,200 bad5
 expect_failure "no terrain" 2 "-terrain" bad6 study -q bad6
+expect_failure "hex percent" 2 "-percent" bad7 \
+  study -q -terrain bump -percent 0x10 bad7
+expect_failure "criterion twice" 2 "twice" bad8 \
+  study -q -terrain bump -criteria delaunay,DELAUNAY bad8
+expect_failure "unknown method" 2 "-methods" bad9 \
+  study -q -terrain bump -methods insert,refine bad9
 
 # An existing non-empty OUTDIR: refused, untouched; -overwrite writes.
 mkdir full && echo keep >full/mine.txt
