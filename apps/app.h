@@ -10,7 +10,8 @@
  *   dem.c       opening the DEM and reading it into a grid
  *   progress.c  the text progress bar and the phase scaling
  *   report.c    the JSON writer and simplify's summary and JSON
- *   simplify.c, generate.c, eval.c, optimize.c   one file per subcommand
+ *   simplify.c, generate.c, eval.c, optimize.c, study.c   one file per
+ *               subcommand
  *
  * Invariants: a run reports at most one failure (the first), as one line;
  * every run either commits its output or leaves nothing behind; GDAL never
@@ -49,7 +50,7 @@ typedef struct app_strlist {
 struct tt_app_options {
   tt_app_settings s;     /* the public view; strings point into the lists */
   app_strlist strings;   /* every single string (input, output, -of, ...) */
-  app_strlist config, lco, dsco;
+  app_strlist config, lco, dsco, terrains;
   tt_progress_fn progress;
   void *progress_arg;
   FILE *out, *err;
@@ -200,6 +201,7 @@ tt_status tt__app_simplify(app_run *r);  /* simplify.c */
 tt_status tt__app_generate(app_run *r);  /* generate.c */
 tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
+tt_status tt__app_study(app_run *r);     /* study.c */
 /* eval.c, for optimize too: opens r->s->tin's kind of dataset (a vector
  * dataset, explaining in one line why not), and picks its triangle layer
  * (-layer, else "triangles" or "*_triangles", else the first polygon

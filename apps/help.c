@@ -17,6 +17,7 @@ static const char help_top[] =
     "  generate   write a synthetic test terrain as a GeoTIFF\n"
     "  eval       measure the error of a triangle layer against a DEM\n"
     "  optimize   re-triangulate a TIN's vertices for a criterion\n"
+    "  study      compare criteria, methods and optimisers over terrains\n"
     "\n"
     "Options of every command:\n"
     "  --help              this help, or the help of COMMAND\n"
@@ -295,6 +296,53 @@ static const char help_optimize[] =
     "  terratin optimize dem.tif tin.gpkg l2.gpkg -criterion l2 "
     "-optimize anneal\n";
 
+static const char help_study[] =
+    "Usage: terratin study [options] OUTDIR\n"
+    "           -terrain DEM|NAME [-terrain ...] [-seed N]\n"
+    "           [-criteria all|NAME,NAME...] [-methods insert,decimate]\n"
+    "           [-optimizers auto,none,local,lookahead,anneal,...]\n"
+    "           [-percent P,P,...] [-start all|greedy|greedy:N]\n"
+    "           [-importance NAME] [-b BAND] [-srcnodata VALUE]\n"
+    "           [-z_factor F] [-z_unit m] [-threads N] [-overwrite] [-q]\n"
+    "\n"
+    "Runs every terrain x method x optimiser x checkpoint x criterion as\n"
+    "'terratin simplify -percent P' would (each checkpoint a run of its\n"
+    "own, the final pass included) and writes into OUTDIR:\n"
+    "  curves.csv  a row per run: terrain, method, criterion, optimizer,\n"
+    "              points, max_error, l2, rmse, mean_abs_error,\n"
+    "              total_abs_error, seconds (building the mesh)\n"
+    "  tables.md   mean absolute error, a table per terrain, method and\n"
+    "              optimiser: a row per percentage, a column per\n"
+    "              criterion, the best of each row in bold\n"
+    "  runs.json   every parameter and the version, to repeat the run\n"
+    "\n"
+    "Options:\n"
+    "  -terrain T        repeatable: a DEM file, or a generated terrain of\n"
+    "                    the study by name: fault_smooth (80x80,\n"
+    "                    displacement 20, wave size 5), fault_rough\n"
+    "                    (100x100, displacement 100), peak_rough (diamond-\n"
+    "                    square 129x129, roughness 0.7, a peak),\n"
+    "                    valley_rough (65x65, a valley), hybrid (129x129, a\n"
+    "                    peak and a valley), sphere, cylinder, bump (a file\n"
+    "                    of such a name: write ./NAME)\n"
+    "  -seed N           the generated terrains' seed (and annealing's)\n"
+    "  -criteria LIST    all (default) or criteria as simplify names them\n"
+    "  -methods LIST     insert (default), decimate, or both\n"
+    "  -optimizers LIST  the final pass: auto (default: simplify's choice\n"
+    "                    per criterion), none, local, lookahead, anneal,\n"
+    "                    edge_insertion (minmax_angle only)\n"
+    "  -percent LIST     checkpoints, % of the valid samples (default\n"
+    "                    1,10,25,50)\n"
+    "  -start, -importance   decimation's, as simplify\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -threads   as simplify\n"
+    "  -overwrite        write into an OUTDIR that is not empty\n"
+    "\n"
+    "Exit codes: 0 success, 1 processing failure, 2 usage error.\n"
+    "\n"
+    "Example:\n"
+    "  terratin study -terrain fault_smooth -terrain dem.tif -criteria\n"
+    "      delaunay,minmax_angle,l2 -methods insert,decimate out/\n";
+
 const char *tt_app_help(tt_app_command topic)
 {
   switch (topic) {
@@ -302,6 +350,7 @@ const char *tt_app_help(tt_app_command topic)
   case TT_APP_GENERATE: return help_generate;
   case TT_APP_EVAL: return help_eval;
   case TT_APP_OPTIMIZE: return help_optimize;
+  case TT_APP_STUDY: return help_study;
   default: return help_top;
   }
 }
@@ -313,6 +362,7 @@ const char *tt__app_command_name(tt_app_command c)
   case TT_APP_GENERATE: return "generate";
   case TT_APP_EVAL: return "eval";
   case TT_APP_OPTIMIZE: return "optimize";
+  case TT_APP_STUDY: return "study";
   default: return "";
   }
 }

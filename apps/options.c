@@ -59,6 +59,7 @@ void tt_app_options_destroy(tt_app_options *o)
   strlist_free(&o->config);
   strlist_free(&o->lco);
   strlist_free(&o->dsco);
+  strlist_free(&o->terrains);
   free(o);
 }
 
@@ -86,7 +87,9 @@ void tt_app_options_set_streams(tt_app_options *o, FILE *out, FILE *err)
 
 int tt_app_options_wants_progress_bar(const tt_app_options *o)
 {
-  return o && o->s.command == TT_APP_SIMPLIFY && !o->s.quiet && !o->s.json;
+  return o && (o->s.command == TT_APP_SIMPLIFY ||
+               o->s.command == TT_APP_STUDY) &&
+         !o->s.quiet && !o->s.json;
 }
 
 /* ===========================================================================
@@ -229,13 +232,15 @@ enum opt_id {
   O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
   O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
   O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START,
-  O_IMPORTANCE, O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY
+  O_IMPORTANCE, O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY,
+  O_TERRAIN, O_CRITERIA, O_METHODS, O_OPTIMIZERS
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
 #define FOR_G (1u << TT_APP_GENERATE)
 #define FOR_E (1u << TT_APP_EVAL)
 #define FOR_O (1u << TT_APP_OPTIMIZE)
+#define FOR_T (1u << TT_APP_STUDY)
 
 static const struct opt_def {
   const char *name;
@@ -243,27 +248,27 @@ static const struct opt_def {
   int takes_value;
   unsigned commands;
 } opt_defs[] = {
-    {"-b", O_B, 1, FOR_S | FOR_E | FOR_O},
+    {"-b", O_B, 1, FOR_S | FOR_E | FOR_O | FOR_T},
     {"-max_error", O_MAX_ERROR, 1, FOR_S | FOR_E | FOR_O},
     {"-max_points", O_MAX_POINTS, 1, FOR_S},
     {"-max_triangles", O_MAX_TRIANGLES, 1, FOR_S},
-    {"-percent", O_PERCENT, 1, FOR_S},
+    {"-percent", O_PERCENT, 1, FOR_S | FOR_T}, /* study: a list */
     {"-of", O_OF, 1, FOR_S | FOR_O},
     {"-f", O_OF, 1, FOR_S | FOR_O}, /* ogr2ogr's spelling */
     {"-lco", O_LCO, 1, FOR_S | FOR_O},
     {"-dsco", O_DSCO, 1, FOR_S | FOR_O},
     {"-nln", O_NLN, 1, FOR_S | FOR_O},
-    {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G | FOR_O},
+    {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G | FOR_O | FOR_T},
     {"-obj_local", O_OBJ_LOCAL, 0, FOR_S},
-    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O},
-    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O},
+    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T},
+    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T},
     {"-criterion", O_CRITERION, 1, FOR_S | FOR_O},
     {"-optimize", O_OPTIMIZE, 1, FOR_S | FOR_O},
     {"-repair", O_REPAIR, 1, FOR_S},
     {"-json", O_JSON, 0, FOR_S | FOR_E | FOR_O},
     {"-layer", O_LAYER, 1, FOR_E | FOR_O},
     {"-size", O_SIZE, 1, FOR_G},
-    {"-seed", O_SEED, 1, FOR_G | FOR_S | FOR_O},
+    {"-seed", O_SEED, 1, FOR_G | FOR_S | FOR_O | FOR_T},
     {"-iterations", O_ITERATIONS, 1, FOR_G},
     {"-displacement", O_DISPLACEMENT, 1, FOR_G},
     {"-wave_size", O_WAVE_SIZE, 1, FOR_G},
@@ -271,24 +276,28 @@ static const struct opt_def {
     {"-amplitude", O_AMPLITUDE, 1, FOR_G},
     {"-seeding", O_SEEDING, 1, FOR_G},
     {"-a_srs", O_A_SRS, 1, FOR_G},
-    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E | FOR_O},
-    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E | FOR_O},
-    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E | FOR_O},
+    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E | FOR_O | FOR_T},
+    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E | FOR_O | FOR_T},
+    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E | FOR_O | FOR_T},
     {"-work_srs", O_WORK_SRS, 1, FOR_S},
     {"-t_srs", O_T_SRS, 1, FOR_S},
-    {"-anneal_t0", O_ANNEAL_T0, 1, FOR_S | FOR_O},
-    {"-anneal_stages", O_ANNEAL_STAGES, 1, FOR_S | FOR_O},
-    {"-anneal_swaps", O_ANNEAL_SWAPS, 1, FOR_S | FOR_O},
-    {"-anneal_good", O_ANNEAL_GOOD, 1, FOR_S | FOR_O},
-    {"-anneal_r", O_ANNEAL_R, 1, FOR_S | FOR_O},
+    {"-anneal_t0", O_ANNEAL_T0, 1, FOR_S | FOR_O | FOR_T},
+    {"-anneal_stages", O_ANNEAL_STAGES, 1, FOR_S | FOR_O | FOR_T},
+    {"-anneal_swaps", O_ANNEAL_SWAPS, 1, FOR_S | FOR_O | FOR_T},
+    {"-anneal_good", O_ANNEAL_GOOD, 1, FOR_S | FOR_O | FOR_T},
+    {"-anneal_r", O_ANNEAL_R, 1, FOR_S | FOR_O | FOR_T},
     {"-method", O_METHOD, 1, FOR_S},
-    {"-start", O_START, 1, FOR_S},
-    {"-importance", O_IMPORTANCE, 1, FOR_S},
+    {"-start", O_START, 1, FOR_S | FOR_T},
+    {"-importance", O_IMPORTANCE, 1, FOR_S | FOR_T},
     {"-selection", O_SELECTION, 1, FOR_S},
     {"-onepass", O_ONEPASS, 0, FOR_S},
     {"-hole", O_HOLE, 1, FOR_S},
-    {"-threads", O_THREADS, 1, FOR_S},
+    {"-threads", O_THREADS, 1, FOR_S | FOR_T},
     {"-max_memory", O_MAX_MEMORY, 1, FOR_S | FOR_E},
+    {"-terrain", O_TERRAIN, 1, FOR_T},
+    {"-criteria", O_CRITERIA, 1, FOR_T},
+    {"-methods", O_METHODS, 1, FOR_T},
+    {"-optimizers", O_OPTIMIZERS, 1, FOR_T},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -414,6 +423,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       else if (tt__app_str_ieq(w, "generate")) first_cmd = TT_APP_GENERATE;
       else if (tt__app_str_ieq(w, "eval")) first_cmd = TT_APP_EVAL;
       else if (tt__app_str_ieq(w, "optimize")) first_cmd = TT_APP_OPTIMIZE;
+      else if (tt__app_str_ieq(w, "study")) first_cmd = TT_APP_STUDY;
       else if (tt__app_str_ieq(w, "help")) { want_help = 1; continue; }
       if (first_cmd == TT_APP_NONE)
         break; /* an unknown command: reported below */
@@ -490,14 +500,15 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (o->s.command == TT_APP_NONE) {
       if (w[0] == '-' && w[1] != '\0')
         USAGE("unknown option '%s' before the command; expected simplify, "
-              "generate, eval or optimize (see 'terratin --help')", w);
+              "generate, eval, optimize or study (see 'terratin --help')", w);
       if (tt__app_str_ieq(w, "simplify")) o->s.command = TT_APP_SIMPLIFY;
       else if (tt__app_str_ieq(w, "generate")) o->s.command = TT_APP_GENERATE;
       else if (tt__app_str_ieq(w, "eval")) o->s.command = TT_APP_EVAL;
       else if (tt__app_str_ieq(w, "optimize")) o->s.command = TT_APP_OPTIMIZE;
+      else if (tt__app_str_ieq(w, "study")) o->s.command = TT_APP_STUDY;
       else
-        USAGE("unknown command '%s'; expected simplify, generate, eval or "
-              "optimize (see 'terratin --help')", w);
+        USAGE("unknown command '%s'; expected simplify, generate, eval, "
+              "optimize or study (see 'terratin --help')", w);
       cmdname = tt__app_command_name(o->s.command);
       snprintf(hint, sizeof hint, " (see 'terratin %s --help')", cmdname);
       continue;
@@ -564,6 +575,11 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.max_triangles = z;
       break;
     case O_PERCENT:
+      if (o->s.command == TT_APP_STUDY) { /* a list, checked by the run */
+        if (!(o->s.percents = keep(o, v)))
+          NOMEM();
+        break;
+      }
       if (!parse_double(v, &x) || !(x > 0 && x <= 100))
         USAGE("%s: -percent must be in (0, 100], got '%s'", cmdname, v);
       o->s.percent = x;
@@ -642,6 +658,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         USAGE("%s: -seed must be an unsigned integer, got '%s'", cmdname, v);
       sf.seed = 1;
       sf.seed_value = u;
+      o->s.seed = u;
+      o->s.seed_set = 1;
       o->s.anneal.seed = u;
       break;
     case O_ANNEAL_T0:
@@ -804,6 +822,24 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.max_memory = z;
       break;
     }
+    case O_TERRAIN:
+      if (!*v)
+        USAGE("%s: -terrain needs a DEM file or a terrain name%s", cmdname,
+              hint);
+      if (!strlist_add(&o->terrains, v))
+        NOMEM();
+      break;
+    case O_CRITERIA:
+    case O_METHODS:
+    case O_OPTIMIZERS:
+      if (!*v)
+        USAGE("%s: %s needs a comma-separated list%s", cmdname, d->name,
+              hint);
+      if (!(*(d->id == O_CRITERIA  ? &o->s.criteria
+              : d->id == O_METHODS ? &o->s.methods
+                                   : &o->s.optimizers) = keep(o, v)))
+        NOMEM();
+      break;
     case O_A_SRS:
       if (!*v)
         USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);
@@ -820,7 +856,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
           cmdname);
   switch (o->s.command) {
   case TT_APP_NONE:
-    USAGE("missing command: simplify, generate, eval or optimize (see "
+    USAGE("missing command: simplify, generate, eval, optimize or study (see "
           "'terratin --help')");
   case TT_APP_SIMPLIFY:
     if (npos < 1)
@@ -841,6 +877,18 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       USAGE("simplify: -hole dp needs a decomposable criterion (delaunay, "
             "minmax_angle, minmax_angle_lex, min_area), not %s",
             tt_criterion_name(o->s.criterion));
+    break;
+  case TT_APP_STUDY:
+    if (npos < 1)
+      USAGE("study: missing OUTDIR%s", hint);
+    if (npos > 1)
+      USAGE("study: unexpected argument '%s'%s", pos[1], hint);
+    if (!o->terrains.n)
+      USAGE("study: no -terrain given (a DEM file or fault_smooth, "
+            "fault_rough, peak_rough, valley_rough, hybrid, sphere, "
+            "cylinder, bump)%s", hint);
+    if (!(o->s.output = keep(o, pos[0])))
+      NOMEM();
     break;
   case TT_APP_EVAL:
     if (npos < 1)
@@ -915,6 +963,8 @@ done:
       o->s.lco = (const char *const *)o->lco.v;
     if (o->dsco.n)
       o->s.dsco = (const char *const *)o->dsco.v;
+    o->s.terrains = o->terrains.n ? (const char *const *)o->terrains.v
+                                  : empty_list;
   }
   tt_context_destroy(ctx);
   if (st != TT_OK) {

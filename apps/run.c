@@ -519,6 +519,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   case TT_APP_GENERATE:
   case TT_APP_EVAL:
   case TT_APP_OPTIMIZE:
+  case TT_APP_STUDY:
     break;
   default:
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
@@ -543,6 +544,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   case TT_APP_SIMPLIFY: st = tt__app_simplify(&r); break;
   case TT_APP_GENERATE: st = tt__app_generate(&r); break;
   case TT_APP_OPTIMIZE: st = tt__app_optimize(&r); break;
+  case TT_APP_STUDY: st = tt__app_study(&r); break;
   default: st = tt__app_eval(&r); break;
   }
 done:

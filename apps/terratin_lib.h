@@ -47,7 +47,8 @@ typedef enum tt_app_command {
   TT_APP_SIMPLIFY,
   TT_APP_GENERATE,
   TT_APP_EVAL,
-  TT_APP_OPTIMIZE            /* optimize DEM IN_TIN OUTPUT */
+  TT_APP_OPTIMIZE,           /* optimize DEM IN_TIN OUTPUT */
+  TT_APP_STUDY               /* study OUTDIR */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
@@ -128,6 +129,16 @@ typedef struct tt_app_settings {
   /* generate */
   tt_synth_options synth;    /* tt_synth_options_init(kind) + the flags */
   const char *srs;           /* -a_srs; NULL: none */
+
+  /* study OUTDIR (output); the lists are checked by the run (study.c) */
+  const char *const *terrains; /* -terrain, in order: a DEM or a name */
+  const char *criteria;      /* -criteria all | NAME,NAME; NULL: all */
+  const char *methods;       /* -methods insert,decimate; NULL: insert */
+  const char *optimizers;    /* -optimizers auto,none,local,...; NULL:
+                                auto */
+  const char *percents;      /* -percent P,P,...; NULL: 1,10,25,50 */
+  uint64_t seed;             /* -seed (study: the generated terrains) */
+  int seed_set;              /* -seed was given */
 } tt_app_settings;
 
 typedef struct tt_app_options tt_app_options;

@@ -1,0 +1,227 @@
+#!/usr/bin/env bash
+# test_study.sh -- end-to-end tests of `terratin study OUTDIR`
+# ($TT_TERRATIN, issue 15) on tiny terrains:
+#  - every row of curves.csv (a DEM file, and the generated 'bump' against
+#    the same terrain written by `terratin generate`) has the numbers of a
+#    single `terratin simplify -json -percent P` run with that method,
+#    criterion and optimiser: points, max_error, l2, rmse, mean_abs_error,
+#    total_abs_error, exactly;
+#  - curves.csv parses with python3's csv, with exactly the issue's
+#    columns and a row per run; tables.md has a table per terrain and
+#    method, a row per percentage, the smallest mean absolute error of each
+#    row in bold; runs.json parses and names the version;
+#  - a terrain that cannot be read, an existing non-empty OUTDIR, an
+#    unknown criterion and edge insertion with another criterion fail with
+#    one line and leave nothing behind; -overwrite writes into OUTDIR.
+# Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
+# missing.
+set -u
+
+T=${TT_TERRATIN:-}
+if [ -z "$T" ] || [ ! -x "$T" ]; then
+  echo "SKIP: TT_TERRATIN is not set or not executable"
+  exit 77
+fi
+if ! command -v python3 >/dev/null 2>&1; then
+  echo "SKIP: python3 is missing"
+  exit 77
+fi
+
+W=$(mktemp -d "${TMPDIR:-/tmp}/tt_study.XXXXXX") || exit 1
+trap 'rm -rf "$W"' EXIT
+cd "$W" || exit 1
+
+passed=0
+failed=0
+pass() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
+rc=0
+run() {
+  "$T" "$@" >out.txt 2>err.txt
+  rc=$?
+}
+lines() { wc -l <"$1" | tr -d ' '; }
+
+# expect_failure NAME CODE NEEDLE OUTDIR ARGS...: exit code CODE, one
+# stderr line containing NEEDLE, OUTDIR not created.
+expect_failure() {
+  local name=$1 code=$2 needle=$3 outdir=$4
+  shift 4
+  run "$@"
+  if [ "$rc" -ne "$code" ]; then
+    fail "$name: exit code $rc, expected $code ($(cat err.txt))"
+    return
+  fi
+  if [ "$(lines err.txt)" -ne 1 ] || ! grep -q -- "$needle" err.txt; then
+    fail "$name: stderr is not one line with '$needle': $(cat err.txt)"
+    return
+  fi
+  if [ -e "$outdir" ]; then
+    fail "$name: $outdir was created"
+    return
+  fi
+  pass
+}
+
+"$T" generate fault tiny.tif -size 24x20 -seed 7 -q || exit 1
+"$T" generate bump bump.tif -q || exit 1
+
+# The study: a DEM and a generated terrain, both methods, two optimisers
+# (none, and auto which is local for minmax_angle), three criteria.
+CRITERIA=delaunay,minmax_angle,l2
+PERCENTS=5,20,50
+run study -q -terrain tiny.tif -terrain bump -criteria "$CRITERIA" \
+  -methods insert,decimate -optimizers none,auto -percent "$PERCENTS" out
+if [ "$rc" -eq 0 ] && [ -f out/curves.csv ] && [ -f out/tables.md ] &&
+  [ -f out/runs.json ]; then
+  pass
+else
+  fail "study run: rc $rc, $(cat err.txt)"
+fi
+if [ -z "$(ls -A out | grep -v -e '^curves.csv$' -e '^tables.md$' \
+  -e '^runs.json$')" ]; then pass; else fail "stray files in out: $(ls -A out)"; fi
+
+# The CSV: the columns, a row per run (2 terrains x 2 methods x 2
+# optimisers x 3 percents x 3 criteria = 72).
+if python3 - out/curves.csv <<'EOF'; then pass; else fail "curves.csv shape"; fi
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1], newline="")))
+want = ["terrain", "method", "criterion", "optimizer", "points", "max_error",
+        "l2", "rmse", "mean_abs_error", "total_abs_error", "seconds"]
+if rows[0] != want:
+    sys.exit("header %r" % rows[0])
+body = rows[1:]
+if len(body) != 72:
+    sys.exit("%d rows" % len(body))
+for r in body:
+    if len(r) != len(want):
+        sys.exit("row %r" % r)
+    int(r[4])
+    [float(x) for x in r[5:]]
+if {r[0] for r in body} != {"tiny.tif", "bump"}:
+    sys.exit("terrains %r" % {r[0] for r in body})
+if {r[3] for r in body} != {"none", "local"}:
+    sys.exit("optimizers %r" % {r[3] for r in body})
+EOF
+
+# Each row against a single simplify run. The generated 'bump' is the
+# terrain `terratin generate bump` writes.
+python3 - out/curves.csv >cases.txt <<'EOF'
+import csv, sys
+for r in csv.DictReader(open(sys.argv[1], newline="")):
+    print(r["terrain"], r["method"], r["criterion"], r["optimizer"],
+          r["points"], r["max_error"], r["l2"], r["rmse"],
+          r["mean_abs_error"], r["total_abs_error"])
+EOF
+# The percentages, in the order of the rows: per (terrain, method,
+# optimiser) block, each percent for every criterion.
+mismatch=0
+checked=0
+i=0
+while read -r terr meth crit opt points mx l2 rmse mae tae; do
+  ncrit=3
+  npct=3
+  k=$(((i / ncrit) % npct))
+  pct=$(echo "$PERCENTS" | cut -d, -f$((k + 1)))
+  i=$((i + 1))
+  dem=$terr
+  [ "$terr" = bump ] && dem=bump.tif
+  "$T" simplify "$dem" one.gpkg -overwrite -json -percent "$pct" \
+    -method "$meth" -criterion "$crit" -optimize "$opt" >one.json 2>/dev/null ||
+    { mismatch=$((mismatch + 1)); echo "simplify failed: $terr $meth $crit $opt $pct" >&2; continue; }
+  if ! python3 - one.json "$points" "$mx" "$l2" "$rmse" "$mae" "$tae" <<'EOF'; then
+import json, sys
+d = json.load(open(sys.argv[1]))
+got = [d["vertices"], d["max_error"], d["l2"], d["rmse"],
+       d["mean_abs_error"], d["total_abs_error"]]
+want = [int(sys.argv[2])] + [float(x) for x in sys.argv[3:]]
+if got != want:
+    sys.exit("simplify %r, study %r" % (got, want))
+EOF
+    mismatch=$((mismatch + 1))
+    echo "  at $terr $meth $crit $opt $pct%" >&2
+  fi
+  checked=$((checked + 1))
+done <cases.txt
+if [ "$mismatch" -eq 0 ] && [ "$checked" -eq 72 ]; then
+  pass
+else
+  fail "study vs simplify: $mismatch of $checked rows differ"
+fi
+
+# tables.md: 2 terrains x 2 methods x 2 optimisers = 8 tables of 3 rows,
+# the smallest value of each row bold (and only the smallest).
+if python3 - out/tables.md <<'EOF'; then pass; else fail "tables.md"; fi
+import sys
+tables = 0
+rows = 0
+for line in open(sys.argv[1]):
+    if line.startswith("## "):
+        tables += 1
+    if not line.startswith("| ") or line.startswith("| %"):
+        continue
+    cells = [c.strip() for c in line.strip().strip("|").split("|")]
+    vals = cells[2:]
+    if len(vals) != 3:
+        sys.exit("row %r" % line)
+    nums = [float(v.strip("*")) for v in vals]
+    best = min(nums)
+    for v, x in zip(vals, nums):
+        if v.startswith("**") != (x == best):
+            sys.exit("bold wrong in %r" % line)
+    rows += 1
+if tables != 8 or rows != 24:
+    sys.exit("%d tables, %d rows" % (tables, rows))
+EOF
+
+if python3 -c 'import json,sys; d=json.load(open(sys.argv[1]))
+assert d["version"] and d["runs"] == 72 and d["terrains"]["2"]["generator"] == "bump", d' out/runs.json; then
+  pass
+else
+  fail "runs.json"
+fi
+
+# Failures: one line, nothing left.
+expect_failure "unreadable terrain" 1 "nosuch.tif" bad1 \
+  study -q -terrain bump -terrain nosuch.tif -percent 10 bad1
+echo "not a raster" >junk.tif
+expect_failure "not a raster" 1 "junk.tif" bad2 \
+  study -q -terrain junk.tif -percent 10 bad2
+expect_failure "edge insertion with delaunay" 2 "edge_insertion" bad3 \
+  study -q -terrain bump -criteria delaunay,minmax_angle \
+  -optimizers edge_insertion -percent 10 bad3
+expect_failure "unknown criterion" 2 "nosuch" bad4 \
+  study -q -terrain bump -criteria delaunay,nosuch bad4
+expect_failure "bad percent" 2 "-percent" bad5 \
+  study -q -terrain bump -percent 10,200 bad5
+expect_failure "no terrain" 2 "-terrain" bad6 study -q bad6
+expect_failure "hex percent" 2 "-percent" bad7 \
+  study -q -terrain bump -percent 0x10 bad7
+expect_failure "criterion twice" 2 "twice" bad8 \
+  study -q -terrain bump -criteria delaunay,DELAUNAY bad8
+expect_failure "unknown method" 2 "-methods" bad9 \
+  study -q -terrain bump -methods insert,refine bad9
+
+# An existing non-empty OUTDIR: refused, untouched; -overwrite writes.
+mkdir full && echo keep >full/mine.txt
+run study -q -terrain bump -percent 10 full
+if [ "$rc" -eq 1 ] && [ "$(lines err.txt)" -eq 1 ] &&
+  grep -q -- "-overwrite" err.txt && [ "$(ls -A full)" = mine.txt ]; then
+  pass
+else
+  fail "non-empty OUTDIR: rc $rc, $(cat err.txt), $(ls -A full)"
+fi
+run study -q -overwrite -terrain bump -criteria delaunay -percent 10 full
+if [ "$rc" -eq 0 ] && [ -f full/mine.txt ] && [ -f full/curves.csv ] &&
+  [ "$(lines full/curves.csv)" -eq 2 ]; then
+  pass
+else
+  fail "-overwrite: rc $rc, $(cat err.txt)"
+fi
+# An empty OUTDIR needs no -overwrite.
+mkdir empty
+run study -q -terrain bump -criteria delaunay -percent 10 empty
+if [ "$rc" -eq 0 ] && [ -f empty/tables.md ]; then pass; else fail "empty OUTDIR: $(cat err.txt)"; fi
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
