@@ -4,7 +4,9 @@
  * one-line failure helpers, the phase-scaled progress, the JSON writer, and
  * one entry point per subcommand.
  *
- *   options.c   the option table, parsing, the options object
+ *   options.c   the option table and the parser
+ *   settings.c  the options object's lists and accessors
+ *   values.c    numbers, sizes, booleans and grid sizes of words
  *   help.c      the help texts
  *   run.c       tt_app_run, GDAL messages, failures, the output driver
  *   dem.c       opening the DEM and reading it into a grid
@@ -55,6 +57,30 @@ struct tt_app_options {
   void *progress_arg;
   FILE *out, *err;
 };
+
+/* --- the values of words (values.c) ------------------------------------- */
+
+/* A list of owned strings kept NULL-terminated; 0 when out of memory. */
+int tt__app_strlist_add(app_strlist *l, const char *s);
+void tt__app_strlist_free(app_strlist *l);
+
+/* What the integer and size parsers found. */
+enum { NUM_BAD = 0, NUM_OK = 1, NUM_TOO_LARGE = 2 };
+
+/* A finite decimal number, the whole word ([+-]digits[.digits][e...]):
+ * 1 and *out, else 0. */
+int tt__app_parse_double(const char *w, double *out);
+/* An unsigned decimal integer, the whole word: NUM_OK, NUM_BAD, or
+ * NUM_TOO_LARGE beyond 2^64 - 1 (resp. SIZE_MAX). */
+int tt__app_parse_u64(const char *w, uint64_t *out);
+int tt__app_parse_size(const char *w, size_t *out);
+/* Bytes, or a number with K, M, G or T (powers of 1024, then B or iB). */
+int tt__app_parse_mem_size(const char *w, size_t *out);
+/* One of the words GDAL's CPLTestBool reads as a boolean. */
+int tt__app_is_gdal_bool(const char *w);
+/* "N" or "NXxNY". */
+int tt__app_parse_grid_size(const char *w, size_t *nx, size_t *ny);
+int tt__app_is_pow2_plus1(size_t n);
 
 /* "simplify", "generate", "eval" or "" (help.c). */
 const char *tt__app_command_name(tt_app_command c);

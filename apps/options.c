@@ -1,8 +1,8 @@
 /*
  * options.c -- the command line of terratin: one table of options (which
  * option applies to which subcommand, whether it takes a value), the parser
- * that turns the words after the program name into a tt_app_options object,
- * and the object's accessors.
+ * that turns the words after the program name into a tt_app_options object
+ * (its accessors are in settings.c, the values of words in values.c).
  *
  * Invariants: parsing has no side effects beyond the options object (GDAL is
  * not touched: --config is applied by tt_app_run); --help and --version win
@@ -21,219 +21,23 @@
 #include <string.h>
 #include <strings.h>
 
-static int strlist_add(app_strlist *l, const char *s)
-{
-  if (l->n + 2 > l->cap) {
-    size_t cap = l->cap ? 2 * l->cap : 8;
-    char **v = realloc(l->v, cap * sizeof *v);
-    if (!v)
-      return 0;
-    l->v = v;
-    l->cap = cap;
-  }
-  char *copy = malloc(strlen(s) + 1);
-  if (!copy)
-    return 0;
-  strcpy(copy, s);
-  l->v[l->n++] = copy;
-  l->v[l->n] = NULL;
-  return 1;
-}
-
-static void strlist_free(app_strlist *l)
-{
-  for (size_t i = 0; i < l->n; i++)
-    free(l->v[i]);
-  free(l->v);
-  l->v = NULL;
-  l->n = l->cap = 0;
-}
-
 static const char *const empty_list[] = {NULL};
-
-void tt_app_options_destroy(tt_app_options *o)
-{
-  if (!o)
-    return;
-  strlist_free(&o->strings);
-  strlist_free(&o->config);
-  strlist_free(&o->lco);
-  strlist_free(&o->dsco);
-  strlist_free(&o->terrains);
-  free(o);
-}
-
-const tt_app_settings *tt_app_options_settings(const tt_app_options *o)
-{
-  return o ? &o->s : NULL;
-}
-
-void tt_app_options_set_progress(tt_app_options *o, tt_progress_fn fn,
-                                 void *arg)
-{
-  if (!o)
-    return;
-  o->progress = fn;
-  o->progress_arg = arg;
-}
-
-void tt_app_options_set_streams(tt_app_options *o, FILE *out, FILE *err)
-{
-  if (!o)
-    return;
-  o->out = out ? out : stdout;
-  o->err = err ? err : stderr;
-}
-
-int tt_app_options_wants_progress_bar(const tt_app_options *o)
-{
-  return o && (o->s.command == TT_APP_SIMPLIFY ||
-               o->s.command == TT_APP_STUDY) &&
-         !o->s.quiet && !o->s.json;
-}
 
 /* ===========================================================================
  * Parsing
  * ========================================================================= */
 
-/* A finite decimal number, the whole word: [+-]digits[.digits][e[+-]digits].
- * strtod alone would also take hex ("0x10" is 16), "inf", "nan" and
- * leading blanks, none of which is meant where a height or a limit goes.
- * A value too small for a double (1e-320 is subnormal, 1e-400 rounds to
- * 0) is taken as strtod rounds it: it is still the number written. */
-static int parse_double(const char *w, double *out)
-{
-  const char *p = w;
-  int digits = 0;
-  if (*p == '+' || *p == '-')
-    p++;
-  for (; *p >= '0' && *p <= '9'; p++)
-    digits++;
-  if (*p == '.')
-    for (p++; *p >= '0' && *p <= '9'; p++)
-      digits++;
-  if (!digits)
-    return 0;
-  if (*p == 'e' || *p == 'E') {
-    p++;
-    if (*p == '+' || *p == '-')
-      p++;
-    if (!(*p >= '0' && *p <= '9'))
-      return 0;
-    while (*p >= '0' && *p <= '9')
-      p++;
-  }
-  if (*p != '\0')
-    return 0;
-  char *end = NULL;
-  errno = 0;
-  double d = strtod(w, &end);
-  if (end == w || *end != '\0' || !isfinite(d))
-    return 0;
-  if (errno == ERANGE && fabs(d) > 1.0)
-    return 0; /* overflow: strtod gave HUGE_VAL */
-  *out = d;
-  return 1;
-}
-
-/* What parse_u64 found: a number, not a number, or one too large. */
-enum { NUM_BAD = 0, NUM_OK = 1, NUM_TOO_LARGE = 2 };
-
-/* An unsigned decimal integer, the whole word, no sign. NUM_TOO_LARGE for
- * digits beyond 2^64 - 1, so the message can say "above the limit" as it
- * does for 18446744073709551615. */
-static int parse_u64(const char *w, uint64_t *out)
-{
-  uint64_t v = 0;
-  int over = 0;
-  if (!*w)
-    return NUM_BAD;
-  for (const char *p = w; *p; p++) {
-    if (*p < '0' || *p > '9')
-      return NUM_BAD;
-    unsigned d = (unsigned)(*p - '0');
-    if (v > (UINT64_MAX - d) / 10)
-      over = 1;
-    else
-      v = v * 10 + d;
-  }
-  if (over)
-    return NUM_TOO_LARGE;
-  *out = v;
-  return NUM_OK;
-}
-
-static int parse_size(const char *w, size_t *out)
-{
-  uint64_t v = 0;
-  int k = parse_u64(w, &v);
-  if (k == NUM_OK && v > (uint64_t)SIZE_MAX)
-    k = NUM_TOO_LARGE;
-  if (k == NUM_OK)
-    *out = (size_t)v;
-  return k;
-}
-
-/* A memory size as GDAL's utilities write them: bytes, or a decimal number
- * with K, M, G or T (powers of 1024, optionally followed by B or iB:
- * "500M", "1.5GB", "2GiB", "1048576"). NUM_TOO_LARGE beyond SIZE_MAX. */
-static int parse_mem_size(const char *w, size_t *out)
-{
-  char num[64];
-  size_t n = strspn(w, "0123456789.");
-  if (n == 0 || n >= sizeof num)
-    return n >= sizeof num ? NUM_TOO_LARGE : NUM_BAD;
-  memcpy(num, w, n);
-  num[n] = '\0';
-  double v;
-  if (!parse_double(num, &v))
-    return NUM_BAD;
-  const char *u = w + n;
-  double mult = 1;
-  static const char units[] = "KMGT";
-  const char *k = *u ? strchr(units, *u >= 'a' ? *u - 'a' + 'A' : *u) : NULL;
-  if (k && *u) {
-    for (const char *q = units; q <= k; q++)
-      mult *= 1024;
-    u++;
-    if (tt__app_str_ieq(u, "iB"))
-      u += 2;
-    else if (*u == 'B' || *u == 'b')
-      u++;
-  } else if (*u == 'B' || *u == 'b') {
-    u++;
-  }
-  if (*u)
-    return NUM_BAD;
-  double bytes = floor(v * mult);
-  if (bytes >= 18446744073709551616.0 || bytes >= (double)SIZE_MAX)
-    return NUM_TOO_LARGE;
-  *out = (size_t)bytes;
-  return NUM_OK;
-}
-
-/* GDAL's booleans for --debug: the words CPLTestBool reads as such. */
-static int is_gdal_bool(const char *w)
-{
-  static const char *const words[] = {"on", "off", "yes", "no", "true",
-                                      "false", "1", "0"};
-  for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
-    if (tt__app_str_ieq(w, words[i]))
-      return 1;
-  return 0;
-}
-
 /* Which option applies to which command: one table, so the parser, the
  * error messages and the tests agree. */
 enum opt_id {
   O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
-  O_DSCO, O_NLN, O_OVERWRITE, O_OBJ_LOCAL, O_Q, O_CRITERION, O_OPTIMIZE, O_REPAIR, O_JSON,
-  O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT, O_WAVE_SIZE,
-  O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA, O_Z_FACTOR,
-  O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
-  O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START,
-  O_IMPORTANCE, O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY,
-  O_TERRAIN, O_CRITERIA, O_METHODS, O_OPTIMIZERS
+  O_DSCO, O_NLN, O_OVERWRITE, O_OBJ_LOCAL, O_Q, O_CRITERION, O_OPTIMIZE,
+  O_REPAIR, O_JSON, O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT,
+  O_WAVE_SIZE, O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA,
+  O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
+  O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START, O_IMPORTANCE,
+  O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY, O_TERRAIN,
+  O_CRITERIA, O_METHODS, O_OPTIMIZERS
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -324,25 +128,6 @@ typedef struct synth_flags {
   tt_synth_seeding seeding_value;
 } synth_flags;
 
-static int parse_grid_size(const char *w, size_t *nx, size_t *ny)
-{
-  const char *x = strpbrk(w, "xX");
-  char buf[64];
-  if (strlen(w) >= sizeof buf)
-    return 0;
-  if (!x)
-    return parse_size(w, nx) == NUM_OK && (*ny = *nx, 1);
-  memcpy(buf, w, (size_t)(x - w));
-  buf[x - w] = '\0';
-  return parse_size(buf, nx) == NUM_OK && parse_size(x + 1, ny) == NUM_OK;
-}
-
-static int is_pow2_plus1(size_t n)
-{
-  size_t m = n - 1;
-  return n >= 3 && (m & (m - 1)) == 0;
-}
-
 #define USAGE(...)                                                             \
   do {                                                                         \
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG, __VA_ARGS__);       \
@@ -366,7 +151,7 @@ static int is_help_word(const char *w)
 
 static const char *keep(tt_app_options *o, const char *w)
 {
-  if (!strlist_add(&o->strings, w))
+  if (!tt__app_strlist_add(&o->strings, w))
     return NULL;
   return o->strings.v[o->strings.n - 1];
 }
@@ -466,8 +251,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
           NOMEM();
         memcpy(key, k, (size_t)(eq - k));
         key[eq - k] = '\0';
-        int ok = strlist_add(&o->config, key) &&
-                 strlist_add(&o->config, eq + 1);
+        int ok = tt__app_strlist_add(&o->config, key) &&
+                 tt__app_strlist_add(&o->config, eq + 1);
         free(key);
         if (!ok)
           NOMEM();
@@ -477,8 +262,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
           USAGE("--config %s needs a VALUE", k);
         if (!*k)
           USAGE("--config needs a non-empty KEY");
-        if (!strlist_add(&o->config, k) ||
-            !strlist_add(&o->config, argv[i + 2]))
+        if (!tt__app_strlist_add(&o->config, k) ||
+            !tt__app_strlist_add(&o->config, argv[i + 2]))
           NOMEM();
         i += 2;
       }
@@ -487,11 +272,11 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (tt__app_str_ieq(w, "--debug")) {
       if (!argv[i + 1])
         USAGE("--debug needs a value: on or off");
-      if (!is_gdal_bool(argv[i + 1]))
+      if (!tt__app_is_gdal_bool(argv[i + 1]))
         USAGE("--debug must be on, off, yes, no, true, false, 1 or 0, got "
               "'%s'", argv[i + 1]);
-      if (!strlist_add(&o->config, "CPL_DEBUG") ||
-          !strlist_add(&o->config, argv[i + 1]))
+      if (!tt__app_strlist_add(&o->config, "CPL_DEBUG") ||
+          !tt__app_strlist_add(&o->config, argv[i + 1]))
         NOMEM();
       i += 1;
       continue;
@@ -517,7 +302,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     /* "-" alone and negative numbers are positional words. */
     const struct opt_def *d = NULL;
     double dummy;
-    if (w[0] == '-' && w[1] != '\0' && !parse_double(w, &dummy)) {
+    if (w[0] == '-' && w[1] != '\0' && !tt__app_parse_double(w, &dummy)) {
       d = find_opt(w);
       if (!d)
         USAGE("%s: unknown option '%s'%s", cmdname, w, hint);
@@ -543,20 +328,20 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     int k; /* what parse_size or parse_mem_size found */
     switch (d->id) {
     case O_B:
-      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+      if ((k = tt__app_parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -b must be a band number >= 1, got '%s'", cmdname, v);
       if (k != NUM_OK || z > INT_MAX)
         USAGE("%s: -b must be a band number >= 1, got '%s'", cmdname, v);
       o->s.band = (int)z;
       break;
     case O_MAX_ERROR:
-      if (!parse_double(v, &x) || x < 0)
+      if (!tt__app_parse_double(v, &x) || x < 0)
         USAGE("%s: -max_error must be a finite number >= 0 (z units), got "
               "'%s'", cmdname, v);
       o->s.max_error = x + 0.0; /* -0 reads as "no limit" to the engine */
       break;
     case O_MAX_POINTS:
-      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+      if ((k = tt__app_parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -max_points must be an integer >= 1, got '%s'", cmdname,
               v);
       if (k != NUM_OK || z > TT_MAX_VERTICES)
@@ -565,7 +350,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.max_points = z;
       break;
     case O_MAX_TRIANGLES:
-      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+      if ((k = tt__app_parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -max_triangles must be an integer >= 1, got '%s'",
               cmdname, v);
       if (k != NUM_OK || z > 2 * TT_MAX_VERTICES)
@@ -580,7 +365,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
           NOMEM();
         break;
       }
-      if (!parse_double(v, &x) || !(x > 0 && x <= 100))
+      if (!tt__app_parse_double(v, &x) || !(x > 0 && x <= 100))
         USAGE("%s: -percent must be in (0, 100], got '%s'", cmdname, v);
       o->s.percent = x;
       break;
@@ -596,7 +381,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (!eq || eq == v)
         USAGE("%s: %s expects NAME=VALUE, got '%s'", cmdname,
               d->id == O_LCO ? "-lco" : "-dsco", v);
-      if (!strlist_add(d->id == O_LCO ? &o->lco : &o->dsco, v))
+      if (!tt__app_strlist_add(d->id == O_LCO ? &o->lco : &o->dsco, v))
         NOMEM();
       break;
     }
@@ -643,8 +428,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         NOMEM();
       break;
     case O_SIZE:
-      if (!parse_grid_size(v, &sf.nx, &sf.ny) || sf.nx < 2 || sf.ny < 2 ||
-          sf.nx > TT_MAX_GRID_SIDE || sf.ny > TT_MAX_GRID_SIDE)
+      if (!tt__app_parse_grid_size(v, &sf.nx, &sf.ny) || sf.nx < 2 ||
+          sf.ny < 2 || sf.nx > TT_MAX_GRID_SIDE || sf.ny > TT_MAX_GRID_SIDE)
         USAGE("%s: -size must be N or NXxNY with sides >= 2, got '%s'",
               cmdname, v);
       if (sf.nx > SIZE_MAX / sf.ny ||
@@ -654,7 +439,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       sf.size = 1;
       break;
     case O_SEED:
-      if (parse_u64(v, &u) != NUM_OK)
+      if (tt__app_parse_u64(v, &u) != NUM_OK)
         USAGE("%s: -seed must be an unsigned integer, got '%s'", cmdname, v);
       sf.seed = 1;
       sf.seed_value = u;
@@ -663,59 +448,59 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.anneal.seed = u;
       break;
     case O_ANNEAL_T0:
-      if (!parse_double(v, &x) || !(x > 0))
+      if (!tt__app_parse_double(v, &x) || !(x > 0))
         USAGE("%s: -anneal_t0 must be a finite number > 0 (the start "
               "temperature, in swap value units), got '%s'", cmdname, v);
       o->s.anneal.t0 = x;
       break;
     case O_ANNEAL_STAGES:
-      if (!parse_size(v, &z) || z < 1 || z > 1000000)
+      if (!tt__app_parse_size(v, &z) || z < 1 || z > 1000000)
         USAGE("%s: -anneal_stages must be an integer in [1, 1000000], got "
               "'%s'", cmdname, v);
       o->s.anneal.stages = (int)z;
       break;
     case O_ANNEAL_SWAPS:
     case O_ANNEAL_GOOD:
-      if (!parse_double(v, &x) || !(x > 0 && x <= 1e6))
+      if (!tt__app_parse_double(v, &x) || !(x > 0 && x <= 1e6))
         USAGE("%s: %s must be a number in (0, 1e6] (per edge), got '%s'",
               cmdname, d->name, v);
       *(d->id == O_ANNEAL_SWAPS ? &o->s.anneal.swaps : &o->s.anneal.good) = x;
       break;
     case O_ANNEAL_R:
-      if (!parse_double(v, &x) || !(x > 0 && x < 1))
+      if (!tt__app_parse_double(v, &x) || !(x > 0 && x < 1))
         USAGE("%s: -anneal_r must be in (0, 1), got '%s'", cmdname, v);
       o->s.anneal.r = x;
       break;
     case O_ITERATIONS:
-      if (parse_size(v, &z) != NUM_OK || z < 1)
+      if (tt__app_parse_size(v, &z) != NUM_OK || z < 1)
         USAGE("%s: -iterations must be an integer >= 1, got '%s'", cmdname,
               v);
       sf.iterations = 1;
       sf.iterations_value = z;
       break;
     case O_DISPLACEMENT:
-      if (!parse_double(v, &x) || x < 0)
+      if (!tt__app_parse_double(v, &x) || x < 0)
         USAGE("%s: -displacement must be a finite number >= 0, got '%s'",
               cmdname, v);
       sf.displacement = 1;
       sf.displacement_value = x;
       break;
     case O_WAVE_SIZE:
-      if (!parse_double(v, &x) || x < 0)
+      if (!tt__app_parse_double(v, &x) || x < 0)
         USAGE("%s: -wave_size must be a finite number >= 0, got '%s'",
               cmdname, v);
       sf.wave_size = 1;
       sf.wave_size_value = x;
       break;
     case O_ROUGHNESS:
-      if (!parse_double(v, &x) || x <= 0)
+      if (!tt__app_parse_double(v, &x) || x <= 0)
         USAGE("%s: -roughness must be a finite number > 0, got '%s'",
               cmdname, v);
       sf.roughness = 1;
       sf.roughness_value = x;
       break;
     case O_AMPLITUDE:
-      if (!parse_double(v, &x) || x < 0)
+      if (!tt__app_parse_double(v, &x) || x < 0)
         USAGE("%s: -amplitude must be a finite number >= 0, got '%s'",
               cmdname, v);
       sf.amplitude = 1;
@@ -732,14 +517,14 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
               cmdname, v);
       break;
     case O_SRCNODATA:
-      if (!tt__app_str_ieq(v, "nan") && !parse_double(v, &x))
+      if (!tt__app_str_ieq(v, "nan") && !tt__app_parse_double(v, &x))
         USAGE("%s: -srcnodata must be a finite decimal number or nan, got "
               "'%s'", cmdname, v);
       if (!(o->s.srcnodata = keep(o, v)))
         NOMEM();
       break;
     case O_Z_FACTOR:
-      if (!parse_double(v, &x) || x == 0)
+      if (!tt__app_parse_double(v, &x) || x == 0)
         USAGE("%s: -z_factor must be a finite non-zero number, got '%s'",
               cmdname, v);
       o->s.z_factor = x;
@@ -802,7 +587,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         o->s.threads = -1;
         break;
       }
-      if ((k = parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+      if ((k = tt__app_parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -threads must be an integer >= 1 or ALL_CPUS, got '%s'",
               cmdname, v);
       if (k != NUM_OK || z > TT_APP_MAX_THREADS)
@@ -811,7 +596,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.threads = (int)z;
       break;
     case O_MAX_MEMORY: {
-      k = parse_mem_size(v, &z);
+      k = tt__app_parse_mem_size(v, &z);
       if (k == NUM_BAD || (k == NUM_OK && z < 1))
         USAGE("%s: -max_memory must be a size of at least 1 byte: bytes, "
               "or a number with K, M, G or T (e.g. 500M, 2G), got '%s'",
@@ -826,7 +611,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (!*v)
         USAGE("%s: -terrain needs a DEM file or a terrain name%s", cmdname,
               hint);
-      if (!strlist_add(&o->terrains, v))
+      if (!tt__app_strlist_add(&o->terrains, v))
         NOMEM();
       break;
     case O_CRITERIA:
@@ -939,7 +724,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       o->s.synth.ny = sf.ny;
     }
     if (kind == TT_SYNTH_DIAMOND_SQUARE &&
-        (o->s.synth.nx != o->s.synth.ny || !is_pow2_plus1(o->s.synth.nx)))
+        (o->s.synth.nx != o->s.synth.ny ||
+         !tt__app_is_pow2_plus1(o->s.synth.nx)))
       USAGE("generate: diamond_square needs a square size 2^n+1 (e.g. 129, "
             "257, 513), got %zux%zu", o->s.synth.nx, o->s.synth.ny);
     if (sf.seed) o->s.synth.seed = sf.seed_value;

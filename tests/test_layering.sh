@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fails when a file of the engine (src/ outside src/gdal/, or the engine's
 # public header) includes a header of GDAL, OGR, CPL, PROJ, GeographicLib or
-# SQLite: the engine builds and links with libm and threads alone.
+# SQLite: the engine builds and links with libm and threads alone; and when
+# a file of apps/ passes 800 lines.
 set -u
 root=${1:?usage: test_layering.sh SOURCE_DIR}
 pattern='^[[:space:]]*#[[:space:]]*include[[:space:]]*[<"](gdal[a-z_]*\.h|ogr[a-z_]*\.h|ogrsf_frmts\.h|cpl_[a-z_]*\.h|vrtdataset\.h|proj\.h|proj_[a-z_]*\.h|geodesic\.h|sqlite3\.h|sqlite3ext\.h)[>"]'
@@ -27,6 +28,14 @@ loose=$(find src -maxdepth 1 -type f)
 if [ -n "$loose" ]; then
   echo "test_layering: files directly in src/ (put each in its stage's folder):"
   echo "$loose"
+  exit 1
+fi
+# The command stays in files of a size a reader can hold: one per
+# subcommand, the parser, the reports (issue 12: none over 800 lines).
+long=$(wc -l apps/*.c apps/*.h | awk '$2 != "total" && $1 > 800 {print}')
+if [ -n "$long" ]; then
+  echo "test_layering: files of apps/ over 800 lines (split them by concept):"
+  echo "$long"
   exit 1
 fi
 echo "test_layering: the engine includes no GDAL-family header"
