@@ -647,7 +647,6 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     goto done;
   }
   sqlite3_extended_result_codes(w.db, 1);
-  if (getenv("FASTSQL")) exec(&w, "PRAGMA synchronous=OFF; PRAGMA journal_mode=MEMORY; PRAGMA cache_size=-65536", "pragma");
   s = exec(&w, "BEGIN IMMEDIATE", "cannot start a transaction");
   if (s != TT_OK)
     goto done;
