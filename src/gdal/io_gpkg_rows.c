@@ -5,11 +5,12 @@
  * tt_ogr_write_tin(ROWS=DEFERRED) makes the layers through OGR (tables,
  * fields, gpkg_contents, gpkg_geometry_columns, the feature-count triggers
  * and gpkg_ogr_contents: the metadata GDAL knows how to get right) and the
- * run_parameters row; this file then fills the two big tables with one
- * prepared INSERT each, as OGR would have filled them feature by feature
- * but without a feature object, a geometry object and a statement of SQL
- * text per row. The content is the same: the same fids (1..n in TIN
- * order), the same columns and values (NaN as NULL), the same geometry
+ * run_parameters row; this file then fills the two big tables with
+ * prepared INSERTs of 64 rows each, as OGR would have filled them feature
+ * by feature but without a feature object, a geometry object and a
+ * statement per row. The content is the same: the same fids (1..n in TIN
+ * order, given by SQLite's append path in a table that never had rows),
+ * the same columns and values (NaN as NULL), the same geometry
  * blobs, which are the GeoPackage binary header ("GP", version 0, flags,
  * srs_id, envelope) followed by ISO WKB, byte for byte as GDAL 3.6 writes
  * them:
@@ -24,14 +25,16 @@
  * are dropped for the inserts and re-created from their own SQL, as GDAL
  * itself does around bulk writes.
  *
- * Everything happens in one IMMEDIATE transaction: a failure (disk full,
- * an interruption through progress) rolls back and leaves the file with
- * its empty layers, as it was. tests/gdal/test_gpkg_rows.c compares every
- * feature with the OGR writer's.
+ * The R-trees of both layers are then packed from the boxes just written
+ * (gpkg_rtree.h), unless LCO=SPATIAL_INDEX=NO. Everything happens in one
+ * IMMEDIATE transaction: a failure (disk full, an interruption through
+ * progress) rolls back and leaves the file with its empty layers, as it
+ * was. tests/gdal/test_gpkg_rows.c compares every row, blob and index
+ * table with the OGR writer's.
  *
  * Workload: O(triangles + vertices) inserts of fixed-size rows (a 165-byte
- * and a 37-byte blob); memory O(1) beyond SQLite's page cache and, with
- * T_SRS, 16 bytes a vertex.
+ * and a 37-byte blob); memory 40 bytes a feature for the boxes, SQLite's
+ * page cache and, with T_SRS, 16 bytes a vertex.
  */
 #include "gdal/gpkg_rtree.h"
 #include "gdal/tin_records.h"
