@@ -131,6 +131,16 @@ tt_status tt__app_simplify(app_run *r)
   size_t mem_limit = s->max_memory ? s->max_memory
                                    : tt_memory_limit(&mem_source);
 
+  /* Decimation does not count its memory as it goes (its start holds a
+   * triangle per half sample): an explicit limit would be a promise it
+   * cannot keep. Refused before anything is read. */
+  if (s->decimate && s->max_memory) {
+    st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                      "simplify: -max_memory bounds -method insert only; "
+                      "decimation does not count its memory yet");
+    goto done;
+  }
+
   /* Read: 0 - 10%. */
   tt__app_phase_set(&r->prog, 0.0, 0.10);
   src = tt__app_open_raster(r, s->input, s->band, &band);
@@ -204,15 +214,6 @@ tt_status tt__app_simplify(app_run *r)
     dopt.progress_arg = ro.progress_arg;
     dopt.threads = ro.threads;
     rep.dopt = &dopt;
-    /* Decimation does not count its memory as it goes (its start holds a
-     * triangle per half sample): an explicit limit would be a promise it
-     * cannot keep. */
-    if (s->max_memory) {
-      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                        "simplify: -max_memory bounds -method insert only; "
-                        "decimation does not count its memory yet");
-      goto done;
-    }
   }
   double t = tt__app_now();
   st = s->decimate ? tt_decimate_run(r->ctx, grid, &dopt, &tin)
