@@ -97,6 +97,13 @@ tt_status tt__app_optimize(app_run *r)
     st = r->res->status;
     goto done;
   }
+  /* Every file either input is read from (an archive, a GPKG: name, VRT
+   * sources) is out of the output's reach, as in simplify. */
+  st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
   st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
                         &info, &valid);
   if (st != TT_OK)
@@ -106,6 +113,11 @@ tt_status tt__app_optimize(app_run *r)
   tds = tt__app_open_vector(r, s->tin);
   if (!tds) {
     st = r->res->status;
+    goto done;
+  }
+  st = tt_output_protect_dataset(r->ctx, outp, tds, s->tin);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
     goto done;
   }
   OGRLayerH layer = tt__app_tin_layer(r, tds);

@@ -179,6 +179,23 @@ before=$(md5sum sq.gpkg)
 expect_failure "existing output" 1 "exists" nothing.gpkg \
   optimize dem.tif square.geojson sq.gpkg
 check "existing output untouched" [ "$(md5sum sq.gpkg)" = "$before" ]
+# An input read through an archive is never replaced, DEM or TIN.
+if command -v zip >/dev/null 2>&1; then
+  zip -q tins.zip tin.gpkg && zip -q dems.zip dem.tif
+  for case in "dem.tif /vsizip/tins.zip/tin.gpkg tins.zip" \
+              "/vsizip/dems.zip/dem.tif tin.gpkg dems.zip"; do
+    set -- $case
+    zbefore=$(md5sum "$3")
+    run optimize -overwrite -of GPKG "$1" "$2" "$3"
+    check "optimize $1 $2 -> $3: refused" [ "$rc" -eq 1 ]
+    check "optimize $1 $2 -> $3: one line naming the cause" \
+      grep -q "input is read from" err.txt
+    check "optimize $1 $2 -> $3: the archive untouched" \
+      [ "$(md5sum "$3")" = "$zbefore" ]
+  done
+else
+  echo "zip is missing: the archive checks skipped"
+fi
 
 # --- simplify passes the annealing schedule on, for both methods -----------
 # (the -anneal_* options and -seed reach the final pass: the same seed gives
