@@ -762,15 +762,16 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       s = TT_OK;
     } else if (s == TT_OK) {
       s = tt_grid_set_ground_frame(ctx, grid, frame);
-      /* Longitude/latitude: every sample projected into a conformal
-       * frame (georef_conformal.c); the affine frame stays only when
-       * that fails. */
+      /* Longitude/latitude and Web Mercator: every sample projected
+       * into a conformal frame (georef_conformal.c); the affine frame
+       * stays only when that fails. */
       /* 24 bytes a sample beside the heights' 4: over MAX_MEMORY, the
        * affine frame stays, with a warning */
       size_t n = nx * ny, with_points = n <= SIZE_MAX / 28 ? n * 28
                                                            : SIZE_MAX;
-      if (s == TT_OK && srs && OSRIsGeographic(srs) &&
-          with_points > opt.max_memory) {
+      int conformal = srs && (OSRIsGeographic(srs) ||
+                              tt__georef_is_web_mercator(srs));
+      if (s == TT_OK && conformal && with_points > opt.max_memory) {
         char need_s[32], max_s[32];
         tt__warn(ctx, "%s: the heights and ground points of %zu x %zu "
                  "samples would need %s, more than %s (%s): keeping the "
@@ -780,7 +781,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                                           "memory"
                                         : "MAX_MEMORY",
                  tt__format_bytes(max_s, sizeof max_s, opt.max_memory), frame_name);
-      } else if (s == TT_OK && srs && OSRIsGeographic(srs)) {
+      } else if (s == TT_OK && conformal) {
         char conformal_name[512];
         s = tt__georef_ground_points(ctx, srs, opt.work_srs, grid,
                                      conformal_name, sizeof conformal_name,
