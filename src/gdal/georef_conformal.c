@@ -32,7 +32,9 @@
  * constant that balances their largest and smallest scale over the DEM (a
  * constant factor keeps a projection conformal); the frame's name says so.
  *
- * Scale factor and convergence come from the projected grid itself: the
+ * Scale factor and convergence come from the projected grid itself
+ * (tt_grid_ground_scale_at, engine, with ellipsoid_metric below; for the
+ * TIN's vertices only, nothing stored per sample): the
  * Jacobian J of pixel -> projection by finite differences over the grid
  * (central inside, second-order one-sided at the edges) against the
  * ground Jacobian G of pixel -> local east/north metres on the ellipsoid
@@ -45,7 +47,7 @@
  * grid's ground frame is J at the centre sample (so its orientation, and
  * the pixel-space orientation the mesh keeps, are the projection's).
  *
- * Workload: one batched PROJ transformation per row (nx points), 24 bytes
+ * Workload: one batched PROJ transformation per row (nx points), 16 bytes
  * of ground points per sample kept on the grid, O(1) per sample after.
  */
 #include "gdal/georef.h"
@@ -152,19 +154,6 @@ int tt__georef_is_web_mercator(OGRSpatialReferenceH srs)
   return web_mercator_of(srs, &src);
 }
 
-/* Derivative of f (samples i*stride, i < n, n >= 2) at i in grid steps. */
-static double d1(const double *f, size_t i, size_t n, size_t stride)
-{
-  if (n == 2)
-    return f[stride] - f[0];
-  if (i == 0)
-    return 0.5 * (-3 * f[0] + 4 * f[stride] - f[2 * stride]);
-  if (i == n - 1)
-    return 0.5 * (3 * f[i * stride] - 4 * f[(i - 1) * stride] +
-                  f[(i - 2) * stride]);
-  return 0.5 * (f[(i + 1) * stride] - f[(i - 1) * stride]);
-}
-
 /* The working CRS on srs's geographic CRS for the extent, or NULL. */
 static OGRSpatialReferenceH choose(OGRSpatialReferenceH srs, double lon0,
                                    double lat0, double lon_min,
@@ -237,6 +226,27 @@ done:
     return NULL;
   }
   return work;
+}
+
+/* Metres on the ellipsoid (a, e2) per map unit east and north at map
+ * point (x, y): longitude/latitude in units of params[2] radians, or Web
+ * Mercator of radius -params[2] (tt_ground_metric_fn). The prime-vertical
+ * and meridional radii times the radians per unit. */
+static void ellipsoid_metric(const double params[4], double x, double y,
+                             double out[2])
+{
+  double a = params[0], e2 = params[1], u = params[2];
+  double lat = y * u, ue = u, un = u;
+  if (u < 0) { /* Web Mercator: d lat / dy = 1 / (R cosh(y / R)) */
+    double R = -u;
+    lat = atan(sinh(y / R));
+    ue = 1.0 / R;
+    un = cos(lat) / R;
+  }
+  (void)x;
+  double sn = sin(lat), w2 = 1.0 - e2 * sn * sn;
+  out[0] = a / sqrt(w2) * cos(lat) * ue;          /* m per unit E */
+  out[1] = a * (1.0 - e2) / (w2 * sqrt(w2)) * un; /* m per unit N */
 }
 
 /* Geodesic area of a triangle of longitudes x and latitudes y (in the
@@ -423,8 +433,6 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   if (s != TT_OK)
     goto done;
   double *xy = tt_grid_ground_xy(grid);
-  float *gk = tt_grid_ground_scale(grid);
-  float *gconv = tt_grid_ground_convergence(grid);
 
   for (size_t r = 0; r < ny; r++) {
     for (size_t c = 0; c < nx; c++) {
@@ -446,52 +454,26 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     }
   }
 
-  /* Scale factor and convergence per sample. */
-  double kmin = HUGE_VAL, kmax = -HUGE_VAL, gdet = gt[1] * gt[5] -
-                                                   gt[2] * gt[4];
-  double centre_frame[4] = {0};
+  /* Scale factor and convergence per sample (tt_grid_ground_scale_at,
+   * against the ellipsoid's metric): their range here; the TIN derives
+   * them again for its vertices. */
+  const double metric_par[4] = {a, e2, sk.webmerc ? -sk.R : u, 0};
+  tt_grid_set_ground_metric_fn(grid, ellipsoid_metric, metric_par);
+  double kmin = HUGE_VAL, kmax = -HUGE_VAL;
   for (size_t r = 0; r < ny; r++) {
     for (size_t c = 0; c < nx; c++) {
-      size_t i = r * nx + c;
-      const double *rowx = xy + 2 * r * nx, *colx = xy + 2 * c;
-      double jcx = d1(rowx, c, nx, 2), jcy = d1(rowx + 1, c, nx, 2);
-      double jrx = d1(colx, r, ny, 2 * nx), jry = d1(colx + 1, r, ny, 2 * nx);
-      double lat = (gt[3] + (c + 0.5) * gt[4] + (r + 0.5) * gt[5]) * u;
-      /* radians of longitude and latitude per map unit */
-      double ue = u, un = u;
-      if (sk.webmerc) {
-        double lam;
-        to_lonlat(&sk, gt[0] + (c + 0.5) * gt[1] + (r + 0.5) * gt[2],
-                  gt[3] + (c + 0.5) * gt[4] + (r + 0.5) * gt[5], &lam, &lat);
-        ue = 1.0 / sk.R;
-        un = cos(lat) / sk.R; /* d lat / dy = 1 / (R cosh(y / R)) */
-      }
-      double sn = sin(lat), w2 = 1.0 - e2 * sn * sn;
-      double ge = a / sqrt(w2) * cos(lat) * ue;          /* m per unit E */
-      double gn = a * (1.0 - e2) / (w2 * sqrt(w2)) * un; /* m per unit N */
-      double detj = jcx * jry - jrx * jcy, detg = ge * gn * gdet;
-      double k = sqrt(fabs(detj / detg));
-      /* true north in pixel steps: G d = (0, 1), G = [ge gt1, ge gt2;
-       * gn gt4, gn gt5]; its image J d */
-      double dc = -ge * gt[2] / detg, dr = ge * gt[1] / detg;
-      double tx = jcx * dc + jrx * dr, ty = jcy * dc + jry * dr;
-      if (!isfinite(k) || !(k > 0) || !isfinite(tx) || !isfinite(ty)) {
+      double k = 0, conv = 0;
+      if (tt_grid_ground_scale_at(grid, c, r, &k, &conv) != TT_OK) {
         s = tt__error(ctx, TT_ERR_DATA, "no scale factor at sample (col "
                       "%zu, row %zu) (a pole?)", c, r);
         goto done;
       }
-      gk[i] = (float)k;
-      gconv[i] = (float)atan2(tx, ty);
       kmin = fmin(kmin, k);
       kmax = fmax(kmax, k);
-      if (c == nx / 2 && r == ny / 2) {
-        centre_frame[0] = jcx;
-        centre_frame[1] = jrx;
-        centre_frame[2] = jcy;
-        centre_frame[3] = jry;
-      }
     }
   }
+  double centre_frame[4];
+  tt__grid_ground_jacobian(grid, nx / 2, ny / 2, centre_frame);
   double scale = 1.0;
   if (kind == FRAME_POLAR || kind == FRAME_MERCATOR || kind == FRAME_STEREO)
     scale = 2.0 / (kmin + kmax);
@@ -499,7 +481,6 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     for (size_t i = 0; i < nx * ny; i++) {
       xy[2 * i] *= scale;
       xy[2 * i + 1] *= scale;
-      gk[i] = (float)(gk[i] * scale);
     }
     for (int k = 0; k < 4; k++)
       centre_frame[k] *= scale;
@@ -524,6 +505,7 @@ done:
   if (s != TT_OK) {
     tt_grid_drop_ground_points(grid);
     tt_grid_set_area_fn(grid, NULL, NULL);
+    tt_grid_set_ground_metric_fn(grid, NULL, NULL);
   }
   free(lx);
   free(ly);

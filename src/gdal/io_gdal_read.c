@@ -765,9 +765,9 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       /* Longitude/latitude and Web Mercator: every sample projected
        * into a conformal frame (georef_conformal.c); the affine frame
        * stays only when that fails. */
-      /* 24 bytes a sample beside the heights' 4: over MAX_MEMORY, the
+      /* 16 bytes a sample beside the heights' 4: over MAX_MEMORY, the
        * affine frame stays, with a warning */
-      size_t n = nx * ny, with_points = n <= SIZE_MAX / 28 ? n * 28
+      size_t n = nx * ny, with_points = n <= SIZE_MAX / 20 ? n * 20
                                                            : SIZE_MAX;
       int conformal = srs && (OSRIsGeographic(srs) ||
                               tt__georef_is_web_mercator(srs));
