@@ -800,6 +800,18 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       s = with_path(ctx, s, path);
       goto done;
     }
+    /* A map in feet is measured in metres (georef_proj.c): heights of no
+     * declared unit are taken as metres then, which they rarely are on
+     * such a map. Say so once; the TIN is the same either way. */
+    char *lin_name = NULL;
+    double lin = srs && OSRIsProjected(srs) ? OSRGetLinearUnits(srs, &lin_name)
+                                            : 1.0;
+    if (lin > 0 && fabs(lin - 1.0) > 1e-9 && !unit_declared[0] &&
+        !opt.has_z_factor)
+      tt__warn(ctx, "%s: the map unit is %s and the heights declare no "
+               "unit: slopes and 3-D areas take them as metres (give "
+               "-z_factor %.10g if they are in that unit too)", path,
+               lin_name && *lin_name ? lin_name : "not the metre", lin);
   }
 
   /* Validity: SRCNODATA overrides the mask; GMF_ALL_VALID needs none. */

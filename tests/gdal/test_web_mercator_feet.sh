@@ -9,7 +9,9 @@
 # a Lambert azimuthal equal-area projection centred on the DEM (areas
 # exact on the ellipsoid, angles within a few 1e-6 over 30 km), the slope
 # from the plane through the three corners. The Web Mercator DEM must say
-# it has ground points ("per vertex"), the feet one the unit factor.
+# it has ground points ("per vertex"), the feet one the unit factor; a
+# feet map whose heights declare no unit warns that they are taken as
+# metres.
 # Exits 1 on a failure, 77 when a tool is missing.
 set -u
 T=${TT_TERRATIN:-}
@@ -92,5 +94,14 @@ check ft ft.gpkg 5e-4 5e-4
 "$T" simplify -q -json -max_error 5 -z_unit m ftz.vrt ftz.gpkg >ftz.json \
   2>ftz.err || fail "feet heights: simplify failed: $(cat ftz.err)"
 check ftz ftz.gpkg 5e-4 5e-4
+
+# a map in feet whose heights declare no unit: one warning that they are
+# taken as metres; none when they declare one
+gdal_translate -q -of VRT ft.tif nounit.vrt && sed -i '/<UnitType>/d' nounit.vrt
+"$T" simplify -q -max_error 20 nounit.vrt nounit.gpkg 2>nounit.err ||
+  fail "no height unit: simplify failed: $(cat nounit.err)"
+grep -q 'heights declare no unit' nounit.err && pass ||
+  fail "no height unit: no warning: $(cat nounit.err)"
+grep -q 'declare no unit' ft.err ftz.err && fail "a warning with a height unit" || pass
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
