@@ -177,11 +177,14 @@ void tt_grid_get_ground_frame(const tt_grid *grid, double out_a[4]);
 /* Ground points: for a grid whose pixels map to the ground through no
  * affine frame (longitude/latitude), every sample's position in a
  * conformal working projection. tt_grid_alloc_ground_points() makes room
- * for them (24 bytes a sample) and the caller fills, per sample i
+ * for them (16 bytes a sample) and the caller fills, per sample i
  * (row-major): xy[2i], xy[2i+1] the projected x, y (any origin; differences
- * must be ground lengths times the scale), scale[i] the projection's scale
- * factor k there (projected length / ground length) and convergence[i] the
- * angle, radians clockwise, from the projection's +y to true north. The
+ * must be ground lengths times the scale). The projection's scale factor k
+ * (projected length / ground length) and convergence (the angle, radians
+ * clockwise, from the projection's +y to true north) at a sample are not
+ * stored: tt_grid_ground_scale_at() derives them from the neighbouring
+ * ground points (finite differences) and the ground metric function
+ * (tt_grid_set_ground_metric_fn), for the TIN's vertices only. The
  * ground frame (tt_grid_set_ground_frame) must still be set, to the
  * projection's Jacobian near the centre: it gives the pixel-space
  * orientation and the fallbacks. Once filled, the Delaunay test runs on the
@@ -201,10 +204,28 @@ typedef double (*tt_area_fn)(const double params[4], const double x[3],
                              const double y[3]);
 void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
                          const double params[4]);
+/* Metres on the ground per map unit east and north (out[0], out[1]) at
+ * map point (x, y) of the geotransform, whose axes point east and north
+ * (the glue's: the ellipsoid's radii for longitude/latitude); params:
+ * four numbers the function reads. NULL (the default): map units are
+ * metres. */
+typedef void (*tt_ground_metric_fn)(const double params[4], double x,
+                                    double y, double out[2]);
+void tt_grid_set_ground_metric_fn(tt_grid *grid, tt_ground_metric_fn fn,
+                                  const double params[4]);
+/* The scale factor k and the convergence (radians clockwise from the
+ * projection's +y to true north) of the ground points at sample (col,
+ * row): the Jacobian J of pixel -> ground point by finite differences
+ * (central, second-order one-sided at the edges) against the ground
+ * Jacobian G of pixel -> east/north metres (the metric function times the
+ * geotransform): k = sqrt(|det J / det G|), true north J G^-1 (0, 1).
+ * TT_ERR_ARG without ground points or outside the grid; TT_ERR_DATA when
+ * k is not finite and positive (a pole). */
+tt_status tt_grid_ground_scale_at(const tt_grid *grid, size_t col,
+                                  size_t row, double *out_k,
+                                  double *out_convergence);
 void tt_grid_drop_ground_points(tt_grid *grid);
 double *tt_grid_ground_xy(tt_grid *grid);
-float *tt_grid_ground_scale(tt_grid *grid);
-float *tt_grid_ground_convergence(tt_grid *grid);
 
 /* Checks the heights: refuses infinities and heights beyond
  * +-TT_MAX_HEIGHT (naming the first row/column) and counts the valid

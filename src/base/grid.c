@@ -228,23 +228,79 @@ tt_status tt_grid_alloc_ground_points(tt_context *ctx, tt_grid *grid)
   tt_grid_drop_ground_points(grid);
   size_t n = grid->nx * grid->ny;
   grid->gxy = malloc(2 * n * sizeof *grid->gxy);
-  grid->gk = malloc(n * sizeof *grid->gk);
-  grid->gconv = malloc(n * sizeof *grid->gconv);
-  if (!grid->gxy || !grid->gk || !grid->gconv) {
-    tt_grid_drop_ground_points(grid);
+  if (!grid->gxy)
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the ground "
-                     "points of %zu samples (24 bytes each)", n);
-  }
+                     "points of %zu samples (16 bytes each)", n);
   return TT_OK;
 }
 
 void tt_grid_drop_ground_points(tt_grid *grid)
 {
   free(grid->gxy);
-  free(grid->gk);
-  free(grid->gconv);
   grid->gxy = NULL;
-  grid->gk = grid->gconv = NULL;
+}
+
+void tt_grid_set_ground_metric_fn(tt_grid *grid, tt_ground_metric_fn fn,
+                                  const double params[4])
+{
+  grid->metric_fn = fn;
+  for (int k = 0; k < 4; k++)
+    grid->metric_par[k] = fn ? params[k] : 0;
+}
+
+/* Derivative of f (samples i*stride, i < n, n >= 2) at i in grid steps:
+ * central inside, second-order one-sided at the edges. */
+static double d1(const double *f, size_t i, size_t n, size_t stride)
+{
+  if (n == 2)
+    return f[stride] - f[0];
+  if (i == 0)
+    return 0.5 * (-3 * f[0] + 4 * f[stride] - f[2 * stride]);
+  if (i == n - 1)
+    return 0.5 * (3 * f[i * stride] - 4 * f[(i - 1) * stride] +
+                  f[(i - 2) * stride]);
+  return 0.5 * (f[(i + 1) * stride] - f[(i - 1) * stride]);
+}
+
+void tt__grid_ground_jacobian(const tt_grid *g, size_t c, size_t r,
+                              double out_j[4])
+{
+  size_t nx = g->nx, ny = g->ny;
+  const double *rowx = g->gxy + 2 * r * nx, *colx = g->gxy + 2 * c;
+  out_j[0] = d1(rowx, c, nx, 2);
+  out_j[1] = d1(colx, r, ny, 2 * nx);
+  out_j[2] = d1(rowx + 1, c, nx, 2);
+  out_j[3] = d1(colx + 1, r, ny, 2 * nx);
+}
+
+tt_status tt_grid_ground_scale_at(const tt_grid *grid, size_t col,
+                                  size_t row, double *out_k,
+                                  double *out_convergence)
+{
+  if (!grid->gxy || col >= grid->nx || row >= grid->ny)
+    return TT_ERR_ARG;
+  const double *gt = grid->gt;
+  double j[4];
+  tt__grid_ground_jacobian(grid, col, row, j);
+  double jcx = j[0], jrx = j[1], jcy = j[2], jry = j[3];
+  double en[2] = {1, 1};
+  if (grid->metric_fn)
+    grid->metric_fn(grid->metric_par,
+                    gt[0] + (col + 0.5) * gt[1] + (row + 0.5) * gt[2],
+                    gt[3] + (col + 0.5) * gt[4] + (row + 0.5) * gt[5], en);
+  double ge = en[0], gn = en[1];
+  double gdet = gt[1] * gt[5] - gt[2] * gt[4];
+  double detj = jcx * jry - jrx * jcy, detg = ge * gn * gdet;
+  double k = sqrt(fabs(detj / detg));
+  /* true north in pixel steps: G d = (0, 1), G = [ge gt1, ge gt2;
+   * gn gt4, gn gt5]; its image J d */
+  double dc = -ge * gt[2] / detg, dr = ge * gt[1] / detg;
+  double tx = jcx * dc + jrx * dr, ty = jcy * dc + jry * dr;
+  if (!isfinite(k) || !(k > 0) || !isfinite(tx) || !isfinite(ty))
+    return TT_ERR_DATA;
+  *out_k = k;
+  *out_convergence = atan2(tx, ty);
+  return TT_OK;
 }
 
 void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
@@ -256,8 +312,6 @@ void tt_grid_set_area_fn(tt_grid *grid, tt_area_fn fn,
 }
 
 double *tt_grid_ground_xy(tt_grid *grid) { return grid->gxy; }
-float *tt_grid_ground_scale(tt_grid *grid) { return grid->gk; }
-float *tt_grid_ground_convergence(tt_grid *grid) { return grid->gconv; }
 
 /* The first sample of row r that is infinite or beyond TT_MAX_HEIGHT, or
  * -1; counts the row's valid samples into *valid. One loop per precision:

@@ -44,10 +44,11 @@ struct tt_grid {
   double frame[4];   /* ground frame: pixel step -> ground units */
   /* Ground points (tt_grid_alloc_ground_points), NULL when the affine frame
    * measures everything: per sample, x and y in a conformal working
-   * projection (gxy, 2 doubles), its scale factor (gk) and the angle from
-   * the projection's +y to true north (gconv, radians clockwise). */
+   * projection (gxy, 2 doubles); the scale factor and convergence come
+   * from them and the ground metric (tt_grid_ground_scale_at). */
   double *gxy;
-  float *gk, *gconv;
+  tt_ground_metric_fn metric_fn;  /* tt_grid_set_ground_metric_fn, or NULL */
+  double metric_par[4];
   tt_area_fn area_fn;  /* tt_grid_set_area_fn, or NULL */
   double area_par[4];
 };
@@ -63,6 +64,12 @@ static inline double tt__grid_z(const tt_grid *g, size_t i)
  * as it is. False when out of memory (the grid is unchanged). For a
  * moment both arrays exist: 12 bytes per sample. */
 TT_HIDDEN bool tt__grid_widen(tt_grid *g);
+
+/* The Jacobian of pixel -> ground point at sample (c, r) by finite
+ * differences, J = [x_c x_r; y_c y_r] as out_j[0..3] (a grid with ground
+ * points, c < nx, r < ny). */
+TT_HIDDEN void tt__grid_ground_jacobian(const tt_grid *g, size_t c, size_t r,
+                                        double out_j[4]);
 
 /* Sets the context's status and message and returns the status, so a
  * failure reads `return tt__error(ctx, TT_ERR_ARG, "...", ...);`. A NULL

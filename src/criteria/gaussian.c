@@ -28,6 +28,15 @@
  * of each other the double products are exact and the bound is 0: no
  * exact sums at all. The common factor det(frame) does not change which
  * side the rays are on, so it is never needed.
+ * Ground points (a geographic DEM, mesh.h): the map from pixels to the
+ * ground is no longer affine, so the rays are taken on the ground points
+ * themselves -- x, y the differences of the projected coordinates (as
+ * tt__geo_vec rounds them), z the height difference -- for the angles and
+ * the signs alike; a sign the bound does not decide is then the exact sign
+ * of the determinant of those rounded rays (exact_sign_ground: 24 exact
+ * partial products summed by expansion arithmetic), and the plan turns of
+ * the hull's proof are tt__orient2d on them. Every decision is then the
+ * ground's, as the other criteria's are.
  * Classification in O(d) (star_curvature): with t_i the exact sign of
  * (e_i x e_{i+1}) . e_{i+2}, the star is convex iff all t_i >= 0 or all
  * <= 0; only pairs whose t_{i-1}, t_i agree can support, so only those
@@ -65,6 +74,8 @@
  * what a cheaper design would need.
  */
 #include "criteria/geometry.h"
+
+#include "base/predicates.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -217,6 +228,9 @@ typedef struct rays {
   bool ints;                            /* x, y, z are integers of at most
                                            2^16: every triple product is
                                            exact in doubles (below) */
+  bool ground;                          /* x, y are ground-point
+                                           differences (then x == gx, y ==
+                                           gy), not pixel steps */
   signed char t[TT__STAR_MAX + 1];      /* sign of (e_i x e_i+1) . e_i+2 */
   int hull[TT__STAR_MAX + 1];           /* the hull rays of a mixed star */
   pair top[TT__STAR_MAX + 1];           /* their faces (hull_graham) */
@@ -263,9 +277,58 @@ static int add_products(double *h, int len, double z, int64_t m)
   return len;
 }
 
+/* Adds the exact product a * b * c of three doubles to expansion h (four
+ * exact partial products; no underflow for the ground rays' magnitudes). */
+static int add_triple(double *h, int len, double a, double b, double c)
+{
+  double ab, e, p[4];
+  ab = a * b;
+  {
+    double ca = 134217729.0 * a, ahi = ca - (ca - a), alo = a - ahi;
+    double cb = 134217729.0 * b, bhi = cb - (cb - b), blo = b - bhi;
+    e = alo * blo - (((ab - ahi * bhi) - alo * bhi) - ahi * blo);
+  }
+  double parts[2] = {ab, e};
+  for (int k = 0; k < 2; k++) {
+    double x = parts[k], y = c, xy = x * y;
+    double cx = 134217729.0 * x, xhi = cx - (cx - x), xlo = x - xhi;
+    double cy = 134217729.0 * y, yhi = cy - (cy - y), ylo = y - yhi;
+    p[2 * k] = xy;
+    p[2 * k + 1] = xlo * ylo - (((xy - xhi * yhi) - xlo * yhi) - xhi * ylo);
+  }
+  for (int k = 0; k < 4; k++) {
+    double b2 = p[k];
+    for (int q = 0; q < len; q++)
+      two_sum(b2, h[q], &b2, &h[q]);
+    h[len++] = b2;
+  }
+  return len;
+}
+
+/* The exact sign of det(e_i, e_j, e_k) for the ground rays as stored
+ * (rounded ground-point differences): six triple products. */
+static int exact_sign_ground(const rays *r, int i, int j, int k)
+{
+  const double *x = r->x, *y = r->y, *z = r->z;
+  double h[24];
+  int len = 0;
+  len = add_triple(h, len, x[i], y[j], z[k]);
+  len = add_triple(h, len, y[i], z[j], x[k]);
+  len = add_triple(h, len, z[i], x[j], y[k]);
+  len = add_triple(h, len, -z[i], y[j], x[k]);
+  len = add_triple(h, len, -y[i], x[j], z[k]);
+  len = add_triple(h, len, -x[i], z[j], y[k]);
+  for (int q = len - 1; q >= 0; q--)
+    if (h[q] != 0)
+      return h[q] > 0 ? 1 : -1;
+  return 0;
+}
+
 /* i, j, k < n */
 static int exact_sign(const rays *r, int i, int j, int k)
 {
+  if (r->ground)
+    return exact_sign_ground(r, i, j, k);
   int64_t mi = r->dc[j] * r->dr[k] - r->dr[j] * r->dc[k];
   int64_t mj = r->dc[k] * r->dr[i] - r->dr[k] * r->dc[i];
   int64_t mk = r->dc[i] * r->dr[j] - r->dr[i] * r->dc[j];
@@ -363,6 +426,7 @@ int tt__gaussian_orient(const int64_t dc[3], const int64_t dr[3],
   }
   r.maxc = mx;
   r.ints = ints && mx <= 65536.0;
+  r.ground = false;
   pair p;
   pair_make(&r, 0, 1, &p);
   return side(&r, &p, 0, 1, 2);
@@ -376,6 +440,26 @@ static void rays_load(const tt__mesh *m, const double fr[4], int32_t v,
   r->zv = tt__mesh_z(m, v);
   double mx = 0;
   int ints = 1;
+  r->ground = m->gxy != NULL;
+  if (r->ground) {
+    /* rays on the ground points: tt__geo_vec's differences */
+    const double *p = m->gxy + 2 * ((size_t)o->r * m->gnx + (size_t)o->c);
+    for (int i = 0; i < n; i++) {
+      const tt__mesh_vertex *w = &m->v[s->nb[i]];
+      const double *q = m->gxy + 2 * ((size_t)w->r * m->gnx + (size_t)w->c);
+      r->dc[i] = (int64_t)w->c - o->c;
+      r->dr[i] = (int64_t)w->r - o->r;
+      r->zk[i] = tt__mesh_z(m, s->nb[i]);
+      double gx = q[0] - p[0], gy = q[1] - p[1], dz = r->zk[i] - r->zv;
+      r->x[i] = r->x[i + n] = r->gx[i] = r->gx[i + n] = gx;
+      r->y[i] = r->y[i + n] = r->gy[i] = r->gy[i + n] = gy;
+      r->z[i] = r->z[i + n] = dz;
+      mx = max3abs(mx, gx, gy, dz);
+    }
+    r->maxc = mx;
+    r->ints = false;
+    return;
+  }
   for (int i = 0; i < n; i++) {
     const tt__mesh_vertex *w = &m->v[s->nb[i]];
     int64_t dci = (int64_t)w->c - o->c, dri = (int64_t)w->r - o->r;
@@ -523,9 +607,15 @@ static int hull_wrap(const rays *r, int n, int start, int sgn, int *out_h)
   return m;
 }
 
-/* sign of (c_i x c_j)_z in pixel space, exact (|dc|, |dr| < 2^28) */
+/* sign of (c_i x c_j)_z in pixel space, exact (|dc|, |dr| < 2^28); of
+ * the ground rays' plan cross product with ground points */
 static inline int cross2_sign(const rays *r, int i, int j)
 {
+  if (r->ground) {
+    const double o[2] = {0, 0}, a[2] = {r->x[i], r->y[i]},
+                 b[2] = {r->x[j], r->y[j]};
+    return tt__orient2d(o, a, b);
+  }
   int64_t c = r->dc[i] * r->dr[j] - r->dr[i] * r->dc[j];
   return (c > 0) - (c < 0);
 }

@@ -12,7 +12,8 @@
  * ears theorem holds with strictly convex ears: a strictly convex vertex
  * whose triangle holds other vertices gives a diagonal to the one farthest
  * from the line prev-next, and the smaller side has an ear of its own), so
- * the loop never stalls. Scores are in the ground frame and only choose;
+ * the loop never stalls. Scores are in the ground frame (on the ground
+ * points when the mesh has them) and only choose;
  * they never decide validity. O(n^2) per hole; holes have about six
  * vertices.
  *
@@ -284,11 +285,20 @@ bool tt__dhole_fill(tt__dhole *h, const tt__mesh *m, const double frame[4],
   if (n < 3 || (size_t)n > h->cap)
     return false;
   int32_t c0 = m->v[h->p[0]].c, r0 = m->v[h->p[0]].r;
+  /* on the ground points when the mesh has them (a geographic DEM) */
+  const double *g0 = m->gxy ? m->gxy + 2 * ((size_t)r0 * m->gnx +
+                                            (size_t)c0)
+                            : NULL;
   for (int i = 0; i < n; i++) {
     const tt__mesh_vertex *q = &m->v[h->p[i]];
     double dc = (double)(q->c - c0), dr = (double)(q->r - r0);
     h->gx[i] = frame[0] * dc + frame[1] * dr;
     h->gy[i] = frame[2] * dc + frame[3] * dr;
+    if (g0) {
+      const double *g = m->gxy + 2 * ((size_t)q->r * m->gnx + (size_t)q->c);
+      h->gx[i] = g[0] - g0[0];
+      h->gy[i] = g[1] - g0[1];
+    }
     h->px[i] = q->c;
     h->py[i] = q->r;
   }

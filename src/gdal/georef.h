@@ -38,7 +38,13 @@ TT_HIDDEN OGRSpatialReferenceH tt__georef_utm_of(OGRSpatialReferenceH srs,
                                                  char *out_name,
                                                  size_t name_size);
 
-/* Ground points for a grid in a geographic CRS (georef_conformal.c):
+/* Whether srs is Web Mercator (a spherical Mercator on geodetic
+ * longitudes and latitudes, EPSG:3857 and its aliases), whose grids get
+ * ground points as geographic ones do (georef_conformal.c). */
+TT_HIDDEN int tt__georef_is_web_mercator(OGRSpatialReferenceH srs);
+
+/* Ground points for a grid in a geographic or Web Mercator CRS
+ * (georef_conformal.c):
  * projects every sample into a conformal working projection suited to the
  * extent (or work_srs), fills the grid's ground points (tt_grid_alloc_
  * ground_points) and sets its ground frame to the projection's Jacobian at

@@ -1,8 +1,17 @@
 /*
- * georef_conformal.c -- the ground points of a longitude/latitude grid:
- * every sample projected once into a conformal working projection, with
- * the projection's scale factor and meridian convergence there (see
- * tt_grid_alloc_ground_points in terratin.h).
+ * georef_conformal.c -- the ground points of a longitude/latitude grid, or
+ * of a Web Mercator one: every sample projected once into a conformal
+ * working projection, with the projection's scale factor and meridian
+ * convergence there (see tt_grid_alloc_ground_points in terratin.h).
+ *
+ * Web Mercator (EPSG:3857 and its aliases: a spherical Mercator of radius
+ * R on the geodetic longitudes and latitudes of an ellipsoid) is conformal
+ * on its sphere but not on the ellipsoid, and its scale grows as sec(lat):
+ * 1.31 at 40 N, so its map units are no ground metres and one affine frame
+ * cannot fix a DEM of any north-south extent. Its samples are treated as
+ * the longitudes and latitudes they stand for (lon = lon0 + x / R,
+ * lat = gd(y / R), checked against PROJ at the grid's corners) and get the
+ * ground points, frames and geodesic areas of a geographic grid.
  *
  * The projection suits the extent of the sample centres:
  *  - beyond 84 N or 80 S: polar stereographic on the pole, centred on the
@@ -23,7 +32,9 @@
  * constant that balances their largest and smallest scale over the DEM (a
  * constant factor keeps a projection conformal); the frame's name says so.
  *
- * Scale factor and convergence come from the projected grid itself: the
+ * Scale factor and convergence come from the projected grid itself
+ * (tt_grid_ground_scale_at, engine, with ellipsoid_metric below; for the
+ * TIN's vertices only, nothing stored per sample): the
  * Jacobian J of pixel -> projection by finite differences over the grid
  * (central inside, second-order one-sided at the edges) against the
  * ground Jacobian G of pixel -> local east/north metres on the ellipsoid
@@ -36,7 +47,7 @@
  * grid's ground frame is J at the centre sample (so its orientation, and
  * the pixel-space orientation the mesh keeps, are the projection's).
  *
- * Workload: one batched PROJ transformation per row (nx points), 24 bytes
+ * Workload: one batched PROJ transformation per row (nx points), 16 bytes
  * of ground points per sample kept on the grid, O(1) per sample after.
  */
 #include "gdal/georef.h"
@@ -60,17 +71,87 @@
 typedef enum frame_kind { FRAME_USER, FRAME_UTM, FRAME_POLAR, FRAME_LCC,
                           FRAME_MERCATOR, FRAME_STEREO } frame_kind;
 
-/* Derivative of f (samples i*stride, i < n, n >= 2) at i in grid steps. */
-static double d1(const double *f, size_t i, size_t n, size_t stride)
+/* Where the grid's map coordinates stand on the ellipsoid: a geographic
+ * CRS (x, y are longitude and latitude in units of u radians) or Web
+ * Mercator (radius R, central meridian lon0 radians, no false origin). */
+typedef struct source {
+  int webmerc;
+  double u;           /* geographic: radians per unit */
+  double R, lon0;     /* Web Mercator */
+} source;
+
+/* Longitude and latitude (radians) of map point (x, y). */
+static void to_lonlat(const source *src, double x, double y, double *lam,
+                      double *phi)
 {
-  if (n == 2)
-    return f[stride] - f[0];
-  if (i == 0)
-    return 0.5 * (-3 * f[0] + 4 * f[stride] - f[2 * stride]);
-  if (i == n - 1)
-    return 0.5 * (3 * f[i * stride] - 4 * f[(i - 1) * stride] +
-                  f[(i - 2) * stride]);
-  return 0.5 * (f[(i + 1) * stride] - f[(i - 1) * stride]);
+  if (!src->webmerc) {
+    *lam = x * src->u;
+    *phi = y * src->u;
+    return;
+  }
+  *lam = src->lon0 + x / src->R;
+  *phi = atan(sinh(y / src->R));
+}
+
+/* Web Mercator: the parameters of a spherical Mercator on no false origin
+ * from srs's PROJ string ("+proj=merc +a=R +b=R", lat_ts 0 or k 1),
+ * 1 when srs is one. */
+static int web_mercator_of(OGRSpatialReferenceH srs, source *out)
+{
+  char *p4 = NULL;
+  int ok = 0;
+  if (!srs || !OSRIsProjected(srs))
+    return 0;
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  OGRErr e = OSRExportToProj4(srs, &p4);
+  CPLPopErrorHandler();
+  if (e != OGRERR_NONE || !p4)
+    goto done;
+  double a = NAN, b = NAN, x0 = 0, y0 = 0, k = 1, lat_ts = 0, lon0 = 0,
+         to_m = 1;
+  int merc = 0, other = 0;
+  char *save = NULL;
+  for (char *t = strtok_r(p4, " ", &save); t; t = strtok_r(NULL, " ", &save)) {
+    if (strcmp(t, "+proj=merc") == 0)
+      merc = 1;
+    else if (strncmp(t, "+a=", 3) == 0)
+      a = CPLAtof(t + 3);
+    else if (strncmp(t, "+b=", 3) == 0)
+      b = CPLAtof(t + 3);
+    else if (strncmp(t, "+x_0=", 5) == 0)
+      x0 = CPLAtof(t + 5);
+    else if (strncmp(t, "+y_0=", 5) == 0)
+      y0 = CPLAtof(t + 5);
+    else if (strncmp(t, "+k=", 3) == 0 || strncmp(t, "+k_0=", 5) == 0)
+      k = CPLAtof(strchr(t, '=') + 1);
+    else if (strncmp(t, "+lat_ts=", 8) == 0)
+      lat_ts = CPLAtof(t + 8);
+    else if (strncmp(t, "+lon_0=", 7) == 0)
+      lon0 = CPLAtof(t + 7);
+    else if (strncmp(t, "+to_meter=", 10) == 0)
+      to_m = CPLAtof(t + 10);
+    else if (strncmp(t, "+units=", 7) == 0)
+      other |= strcmp(t, "+units=m") != 0;
+    else if (strncmp(t, "+ellps=", 7) == 0 || strncmp(t, "+datum=", 7) == 0)
+      other = 1; /* an ellipsoidal Mercator: conformal itself */
+  }
+  ok = merc && !other && a > 0 && a == b && x0 == 0 && y0 == 0 && k == 1 &&
+       lat_ts == 0 && to_m == 1 && isfinite(lon0);
+  if (ok) {
+    out->webmerc = 1;
+    out->u = 0;
+    out->R = a;
+    out->lon0 = lon0 * TT_PI / 180;
+  }
+done:
+  CPLFree(p4);
+  return ok;
+}
+
+int tt__georef_is_web_mercator(OGRSpatialReferenceH srs)
+{
+  source src;
+  return web_mercator_of(srs, &src);
 }
 
 /* The working CRS on srs's geographic CRS for the extent, or NULL. */
@@ -147,9 +228,31 @@ done:
   return work;
 }
 
+/* Metres on the ellipsoid (a, e2) per map unit east and north at map
+ * point (x, y): longitude/latitude in units of params[2] radians, or Web
+ * Mercator of radius -params[2] (tt_ground_metric_fn). The prime-vertical
+ * and meridional radii times the radians per unit. */
+static void ellipsoid_metric(const double params[4], double x, double y,
+                             double out[2])
+{
+  double a = params[0], e2 = params[1], u = params[2];
+  double lat = y * u, ue = u, un = u;
+  if (u < 0) { /* Web Mercator: d lat / dy = 1 / (R cosh(y / R)) */
+    double R = -u;
+    lat = atan(sinh(y / R));
+    ue = 1.0 / R;
+    un = cos(lat) / R;
+  }
+  (void)x;
+  double sn = sin(lat), w2 = 1.0 - e2 * sn * sn;
+  out[0] = a / sqrt(w2) * cos(lat) * ue;          /* m per unit E */
+  out[1] = a * (1.0 - e2) / (w2 * sqrt(w2)) * un; /* m per unit N */
+}
+
 /* Geodesic area of a triangle of longitudes x and latitudes y (in the
  * CRS's angular unit) on the ellipsoid of params (a, f, degrees per
- * unit): GeographicLib's geod_polygonarea. */
+ * unit), or of Web Mercator x, y (params a, f, -1 / R, central meridian in
+ * degrees): GeographicLib's geod_polygonarea. */
 static double geodesic_area(const double params[4], const double x[3],
                             const double y[3])
 {
@@ -164,11 +267,61 @@ static double geodesic_area(const double params[4], const double x[3],
   }
   double lat[3], lon[3], area = 0, perimeter = 0;
   for (int k = 0; k < 3; k++) {
-    lon[k] = x[k] * params[2];
-    lat[k] = y[k] * params[2];
+    if (params[2] > 0) {
+      lon[k] = x[k] * params[2];
+      lat[k] = y[k] * params[2];
+    } else { /* Web Mercator */
+      lon[k] = params[3] - x[k] * params[2] * (180 / TT_PI);
+      lat[k] = atan(sinh(-y[k] * params[2])) * (180 / TT_PI);
+    }
   }
   geod_polygonarea(&g, lat, lon, 3, &area, &perimeter);
   return fabs(area);
+}
+
+/* Web Mercator's inverse (to_lonlat) against PROJ's at the grid's corners
+ * and centre: within 1e-9 degree, or TT_ERR_DATA (then the affine frame
+ * stays). src is the CRS in GIS axis order. */
+static tt_status check_web_mercator(tt_context *ctx,
+                                    OGRSpatialReferenceH src,
+                                    const source *sk, const double gt[6],
+                                    size_t nx, size_t ny)
+{
+  OGRSpatialReferenceH geog = src ? OSRCloneGeogCS(src) : NULL;
+  OGRCoordinateTransformationH ct = NULL;
+  int ok = 0;
+  if (geog) {
+    OSRSetAxisMappingStrategy(geog, OAMS_TRADITIONAL_GIS_ORDER);
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    ct = OCTNewCoordinateTransformation(src, geog);
+    CPLPopErrorHandler();
+  }
+  double deg = OSRGetAngularUnits(geog ? geog : src, NULL) * 180 / TT_PI;
+  if (ct) {
+    double x[5], y[5], mx[5], my[5];
+    int good[5];
+    for (int k = 0; k < 5; k++) {
+      double px = k == 4 ? 0.5 * nx : (k & 1) ? (double)nx - 0.5 : 0.5;
+      double py = k == 4 ? 0.5 * ny : (k & 2) ? (double)ny - 0.5 : 0.5;
+      mx[k] = x[k] = gt[0] + px * gt[1] + py * gt[2];
+      my[k] = y[k] = gt[3] + px * gt[4] + py * gt[5];
+    }
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    ok = OCTTransformEx(ct, 5, x, y, NULL, good);
+    CPLPopErrorHandler();
+    for (int k = 0; ok && k < 5; k++) {
+      double lam, phi;
+      to_lonlat(sk, mx[k], my[k], &lam, &phi);
+      ok = good[k] && fabs(x[k] * deg - lam * 180 / TT_PI) <= 1e-9 &&
+           fabs(y[k] * deg - phi * 180 / TT_PI) <= 1e-9;
+    }
+    OCTDestroyCoordinateTransformation(ct);
+  }
+  OSRDestroySpatialReference(geog);
+  if (!ok)
+    return tt__error(ctx, TT_ERR_DATA, "PROJ does not take this CRS as Web "
+                     "Mercator (spherical Mercator on geodetic latitudes)");
+  return TT_OK;
 }
 
 tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
@@ -187,9 +340,15 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   const double *gt = grid->gt;
 
   OGRErr err = OGRERR_NONE;
+  source sk = {0, 0, 0, 0};
+  if (!OSRIsGeographic(srs) && !web_mercator_of(srs, &sk))
+    return tt__error(ctx, TT_ERR_DATA, "ground points need a geographic "
+                     "or Web Mercator CRS");
   double a = OSRGetSemiMajor(srs, &err);
   double invf = err == OGRERR_NONE ? OSRGetInvFlattening(srs, &err) : 0;
-  double u = OSRGetAngularUnits(srs, NULL); /* radians per unit */
+  double u = sk.webmerc ? 1.0 : OSRGetAngularUnits(srs, NULL); /* radians
+                                                                   per unit */
+  sk.u = u;
   if (err != OGRERR_NONE || !(a > 0) || !isfinite(invf) || invf < 0 ||
       !(u > 0) || nx < 2 || ny < 2)
     return tt__error(ctx, TT_ERR_DATA, "no ellipsoid or angular unit for "
@@ -197,7 +356,8 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   double f = invf > 0 ? 1.0 / invf : 0.0, e2 = f * (2.0 - f);
   double deg = u * 180.0 / TT_PI;
 
-  /* Extent of the sample centres (a geotransform is affine: corners). */
+  /* Extent of the sample centres (a geotransform is affine, longitude
+   * and latitude monotonic in x and y: the corners). */
   double lon_min = HUGE_VAL, lon_max = -HUGE_VAL, lat_min = HUGE_VAL,
          lat_max = -HUGE_VAL;
   for (int k = 0; k < 4; k++) {
@@ -205,6 +365,12 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     double py = (k & 2) ? (double)ny - 0.5 : 0.5;
     double lon = (gt[0] + px * gt[1] + py * gt[2]) * deg;
     double lat = (gt[3] + px * gt[4] + py * gt[5]) * deg;
+    if (sk.webmerc) {
+      to_lonlat(&sk, gt[0] + px * gt[1] + py * gt[2],
+                gt[3] + px * gt[4] + py * gt[5], &lon, &lat);
+      lon *= 180 / TT_PI;
+      lat *= 180 / TT_PI;
+    }
     lon_min = fmin(lon_min, lon);
     lon_max = fmax(lon_max, lon);
     lat_min = fmin(lat_min, lat);
@@ -241,6 +407,11 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   src = OSRClone(srs);
   if (src)
     OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+  if (sk.webmerc) {
+    s = check_web_mercator(ctx, src, &sk, gt, nx, ny);
+    if (s != TT_OK)
+      goto done;
+  }
   OSRSetAxisMappingStrategy(work, OAMS_TRADITIONAL_GIS_ORDER);
   CPLPushErrorHandler(CPLQuietErrorHandler);
   ct = src ? OCTNewCoordinateTransformation(src, work) : NULL;
@@ -262,8 +433,6 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   if (s != TT_OK)
     goto done;
   double *xy = tt_grid_ground_xy(grid);
-  float *gk = tt_grid_ground_scale(grid);
-  float *gconv = tt_grid_ground_convergence(grid);
 
   for (size_t r = 0; r < ny; r++) {
     for (size_t c = 0; c < nx; c++) {
@@ -285,43 +454,26 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     }
   }
 
-  /* Scale factor and convergence per sample. */
-  double kmin = HUGE_VAL, kmax = -HUGE_VAL, gdet = gt[1] * gt[5] -
-                                                   gt[2] * gt[4];
-  double centre_frame[4] = {0};
+  /* Scale factor and convergence per sample (tt_grid_ground_scale_at,
+   * against the ellipsoid's metric): their range here; the TIN derives
+   * them again for its vertices. */
+  const double metric_par[4] = {a, e2, sk.webmerc ? -sk.R : u, 0};
+  tt_grid_set_ground_metric_fn(grid, ellipsoid_metric, metric_par);
+  double kmin = HUGE_VAL, kmax = -HUGE_VAL;
   for (size_t r = 0; r < ny; r++) {
     for (size_t c = 0; c < nx; c++) {
-      size_t i = r * nx + c;
-      const double *rowx = xy + 2 * r * nx, *colx = xy + 2 * c;
-      double jcx = d1(rowx, c, nx, 2), jcy = d1(rowx + 1, c, nx, 2);
-      double jrx = d1(colx, r, ny, 2 * nx), jry = d1(colx + 1, r, ny, 2 * nx);
-      double lat = (gt[3] + (c + 0.5) * gt[4] + (r + 0.5) * gt[5]) * u;
-      double sn = sin(lat), w2 = 1.0 - e2 * sn * sn;
-      double ge = a / sqrt(w2) * cos(lat) * u;          /* m per unit E */
-      double gn = a * (1.0 - e2) / (w2 * sqrt(w2)) * u; /* m per unit N */
-      double detj = jcx * jry - jrx * jcy, detg = ge * gn * gdet;
-      double k = sqrt(fabs(detj / detg));
-      /* true north in pixel steps: G d = (0, 1), G = [ge gt1, ge gt2;
-       * gn gt4, gn gt5]; its image J d */
-      double dc = -ge * gt[2] / detg, dr = ge * gt[1] / detg;
-      double tx = jcx * dc + jrx * dr, ty = jcy * dc + jry * dr;
-      if (!isfinite(k) || !(k > 0) || !isfinite(tx) || !isfinite(ty)) {
+      double k = 0, conv = 0;
+      if (tt_grid_ground_scale_at(grid, c, r, &k, &conv) != TT_OK) {
         s = tt__error(ctx, TT_ERR_DATA, "no scale factor at sample (col "
                       "%zu, row %zu) (a pole?)", c, r);
         goto done;
       }
-      gk[i] = (float)k;
-      gconv[i] = (float)atan2(tx, ty);
       kmin = fmin(kmin, k);
       kmax = fmax(kmax, k);
-      if (c == nx / 2 && r == ny / 2) {
-        centre_frame[0] = jcx;
-        centre_frame[1] = jrx;
-        centre_frame[2] = jcy;
-        centre_frame[3] = jry;
-      }
     }
   }
+  double centre_frame[4];
+  tt__grid_ground_jacobian(grid, nx / 2, ny / 2, centre_frame);
   double scale = 1.0;
   if (kind == FRAME_POLAR || kind == FRAME_MERCATOR || kind == FRAME_STEREO)
     scale = 2.0 / (kmin + kmax);
@@ -329,7 +481,6 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     for (size_t i = 0; i < nx * ny; i++) {
       xy[2 * i] *= scale;
       xy[2 * i + 1] *= scale;
-      gk[i] = (float)(gk[i] * scale);
     }
     for (int k = 0; k < 4; k++)
       centre_frame[k] *= scale;
@@ -342,7 +493,8 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   s = tt_grid_set_ground_frame(ctx, grid, centre_frame);
   if (s != TT_OK)
     goto done;
-  const double area_par[4] = {a, f, deg, 0};
+  const double area_par[4] = {a, f, sk.webmerc ? -1.0 / sk.R : deg,
+                              sk.lon0 * 180 / TT_PI};
   tt_grid_set_area_fn(grid, geodesic_area, area_par);
   double err_max = fmax(fabs(kmax - 1.0), fabs(kmin - 1.0));
   *out_scale_error = err_max;
@@ -353,6 +505,7 @@ done:
   if (s != TT_OK) {
     tt_grid_drop_ground_points(grid);
     tt_grid_set_area_fn(grid, NULL, NULL);
+    tt_grid_set_ground_metric_fn(grid, NULL, NULL);
   }
   free(lx);
   free(ly);

@@ -9,8 +9,11 @@
  *  - A projected CRS in metres whose scale is within TT_METRIC_TOLERANCE of
  *    the local UTM zone's (UTM itself, national grids, conformal conics):
  *    the geotransform's linear part, unchanged.
+ *  - A projected CRS in another linear unit (feet, US survey feet) that is
+ *    metric in that sense once the unit is converted: the geotransform's
+ *    linear part times the unit (metres per map unit).
  *  - A geographic CRS, or a projected CRS whose map units are not ground
- *    metres (Web Mercator, feet, a sheared sinusoidal), or any CRS when the
+ *    metres (Web Mercator, a sheared sinusoidal), or any CRS when the
  *    caller names a working CRS (-work_srs): the Jacobian of
  *    pixel -> working-CRS coordinates at the grid's centre, by central
  *    differences over TT_JACOBIAN_STEP pixels through PROJ (OGR coordinate
@@ -33,6 +36,8 @@
  * DEM, 0.84% for a 1-degree DTED tile (tests/gdal/test_georef.c measures
  * it against PROJ's own coordinates). The frame's name says how far it
  * strays at the grid's corners, and beyond 1% a warning says so.
+ * Geographic and Web Mercator grids then get ground points instead
+ * (georef_conformal.c); the affine frame is their fallback.
  *
  * Heights are never touched here.
  *
@@ -400,6 +405,28 @@ tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
                "within %g%% of %s)", 100 * TT_METRIC_TOLERANCE, work_name);
       goto done;
     }
+    /* Feet (or any linear unit) on a projection that is metric once the
+     * unit is converted (a state plane in US survey feet): the
+     * geotransform times the unit, the exact path of a metric DEM; its
+     * TIN is the one of the same samples in metres. */
+    char *unit = NULL;
+    m_per_unit = projected ? OSRGetLinearUnits(srs, &unit) : 0;
+    double gts[6] = {0, gt[1] * m_per_unit, gt[2] * m_per_unit, 0,
+                     gt[4] * m_per_unit, gt[5] * m_per_unit};
+    if (!(work_srs && *work_srs) && projected && m_per_unit > 0 &&
+        isfinite(m_per_unit) && m_per_unit != 1.0 &&
+        !tt__georef_is_web_mercator(srs) &&
+        same_metric(frame, gts, TT_METRIC_TOLERANCE)) {
+      out_frame[0] = gts[1];
+      out_frame[1] = gts[2];
+      out_frame[2] = gts[4];
+      out_frame[3] = gts[5];
+      snprintf(out_name, name_size, "geotransform x %.10g m per %s (map "
+               "units are metres within %g%% of %s once converted)",
+               m_per_unit, unit && *unit ? unit : "map unit",
+               100 * TT_METRIC_TOLERANCE, work_name);
+      goto done;
+    }
     memcpy(out_frame, frame, sizeof frame);
     char centre[64] = "", corners[96] = "";
     if (have_centre)
@@ -413,7 +440,8 @@ tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
      * say so rather than measure angles that mean little. A geographic
      * grid gets ground points instead (georef_conformal.c), which warns
      * itself if it cannot. */
-    if (isfinite(corner_error) && corner_error > 0.01 && !geographic)
+    if (isfinite(corner_error) && corner_error > 0.01 && !geographic &&
+        !tt__georef_is_web_mercator(srs))
       tt__warn(ctx, "the grid is large for one affine frame: the ground "
                "frame strays %.2g%% from %s at the grid's corners; angles, "
                "areas and the Delaunay test are approximate there (tile "

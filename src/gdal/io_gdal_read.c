@@ -762,15 +762,16 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       s = TT_OK;
     } else if (s == TT_OK) {
       s = tt_grid_set_ground_frame(ctx, grid, frame);
-      /* Longitude/latitude: every sample projected into a conformal
-       * frame (georef_conformal.c); the affine frame stays only when
-       * that fails. */
-      /* 24 bytes a sample beside the heights' 4: over MAX_MEMORY, the
+      /* Longitude/latitude and Web Mercator: every sample projected
+       * into a conformal frame (georef_conformal.c); the affine frame
+       * stays only when that fails. */
+      /* 16 bytes a sample beside the heights' 4: over MAX_MEMORY, the
        * affine frame stays, with a warning */
-      size_t n = nx * ny, with_points = n <= SIZE_MAX / 28 ? n * 28
+      size_t n = nx * ny, with_points = n <= SIZE_MAX / 20 ? n * 20
                                                            : SIZE_MAX;
-      if (s == TT_OK && srs && OSRIsGeographic(srs) &&
-          with_points > opt.max_memory) {
+      int conformal = srs && (OSRIsGeographic(srs) ||
+                              tt__georef_is_web_mercator(srs));
+      if (s == TT_OK && conformal && with_points > opt.max_memory) {
         char need_s[32], max_s[32];
         tt__warn(ctx, "%s: the heights and ground points of %zu x %zu "
                  "samples would need %s, more than %s (%s): keeping the "
@@ -780,7 +781,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                                           "memory"
                                         : "MAX_MEMORY",
                  tt__format_bytes(max_s, sizeof max_s, opt.max_memory), frame_name);
-      } else if (s == TT_OK && srs && OSRIsGeographic(srs)) {
+      } else if (s == TT_OK && conformal) {
         char conformal_name[512];
         s = tt__georef_ground_points(ctx, srs, opt.work_srs, grid,
                                      conformal_name, sizeof conformal_name,
@@ -799,6 +800,18 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       s = with_path(ctx, s, path);
       goto done;
     }
+    /* A map in feet is measured in metres (georef_proj.c): heights of no
+     * declared unit are taken as metres then, which they rarely are on
+     * such a map. Say so once; the TIN is the same either way. */
+    char *lin_name = NULL;
+    double lin = srs && OSRIsProjected(srs) ? OSRGetLinearUnits(srs, &lin_name)
+                                            : 1.0;
+    if (lin > 0 && fabs(lin - 1.0) > 1e-9 && !unit_declared[0] &&
+        !opt.has_z_factor)
+      tt__warn(ctx, "%s: the map unit is %s and the heights declare no "
+               "unit: slopes and 3-D areas take them as metres (give "
+               "-z_factor %.10g if they are in that unit too)", path,
+               lin_name && *lin_name ? lin_name : "not the metre", lin);
   }
 
   /* Validity: SRCNODATA overrides the mask; GMF_ALL_VALID needs none. */

@@ -27,6 +27,10 @@
  * outline" test is needed; earlier versions made them and no result
  * changed when they were dropped.
  *
+ * Areas are 3-D areas on the ground: in the ground frame, or on the
+ * grid's ground points when the mesh has them (a geographic DEM, mesh.h),
+ * as every criterion measures (criteria/geometry.h); orientation stays the
+ * mesh's exact pixel-space one, which is its topology.
  * Areas are computed from the triangle's corners in one canonical order
  * (smallest vertex index first), so the same triangle has the same area,
  * bit for bit, in the current sum and in the DP. Workload: one call per
@@ -64,6 +68,9 @@ typedef struct hole {
   int32_t id[MAXN + 1];
   int64_t c[MAXN + 1], r[MAXN + 1];
   double z[MAXN + 1];
+  /* the ground points (x, y) when the mesh has them (mesh.h), else unused */
+  bool ground;
+  double gx[MAXN + 1], gy[MAXN + 1];
   /* per triangle of local indices i < j < k (tri_index): its orientation
    * in that order, -1, 0 or +1, or 2: not yet computed, 3: +1 and area[]
    * holds its area; each computed at most once per call */
@@ -113,9 +120,15 @@ static int tri_index(int i, int j, int k)
 }
 
 /* Ground vector from local point a to local point b: tt__geo_vec's
- * arithmetic on the copied coordinates, so the same bits. */
+ * arithmetic on the copied coordinates, so the same bits (on the ground
+ * points when the mesh has them). */
 static tt__gvec gvec(const hole *h, int a, int b)
 {
+  if (h->ground) {
+    tt__gvec g = {h->gx[b] - h->gx[a], h->gy[b] - h->gy[a],
+                  h->z[b] - h->z[a]};
+    return g;
+  }
   double dc = (double)(h->c[b] - h->c[a]);
   double dr = (double)(h->r[b] - h->r[a]);
   tt__gvec g = {h->fr[0] * dc + h->fr[1] * dr, h->fr[2] * dc + h->fr[3] * dr,
@@ -452,6 +465,13 @@ static bool build_hole(const tt__mesh *m, int32_t v, hole *h)
     h->c[i] = m->v[w].c;
     h->r[i] = m->v[w].r;
     h->z[i] = tt__mesh_z(m, w);
+  }
+  h->ground = m->gxy != NULL;
+  for (int i = 0; h->ground && i <= h->n; i++) {
+    const double *g = m->gxy + 2 * ((size_t)h->r[i] * m->gnx +
+                                    (size_t)h->c[i]);
+    h->gx[i] = g[0];
+    h->gy[i] = g[1];
   }
   int nt = tri_index(h->n - 2, h->n - 1, h->n) + 1;
   for (int i = 0; i < nt; i++)

@@ -203,8 +203,16 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
       size_t i = (size_t)m->v[v].r * g->nx + (size_t)m->v[v].c;
       tin->vgxy[2 * v] = g->gxy[2 * i];
       tin->vgxy[2 * v + 1] = g->gxy[2 * i + 1];
-      tin->vgk[v] = g->gk[i];
-      tin->vgconv[v] = g->gconv[i];
+      /* the scale and convergence of the vertex's sample, derived here
+       * for vertices only (the grid keeps 16 bytes a sample) */
+      double k = 1, conv = 0;
+      if (tt_grid_ground_scale_at(g, m->v[v].c, m->v[v].r, &k, &conv) !=
+          TT_OK) {
+        k = 1;
+        conv = 0;
+      }
+      tin->vgk[v] = (float)k;
+      tin->vgconv[v] = (float)conv;
     }
   }
   for (size_t v = 0; v < m->nv; v++) {

@@ -6,7 +6,9 @@
  *    leaves a valid mesh again;
  *  - dp holes are optimal: compared with the best of every triangulation
  *    of small random star-shaped polygons, enumerated, for each measure
- *    (max-min angle, min-max angle, least 3-D area);
+ *    (max-min angle, min-max angle, least 3-D area); again on ground
+ *    points (the frame bent by a conformal map, as a geographic DEM's),
+ *    measured on them;
  *  - each importance against a direct computation by hand;
  *  - a vertex on a straight border run may go, a corner may not. */
 #include "decimate/decimate.h"
@@ -39,6 +41,8 @@ static void star_init(tt__dec *d, tt_decimate_options *o, const int64_t *x,
   tt__metric metric;
   tt__metric_from_frame(grid->frame, &metric);
   tt__mesh_init(&d->m, &metric);
+  if (tt_grid_ground_xy(grid))
+    tt__mesh_use_ground_points(&d->m, tt_grid_ground_xy(grid), SIDE);
   d->env.mesh = &d->m;
   d->env.grid = grid;
   tt__dhole_init(&d->h);
@@ -204,11 +208,28 @@ static void test_hard_stars(void)
 /* The measure of triangle (a, b, c) of mesh vertices, computed here from
  * scratch: mode 0 its smallest angle, 1 its largest, 2 its 3-D area (the
  * ground frame is (c, -r): angles and areas as in pixel space). */
+/* Plan coordinates of mesh vertex v: its ground point when the mesh has
+ * them, else (c, r) (mirrored, which changes no angle or area). */
+static void plan_xy(const tt__mesh *m, int32_t v, double *x, double *y)
+{
+  *x = m->v[v].c;
+  *y = m->v[v].r;
+  if (m->gxy) {
+    const double *q = m->gxy + 2 * ((size_t)m->v[v].r * m->gnx +
+                                    (size_t)m->v[v].c);
+    *x = q[0];
+    *y = q[1];
+  }
+}
+
 static double tri_measure(const tt__mesh *m, const int32_t c[3], int mode)
 {
+  double px[3], py[3];
+  for (int k = 0; k < 3; k++)
+    plan_xy(m, c[k], &px[k], &py[k]);
   if (mode == 2) {
-    double ux = m->v[c[1]].c - m->v[c[0]].c, uy = m->v[c[1]].r - m->v[c[0]].r;
-    double vx = m->v[c[2]].c - m->v[c[0]].c, vy = m->v[c[2]].r - m->v[c[0]].r;
+    double ux = px[1] - px[0], uy = py[1] - py[0];
+    double vx = px[2] - px[0], vy = py[2] - py[0];
     double uz = (double)m->v[c[1]].z - m->v[c[0]].z;
     double vz = (double)m->v[c[2]].z - m->v[c[0]].z;
     double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz,
@@ -217,10 +238,9 @@ static double tri_measure(const tt__mesh *m, const int32_t c[3], int mode)
   }
   double a[3];
   for (int e = 0; e < 3; e++) {
-    const tt__mesh_vertex *P = &m->v[c[e]], *Q = &m->v[c[(e + 1) % 3]],
-                          *R = &m->v[c[(e + 2) % 3]];
-    double ux = Q->c - P->c, uy = Q->r - P->r, vx = R->c - P->c,
-           vy = R->r - P->r;
+    int p = e, q = (e + 1) % 3, r = (e + 2) % 3;
+    double ux = px[q] - px[p], uy = py[q] - py[p], vx = px[r] - px[p],
+           vy = py[r] - py[p];
     a[e] = atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy);
   }
   return mode == 0 ? fmin(a[0], fmin(a[1], a[2]))
@@ -492,6 +512,19 @@ int main(void)
     z[i] = (float)(100 * tt_test_uniform(&rng));
   test_hard_stars();
   test_dp_optimal();
+  /* again on ground points: (c - MID, MID - r) through p + alpha p^2
+   * (complex), 0.6 % of bend over a star's 65 pixels */
+  CHECK_OK(ctx, tt_grid_alloc_ground_points(ctx, grid));
+  double *xy = tt_grid_ground_xy(grid);
+  for (size_t r = 0; xy && r < SIDE; r++)
+    for (size_t c = 0; c < SIDE; c++) {
+      double x = (double)c - MID, y = (double)MID - (double)r, al = 0.003 / 65;
+      xy[2 * (r * SIDE + c)] = x + al * (x * x - y * y);
+      xy[2 * (r * SIDE + c) + 1] = y + al * 2 * x * y;
+    }
+  if (xy)
+    test_dp_optimal();
+  tt_grid_drop_ground_points(grid);
   test_boundary();
   test_importances();
   tt_grid_destroy(grid);

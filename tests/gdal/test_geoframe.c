@@ -13,7 +13,14 @@
  *    east/north from geodesics at the triangle's centroid);
  *  - a plane tilted on the ground over 60 degrees of latitude (heights
  *    proportional to the meridian arc, so every true slope is the same):
- *    one slope, and aspect south, everywhere.
+ *    one slope, and aspect south, everywhere; the same plane on a Web
+ *    Mercator grid (EPSG:3857, scale 1 to 2 over it): one slope again, and
+ *    areas and slopes against GeographicLib on PROJ's longitudes and
+ *    latitudes of the vertices;
+ *  - a DEM in US survey feet (EPSG:2277) and the same samples in metres
+ *    (EPSG:32139, the same projection): the same triangles, areas and
+ *    slopes; with heights in feet too (band unit us-ft, Z_UNIT=m), the
+ *    same slopes.
  * Figures go to stdout (ctest -V). */
 #include "gdal/tin_records.h"
 #include "terratin/terratin_gdal.h"
@@ -295,9 +302,9 @@ static void test_srtm_57n(void)
     free(axy);
   }
   printf("  cost: refine %.3f s with ground points, %.3f s affine (%+.1f%%);"
-         " ground points 24 bytes a sample = %.2f MB here\n", t_points,
+         " ground points 16 bytes a sample = %.2f MB here\n", t_points,
          t_affine, 100 * (t_points / t_affine - 1),
-         24.0 * 350 * 400 / 1e6);
+         16.0 * 350 * 400 / 1e6);
   free(uxy);
   tt_tin_destroy(affine);
   tt_tin_destroy(tin);
@@ -355,7 +362,6 @@ static void check_triangles(tt_grid *g, const tt_tin *tin, double area_tol,
 {
   *out_area = *out_slope = *out_aspect = *out_plane = 0;
   const double *gxy = tt_grid_ground_xy(g);
-  const float *gk = tt_grid_ground_scale(g);
   size_t nx = tt_grid_width(g);
   for (size_t t = 0; t < tt_tin_triangle_count(tin); t++) {
     tt_triangle_info ti;
@@ -370,7 +376,10 @@ static void check_triangles(tt_grid *g, const tt_tin *tin, double area_tol,
       size_t i = (size_t)v.row * nx + (size_t)v.col;
       px[j] = gxy[2 * i];
       py[j] = gxy[2 * i + 1];
-      k += gk[i] / 3.0;
+      double ki = 0, conv = 0;
+      CHECK_INT_EQ(tt_grid_ground_scale_at(g, (size_t)v.col, (size_t)v.row,
+                                           &ki, &conv), TT_OK);
+      k += ki / 3.0;
     }
     double area = 0, perim = 0;
     geod_polygonarea(&wgs84, lat, lon, 3, &area, &perim);
@@ -473,6 +482,58 @@ static double tilted(double lon, double lat)
   return 1e-4 * s12 * (lat < 0 ? -1 : 1) + noise;
 }
 
+/* A one-band Float64 MEM dataset of nx x ny heights z in CRS epsg with
+ * geotransform gt (band unit unit, or none), read through the glue with
+ * options opts. */
+static tt_grid *read_mem(size_t nx, size_t ny, const double gt[6], int epsg,
+                         const double *z, const char *unit, char **opts,
+                         tt_raster_info **out_info)
+{
+  GDALDriverH mem = GDALGetDriverByName("MEM");
+  GDALDatasetH ds = mem ? GDALCreate(mem, "", (int)nx, (int)ny, 1,
+                                     GDT_Float64, NULL)
+                        : NULL;
+  if (!ds) {
+    TT_FAIL_("cannot make a MEM dataset");
+    return NULL;
+  }
+  GDALSetGeoTransform(ds, (double *)gt);
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
+  OSRImportFromEPSG(srs, epsg);
+  GDALSetSpatialRef(ds, srs);
+  OSRDestroySpatialReference(srs);
+  GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+  if (unit)
+    GDALSetRasterUnitType(band, unit);
+  CHECK(GDALRasterIO(band, GF_Write, 0, 0, (int)nx, (int)ny, (void *)z,
+                     (int)nx, (int)ny, GDT_Float64, 0, 0) == CE_None);
+  tt_grid *g = NULL;
+  CHECK_OK(ctx, tt_gdal_read_grid(ctx, band, opts, NULL, NULL, &g,
+                                  out_info));
+  GDALClose(ds);
+  if (g)
+    printf("%zu x %zu grid in EPSG:%d: frame %s\n", nx, ny, epsg,
+           (*out_info)->frame_name);
+  return g;
+}
+
+/* PROJ's longitudes and latitudes (degrees) of n points of CRS epsg. */
+static void to_wgs84(int epsg, size_t n, double *x, double *y)
+{
+  OGRSpatialReferenceH a = OSRNewSpatialReference(NULL);
+  OGRSpatialReferenceH b = OSRNewSpatialReference(NULL);
+  OSRImportFromEPSG(a, epsg);
+  OSRImportFromEPSG(b, 4326);
+  OSRSetAxisMappingStrategy(a, OAMS_TRADITIONAL_GIS_ORDER);
+  OSRSetAxisMappingStrategy(b, OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformationH ct = OCTNewCoordinateTransformation(a, b);
+  CHECK(ct && OCTTransform(ct, (int)n, x, y, NULL));
+  if (ct)
+    OCTDestroyCoordinateTransformation(ct);
+  OSRDestroySpatialReference(a);
+  OSRDestroySpatialReference(b);
+}
+
 static void test_sixty_degrees(void)
 {
   tt_raster_info *info = NULL;
@@ -505,6 +566,160 @@ static void test_sixty_degrees(void)
 done:
   tt_grid_destroy(g);
   tt_raster_info_destroy(info);
+}
+
+/* The tilted plane of test_sixty_degrees on a Web Mercator grid: 10-14 E,
+ * 0-60 N, 40 x 600 samples (the scale of the map grows from 1 to 2 over
+ * it). Every sample a vertex: one slope, aspect south; every triangle's
+ * area the geodesic one, and its slope the ellipsoid's, on PROJ's
+ * longitudes and latitudes of its corners. */
+static void test_web_mercator(void)
+{
+  const double R = 6378137.0, d2r = PI / 180;
+  const size_t nx = 40, ny = 600;
+  double x0 = 10 * d2r * R, x1 = 14 * d2r * R;
+  double y1 = R * log(tan(PI / 4 + 30 * d2r));
+  const double gt[6] = {x0, (x1 - x0) / nx, 0, y1, 0, -y1 / ny};
+  double *z = malloc(nx * ny * sizeof *z), *lx = malloc(nx * sizeof *lx),
+         *ly = malloc(nx * sizeof *ly);
+  for (size_t r = 0; r < ny; r++) {
+    for (size_t c = 0; c < nx; c++) {
+      lx[c] = gt[0] + (c + 0.5) * gt[1];
+      ly[c] = gt[3] + (r + 0.5) * gt[5];
+    }
+    to_wgs84(3857, nx, lx, ly);
+    for (size_t c = 0; c < nx; c++)
+      z[r * nx + c] = tilted(lx[c], ly[c]);
+  }
+  tt_raster_info *info = NULL;
+  tt_grid *g = read_mem(nx, ny, gt, 3857, z, NULL, NULL, &info);
+  free(lx);
+  free(ly);
+  free(z);
+  if (!g)
+    return;
+  CHECK(strstr(info->frame_name, "per vertex") != NULL);
+  CHECK(tt_grid_ground_xy(g) != NULL);
+  tt_tin *tin = refine(g, -1, NULL);
+  if (!tin)
+    goto done;
+  size_t nt = tt_tin_triangle_count(tin), nv = tt_tin_vertex_count(tin);
+  double *vx = malloc(nv * sizeof *vx), *vy = malloc(nv * sizeof *vy),
+         *vz = malloc(nv * sizeof *vz);
+  for (size_t i = 0; i < nv; i++) {
+    tt_vertex_info v;
+    tt_tin_vertex(tin, i, &v);
+    vx[i] = v.x;
+    vy[i] = v.y;
+    vz[i] = v.z;
+  }
+  to_wgs84(3857, nv, vx, vy);
+  double lo = INFINITY, hi = 0, asp = 0, darea = 0, dslope = 0;
+  for (size_t t = 0; t < nt; t++) {
+    tt_triangle_info ti;
+    tt_tin_triangle(tin, t, &ti);
+    double s = tan(ti.slope_deg * PI / 180);
+    lo = fmin(lo, s);
+    hi = fmax(hi, s);
+    asp = fmax(asp, angle_diff(ti.aspect_deg, 180.0));
+    double lon[3], lat[3], zz[3], area = 0, perim = 0, tn = 0, a2 = 0;
+    for (int j = 0; j < 3; j++) {
+      lon[j] = vx[ti.v[j]];
+      lat[j] = vy[ti.v[j]];
+      zz[j] = vz[ti.v[j]];
+    }
+    geod_polygonarea(&wgs84, lat, lon, 3, &area, &perim);
+    darea = fmax(darea, fabs(ti.area_2d / fabs(area) - 1));
+    ellipsoid_slope(lon, lat, zz, &tn, &a2);
+    dslope = fmax(dslope, fabs(s / tn - 1));
+  }
+  printf("  %zu triangles: slope %.7g to %.7g (spread %.3g), aspect within "
+         "%.3g degree of south; areas within %.3g of geodesic, slopes "
+         "within %.3g of the ellipsoid's\n", nt, lo, hi, hi / lo - 1, asp,
+         darea, dslope);
+  CHECK_DBL_LE(hi / 1e-4 - 1, 1e-3);
+  CHECK_DBL_LE(1 - lo / 1e-4, 1e-3);
+  CHECK_DBL_LE(asp, 0.1);
+  CHECK_DBL_LE(darea, 1e-9);
+  CHECK_DBL_LE(dslope, 1e-3);
+  free(vx);
+  free(vy);
+  free(vz);
+  tt_tin_destroy(tin);
+done:
+  tt_grid_destroy(g);
+  tt_raster_info_destroy(info);
+}
+
+/* The same samples in US survey feet (EPSG:2277, NAD83 / Texas Central
+ * ftUS) and in metres (EPSG:32139, the same projection): the same TIN,
+ * areas and slopes; and with the heights in (international) feet as well
+ * (band unit ft, converted by Z_UNIT=m), the same again. */
+static void test_feet(void)
+{
+  const double ft = 1200.0 / 3937.0; /* metres per US survey foot */
+  const size_t nx = 300, ny = 240;
+  const double gtf[6] = {2950000.0, 100.0, 0, 10100000.0, 0, -100.0};
+  const double gtm[6] = {gtf[0] * ft, gtf[1] * ft, 0, gtf[3] * ft, 0,
+                         gtf[5] * ft};
+  double *z = malloc(nx * ny * sizeof *z), *zf = malloc(nx * ny * sizeof *zf);
+  for (size_t r = 0; r < ny; r++)
+    for (size_t c = 0; c < nx; c++) {
+      /* integer feet, and their metres as the reader converts them */
+      zf[r * nx + c] = srtm_like(-97.5 + c * 0.0003, 30.5 + r * 0.0003);
+      z[r * nx + c] = zf[r * nx + c] * 0.3048;
+    }
+  tt_raster_info *im = NULL, *iff = NULL, *izf = NULL;
+  char *zopts[] = {"Z_UNIT=m", NULL};
+  tt_grid *gm = read_mem(nx, ny, gtm, 32139, z, NULL, NULL, &im);
+  tt_grid *gf = read_mem(nx, ny, gtf, 2277, z, NULL, NULL, &iff);
+  tt_grid *gz = read_mem(nx, ny, gtf, 2277, zf, "ft", zopts, &izf);
+  free(z);
+  free(zf);
+  tt_tin *tm = gm ? refine(gm, 2.0, NULL) : NULL;
+  tt_tin *tf = gf ? refine(gf, 2.0, NULL) : NULL;
+  tt_tin *tz = gz ? refine(gz, 2.0, NULL) : NULL;
+  if (!tm || !tf || !tz)
+    goto done;
+  CHECK(strstr(iff->frame_name, "m per US survey foot") != NULL);
+  CHECK(tt_grid_ground_xy(gf) == NULL);
+  CHECK_INT_EQ(tt_tin_triangle_count(tf), tt_tin_triangle_count(tm));
+  size_t nt = tt_tin_triangle_count(tm), same = 0;
+  double darea = 0, dslope = 0, dzslope = 0, darea3 = 0;
+  for (size_t t = 0; t < nt && t < tt_tin_triangle_count(tf) &&
+                     t < tt_tin_triangle_count(tz); t++) {
+    tt_triangle_info a, b, c;
+    tt_tin_triangle(tm, t, &a);
+    tt_tin_triangle(tf, t, &b);
+    tt_tin_triangle(tz, t, &c);
+    same += a.v[0] == b.v[0] && a.v[1] == b.v[1] && a.v[2] == b.v[2] &&
+            a.v[0] == c.v[0] && a.v[1] == c.v[1] && a.v[2] == c.v[2];
+    darea = fmax(darea, fabs(b.area_2d / a.area_2d - 1));
+    darea3 = fmax(darea3, fabs(b.area_3d / a.area_3d - 1));
+    if (a.slope_deg > 0.01) {
+      dslope = fmax(dslope, fabs(b.slope_deg / a.slope_deg - 1));
+      dzslope = fmax(dzslope, fabs(c.slope_deg / a.slope_deg - 1));
+    }
+  }
+  printf("  feet: %zu of %zu triangles the same as in metres (heights in "
+         "feet too: %zu triangles); areas within %.3g (3-D %.3g), slopes "
+         "within %.3g (heights in feet too: %.3g)\n", same, nt,
+         tt_tin_triangle_count(tz), darea, darea3, dslope, dzslope);
+  CHECK_INT_EQ(same, nt);
+  CHECK_DBL_LE(darea, 1e-12);
+  CHECK_DBL_LE(darea3, 1e-12);
+  CHECK_DBL_LE(dslope, 1e-12);
+  CHECK_DBL_LE(dzslope, 1e-12);
+done:
+  tt_tin_destroy(tm);
+  tt_tin_destroy(tf);
+  tt_tin_destroy(tz);
+  tt_grid_destroy(gm);
+  tt_grid_destroy(gf);
+  tt_grid_destroy(gz);
+  tt_raster_info_destroy(im);
+  tt_raster_info_destroy(iff);
+  tt_raster_info_destroy(izf);
 }
 
 /* The frame for the extent, and its scale error over the DEM. */
@@ -557,7 +772,7 @@ static void test_memory_limit(void)
     TT_FAIL_("cannot open %s", path);
     return;
   }
-  /* 138,632 samples: 0.55 MB of heights, 3.9 MB with ground points */
+  /* 138,632 samples: 0.55 MB of heights, 2.8 MB with ground points */
   char *opts[] = {"MAX_MEMORY=2000000", NULL};
   size_t warnings = tt_context_warning_count(ctx);
   tt_grid *g = NULL;
@@ -583,6 +798,8 @@ int main(void)
   test_srtm_57n();
   test_ten_degrees();
   test_sixty_degrees();
+  test_web_mercator();
+  test_feet();
   test_frame_choice();
   test_memory_limit();
   tt_context_destroy(ctx);
