@@ -411,6 +411,9 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   st = tt__records_init(&rec, ctx, tin, srs, t_srs);
   if (st != TT_OK)
     goto done;
+  /* No mesh format holds the triangles' areas: no geodesic areas to
+   * compute (a third of the write of a geographic DEM's TIN). */
+  rec.geodesic = 0;
   const size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
   const size_t total = nv + nt;
   double origin[2] = {0.0, 0.0};
