@@ -13,8 +13,10 @@
 #    netCDF-4 file;
 #  - nothing left behind by a failure (a missing folder, the file size
 #    limit) or an interrupt (SIGINT);
+#  - the LandXML file valid against the LandXML 1.2 schema when
+#    TT_LANDXML_XSD names a copy of it (skipped with a message otherwise);
 #  - QGIS (PyQGIS) mesh layers only when python3-qgis is installed: skipped
-#    with a message otherwise.
+#    with a message otherwise (test_qgis_mesh.sh checks their content).
 # Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
 # missing.
 set -u
@@ -95,6 +97,17 @@ check ".xml: a LandXML 1.2 TIN" \
   bash -c 'grep -q "<LandXML xmlns=\"http://www.landxml.org/schema/LandXML-1.2\"" t.xml && grep -q "surfType=\"TIN\"" t.xml'
 if command -v xmllint >/dev/null 2>&1; then
   check ".xml: well-formed (xmllint)" xmllint --noout t.xml
+fi
+# The LandXML 1.2 schema is LandXML.org's; its terms do not say it may be
+# redistributed, so no copy is kept here: TT_LANDXML_XSD names one.
+if [ -n "${TT_LANDXML_XSD:-}" ] && [ -f "$TT_LANDXML_XSD" ] &&
+   command -v xmllint >/dev/null 2>&1; then
+  check ".xml: valid against $TT_LANDXML_XSD (xmllint --schema)" \
+    xmllint --noout --nonet --schema "$TT_LANDXML_XSD" t.xml
+else
+  echo "SKIP: LandXML 1.2 schema validation: set TT_LANDXML_XSD to a copy" \
+       "of LandXML-1.2.xsd (from landxml.org; not redistributed here) and" \
+       "install xmllint (libxml2-utils)"
 fi
 
 for pair in "2dm:2DM" "ply:ply" "obj:Obj" "xml:LANDXML"; do
