@@ -411,9 +411,6 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   st = tt__records_init(&rec, ctx, tin, srs, t_srs);
   if (st != TT_OK)
     goto done;
-  /* No mesh format holds the triangles' areas: no geodesic areas to
-   * compute (a third of the write of a geographic DEM's TIN). */
-  rec.geodesic = 0;
   const size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
   const size_t total = nv + nt;
   double origin[2] = {0.0, 0.0};
@@ -470,9 +467,7 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   write_middle(f, fmt);
   for (size_t i = 0; i < nt && st == TT_OK; i++) {
     tt_triangle_info t;
-    tt_vertex_info tv[3];
-    double tx[3], ty[3];
-    st = tt__records_triangle(&rec, ctx, i, &t, tv, tx, ty);
+    st = tt__records_face(&rec, ctx, i, &t);
     if (st == TT_OK)
       write_face(f, fmt, i, &t, swap);
     for (int k = N_VERTEX_DATASETS; st == TT_OK && k < ndat; k++)

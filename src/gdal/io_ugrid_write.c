@@ -268,9 +268,7 @@ tt_status tt__ugrid_write(tt_context *ctx, const char *path,
     int *conn = ibuf, *count = ibuf + 3 * (size_t)BLOCK;
     for (size_t j = 0; j < n; j++) {
       tt_triangle_info t;
-      tt_vertex_info tv[3];
-      double tx[3], ty[3];
-      st = tt__records_triangle(rec, ctx, i0 + j, &t, tv, tx, ty);
+      st = tt__records_face(rec, ctx, i0 + j, &t);
       if (st != TT_OK)
         goto done;
       for (int k = 0; k < 3; k++)
