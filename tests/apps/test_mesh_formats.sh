@@ -181,8 +181,10 @@ run generate fault big.tif -size 700 -seed 3 -q
 check "file size limit: exit 1 ($rc: $(cat err.txt))" [ "$rc" -eq 1 ]
 check "file size limit: names the output" grep -q "full.ply" err.txt
 check "file size limit: nothing left" bash -c '[ ! -e full.ply ] && [ -z "$(ls -A | grep "^\.tt")" ]'
-for ext in 2dm xml; do
-  "$T" simplify big.tif "int.$ext" -max_error 0 -q >out.txt 2>err.txt &
+for ext in 2dm xml nc; do
+  of=()
+  [ "$ext" = nc ] && of=(-of UGRID)
+  "$T" simplify big.tif "int.$ext" "${of[@]}" -max_error 0 -q >out.txt 2>err.txt &
   pid=$!
   sleep 0.4
   kill -INT "$pid" 2>/dev/null
@@ -192,6 +194,7 @@ for ext in 2dm xml; do
     check "SIGINT .$ext: finished before the signal ($rc)" [ "$rc" -eq 0 ]
   else
     check "SIGINT .$ext: ended by it ($rc)" [ "$rc" -ne 0 ]
+    check "SIGINT .$ext: no dataset file" bash -c '[ -z "$(ls -A | grep "^int_")" ]'
   fi
   check "SIGINT .$ext: no temporary file" no_temp
 done
