@@ -205,7 +205,7 @@ typedef enum tt_mesh_format {
   TT_MESH_OBJ,     /* v x y z, f a b c (1-based) */
   TT_MESH_LANDXML, /* Surface/Definition surfType="TIN": Pnts P id=
                       "northing easting elevation", Faces F "a b c" */
-  TT_MESH_UGRID    /* netCDF-4, UGRID 1.0: mesh_node_x/y/z, mesh_face_nodes
+  TT_MESH_UGRID    /* netCDF (CDF-2), UGRID 1.0: mesh_node_x/y/z, mesh_face_nodes
                       (start_index 0), node and face data variables */
 } tt_mesh_format;
 

@@ -1,6 +1,10 @@
 /*
- * io_ugrid_write.c -- a TIN as a UGRID 1.0 mesh in a netCDF-4 file
- * (-of UGRID), through libnetcdf, laid out as QGIS's MDAL reads it:
+ * io_ugrid_write.c -- a TIN as a UGRID 1.0 mesh in a netCDF file (-of
+ * UGRID), through libnetcdf, laid out as QGIS's MDAL reads it. The file is
+ * netCDF classic with 64-bit offsets (CDF-2), which every netCDF reader
+ * takes (faster to write than netCDF-4, see docs/cli.md); each variable
+ * but the last may hold 4 GiB (about 358 million triangles), more fails
+ * cleanly (NC_EVARSIZE).
  *
  *   int mesh            cf_role = "mesh_topology", topology_dimension = 2,
  *                       node_coordinates = "mesh_node_x mesh_node_y",
@@ -137,7 +141,7 @@ tt_status tt__ugrid_write(tt_context *ctx, const char *path,
   if (nv == 0 || nt == 0)
     return tt__error(ctx, TT_ERR_DATA, "%s: UGRID: the TIN has no "
                      "triangles", path);
-  if (!ok(&u, nc_create(path, NC_CLOBBER | NC_NETCDF4, &u.nc)))
+  if (!ok(&u, nc_create(path, NC_CLOBBER | NC_64BIT_OFFSET, &u.nc)))
     goto done;
   int d_node, d_face, d_three;
   int v_mesh, v_crs = -1, v_node[N_NODE_VARS], v_fn, v_face[N_FACE_DOUBLES + 1];

@@ -10,7 +10,7 @@
 #  - 2DM's six .dat datasets beside it: a value a vertex or a face, an
 #    existing one refused without -overwrite (nothing written), all
 #    replaced with it, a name holding "_els" refused; -of UGRID writes a
-#    netCDF-4 file;
+#    netCDF (CDF-2) file;
 #  - nothing left behind by a failure (a missing folder, the file size
 #    limit) or an interrupt (SIGINT);
 #  - the LandXML file valid against the LandXML 1.2 schema when
@@ -152,8 +152,8 @@ check "_els in a 2DM name: usage error ($rc: $(cat err.txt))" [ "$rc" -eq 2 ]
 check "_els in a 2DM name: nothing written" bash -c '[ -z "$(ls -A | grep "^x_els")" ]'
 run simplify dem.tif u.nc -of UGRID -max_error 5 -q
 check "-of UGRID: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-check "-of UGRID: a netCDF-4 (HDF5) file" \
-  bash -c '[ "$(head -c 4 u.nc | od -An -c | tr -d " ")" = "211HDF" ]'
+check "-of UGRID: a netCDF CDF-2 file" \
+  bash -c '[ "$(head -c 4 u.nc | od -An -c | tr -d " ")" = "CDF002" ]'
 run simplify dem.tif u.nc -of UGRID -max_error 5 -q
 check "-of UGRID: an existing one refused ($rc)" [ "$rc" -eq 1 ]
 
