@@ -108,9 +108,12 @@ static int host_big_endian(void)
   return b == 0;
 }
 
-static void put_le(FILE *f, const void *value, size_t size, int swap)
+/* Appends value (size bytes) to the record at *p in little-endian order
+ * and moves *p past it; a record goes out in one fwrite(). */
+static void put_le(unsigned char **p, const void *value, size_t size,
+                   int swap)
 {
-  unsigned char b[8];
+  unsigned char *b = *p;
   memcpy(b, value, size);
   if (swap)
     for (size_t i = 0; i < size / 2; i++) {
@@ -118,7 +121,42 @@ static void put_le(FILE *f, const void *value, size_t size, int swap)
       b[i] = b[size - 1 - i];
       b[size - 1 - i] = t;
     }
-  fwrite(b, 1, size, f);
+  *p = b + size;
+}
+
+/* A double as %.17g writes it (the exact value back on reading), with a
+ * fast path for the integers below 10^15 that DEMs are full of (heights of
+ * integer bands, coordinates of whole-unit grids, sample counts), which
+ * %.17g writes as plain digits too: the text is the same, the time a
+ * fraction. -0 keeps printf's "-0". */
+static void put_num(FILE *f, double v)
+{
+  if (v > -1e15 && v < 1e15 && v == (double)(int64_t)v &&
+      !(v == 0 && signbit(v))) {
+    char buf[24], *p = buf + sizeof buf;
+    int64_t n = (int64_t)v;
+    uint64_t u = n < 0 ? (uint64_t)0 - (uint64_t)n : (uint64_t)n;
+    do {
+      *--p = (char)('0' + (int)(u % 10));
+      u /= 10;
+    } while (u);
+    if (n < 0)
+      *--p = '-';
+    fwrite(p, 1, (size_t)(buf + sizeof buf - p), f);
+  } else {
+    fprintf(f, "%.17g", v);
+  }
+}
+
+/* Numbers separated by spaces, then end (a newline or a closing tag). */
+static void put_nums(FILE *f, const double *v, int n, const char *end)
+{
+  for (int k = 0; k < n; k++) {
+    if (k)
+      fputc(' ', f);
+    put_num(f, v[k]);
+  }
+  fputs(end, f);
 }
 
 /* Text with XML's five special characters escaped. */
@@ -284,22 +322,27 @@ static void write_vertex(FILE *f, tt_mesh_format fmt, size_t i,
 {
   switch (fmt) {
   case TT_MESH_2DM:
-    fprintf(f, "ND %zu %.17g %.17g %.17g\n", i + 1, x, y, v->z);
+    fprintf(f, "ND %zu ", i + 1);
+    put_nums(f, (const double[3]){x, y, v->z}, 3, "\n");
     break;
   case TT_MESH_PLY: {
     const double d[6] = {x, y, v->z, v->insert_error, v->star_max_error,
                          v->star_rmse};
+    unsigned char rec[sizeof d], *p = rec;
     for (int k = 0; k < 6; k++)
-      put_le(f, &d[k], sizeof d[k], swap);
+      put_le(&p, &d[k], sizeof d[k], swap);
+    fwrite(rec, 1, sizeof rec, f);
     break;
   }
   case TT_MESH_OBJ:
-    fprintf(f, "v %.17g %.17g %.17g\n", x - origin[0], y - origin[1], v->z);
+    fputs("v ", f);
+    put_nums(f, (const double[3]){x - origin[0], y - origin[1], v->z}, 3,
+             "\n");
     break;
   case TT_MESH_LANDXML:
     /* The standard's order: northing (y), easting (x), elevation. */
-    fprintf(f, "          <P id=\"%zu\">%.17g %.17g %.17g</P>\n", i + 1, y,
-            x, v->z);
+    fprintf(f, "          <P id=\"%zu\">", i + 1);
+    put_nums(f, (const double[3]){y, x, v->z}, 3, "</P>\n");
     break;
   default:
     break;
@@ -324,17 +367,20 @@ static void write_face(FILE *f, tt_mesh_format fmt, size_t i,
             (long)t->v[1] + 1, (long)t->v[2] + 1);
     break;
   case TT_MESH_PLY: {
-    const unsigned char three = 3;
-    fwrite(&three, 1, 1, f);
+    /* count (uchar), 3 indices (int), max_err, rmse (double), n_samples
+     * (int): 33 bytes */
+    unsigned char rec[33], *p = rec;
+    *p++ = 3;
     for (int k = 0; k < 3; k++) {
       const int32_t vi = t->v[k];
-      put_le(f, &vi, sizeof vi, swap);
+      put_le(&p, &vi, sizeof vi, swap);
     }
     const double d[2] = {t->max_error, t->rmse};
-    put_le(f, &d[0], sizeof d[0], swap);
-    put_le(f, &d[1], sizeof d[1], swap);
+    put_le(&p, &d[0], sizeof d[0], swap);
+    put_le(&p, &d[1], sizeof d[1], swap);
     const int32_t n = t->samples > INT32_MAX ? INT32_MAX : (int32_t)t->samples;
-    put_le(f, &n, sizeof n, swap);
+    put_le(&p, &n, sizeof n, swap);
+    fwrite(rec, 1, sizeof rec, f);
     break;
   }
   case TT_MESH_OBJ:
@@ -458,7 +504,7 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
     if (st == TT_OK)
       write_vertex(f, fmt, i, &v, x, y, origin, swap);
     for (int k = 0; st == TT_OK && k < ndat && k < N_VERTEX_DATASETS; k++)
-      fprintf(dat[k], "%.17g\n", vertex_value(k, &v));
+      put_nums(dat[k], (const double[1]){vertex_value(k, &v)}, 1, "\n");
     if (st == TT_OK && !keep_going(progress, progress_arg, i + 1, total))
       st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
@@ -471,7 +517,7 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
     if (st == TT_OK)
       write_face(f, fmt, i, &t, swap);
     for (int k = N_VERTEX_DATASETS; st == TT_OK && k < ndat; k++)
-      fprintf(dat[k], "%.17g\n", face_value(k, &t));
+      put_nums(dat[k], (const double[1]){face_value(k, &t)}, 1, "\n");
     if (st == TT_OK &&
         !keep_going(progress, progress_arg, nv + i + 1, total))
       st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
