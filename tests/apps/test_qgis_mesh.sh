@@ -15,6 +15,8 @@
 #    GeoPackage's field (NaN where the field is NULL);
 #  - 2DM: QGIS does not load the .dat files by itself (only "Bed
 #    Elevation" before), each loads with addDataset().
+# OBJ and LandXML are not here: QGIS 3.22's MDAL (0.9.4) has no driver
+# for them ("not recognized as a supported file format").
 # Skips (77) when python3-qgis is not installed: it is an optional heavy
 # client (apt-get install -y --no-install-recommends python3-qgis).
 set -u
