@@ -36,6 +36,7 @@
 
 #include <netcdf.h>
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -191,10 +192,13 @@ tt_status tt__ugrid_write(tt_context *ctx, const char *path,
         put_text(&u, v, "units", k == NV_X ? "degrees_east"
                                            : "degrees_north");
       else if (srs) {
-        char *unit = NULL;
-        double m = OSRGetLinearUnits(srs, &unit);
-        if (m == 1.0)
-          put_text(&u, v, "units", "m");
+        /* UDUNITS names of the common linear units; none for others */
+        double m = OSRGetLinearUnits(srs, NULL);
+        put_text(&u, v, "units", m == 1.0            ? "m"
+                                 : m == 0.3048        ? "ft"
+                                 : fabs(m - 1200.0 / 3937.0) < 1e-12
+                                     ? "US_survey_foot"
+                                     : NULL);
       }
     } else {
       put_text(&u, v, "coordinates", "mesh_node_x mesh_node_y");
