@@ -309,14 +309,15 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
   fprintf(r->out,
           "%s: %zu cells, %zu valid samples -> %zu vertices, %zu triangles; "
           "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s; "
-          "frame %s; z unit %s; %.2f s\n",
+          "frame %s; z unit %s; mesh %.2f s, write %.2f s (%s); %.2f s\n",
           r->s->output, p->cells, p->valid, p->sum.vertices,
           p->sum.triangles, p->sum.errors.max_error, unit,
           p->sum.errors.rmse, unit, lim,
           tt_stop_reason_name(p->sum.stop_reason),
           in->crs_name && *in->crs_name ? in->crs_name : "none",
           r->s->t_srs ? ", written in " : "", r->s->t_srs ? r->s->t_srs : "",
-          in->frame_name, zu, p->t_total);
+          in->frame_name, zu, p->sum.seconds_mesh, p->t_write,
+          p->driver ? p->driver : "?", p->t_total);
   if (p->dopt)
     fprintf(r->out,
             "%s: decimated from %zu vertices: %zu removed in %zu %s\n",

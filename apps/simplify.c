@@ -94,6 +94,20 @@ tt_status tt__app_simplify(app_run *r)
   /* Plan the output first: a refusal costs nothing yet. */
   r->msg.last[0] = '\0';
   st = tt_output_begin(r->ctx, s->output, drvname, s->overwrite, &outp);
+  /* 2DM's datasets beside it (OUT_ins_err.dat, ...) are part of it. MDAL
+   * reads a dataset file whose name holds "_els" as face values: a name
+   * with it would turn the vertex datasets into face ones. */
+  if (st == TT_OK && mesh == TT_MESH_2DM &&
+      strstr(CPLGetFilename(s->output), "_els")) {
+    st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, s->output,
+                      "2DM: a name holding \"_els\" would make MDAL read "
+                      "the vertex datasets beside it as face values; "
+                      "name the output otherwise");
+    goto done;
+  }
+  for (const char *const *sc = tt_mesh_format_sidecars(mesh);
+       st == TT_OK && *sc; sc++)
+    st = tt_output_add_sidecar(r->ctx, outp, *sc);
   if (st == TT_OK && !s->overwrite && s->nln[0] &&
       tt__app_str_ieq(drvname, "ESRI Shapefile")) {
     /* tt_output checked the files of the plain layer names; with -nln the

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Fails when a file of the engine (src/ outside src/gdal/, or the engine's
-# public header) includes a header of GDAL, OGR, CPL, PROJ, GeographicLib or
-# SQLite: the engine builds and links with libm and threads alone; and when
+# public header) includes a header of GDAL, OGR, CPL, PROJ, GeographicLib,
+# SQLite or netCDF: the engine builds and links with libm and threads alone; and when
 # a file of apps/ passes 800 lines.
 set -u
 root=${1:?usage: test_layering.sh SOURCE_DIR}
-pattern='^[[:space:]]*#[[:space:]]*include[[:space:]]*[<"](gdal[a-z_]*\.h|ogr[a-z_]*\.h|ogrsf_frmts\.h|cpl_[a-z_]*\.h|vrtdataset\.h|proj\.h|proj_[a-z_]*\.h|geodesic\.h|sqlite3\.h|sqlite3ext\.h)[>"]'
+pattern='^[[:space:]]*#[[:space:]]*include[[:space:]]*[<"](gdal[a-z_]*\.h|ogr[a-z_]*\.h|ogrsf_frmts\.h|cpl_[a-z_]*\.h|vrtdataset\.h|proj\.h|proj_[a-z_]*\.h|geodesic\.h|sqlite3\.h|sqlite3ext\.h|netcdf\.h)[>"]'
 cd "$root" || exit 1
 bad=$(find src include/terratin/terratin.h -path src/gdal -prune -o \
         -type f \( -name '*.c' -o -name '*.h' \) -print |

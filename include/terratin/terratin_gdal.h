@@ -194,7 +194,7 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
 
 /* ---------------------------------------------------------------------------
  * Mesh and survey files (not OGR drivers): SMS 2DM, binary little-endian
- * PLY, Wavefront OBJ and a LandXML 1.2 TIN surface.
+ * PLY, Wavefront OBJ, a LandXML 1.2 TIN surface and UGRID netCDF.
  * ------------------------------------------------------------------------- */
 typedef enum tt_mesh_format {
   TT_MESH_NONE = 0,
@@ -203,17 +203,24 @@ typedef enum tt_mesh_format {
                       face vertex_indices (uchar, int) max_err rmse
                       (double) n_samples (int); NaN kept */
   TT_MESH_OBJ,     /* v x y z, f a b c (1-based) */
-  TT_MESH_LANDXML  /* Surface/Definition surfType="TIN": Pnts P id=
+  TT_MESH_LANDXML, /* Surface/Definition surfType="TIN": Pnts P id=
                       "northing easting elevation", Faces F "a b c" */
+  TT_MESH_UGRID    /* netCDF (CDF-2), UGRID 1.0: mesh_node_x/y/z, mesh_face_nodes
+                      (start_index 0), node and face data variables */
 } tt_mesh_format;
 
-/* The format of an -of name ("2DM", "PLY", "OBJ", "LandXML", any case),
- * or of a path's extension (.2dm, .ply, .obj, .xml, any case);
+/* The format of an -of name ("2DM", "PLY", "OBJ", "LandXML", "UGRID", any
+ * case), or of a path's extension (.2dm, .ply, .obj, .xml, any case; .nc
+ * is left to OGR's netCDF driver);
  * TT_MESH_NONE for anything else. */
 tt_mesh_format tt_mesh_format_from_name(const char *name);
 tt_mesh_format tt_mesh_format_from_path(const char *path);
-/* "2DM", "PLY", "OBJ", "LandXML"; NULL for TT_MESH_NONE. */
+/* "2DM", "PLY", "OBJ", "LandXML", "UGRID"; NULL for TT_MESH_NONE. */
 const char *tt_mesh_format_name(tt_mesh_format fmt);
+/* The files a format writes beside OUTPUT, as suffixes that replace its
+ * extension (2DM: "_ins_err.dat", ..., "_n_samples_els.dat", its datasets;
+ * the others: none), NULL-terminated; static storage. */
+const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt);
 
 /* Writes tin to the file path (create or truncate: give it the temporary
  * name of a tt_output and commit that) in fmt. Every vertex is written, in
@@ -223,8 +230,10 @@ const char *tt_mesh_format_name(tt_mesh_format fmt);
  * (%.17g, or binary in PLY). name labels the mesh (2DM MESHNAME, LandXML
  * Surface name, OBJ object; NULL: "TIN"). local (OBJ only): vertices
  * relative to the centre of the extent rounded to whole units, which a
- * comment line `# origin X Y` gives. progress may stop the write
- * (TT_ERR_INTERRUPTED). On any failure the file at path is removed. */
+ * comment line `# origin X Y` gives. 2DM's datasets are written beside
+ * path under the names tt_mesh_format_sidecars() gives; PLY's header names
+ * the CRS ("comment crs:WKT"). progress may stop the write
+ * (TT_ERR_INTERRUPTED). On any failure the files written are removed. */
 tt_status tt_mesh_write(tt_context *ctx, const char *path,
                         tt_mesh_format fmt, const char *name,
                         const tt_tin *tin, OGRSpatialReferenceH srs,
@@ -255,6 +264,13 @@ tt_status tt_output_begin(tt_context *ctx, const char *path,
                           tt_output **out_output);
 /* The name to create the dataset under (temporary). */
 const char *tt_output_temp_path(const tt_output *out);
+/* A file written beside a single-file output: the final stem (path without
+ * its extension) + suffix, written as the temporary stem + suffix, checked
+ * now and at commit as the output is (an existing one only replaced with
+ * overwrite), renamed into place with it at commit and removed with it on
+ * failure. */
+tt_status tt_output_add_sidecar(tt_context *ctx, tt_output *out,
+                                const char *suffix);
 /* The path as given to tt_output_begin(), for messages. */
 const char *tt_output_final_path(const tt_output *out);
 /* The layer-name prefix to give tt_ogr_write_tin() as NLN_PREFIX: "<name>_"

@@ -2,7 +2,8 @@
  * io_mesh_write.c -- a TIN written as one mesh or survey file, without
  * OGR: SMS 2DM (QGIS's MDAL reads it as a mesh layer), binary PLY (vertex
  * and face properties), Wavefront OBJ (3-D and game tools) and a LandXML
- * 1.2 TIN surface (civil and survey software).
+ * 1.2 TIN surface (civil and survey software); UGRID netCDF is
+ * io_ugrid_write.c's, called from here.
  *
  * The coordinates and the triangles come from tin_records.h, as for the
  * OGR layers: the output CRS is the input's or T_SRS with every vertex
@@ -13,7 +14,18 @@
  * %.17g (ASCII formats) or as IEEE doubles (PLY): a reader gets back the
  * very doubles. The caller gives the path to write (the temporary name of
  * a tt_output); a failure or an interruption removes the partial file.
+ *
+ * 2DM holds no values but the heights, so its datasets go beside it, one
+ * SMS ASCII dataset file (.dat, "DATASET" ... "ENDDS", one time step) per
+ * attribute, named after the mesh: OUT_ins_err.dat, OUT_star_max.dat,
+ * OUT_star_rmse.dat on the vertices; OUT_max_err_els.dat, OUT_rmse_els.dat,
+ * OUT_n_samples_els.dat on the triangles (MDAL takes a dataset file whose
+ * name holds "_els" as face values, any other as vertex values; QGIS loads
+ * them with "Add extra dataset" or QgsMeshDataProvider::addDataset(), not
+ * by itself). The same attributes are PLY's properties. NaN (ins_err of
+ * the starting vertices) is written "nan", which MDAL reads back as NaN.
  */
+#include "gdal/mesh_ugrid.h"
 #include "tin_records.h"
 
 #include <cpl_conv.h>
@@ -23,6 +35,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include <time.h>
@@ -37,8 +50,26 @@ static const struct {
     {TT_MESH_PLY, "PLY", "ply"},
     {TT_MESH_OBJ, "OBJ", "obj"},
     {TT_MESH_LANDXML, "LandXML", "xml"},
+    /* .nc stays the OGR netCDF driver's: UGRID by -of only. */
+    {TT_MESH_UGRID, "UGRID", NULL},
 };
 enum { N_MESH_FORMATS = sizeof mesh_formats / sizeof mesh_formats[0] };
+
+/* The attributes written as datasets: 2DM's files beside the mesh (the
+ * suffix of each name), PLY's properties. */
+enum { DS_INS_ERR, DS_STAR_MAX, DS_STAR_RMSE, DS_MAX_ERR, DS_RMSE,
+       DS_N_SAMPLES, N_DATASETS, N_VERTEX_DATASETS = DS_MAX_ERR };
+static const char *const dataset_names[N_DATASETS] = {
+    "ins_err", "star_max", "star_rmse", "max_err", "rmse", "n_samples"};
+static const char *const dat_suffixes[N_DATASETS + 1] = {
+    "_ins_err.dat",     "_star_max.dat", "_star_rmse.dat",
+    "_max_err_els.dat", "_rmse_els.dat", "_n_samples_els.dat", NULL};
+static const char *const no_suffixes[1] = {NULL};
+
+const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt)
+{
+  return fmt == TT_MESH_2DM ? dat_suffixes : no_suffixes;
+}
 
 tt_mesh_format tt_mesh_format_from_name(const char *name)
 {
@@ -54,7 +85,7 @@ tt_mesh_format tt_mesh_format_from_path(const char *path)
   base = base ? base + 1 : path;
   const char *dot = base ? strrchr(base, '.') : NULL;
   for (size_t i = 0; dot && i < N_MESH_FORMATS; i++)
-    if (strcasecmp(dot + 1, mesh_formats[i].ext) == 0)
+    if (mesh_formats[i].ext && strcasecmp(dot + 1, mesh_formats[i].ext) == 0)
       return mesh_formats[i].fmt;
   return TT_MESH_NONE;
 }
@@ -77,9 +108,12 @@ static int host_big_endian(void)
   return b == 0;
 }
 
-static void put_le(FILE *f, const void *value, size_t size, int swap)
+/* Appends value (size bytes) to the record at *p in little-endian order
+ * and moves *p past it; a record goes out in one fwrite(). */
+static void put_le(unsigned char **p, const void *value, size_t size,
+                   int swap)
 {
-  unsigned char b[8];
+  unsigned char *b = *p;
   memcpy(b, value, size);
   if (swap)
     for (size_t i = 0; i < size / 2; i++) {
@@ -87,7 +121,42 @@ static void put_le(FILE *f, const void *value, size_t size, int swap)
       b[i] = b[size - 1 - i];
       b[size - 1 - i] = t;
     }
-  fwrite(b, 1, size, f);
+  *p = b + size;
+}
+
+/* A double as %.17g writes it (the exact value back on reading), with a
+ * fast path for the integers below 10^15 that DEMs are full of (heights of
+ * integer bands, coordinates of whole-unit grids, sample counts), which
+ * %.17g writes as plain digits too: the text is the same, the time a
+ * fraction. -0 keeps printf's "-0". */
+static void put_num(FILE *f, double v)
+{
+  if (v > -1e15 && v < 1e15 && v == (double)(int64_t)v &&
+      !(v == 0 && signbit(v))) {
+    char buf[24], *p = buf + sizeof buf;
+    int64_t n = (int64_t)v;
+    uint64_t u = n < 0 ? (uint64_t)0 - (uint64_t)n : (uint64_t)n;
+    do {
+      *--p = (char)('0' + (int)(u % 10));
+      u /= 10;
+    } while (u);
+    if (n < 0)
+      *--p = '-';
+    fwrite(p, 1, (size_t)(buf + sizeof buf - p), f);
+  } else {
+    fprintf(f, "%.17g", v);
+  }
+}
+
+/* Numbers separated by spaces, then end (a newline or a closing tag). */
+static void put_nums(FILE *f, const double *v, int n, const char *end)
+{
+  for (int k = 0; k < n; k++) {
+    if (k)
+      fputc(' ', f);
+    put_num(f, v[k]);
+  }
+  fputs(end, f);
 }
 
 /* Text with XML's five special characters escaped. */
@@ -160,7 +229,20 @@ static void write_header(FILE *f, tt_mesh_format fmt, const char *name,
     fprintf(f, "ply\nformat binary_little_endian 1.0\n"
                "comment terratin TIN ");
     put_plain(f, name);
-    fprintf(f, "\n"
+    fputc('\n', f);
+    if (rec->out_srs) {
+      /* MDAL's convention: a "comment crs:" line gives the mesh's CRS
+       * (the WKT is one line). */
+      char *wkt = NULL;
+      if (OSRExportToWkt(rec->out_srs, &wkt) == OGRERR_NONE && wkt) {
+        fputs("comment crs:", f);
+        for (const char *c = wkt; *c; c++)
+          fputc((unsigned char)*c < 0x20 ? ' ' : *c, f);
+        fputc('\n', f);
+      }
+      CPLFree(wkt);
+    }
+    fprintf(f,
                "element vertex %zu\n"
                "property double x\nproperty double y\nproperty double z\n"
                "property double ins_err\nproperty double star_max\n"
@@ -240,22 +322,27 @@ static void write_vertex(FILE *f, tt_mesh_format fmt, size_t i,
 {
   switch (fmt) {
   case TT_MESH_2DM:
-    fprintf(f, "ND %zu %.17g %.17g %.17g\n", i + 1, x, y, v->z);
+    fprintf(f, "ND %zu ", i + 1);
+    put_nums(f, (const double[3]){x, y, v->z}, 3, "\n");
     break;
   case TT_MESH_PLY: {
     const double d[6] = {x, y, v->z, v->insert_error, v->star_max_error,
                          v->star_rmse};
+    unsigned char rec[sizeof d], *p = rec;
     for (int k = 0; k < 6; k++)
-      put_le(f, &d[k], sizeof d[k], swap);
+      put_le(&p, &d[k], sizeof d[k], swap);
+    fwrite(rec, 1, sizeof rec, f);
     break;
   }
   case TT_MESH_OBJ:
-    fprintf(f, "v %.17g %.17g %.17g\n", x - origin[0], y - origin[1], v->z);
+    fputs("v ", f);
+    put_nums(f, (const double[3]){x - origin[0], y - origin[1], v->z}, 3,
+             "\n");
     break;
   case TT_MESH_LANDXML:
     /* The standard's order: northing (y), easting (x), elevation. */
-    fprintf(f, "          <P id=\"%zu\">%.17g %.17g %.17g</P>\n", i + 1, y,
-            x, v->z);
+    fprintf(f, "          <P id=\"%zu\">", i + 1);
+    put_nums(f, (const double[3]){y, x, v->z}, 3, "</P>\n");
     break;
   default:
     break;
@@ -280,17 +367,20 @@ static void write_face(FILE *f, tt_mesh_format fmt, size_t i,
             (long)t->v[1] + 1, (long)t->v[2] + 1);
     break;
   case TT_MESH_PLY: {
-    const unsigned char three = 3;
-    fwrite(&three, 1, 1, f);
+    /* count (uchar), 3 indices (int), max_err, rmse (double), n_samples
+     * (int): 33 bytes */
+    unsigned char rec[33], *p = rec;
+    *p++ = 3;
     for (int k = 0; k < 3; k++) {
       const int32_t vi = t->v[k];
-      put_le(f, &vi, sizeof vi, swap);
+      put_le(&p, &vi, sizeof vi, swap);
     }
     const double d[2] = {t->max_error, t->rmse};
-    put_le(f, &d[0], sizeof d[0], swap);
-    put_le(f, &d[1], sizeof d[1], swap);
+    put_le(&p, &d[0], sizeof d[0], swap);
+    put_le(&p, &d[1], sizeof d[1], swap);
     const int32_t n = t->samples > INT32_MAX ? INT32_MAX : (int32_t)t->samples;
-    put_le(f, &n, sizeof n, swap);
+    put_le(&p, &n, sizeof n, swap);
+    fwrite(rec, 1, sizeof rec, f);
     break;
   }
   case TT_MESH_OBJ:
@@ -313,6 +403,38 @@ static void write_footer(FILE *f, tt_mesh_format fmt)
           "  </Surfaces>\n</LandXML>\n", f);
 }
 
+/* The file of a 2DM dataset: path with its extension replaced by the
+ * dataset's suffix (".tt01234567.2dm" -> ".tt01234567_ins_err.dat"), as
+ * tt_output commits a temporary name's sidecars; malloc'd. */
+static char *sidecar_path(const char *path, const char *suffix)
+{
+  const char *slash = strrchr(path, '/');
+  const char *dot = strrchr(slash ? slash + 1 : path, '.');
+  size_t stem = dot && dot != (slash ? slash + 1 : path)
+                    ? (size_t)(dot - path)
+                    : strlen(path);
+  size_t n = stem + strlen(suffix) + 1;
+  char *p = malloc(n);
+  if (p)
+    snprintf(p, n, "%.*s%s", (int)stem, path, suffix);
+  return p;
+}
+
+/* The value of dataset k for a vertex or a triangle. */
+static double vertex_value(int k, const tt_vertex_info *v)
+{
+  return k == DS_INS_ERR    ? v->insert_error
+         : k == DS_STAR_MAX ? v->star_max_error
+                            : v->star_rmse;
+}
+
+static double face_value(int k, const tt_triangle_info *t)
+{
+  return k == DS_MAX_ERR ? t->max_error
+         : k == DS_RMSE  ? t->rmse
+                         : (double)t->samples;
+}
+
 tt_status tt_mesh_write(tt_context *ctx, const char *path,
                         tt_mesh_format fmt, const char *name,
                         const tt_tin *tin, OGRSpatialReferenceH srs,
@@ -322,7 +444,10 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   tt_status st = TT_OK;
   tt__records rec;
   FILE *f = NULL;
+  FILE *dat[N_DATASETS] = {NULL};
+  char *dat_path[N_DATASETS] = {NULL};
   int made = 0;
+  const int ndat = fmt == TT_MESH_2DM ? N_DATASETS : 0;
   memset(&rec, 0, sizeof rec);
   if (!path || !tin || !tt_mesh_format_name(fmt))
     return tt__error(ctx, TT_ERR_ARG, "tt_mesh_write: no path, TIN or "
@@ -341,6 +466,16 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
     if (st != TT_OK)
       goto done;
   }
+  if (fmt == TT_MESH_UGRID) {
+    made = 1;
+    st = tt__ugrid_write(ctx, path, name, &rec, progress, progress_arg);
+    goto done;
+  }
+  for (int k = 0; k < ndat; k++)
+    if (!(dat_path[k] = sidecar_path(path, dat_suffixes[k]))) {
+      st = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+      goto done;
+    }
   f = fopen(path, "wb");
   if (!f) {
     st = tt__error(ctx, TT_ERR_IO, "%s: cannot create: %s", path,
@@ -348,6 +483,18 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
     goto done;
   }
   made = 1;
+  for (int k = 0; k < ndat; k++) {
+    dat[k] = fopen(dat_path[k], "wb");
+    if (!dat[k]) {
+      st = tt__error(ctx, TT_ERR_IO, "%s: cannot create: %s", dat_path[k],
+                     strerror(errno));
+      goto done;
+    }
+    /* SMS's ASCII dataset, as MDAL reads it: the counts must be the
+     * mesh's; one time step, no status flags. */
+    fprintf(dat[k], "DATASET\nOBJTYPE \"mesh2d\"\nBEGSCL\nND %zu\nNC %zu\n"
+                    "NAME \"%s\"\nTS 0 0\n", nv, nt, dataset_names[k]);
+  }
   const int swap = host_big_endian();
   write_header(f, fmt, name, &rec, nv, nt, origin, local);
   for (size_t i = 0; i < nv && st == TT_OK; i++) {
@@ -356,6 +503,8 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
     st = tt__records_vertex(&rec, ctx, i, &v, &x, &y);
     if (st == TT_OK)
       write_vertex(f, fmt, i, &v, x, y, origin, swap);
+    for (int k = 0; st == TT_OK && k < ndat && k < N_VERTEX_DATASETS; k++)
+      put_nums(dat[k], (const double[1]){vertex_value(k, &v)}, 1, "\n");
     if (st == TT_OK && !keep_going(progress, progress_arg, i + 1, total))
       st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
@@ -364,11 +513,11 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   write_middle(f, fmt);
   for (size_t i = 0; i < nt && st == TT_OK; i++) {
     tt_triangle_info t;
-    tt_vertex_info tv[3];
-    double tx[3], ty[3];
-    st = tt__records_triangle(&rec, ctx, i, &t, tv, tx, ty);
+    st = tt__records_face(&rec, ctx, i, &t);
     if (st == TT_OK)
       write_face(f, fmt, i, &t, swap);
+    for (int k = N_VERTEX_DATASETS; st == TT_OK && k < ndat; k++)
+      put_nums(dat[k], (const double[1]){face_value(k, &t)}, 1, "\n");
     if (st == TT_OK &&
         !keep_going(progress, progress_arg, nv + i + 1, total))
       st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
@@ -376,24 +525,39 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   if (st != TT_OK)
     goto done;
   write_footer(f, fmt);
-  if (ferror(f)) {
-    st = tt__error(ctx, TT_ERR_IO, "%s: write failed: %s", path,
-                   strerror(errno));
-    goto done;
+  for (int k = 0; k < ndat; k++)
+    fputs("ENDDS\n", dat[k]);
+  /* Each file flushed and closed, the first failure named. */
+  for (int k = -1; k < ndat && st == TT_OK; k++) {
+    FILE **pf = k < 0 ? &f : &dat[k];
+    const char *p = k < 0 ? path : dat_path[k];
+    FILE *g = *pf;
+    *pf = NULL;
+    int bad = ferror(g);
+    int e = errno;
+    if (fclose(g) != 0 && !bad) {
+      bad = 1;
+      e = errno;
+    }
+    if (bad)
+      st = tt__error(ctx, TT_ERR_IO, "%s: write failed: %s", p,
+                     strerror(e));
   }
-  FILE *g = f;
-  f = NULL;
-  if (fclose(g) != 0) {
-    st = tt__error(ctx, TT_ERR_IO, "%s: write failed: %s", path,
-                   strerror(errno));
+  if (st != TT_OK)
     goto done;
-  }
   if (progress && !progress(1.0, NULL, progress_arg))
     st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
 
 done:
   if (f)
     fclose(f);
+  for (int k = 0; k < ndat; k++) {
+    if (dat[k])
+      fclose(dat[k]);
+    if (st != TT_OK && made && dat_path[k])
+      remove(dat_path[k]);
+    free(dat_path[k]);
+  }
   if (st != TT_OK && made)
     remove(path);
   tt__records_free(&rec);

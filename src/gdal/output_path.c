@@ -36,6 +36,9 @@
  * 120..128, which every WAL connection holds while open), and otherwise the
  * stale sidecars (a crashed writer's) are moved aside just before the new
  * file is renamed into place and deleted after.
+ * Files a format writes beside a single file (2DM's datasets) are
+ * registered with tt_output_add_sidecar(): written under the temporary
+ * stem, checked like the output, renamed with it.
  * The checks run at begin (fail early) and again at commit.
  * destroy() removes whatever temporary files remain, folders included.
  * Live outputs are kept in a process-wide list, so tt_output_abandon_all()
@@ -103,6 +106,8 @@ struct tt_output {
   size_t nfinals;
   protected_file *prot;
   size_t nprot, capprot;
+  char **sidecars;     /* single-file: files written beside the output */
+  size_t nsidecars, capsidecars;
   tt_output *prev, *next; /* the list of live outputs */
 };
 
@@ -225,6 +230,9 @@ void tt_output_destroy(tt_output *out)
     free(out->prot[i].real);
     free(out->prot[i].name);
   }
+  for (size_t i = 0; i < out->nsidecars; i++)
+    free(out->sidecars[i]);
+  free(out->sidecars);
   free(out->prot);
   free(out->finals);
   free(out->dir);
@@ -478,6 +486,20 @@ static tt_status refuse_in_use(tt_context *ctx, const tt_output *out)
  * an earlier output's, a FIFO, device, socket or symbolic link); refuses a
  * name that is a protected file (TT_ERR_ARG) and an SQLite output whose
  * old file another process has open (TT_ERR_IO). */
+/* A file the output writes beside its main one: a regular file (or none),
+ * replaced only with -overwrite, never one the input is read from. */
+static tt_status check_sidecar(tt_context *ctx, const tt_output *out,
+                               const char *p)
+{
+  struct stat st;
+  if (lstat(p, &st) == 0 && !S_ISREG(st.st_mode))
+    return refuse_kind(ctx, p, st.st_mode);
+  if (lstat(p, &st) == 0 && !out->overwrite)
+    return tt__error(ctx, TT_ERR_EXISTS, "%s exists; not overwriting it "
+                     "without permission", p);
+  return refuse_protected(ctx, out, p);
+}
+
 static tt_status check_finals(tt_context *ctx, const tt_output *out)
 {
   tt_status s = TT_OK;
@@ -508,6 +530,8 @@ static tt_status check_finals(tt_context *ctx, const tt_output *out)
         s = refuse_protected(ctx, out, p);
       free(p);
     }
+    for (size_t i = 0; s == TT_OK && i < out->nsidecars; i++)
+      s = check_sidecar(ctx, out, out->sidecars[i]);
     if (out->sqlite && s == TT_OK)
       s = refuse_in_use(ctx, out);
     return s;
@@ -705,6 +729,22 @@ done:
   pthread_mutex_unlock(&live_lock);
   *out_output = out;
   return TT_OK;
+}
+
+tt_status tt_output_add_sidecar(tt_context *ctx, tt_output *out,
+                                const char *suffix)
+{
+  if (!out || out->shapefile || !suffix || !*suffix || strchr(suffix, '/'))
+    return tt__error(ctx, TT_ERR_ARG, "tt_output_add_sidecar: a suffix for "
+                     "a single-file output");
+  if (!tt__grow((void **)&out->sidecars, &out->capsidecars,
+                out->nsidecars + 1, sizeof *out->sidecars))
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  char *p = str_printf("%s/%s%s", out->dir, out->final_stem, suffix);
+  if (!p)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  out->sidecars[out->nsidecars++] = p;
+  return check_sidecar(ctx, out, p);
 }
 
 const char *tt_output_temp_path(const tt_output *out)

@@ -28,6 +28,7 @@
  * (16 bytes a vertex), then O(1) per feature.
  */
 #include "gdal/tin_records.h"
+#include "tin/tin.h"
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
@@ -246,6 +247,47 @@ tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
     t->area_3d = t->area_2d > 0 ? t->area_3d * (area / t->area_2d) : area;
     t->area_2d = area;
   }
+  return TT_OK;
+}
+
+/* Vertex v's output x, y: tt_tin_vertex()'s map coordinates (the same
+ * doubles), or the T_SRS ones. */
+static void output_xy(const tt__records *r, size_t v, double *x, double *y)
+{
+  const tt_tin *tin = r->tin;
+  if (r->xy) {
+    *x = r->xy[2 * v];
+    *y = r->xy[2 * v + 1];
+    return;
+  }
+  const double *gt = tin->gt;
+  double px = tin->vc[v] + 0.5, py = tin->vr[v] + 0.5;
+  *x = gt[0] + px * gt[1] + py * gt[2];
+  *y = gt[3] + px * gt[4] + py * gt[5];
+}
+
+tt_status tt__records_face(const tt__records *r, tt_context *ctx, size_t i,
+                           tt_triangle_info *out_t)
+{
+  const tt_tin *tin = r->tin;
+  if (i >= tin->nt)
+    return tt__error(ctx, TT_ERR_INTERNAL, "triangle %zu of %zu could not "
+                     "be read from the TIN", i, tin->nt);
+  double x[3], y[3];
+  for (int k = 0; k < 3; k++) {
+    out_t->v[k] = tin->tv[3 * i + (size_t)k];
+    output_xy(r, (size_t)out_t->v[k], &x[k], &y[k]);
+  }
+  /* the test and the swap of tt__records_triangle() */
+  if ((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]) < 0) {
+    int32_t si = out_t->v[1];
+    out_t->v[1] = out_t->v[2], out_t->v[2] = si;
+  }
+  out_t->max_error = tin->t_max[i];
+  out_t->rmse = tin->t_rmse[i];
+  out_t->samples = (size_t)tin->t_n[i];
+  out_t->area_2d = out_t->area_3d = out_t->slope_deg = out_t->aspect_deg =
+      out_t->min_angle_deg = out_t->max_angle_deg = NAN;
   return TT_OK;
 }
 

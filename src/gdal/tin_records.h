@@ -73,6 +73,14 @@ TT_HIDDEN tt_status tt__records_triangle(const tt__records *r,
                                          tt_triangle_info *out_t,
                                          tt_vertex_info out_v[3],
                                          double out_x[3], double out_y[3]);
+/* Triangle i as the mesh writers need it, without the derived fields:
+ * out_t->v (counter-clockwise in the output coordinates, as
+ * tt__records_triangle() orders them), max_error, rmse and samples; the
+ * areas, slope, aspect and angles are left NaN. The TIN's own arrays are
+ * read, so the trigonometry of tt_tin_triangle() is skipped (most of a
+ * mesh writer's time otherwise). */
+TT_HIDDEN tt_status tt__records_face(const tt__records *r, tt_context *ctx,
+                                     size_t i, tt_triangle_info *out_t);
 /* Vertex i and its output x, y. */
 TT_HIDDEN tt_status tt__records_vertex(const tt__records *r, tt_context *ctx,
                                        size_t i, tt_vertex_info *out_v,

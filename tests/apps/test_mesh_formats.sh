@@ -7,10 +7,16 @@
 #  - an existing output refused without -overwrite (untouched), replaced
 #    with it;
 #  - -obj_local without OBJ and -lco with a mesh format are usage errors;
+#  - 2DM's six .dat datasets beside it: a value a vertex or a face, an
+#    existing one refused without -overwrite (nothing written), all
+#    replaced with it, a name holding "_els" refused; -of UGRID writes a
+#    netCDF (CDF-2) file;
 #  - nothing left behind by a failure (a missing folder, the file size
 #    limit) or an interrupt (SIGINT);
+#  - the LandXML file valid against the LandXML 1.2 schema when
+#    TT_LANDXML_XSD names a copy of it (skipped with a message otherwise);
 #  - QGIS (PyQGIS) mesh layers only when python3-qgis is installed: skipped
-#    with a message otherwise.
+#    with a message otherwise (test_qgis_mesh.sh checks their content).
 # Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
 # missing.
 set -u
@@ -92,6 +98,17 @@ check ".xml: a LandXML 1.2 TIN" \
 if command -v xmllint >/dev/null 2>&1; then
   check ".xml: well-formed (xmllint)" xmllint --noout t.xml
 fi
+# The LandXML 1.2 schema is LandXML.org's; its terms do not say it may be
+# redistributed, so no copy is kept here: TT_LANDXML_XSD names one.
+if [ -n "${TT_LANDXML_XSD:-}" ] && [ -f "$TT_LANDXML_XSD" ] &&
+   command -v xmllint >/dev/null 2>&1; then
+  check ".xml: valid against $TT_LANDXML_XSD (xmllint --schema)" \
+    xmllint --noout --nonet --schema "$TT_LANDXML_XSD" t.xml
+else
+  echo "SKIP: LandXML 1.2 schema validation: set TT_LANDXML_XSD to a copy" \
+       "of LandXML-1.2.xsd (from landxml.org; not redistributed here) and" \
+       "install xmllint (libxml2-utils)"
+fi
 
 for pair in "2dm:2DM" "ply:ply" "obj:Obj" "xml:LANDXML"; do
   ext=${pair%%:*}
@@ -110,6 +127,36 @@ check "-obj_local: the vertices around it" \
 v=[l.split() for l in open("local.obj") if l.startswith("v ")]
 sys.exit(0 if max(max(abs(float(a[1])),abs(float(a[2]))) for a in v) <= 30 else 1)'
 
+# --- 2DM's datasets beside it, -of UGRID ----------------------------------
+dats="t_ins_err.dat t_star_max.dat t_star_rmse.dat t_max_err_els.dat t_rmse_els.dat t_n_samples_els.dat"
+check ".2dm: its six datasets beside it" bash -c "for d in $dats; do [ -f \$d ] || exit 1; done"
+check ".2dm: a dataset per vertex" \
+  [ "$(grep -c . t_ins_err.dat)" -eq "$(( $(grep -c '^ND ' t.2dm) + 8 ))" ]
+check ".2dm: a dataset per face" \
+  [ "$(grep -c . t_max_err_els.dat)" -eq "$(( $(grep -c '^E3T ' t.2dm) + 8 ))" ]
+cp t_rmse_els.dat keep.dat
+: >s_rmse_els.dat
+run simplify dem.tif s.2dm -max_error 5 -q
+check "a dataset exists: exit 1 ($rc)" [ "$rc" -eq 1 ]
+check "a dataset exists: one line naming it and -overwrite ($(cat err.txt))" \
+  bash -c '[ $(wc -l <err.txt) = 1 ] && grep -q "s_rmse_els.dat" err.txt && grep -q -- "-overwrite" err.txt'
+check "a dataset exists: nothing written" \
+  bash -c '[ ! -e s.2dm ] && [ ! -e s_ins_err.dat ] && [ ! -s s_rmse_els.dat ]'
+run simplify dem.tif t.2dm -percent 50 -q -overwrite
+check "-overwrite 2DM: exit 0" [ "$rc" -eq 0 ]
+check "-overwrite 2DM: the datasets replaced too" bash -c '! cmp -s t_rmse_els.dat keep.dat'
+check "-overwrite 2DM: as many vertex values as vertices" \
+  [ "$(grep -c . t_ins_err.dat)" -eq "$(( $(grep -c '^ND ' t.2dm) + 8 ))" ]
+run simplify dem.tif x_els.2dm -q
+check "_els in a 2DM name: usage error ($rc: $(cat err.txt))" [ "$rc" -eq 2 ]
+check "_els in a 2DM name: nothing written" bash -c '[ -z "$(ls -A | grep "^x_els")" ]'
+run simplify dem.tif u.nc -of UGRID -max_error 5 -q
+check "-of UGRID: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "-of UGRID: a netCDF CDF-2 file" \
+  bash -c '[ "$(head -c 4 u.nc | od -An -c | tr -d " ")" = "CDF002" ]'
+run simplify dem.tif u.nc -of UGRID -max_error 5 -q
+check "-of UGRID: an existing one refused ($rc)" [ "$rc" -eq 1 ]
+
 # --- existing outputs, usage errors ---------------------------------------
 cp t.ply keep.ply
 run simplify dem.tif t.ply -max_error 1 -q
@@ -124,7 +171,7 @@ run simplify dem.tif u.2dm -obj_local -q
 check "-obj_local with 2DM: usage error ($rc)" [ "$rc" -eq 2 ]
 run simplify dem.tif u.xml -lco FOO=BAR -q
 check "-lco with LandXML: usage error ($rc)" [ "$rc" -eq 2 ]
-check "usage errors: nothing written" bash -c '[ ! -e u.2dm ] && [ ! -e u.xml ]'
+check "usage errors: nothing written" bash -c '[ ! -e u.2dm ] && [ ! -e u.xml ] && [ ! -e u_ins_err.dat ]'
 
 # --- failures and interrupts leave nothing ---------------------------------
 run simplify dem.tif no/such/x.2dm -q
@@ -134,8 +181,10 @@ run generate fault big.tif -size 700 -seed 3 -q
 check "file size limit: exit 1 ($rc: $(cat err.txt))" [ "$rc" -eq 1 ]
 check "file size limit: names the output" grep -q "full.ply" err.txt
 check "file size limit: nothing left" bash -c '[ ! -e full.ply ] && [ -z "$(ls -A | grep "^\.tt")" ]'
-for ext in 2dm xml; do
-  "$T" simplify big.tif "int.$ext" -max_error 0 -q >out.txt 2>err.txt &
+for ext in 2dm xml nc; do
+  of=()
+  [ "$ext" = nc ] && of=(-of UGRID)
+  "$T" simplify big.tif "int.$ext" "${of[@]}" -max_error 0 -q >out.txt 2>err.txt &
   pid=$!
   sleep 0.4
   kill -INT "$pid" 2>/dev/null
@@ -145,6 +194,7 @@ for ext in 2dm xml; do
     check "SIGINT .$ext: finished before the signal ($rc)" [ "$rc" -eq 0 ]
   else
     check "SIGINT .$ext: ended by it ($rc)" [ "$rc" -ne 0 ]
+    check "SIGINT .$ext: no dataset file" bash -c '[ -z "$(ls -A | grep "^int_")" ]'
   fi
   check "SIGINT .$ext: no temporary file" no_temp
 done

@@ -6,9 +6,12 @@
  * vertices in the same counter-clockwise order, PLY's attributes equal to
  * the TIN's (NaN kept), LandXML read with libxml2 (when the test was built
  * with it) in the northing, easting, elevation order, the mesh's name
- * escaped in LandXML and made plain in 2DM. Also: -t_srs's
- * transformed coordinates, the format names and extensions, and an
- * interruption through progress, which leaves no file.
+ * escaped in LandXML and made plain in 2DM. 2DM's six .dat datasets
+ * (SMS's ASCII dataset cards, one value a vertex or a face, NaN kept) and
+ * the UGRID netCDF read back with libnetcdf (dimensions, coordinates,
+ * start_index and connectivity, the data variables, the CRS). Also:
+ * -t_srs's transformed coordinates, the format names and extensions, and
+ * an interruption through progress, which leaves no file (nor dataset).
  */
 #include "gdal/tin_records.h"
 #include "terratin/terratin_gdal.h"
@@ -16,6 +19,7 @@
 
 #include <cpl_vsi.h>
 #include <gdal.h>
+#include <netcdf.h>
 #include <ogr_srs_api.h>
 
 #include <stdint.h>
@@ -212,9 +216,9 @@ static void read_ply(const char *path, const expected *e)
   CHECK(f != NULL);
   if (!f)
     return;
-  char line[256];
+  char line[4096];
   size_t nv = 0, nt = 0;
-  int props = 0, binary = 0;
+  int props = 0, binary = 0, crs = 0;
   while (fgets(line, sizeof line, f) && strcmp(line, "end_header\n")) {
     sscanf(line, "element vertex %zu", &nv);
     sscanf(line, "element face %zu", &nt);
@@ -222,8 +226,11 @@ static void read_ply(const char *path, const expected *e)
       props++;
     if (strcmp(line, "format binary_little_endian 1.0\n") == 0)
       binary = 1;
+    if (strncmp(line, "comment crs:PROJCS[\"", 19) == 0)
+      crs = 1;
   }
   CHECK(binary);
+  CHECK(crs); /* MDAL's "comment crs:" line, the WKT on one line */
   CHECK_INT_EQ(props, 10);
   CHECK(nv == e->nv && nt == e->nt);
   const uint16_t one = 1;
@@ -264,6 +271,173 @@ static void read_ply(const char *path, const expected *e)
   CHECK(bad_attr == 0);
   CHECK(nan_ins > 0); /* the starting vertices: NaN kept as NaN */
   check_tally(&k, e, path);
+}
+
+/* 2DM's datasets beside stem.2dm: SMS ASCII dataset files, each the
+ * cards MDAL reads and one value a vertex (or a face, "_els" files). */
+static void read_dat(const char *stem, const expected *e)
+{
+  static const char *const names[6] = {"ins_err", "star_max", "star_rmse",
+                                       "max_err", "rmse", "n_samples"};
+  for (int k = 0; k < 6; k++) {
+    char p[600], line[256], want[64];
+    snprintf(p, sizeof p, "%s_%s%s.dat", stem, names[k], k < 3 ? "" : "_els");
+    FILE *f = fopen(p, "r");
+    CHECK(f != NULL);
+    if (!f)
+      continue;
+    const char *head[7] = {"DATASET\n", "OBJTYPE \"mesh2d\"\n", "BEGSCL\n",
+                           NULL, NULL, NULL, "TS 0 0\n"};
+    char nd[32], nc[32];
+    snprintf(nd, sizeof nd, "ND %zu\n", e->nv);
+    snprintf(nc, sizeof nc, "NC %zu\n", e->nt);
+    snprintf(want, sizeof want, "NAME \"%s\"\n", names[k]);
+    head[3] = nd;
+    head[4] = nc;
+    head[5] = want;
+    for (int h = 0; h < 7; h++)
+      CHECK_STR_EQ(fgets(line, sizeof line, f) ? line : "", head[h]);
+    size_t n = k < 3 ? e->nv : e->nt, got = 0, bad = 0;
+    while (got < n && fgets(line, sizeof line, f)) {
+      double v = strtod(line, NULL);
+      double w = k == 0   ? e->v[got].insert_error
+                 : k == 1 ? e->v[got].star_max_error
+                 : k == 2 ? e->v[got].star_rmse
+                 : k == 3 ? e->t[got].max_error
+                 : k == 4 ? e->t[got].rmse
+                          : (double)e->t[got].samples;
+      bad += !(v == w || (isnan(v) && isnan(w)));
+      got++;
+    }
+    CHECK(got == n);
+    CHECK(bad == 0);
+    CHECK_STR_EQ(fgets(line, sizeof line, f) ? line : "", "ENDDS\n");
+    CHECK(fgetc(f) == EOF);
+    fclose(f);
+  }
+}
+
+/* Whether any of 2DM's dataset files exists beside stem.2dm. */
+static int any_dat(const char *stem)
+{
+  static const char *const sfx[6] = {"_ins_err", "_star_max", "_star_rmse",
+                                     "_max_err_els", "_rmse_els",
+                                     "_n_samples_els"};
+  int n = 0;
+  for (int k = 0; k < 6; k++) {
+    char p[600];
+    struct stat sb;
+    snprintf(p, sizeof p, "%s%s.dat", stem, sfx[k]);
+    n += stat(p, &sb) == 0;
+  }
+  return n;
+}
+
+/* A text attribute of a netCDF variable, or "" (static buffer). */
+static const char *nc_text(int nc, int var, const char *att)
+{
+  static char buf[4096];
+  size_t len = 0;
+  buf[0] = '\0';
+  if (nc_inq_attlen(nc, var, att, &len) == NC_NOERR && len < sizeof buf &&
+      nc_get_att_text(nc, var, att, buf) == NC_NOERR)
+    buf[len] = '\0';
+  return buf;
+}
+
+/* The UGRID file through libnetcdf: what MDAL reads, equal to the TIN. */
+static void read_ugrid(const char *path, const expected *e, int epsg)
+{
+  int nc, dn, df, d3, var;
+  size_t nv = 0, nt = 0, three = 0;
+  CHECK_INT_EQ(nc_open(path, NC_NOWRITE, &nc), NC_NOERR);
+  CHECK_INT_EQ(nc_inq_dimid(nc, "nmesh_node", &dn), NC_NOERR);
+  CHECK_INT_EQ(nc_inq_dimid(nc, "nmesh_face", &df), NC_NOERR);
+  CHECK_INT_EQ(nc_inq_dimid(nc, "max_nmesh_face_nodes", &d3), NC_NOERR);
+  nc_inq_dimlen(nc, dn, &nv);
+  nc_inq_dimlen(nc, df, &nt);
+  nc_inq_dimlen(nc, d3, &three);
+  CHECK(nv == e->nv && nt == e->nt && three == 3);
+  if (nv != e->nv || nt != e->nt) {
+    nc_close(nc);
+    return;
+  }
+  CHECK_STR_EQ(nc_text(nc, NC_GLOBAL, "Conventions"), "CF-1.8 UGRID-1.0");
+  CHECK_INT_EQ(nc_inq_varid(nc, "mesh", &var), NC_NOERR);
+  CHECK_STR_EQ(nc_text(nc, var, "cf_role"), "mesh_topology");
+  CHECK_STR_EQ(nc_text(nc, var, "node_coordinates"),
+               "mesh_node_x mesh_node_y");
+  CHECK_STR_EQ(nc_text(nc, var, "face_node_connectivity"), "mesh_face_nodes");
+  int dim = 0;
+  CHECK(nc_get_att_int(nc, var, "topology_dimension", &dim) == NC_NOERR &&
+        dim == 2);
+
+  double *d = malloc(nv * sizeof *d);
+  size_t bad = 0;
+  static const char *const coords[3] = {"mesh_node_x", "mesh_node_y",
+                                        "mesh_node_z"};
+  for (int c = 0; c < 3; c++) {
+    CHECK_INT_EQ(nc_inq_varid(nc, coords[c], &var), NC_NOERR);
+    CHECK_INT_EQ(nc_get_var_double(nc, var, d), NC_NOERR);
+    for (size_t i = 0; i < nv; i++)
+      bad += d[i] != e->xyz[3 * i + (size_t)c];
+  }
+  CHECK_STR_EQ(nc_text(nc, var, "standard_name"), "altitude");
+  CHECK(bad == 0);
+  static const char *const vnames[3] = {"ins_err", "star_max", "star_rmse"};
+  for (int k = 0; k < 3; k++) {
+    CHECK_INT_EQ(nc_inq_varid(nc, vnames[k], &var), NC_NOERR);
+    CHECK_STR_EQ(nc_text(nc, var, "location"), "node");
+    CHECK_STR_EQ(nc_text(nc, var, "mesh"), "mesh");
+    CHECK_INT_EQ(nc_get_var_double(nc, var, d), NC_NOERR);
+    bad = 0;
+    for (size_t i = 0; i < nv; i++) {
+      double w = k == 0 ? e->v[i].insert_error
+                 : k == 1 ? e->v[i].star_max_error : e->v[i].star_rmse;
+      bad += !(d[i] == w || (isnan(d[i]) && isnan(w)));
+    }
+    CHECK(bad == 0);
+  }
+  free(d);
+
+  int *conn = malloc(3 * nt * sizeof *conn);
+  d = malloc(nt * sizeof *d);
+  CHECK_INT_EQ(nc_inq_varid(nc, "mesh_face_nodes", &var), NC_NOERR);
+  CHECK_STR_EQ(nc_text(nc, var, "cf_role"), "face_node_connectivity");
+  int start = -1;
+  CHECK(nc_get_att_int(nc, var, "start_index", &start) == NC_NOERR &&
+        start == 0);
+  CHECK_INT_EQ(nc_get_var_int(nc, var, conn), NC_NOERR);
+  bad = 0;
+  for (size_t i = 0; i < 3 * nt; i++)
+    bad += conn[i] != e->tri[i];
+  CHECK(bad == 0);
+  static const char *const fnames[3] = {"max_err", "rmse", "n_samples"};
+  for (int k = 0; k < 3; k++) {
+    CHECK_INT_EQ(nc_inq_varid(nc, fnames[k], &var), NC_NOERR);
+    CHECK_STR_EQ(nc_text(nc, var, "location"), "face");
+    CHECK_INT_EQ(nc_get_var_double(nc, var, d), NC_NOERR);
+    bad = 0;
+    for (size_t i = 0; i < nt; i++) {
+      double w = k == 0 ? e->t[i].max_error
+                 : k == 1 ? e->t[i].rmse : (double)e->t[i].samples;
+      bad += d[i] != w;
+    }
+    CHECK(bad == 0);
+  }
+  free(d);
+  free(conn);
+
+  CHECK_INT_EQ(nc_inq_varid(nc, "mesh_node_x", &var), NC_NOERR);
+  CHECK_STR_EQ(nc_text(nc, var, "grid_mapping"), "crs");
+  CHECK_INT_EQ(nc_inq_varid(nc, "crs", &var), NC_NOERR);
+  int code = 0;
+  CHECK(nc_get_att_int(nc, var, "epsg", &code) == NC_NOERR && code == epsg);
+  char wkt[4096];
+  snprintf(wkt, sizeof wkt, "%s", nc_text(nc, var, "wkt"));
+  CHECK(strncmp(wkt, "PROJCS[", 7) == 0);
+  CHECK_STR_EQ(nc_text(nc, var, "crs_wkt"), wkt);
+  nc_close(nc);
 }
 
 #ifdef TT_HAVE_LIBXML2
@@ -382,6 +556,12 @@ int main(void)
   CHECK(tt_mesh_format_from_path("x.ply.gpkg") == TT_MESH_NONE);
   CHECK(tt_mesh_format_from_path("dir.obj/x") == TT_MESH_NONE);
   CHECK_STR_EQ(tt_mesh_format_name(TT_MESH_LANDXML), "LandXML");
+  CHECK(tt_mesh_format_from_name("ugrid") == TT_MESH_UGRID);
+  CHECK(tt_mesh_format_from_path("x.nc") == TT_MESH_NONE); /* OGR's */
+  CHECK_STR_EQ(tt_mesh_format_sidecars(TT_MESH_2DM)[5],
+               "_n_samples_els.dat");
+  CHECK(tt_mesh_format_sidecars(TT_MESH_2DM)[6] == NULL);
+  CHECK(tt_mesh_format_sidecars(TT_MESH_PLY)[0] == NULL);
 
   tt_context *ctx = tt_context_create();
   tt_tin *tin = make_tin(ctx);
@@ -396,6 +576,11 @@ int main(void)
     snprintf(p, sizeof p, "%s/t.2dm", tmpdir);
     write_file(ctx, tin, p, TT_MESH_2DM, srs, NULL, 0);
     read_2dm(p, &e);
+    snprintf(p, sizeof p, "%s/t", tmpdir);
+    read_dat(p, &e);
+    snprintf(p, sizeof p, "%s/t.nc", tmpdir);
+    write_file(ctx, tin, p, TT_MESH_UGRID, srs, NULL, 0);
+    read_ugrid(p, &e, 32633);
     snprintf(p, sizeof p, "%s/t.ply", tmpdir);
     write_file(ctx, tin, p, TT_MESH_PLY, srs, NULL, 0);
     read_ply(p, &e);
@@ -419,15 +604,22 @@ int main(void)
     snprintf(p, sizeof p, "%s/merc.ply", tmpdir);
     write_file(ctx, tin, p, TT_MESH_PLY, srs, "EPSG:3857", 0);
     read_ply(p, &eg);
+    snprintf(p, sizeof p, "%s/merc", tmpdir);
+    read_dat(p, &eg);
+    snprintf(p, sizeof p, "%s/merc.nc", tmpdir);
+    write_file(ctx, tin, p, TT_MESH_UGRID, srs, "EPSG:3857", 0);
+    read_ugrid(p, &eg, 3857);
 
     /* An interruption halfway removes the partial file. */
-    for (int f = TT_MESH_2DM; f <= TT_MESH_LANDXML; f++) {
+    for (int f = TT_MESH_2DM; f <= TT_MESH_UGRID; f++) {
       struct stat sb;
       snprintf(p, sizeof p, "%s/stopped.%d", tmpdir, f);
       CHECK(tt_mesh_write(ctx, p, (tt_mesh_format)f, NULL, tin, srs, NULL, 0,
                           stop_at_half, NULL) == TT_ERR_INTERRUPTED);
       CHECK(stat(p, &sb) != 0);
     }
+    snprintf(p, sizeof p, "%s/stopped", tmpdir);
+    CHECK_INT_EQ(any_dat(p), 0);
     /* A folder that does not exist: TT_ERR_IO, nothing made. */
     snprintf(p, sizeof p, "%s/no/such.2dm", tmpdir);
     CHECK(tt_mesh_write(ctx, p, TT_MESH_2DM, NULL, tin, srs, NULL, 0, NULL,

@@ -604,6 +604,91 @@ static void test_abandon(tt_context *ctx)
   CHECK_INT_EQ(read_tag(path, "vertices"), 6);
 }
 
+/* Writes text to path (or fails the test). */
+static void put_file(const char *path, const char *text)
+{
+  FILE *f = fopen(path, "w");
+  CHECK(f != NULL);
+  if (f) {
+    fputs(text, f);
+    fclose(f);
+  }
+}
+
+/* The first line of path, "" when it cannot be read (static buffer). */
+static const char *first_line(const char *path)
+{
+  static char line[64];
+  FILE *f = fopen(path, "r");
+  line[0] = '\0';
+  if (f) {
+    if (!fgets(line, sizeof line, f))
+      line[0] = '\0';
+    fclose(f);
+  }
+  return line;
+}
+
+/* Issue 17: files written beside a single file (2DM's datasets) through
+ * tt_output_add_sidecar(): refused when they exist without overwrite,
+ * written under the temporary stem, renamed with the output at commit,
+ * removed with it when it is not committed; only regular files replaced;
+ * no sidecar for a shapefile. */
+static void test_mesh_sidecars(tt_context *ctx)
+{
+  char dir[300], path[400], side[420], temp[420], listing[1024];
+  snprintf(dir, sizeof dir, "%s/mesh", tmpdir);
+  mkdir(dir, 0777);
+  snprintf(path, sizeof path, "%s/m.2dm", dir);
+  snprintf(side, sizeof side, "%s/m_a.dat", dir);
+  put_file(side, "old\n");
+  tt_output *out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "2DM", 0, &out));
+  CHECK_INT_EQ(tt_output_add_sidecar(ctx, out, "_a.dat"), TT_ERR_EXISTS);
+  CHECK(strstr(tt_context_errmsg(ctx), "m_a.dat exists") != NULL);
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "m_a.dat");
+
+  /* Not committed: the temporary files go, the old one stays. */
+  for (int commit = 0; commit < 2; commit++) {
+    out = NULL;
+    CHECK_OK(ctx, tt_output_begin(ctx, path, "2DM", 1, &out));
+    if (!out)
+      return;
+    CHECK_OK(ctx, tt_output_add_sidecar(ctx, out, "_a.dat"));
+    CHECK_OK(ctx, tt_output_add_sidecar(ctx, out, "_b_els.dat"));
+    const char *tp = tt_output_temp_path(out);
+    put_file(tp, "MESH2D\n");
+    snprintf(temp, sizeof temp, "%.*s_a.dat", (int)(strlen(tp) - 4), tp);
+    put_file(temp, "new\n");
+    snprintf(temp, sizeof temp, "%.*s_b_els.dat", (int)(strlen(tp) - 4), tp);
+    put_file(temp, "new\n");
+    if (commit)
+      CHECK_OK(ctx, tt_output_commit(ctx, out));
+    tt_output_destroy(out);
+    list_dir(dir, listing, sizeof listing);
+    CHECK_STR_EQ(listing, commit ? "m.2dm m_a.dat m_b_els.dat" : "m_a.dat");
+    CHECK_STR_EQ(first_line(side), commit ? "new\n" : "old\n");
+  }
+  /* A sidecar name that is not a regular file is refused, -overwrite or
+   * not; a shapefile takes none. */
+  snprintf(side, sizeof side, "%s/m_c.dat", dir);
+  CHECK(mkfifo(side, 0666) == 0);
+  out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "2DM", 1, &out));
+  CHECK(tt_output_add_sidecar(ctx, out, "_c.dat") != TT_OK);
+  tt_output_destroy(out);
+  unlink(side);
+  snprintf(path, sizeof path, "%s/s.shp", dir);
+  out = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "ESRI Shapefile", 0, &out));
+  CHECK_INT_EQ(tt_output_add_sidecar(ctx, out, "_a.dat"), TT_ERR_ARG);
+  tt_output_destroy(out);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, "m.2dm m_a.dat m_b_els.dat");
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -623,6 +708,7 @@ int main(void)
   test_protect(ctx);
   test_sqlite_sidecars(ctx);
   test_abandon(ctx);
+  test_mesh_sidecars(ctx);
   CPLPopErrorHandler();
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);
