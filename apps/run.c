@@ -520,6 +520,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   case TT_APP_EVAL:
   case TT_APP_OPTIMIZE:
   case TT_APP_STUDY:
+  case TT_APP_RASTERIZE:
     break;
   default:
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
@@ -545,6 +546,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   case TT_APP_GENERATE: st = tt__app_generate(&r); break;
   case TT_APP_OPTIMIZE: st = tt__app_optimize(&r); break;
   case TT_APP_STUDY: st = tt__app_study(&r); break;
+  case TT_APP_RASTERIZE: st = tt__app_rasterize(&r); break;
   default: st = tt__app_eval(&r); break;
   }
 done:

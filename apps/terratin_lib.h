@@ -48,7 +48,8 @@ typedef enum tt_app_command {
   TT_APP_GENERATE,
   TT_APP_EVAL,
   TT_APP_OPTIMIZE,           /* optimize DEM IN_TIN OUTPUT */
-  TT_APP_STUDY               /* study OUTDIR */
+  TT_APP_STUDY,              /* study OUTDIR */
+  TT_APP_RASTERIZE           /* rasterize TIN DEM OUTPUT */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
@@ -139,6 +140,11 @@ typedef struct tt_app_settings {
   const char *percents;      /* -percent P,P,...; NULL: 1,10,25,50 */
   uint64_t seed;             /* -seed (study: the generated terrains) */
   int seed_set;              /* -seed was given */
+
+  /* rasterize TIN DEM OUTPUT (tin, input, output; -of the raster driver);
+   * eval -error_raster */
+  const char *error_raster;  /* -error_raster: TIN - DEM as a GeoTIFF */
+  const char *const *co;     /* -co NAME=VALUE (raster creation options) */
 } tt_app_settings;
 
 typedef struct tt_app_options tt_app_options;
