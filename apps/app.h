@@ -99,7 +99,10 @@ int tt__app_str_ieq(const char *a, const char *b);
 /* GDAL's failures and warnings while a run is active (run.c). */
 typedef struct app_messages {
   FILE *err;
-  size_t warnings;           /* printed or dropped */
+  size_t warnings;           /* printed or dropped (repeats not counted) */
+  uint64_t seen[32];         /* hashes of the warnings printed */
+  size_t nseen;
+  tt_app_term_progress *bar; /* the text bar, if the run draws one */
   unsigned failures;         /* GDAL failures seen */
   char last[TT_APP_MESSAGE_MAX];
 } app_messages;

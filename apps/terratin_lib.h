@@ -191,12 +191,17 @@ typedef struct tt_app_term_progress {
   FILE *fp;                        /* NULL: draw nothing */
   int ticks;                       /* ticks drawn, 0..41 (-1: none yet) */
   volatile sig_atomic_t *stop;     /* may be NULL */
+  int line_ended;                  /* a message ended the bar's line */
 } tt_app_term_progress;
 
 void tt_app_term_progress_init(tt_app_term_progress *bar, FILE *fp,
                                volatile sig_atomic_t *stop);
 /* A tt_progress_fn; arg is a tt_app_term_progress. */
 int tt_app_term_progress_fn(double complete, const char *message, void *arg);
+/* Ends the bar's line when it is half drawn, so that a warning or the
+ * failure printed next starts a line of its own (a bar that goes on, goes
+ * on on the next line). NULL: nothing. */
+void tt_app_term_progress_break(tt_app_term_progress *bar);
 
 #ifdef __cplusplus
 }

@@ -321,6 +321,13 @@ void tt_output_destroy(tt_output *out);
  * no live output was committed, 0 when one was (its run is finishing and
  * should be let finish). Thread-safe; not async-signal-safe. */
 int tt_output_abandon_all(void);
+/* Copies text (a driver's message) into buf (size bytes, truncated) with
+ * the temporary names of every live tt_output replaced by their final
+ * names, so that messages name the user's output: the temporary path (or
+ * its bare file name) reads as the final path, a file inside a temporary
+ * folder as that file in the final folder. Returns 1 when a name was
+ * replaced. Thread-safe. */
+int tt_output_rename_in_text(const char *text, char *buf, size_t size);
 
 #ifdef __cplusplus
 }
