@@ -699,6 +699,9 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       USAGE("eval: missing TIN after '%s'%s", pos[0], hint);
     if (!(o->s.input = keep(o, pos[0])) || !(o->s.tin = keep(o, pos[1])))
       NOMEM();
+    if (!o->s.error_raster && (o->s.overwrite || o->co.n))
+      USAGE("eval: option %s does not apply without -error_raster%s",
+            o->s.overwrite ? "-overwrite" : "-co", hint);
     break;
   case TT_APP_RASTERIZE:
     if (npos < 3)
