@@ -251,5 +251,7 @@ tt_status tt__app_write_raster(app_run *r, tt_output *out, GDALDriverH drv,
  * layer); NULL with the failure recorded. */
 GDALDatasetH tt__app_open_vector(app_run *r, const char *path);
 OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds);
+/* Whether the layer declares a CRS that is not the DEM's (eval.c). */
+int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info);
 
 #endif /* TERRATIN_APP_H */

@@ -74,6 +74,22 @@ OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds)
   return NULL;
 }
 
+int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info)
+{
+  static const char *const same_opts[] = {
+      "IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
+      "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", NULL};
+  OGRSpatialReferenceH lsrs = OGR_L_GetSpatialRef(layer);
+  if (!lsrs || !info->crs_wkt || !*info->crs_wkt)
+    return 0;
+  OGRSpatialReferenceH rsrs = OSRNewSpatialReference(info->crs_wkt);
+  int other =
+      rsrs && !OSRIsSameEx(rsrs, lsrs, (const char *const *)same_opts);
+  if (rsrs)
+    OSRDestroySpatialReference(rsrs);
+  return other;
+}
+
 GDALDatasetH tt__app_open_vector(app_run *r, const char *path)
 {
   VSIStatBufL sb;
@@ -119,7 +135,6 @@ tt_status tt__app_eval(app_run *r)
   double *xyz = NULL, *err = NULL;
   size_t ntri = 0, rejected = 0, valid = 0;
   tt_eval_result ev;
-  OGRSpatialReferenceH rsrs = NULL;
   tt_output *outp = NULL;
   GDALDriverH rdrv = NULL;
   memset(&ev, 0, sizeof ev);
@@ -184,16 +199,7 @@ tt_status tt__app_eval(app_run *r)
   const char *lname = OGR_L_GetName(layer);
 
   /* Triangles in another CRS would be measured in the wrong place. */
-  int other_crs = 0;
-  OGRSpatialReferenceH lsrs = OGR_L_GetSpatialRef(layer);
-  if (lsrs && info->crs_wkt && *info->crs_wkt) {
-    static const char *const same_opts[] = {
-        "IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
-        "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", NULL};
-    rsrs = OSRNewSpatialReference(info->crs_wkt);
-    other_crs =
-        rsrs && !OSRIsSameEx(rsrs, lsrs, (const char *const *)same_opts);
-  }
+  int other_crs = tt__app_layer_in_other_crs(layer, info);
 
   r->msg.last[0] = '\0';
   st = tt_ogr_read_triangles(r->ctx, layer, info->gt, &xyz, &ntri,
@@ -372,8 +378,6 @@ tt_status tt__app_eval(app_run *r)
 done:
   tt_output_destroy(outp);
   free(err);
-  if (rsrs)
-    OSRDestroySpatialReference(rsrs);
   if (tds)
     GDALClose(tds);
   if (src)

@@ -177,6 +177,9 @@ tt_status tt__app_rasterize(app_run *r)
   }
   char lname[256];
   snprintf(lname, sizeof lname, "%s", OGR_L_GetName(layer));
+  if (tt__app_layer_in_other_crs(layer, info))
+    tt__app_warn(&r->msg, "%s: layer '%s' is not in the CRS of %s; it is "
+                 "drawn as if it were", s->tin, lname, s->input);
   r->msg.last[0] = '\0';
   st = tt_ogr_read_triangles(r->ctx, layer, info->gt, &xyz, &ntri,
                              &rejected);
