@@ -233,10 +233,11 @@ tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
 tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
-/* rasterize.c, for eval -error_raster too: the raster driver of -of (else
- * GTiff) that can write a Float32 or Float64 band; NULL with the failure
- * recorded. */
-GDALDriverH tt__app_raster_driver(app_run *r, const char *of);
+/* rasterize.c, for eval -error_raster too: the raster driver of -of, else
+ * the one path's extension names (NULL path: GTiff), that can write a
+ * Float32 or Float64 band; NULL with the failure recorded. */
+GDALDriverH tt__app_raster_driver(app_run *r, const char *of,
+                                  const char *path);
 /* Writes values (the DEM's grid, NaN: nodata) to out's temporary name with
  * drv (GTiff: tiled, DEFLATE, unless -co says otherwise; -co), Float64
  * when the grid holds doubles, else Float32, in the DEM's geotransform and

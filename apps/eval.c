@@ -146,7 +146,7 @@ tt_status tt__app_eval(app_run *r)
       return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG,
                           s->error_raster,
                           "is an input; refusing to replace it");
-    if (!(rdrv = tt__app_raster_driver(r, NULL)))
+    if (!(rdrv = tt__app_raster_driver(r, NULL, NULL)))
       return r->res->status;
     st = tt_output_begin(r->ctx, s->error_raster, "GTiff", s->overwrite,
                          &outp);

@@ -26,23 +26,93 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
-GDALDriverH tt__app_raster_driver(app_run *r, const char *of)
+/* A raster driver that can write a float band. */
+static int can_write_floats(GDALDriverH drv)
 {
+  const char *types =
+      GDALGetMetadataItem(drv, GDAL_DMD_CREATIONDATATYPES, NULL);
+  return GDALGetMetadataItem(drv, GDAL_DCAP_RASTER, NULL) &&
+         (GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL) ||
+          GDALGetMetadataItem(drv, GDAL_DCAP_CREATECOPY, NULL)) &&
+         (!types || strstr(types, "Float32") || strstr(types, "Float64"));
+}
+
+/* Whether the space-separated list holds ext (any case). */
+static int has_ext(const char *list, const char *ext)
+{
+  size_t n = strlen(ext);
+  for (const char *p = list; p && *p;) {
+    while (*p == ' ')
+      p++;
+    const char *e = strchr(p, ' ');
+    size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (len == n && n && strncasecmp(p, ext, n) == 0)
+      return 1;
+    p = e;
+  }
+  return 0;
+}
+
+/* No -of: GTiff for .tif, .tiff or no extension, else the first driver
+ * that claims the extension and writes floats (as GDAL's utilities guess);
+ * an extension only drivers without floats claim (.png) is theirs, refused
+ * by the caller; an extension no driver claims gets GTiff and a warning. */
+static const char *guess_driver(app_run *r, const char *path)
+{
+  const char *claimed = NULL;
+  const char *base = strrchr(path, '/');
+  const char *dot = strrchr(base ? base + 1 : path, '.');
+  if (!dot || !dot[1] || strcasecmp(dot, ".tif") == 0 ||
+      strcasecmp(dot, ".tiff") == 0)
+    return "GTiff";
+  for (int i = 0; i < GDALGetDriverCount(); i++) {
+    GDALDriverH d = GDALGetDriver(i);
+    const char *exts = GDALGetMetadataItem(d, GDAL_DMD_EXTENSIONS, NULL);
+    if (!exts)
+      exts = GDALGetMetadataItem(d, GDAL_DMD_EXTENSION, NULL);
+    if (!exts || !has_ext(exts, dot + 1) ||
+        !GDALGetMetadataItem(d, GDAL_DCAP_RASTER, NULL) ||
+        strcmp(GDALGetDriverShortName(d), "MEM") == 0)
+      continue;
+    if (can_write_floats(d))
+      return GDALGetDriverShortName(d);
+    if (!claimed)
+      claimed = GDALGetDriverShortName(d);
+  }
+  if (claimed)
+    return claimed;
+  tt__app_warn(&r->msg, "%s: no raster driver that writes floats claims "
+               "the extension '%s'; writing a GeoTIFF (use -of to choose)",
+               path, dot);
+  return "GTiff";
+}
+
+GDALDriverH tt__app_raster_driver(app_run *r, const char *of,
+                                  const char *path)
+{
+  char what[300]; /* "-of 'X'", or the output whose extension chose X */
   const char *cmd = tt__app_command_name(r->s->command);
-  GDALDriverH drv = GDALGetDriverByName(of ? of : "GTiff");
+  if (of || !path) {
+    of = of ? of : "GTiff";
+    snprintf(what, sizeof what, "-of '%s'", of);
+  } else {
+    of = guess_driver(r, path);
+    snprintf(what, sizeof what, "%.200s (by its extension: %s)", path, of);
+  }
+  GDALDriverH drv = GDALGetDriverByName(of);
   if (!drv) {
     tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                 "%s: -of '%s': no such GDAL driver (see 'gdalinfo "
-                 "--formats')", cmd, of ? of : "GTiff");
+                 "%s: %s: no such GDAL driver (see 'gdalinfo --formats')",
+                 cmd, what);
     return NULL;
   }
-  const char *name = GDALGetDriverShortName(drv);
   if (!GDALGetMetadataItem(drv, GDAL_DCAP_RASTER, NULL) ||
       (!GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL) &&
        !GDALGetMetadataItem(drv, GDAL_DCAP_CREATECOPY, NULL))) {
     tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                 "%s: -of '%s': the driver cannot write rasters", cmd, name);
+                 "%s: %s: the driver cannot write rasters", cmd, what);
     return NULL;
   }
   /* A driver that lists its band types must take floats. */
@@ -50,8 +120,8 @@ GDALDriverH tt__app_raster_driver(app_run *r, const char *of)
       GDALGetMetadataItem(drv, GDAL_DMD_CREATIONDATATYPES, NULL);
   if (types && !strstr(types, "Float32") && !strstr(types, "Float64")) {
     tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                 "%s: -of '%s': the driver cannot write Float32 or Float64 "
-                 "bands (it takes %s)", cmd, name, types);
+                 "%s: %s: the driver cannot write Float32 or Float64 bands "
+                 "(it takes %s); choose another with -of", cmd, what, types);
     return NULL;
   }
   return drv;
@@ -128,7 +198,7 @@ tt_status tt__app_rasterize(app_run *r)
       tt__app_same_file(s->tin, s->output))
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
                         "is an input; refusing to replace it");
-  GDALDriverH drv = tt__app_raster_driver(r, s->format);
+  GDALDriverH drv = tt__app_raster_driver(r, s->format, s->output);
   if (!drv)
     return r->res->status;
   r->msg.last[0] = '\0';

@@ -12,7 +12,8 @@
  *    and TIN - DEM = the rasterized TIN minus the DEM;
  *  - a Float64 DEM whose heights are no floats: both rasters Float64, the
  *    same identities to double rounding;
- *  - -of AAIGrid (a driver that only copies) and -co;
+ *  - -of AAIGrid (a driver that only copies) and -co; the driver guessed
+ *    from the extension without -of (.asc, .png refused, .foo GTiff);
  *  - refusals that leave nothing behind: an existing output without
  *    -overwrite (untouched), an unreadable TIN or DEM, a driver that cannot
  *    write floats, an interrupt during the write;
@@ -36,9 +37,9 @@ static tt_context *ctx;
 
 static const char *tmp_path(const char *name)
 {
-  static char buf[8][512];
+  static char buf[32][512];
   static int k = 0;
-  k = (k + 1) % 8;
+  k = (k + 1) % 32;
   snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir, name);
   return buf[k];
 }
@@ -416,6 +417,33 @@ static void test_refusals(void)
     free(v);
   }
   CHECK(exists(tmp_path("plane_tin.prj")));
+  CHECK_INT_EQ(leftovers(), 0);
+
+  /* no -of: the extension chooses (.asc AAIGrid, .png refused: no floats;
+   * one no driver claims: GTiff) */
+  const char *asc2 = tmp_path("guessed.asc"), *png = tmp_path("x.png");
+  const char *foo = tmp_path("x.foo");
+  char *a9[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)asc2,
+                NULL};
+  CHECK_INT_EQ(run(a9, NULL, 0), 0);
+  GDALDatasetH ds = GDALOpen(asc2, GA_ReadOnly);
+  CHECK(ds && strcmp(GDALGetDriverShortName(GDALGetDatasetDriver(ds)),
+                     "AAIGrid") == 0);
+  if (ds)
+    GDALClose(ds);
+  char *a10[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)png,
+                 NULL};
+  CHECK_INT_EQ(run(a10, msg, sizeof msg), 2);
+  CHECK(strstr(msg, "x.png (by its extension: PNG)") != NULL);
+  CHECK(!exists(png));
+  char *a11[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)foo,
+                 NULL};
+  CHECK_INT_EQ(run(a11, NULL, 0), 0);
+  ds = GDALOpen(foo, GA_ReadOnly);
+  CHECK(ds && strcmp(GDALGetDriverShortName(GDALGetDatasetDriver(ds)),
+                     "GTiff") == 0);
+  if (ds)
+    GDALClose(ds);
   CHECK_INT_EQ(leftovers(), 0);
 }
 
