@@ -14,7 +14,7 @@
  * TIN rasterized, TIN - DEM) with any GDAL raster driver, into a file the
  * caller named (the temporary name of its tt_output): Create and strips of
  * rows, polling the progress callback between strips so an interrupt
- * stops a slow write, or, for drivers that only copy (AAIGrid, PNG), an
+ * stops a slow write, or, for drivers that only copy (AAIGrid, XYZ), an
  * in-memory dataset handed to CreateCopy with the same callback.
  *
  * Workload: one pass over the heights to look for NaN, one RasterIO (or
