@@ -9,7 +9,8 @@
  *  - a bumpy surface on the same grid: the error raster's max |value| and
  *    RMS equal the max error and RMSE of an independent evaluation
  *    (tt_ogr_read_triangles + tt_eval_triangles), NaN at the DEM's nodata,
- *    and TIN - DEM = the rasterized TIN minus the DEM;
+ *    and TIN - DEM = the rasterized TIN minus the DEM, on the DEM's grid
+ *    and CRS; a failed -max_error check (exit 3) still writes it;
  *  - a Float64 DEM whose heights are no floats: both rasters Float64, the
  *    same identities to double rounding;
  *  - -of AAIGrid (a driver that only copies) and -co; the driver guessed
@@ -282,7 +283,15 @@ static void test_error_raster(int kind)
   tt_eval_result ref = reference_eval(dem, tin);
   GDALDataType te, tr;
   int nx, ny, nx2, ny2;
-  double *ve = read_raster(err, &te, &nx, &ny, NULL, NULL);
+  double gte[6];
+  char *wkt = NULL;
+  double *ve = read_raster(err, &te, &nx, &ny, gte, &wkt);
+  CHECK_INT_EQ(nx, NX);
+  CHECK_INT_EQ(ny, NY);
+  for (int i = 0; i < 6; i++)
+    CHECK_DBL_NEAR(gte[i], gt_dem[i], 0.0);
+  CHECK(wkt && strstr(wkt, "32633") != NULL);
+  CPLFree(wkt);
   double *vr = read_raster(ras, &tr, &nx2, &ny2, NULL, NULL);
   if (!ve || !vr) {
     free(ve);
@@ -339,6 +348,13 @@ static void test_error_raster(int kind)
   char *eo[] = {"eval", "-q", (char *)dem, (char *)tin, "-error_raster",
                 (char *)err, "-overwrite", NULL};
   CHECK_INT_EQ(run(eo, NULL, 0), 0);
+  CHECK_INT_EQ(leftovers(), 0);
+  /* a failed -max_error check (exit 3) still writes the raster */
+  remove(err);
+  char *et[] = {"eval", "-q", (char *)dem, (char *)tin, "-error_raster",
+                (char *)err, "-max_error", "0.01", NULL};
+  CHECK_INT_EQ(run(et, NULL, 0), 3);
+  CHECK(exists(err));
   CHECK_INT_EQ(leftovers(), 0);
 }
 
