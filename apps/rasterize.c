@@ -165,13 +165,11 @@ tt_status tt__app_write_raster(app_run *r, tt_output *out, GDALDriverH drv,
       tt_grid_height(grid), values, type, info->gt, info->crs_wkt,
       (CSLConstList)co, tt__app_phase_fn, &r->prog);
   CSLDestroy(co);
-  if (st == TT_OK && r->msg.failures != failures)
-    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s",
-                      r->msg.last);
-  else if (st != TT_OK)
-    return tt__app_fail_write(r, st, path, tt_output_temp_path(out), NULL);
   if (st != TT_OK)
-    return st;
+    return tt__app_fail_write(r, st, path, tt_output_temp_path(out), NULL);
+  if (r->msg.failures != failures) /* a driver's failure it survived */
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s",
+                        r->msg.last);
   st = tt_output_commit(r->ctx, out);
   if (st == TT_ERR_EXISTS)
     return tt__app_fail_exists(r, path);

@@ -190,10 +190,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
 {
   char buf[TT_APP_MESSAGE_MAX], name[TT_TEXT_WORD_MAX + 1];
+  char named[TT_APP_MESSAGE_MAX];
   va_list ap;
   va_start(ap, fmt);
   vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
+  /* a driver's message kept by the glue may name a temporary file */
+  if (tt_output_rename_in_text(buf, named, sizeof named))
+    memcpy(buf, named, sizeof buf);
   if (file)
     tt__app_result_set(r->res, exit_code, st, "%s: %s",
                        tt_text_fit(name, sizeof name, file), buf);

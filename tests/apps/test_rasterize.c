@@ -398,6 +398,12 @@ static void test_refusals(void)
   CHECK_INT_EQ(run(a6, msg, sizeof msg), 1);
   CHECK(strstr(msg, "Point") && !strstr(msg, "polygons rejected"));
   CHECK(!exists(out));
+  /* a driver's failure names the output, not its temporary file */
+  char *a12[] = {"rasterize", (char *)tin, (char *)dem, (char *)out, "-co",
+                 "TILED=YES", "-co", "BLOCKXSIZE=7", NULL};
+  CHECK_INT_EQ(run(a12, msg, sizeof msg), 1);
+  CHECK(strstr(msg, "refused.tif") && !strstr(msg, "/.tt"));
+  CHECK(!exists(out));
 
   /* an interrupt during the write */
   tt_app_options *opts = NULL;
