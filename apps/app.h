@@ -53,6 +53,7 @@ struct tt_app_options {
   tt_app_settings s;     /* the public view; strings point into the lists */
   app_strlist strings;   /* every single string (input, output, -of, ...) */
   app_strlist config, lco, dsco, terrains;
+  app_strlist co;        /* -co (rasterize, eval -error_raster) */
   tt_progress_fn progress;
   void *progress_arg;
   FILE *out, *err;
@@ -98,7 +99,10 @@ int tt__app_str_ieq(const char *a, const char *b);
 /* GDAL's failures and warnings while a run is active (run.c). */
 typedef struct app_messages {
   FILE *err;
-  size_t warnings;           /* printed or dropped */
+  size_t warnings;           /* printed or dropped (repeats not counted) */
+  uint64_t seen[32];         /* hashes of the warnings printed */
+  size_t nseen;
+  tt_app_term_progress *bar; /* the text bar, if the run draws one */
   unsigned failures;         /* GDAL failures seen */
   char last[TT_APP_MESSAGE_MAX];
 } app_messages;
@@ -228,11 +232,27 @@ tt_status tt__app_generate(app_run *r);  /* generate.c */
 tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
+tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+/* rasterize.c, for eval -error_raster too: the raster driver of -of, else
+ * the one path's extension names (NULL path: GTiff), that can write a
+ * Float32 or Float64 band; NULL with the failure recorded. */
+GDALDriverH tt__app_raster_driver(app_run *r, const char *of,
+                                  const char *path);
+/* Writes values (the DEM's grid, NaN: nodata) to out's temporary name with
+ * drv (GTiff: tiled, DEFLATE, unless -co says otherwise; -co), Float64
+ * when the grid holds doubles, else Float32, in the DEM's geotransform and
+ * CRS, and commits it; the failure recorded otherwise. */
+tt_status tt__app_write_raster(app_run *r, tt_output *out, GDALDriverH drv,
+                               const tt_grid *grid,
+                               const tt_raster_info *info,
+                               const double *values);
 /* eval.c, for optimize too: opens r->s->tin's kind of dataset (a vector
  * dataset, explaining in one line why not), and picks its triangle layer
  * (-layer, else "triangles" or "*_triangles", else the first polygon
  * layer); NULL with the failure recorded. */
 GDALDatasetH tt__app_open_vector(app_run *r, const char *path);
 OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds);
+/* Whether the layer declares a CRS that is not the DEM's (eval.c). */
+int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info);
 
 #endif /* TERRATIN_APP_H */

@@ -2,7 +2,9 @@
  * eval.c -- `terratin eval DEM TIN`: read any layer of triangles (the
  * triangles layer of a terratin output, or any POLYGON Z layer), measure it
  * against the DEM's valid samples (tt_eval_triangles), print the errors, and
- * exit with code 3 when -max_error is exceeded.
+ * exit with code 3 when -max_error is exceeded. With -error_raster, also
+ * write TIN - DEM on the DEM's grid (rasterize.c's writer), refused before
+ * anything is read when it exists without -overwrite.
  */
 #include "app.h"
 
@@ -38,9 +40,20 @@ OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds)
   int n = GDALDatasetGetLayerCount(ds);
   if (r->s->layer) {
     OGRLayerH l = GDALDatasetGetLayerByName(ds, r->s->layer);
-    if (!l)
+    if (!l) {
       tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, path,
                "no layer named '%s'", r->s->layer);
+      return NULL;
+    }
+    /* A layer of points or lines is no TIN: say what it holds. */
+    OGRwkbGeometryType t = OGR_L_GetGeomType(l);
+    if (t != wkbUnknown && !is_polygon_layer(l)) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, path,
+                   "layer '%s' holds %s geometries, not triangles (polygons "
+                   "or TINs)", r->s->layer,
+                   t == wkbNone ? "no" : OGRGeometryTypeToName(t));
+      return NULL;
+    }
     return l;
   }
   for (int pass = 0; pass < 2; pass++) {
@@ -59,6 +72,22 @@ OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds)
            "no triangles layer and no polygon layer (%d layer%s)", n,
            n == 1 ? "" : "s");
   return NULL;
+}
+
+int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info)
+{
+  static const char *const same_opts[] = {
+      "IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
+      "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", NULL};
+  OGRSpatialReferenceH lsrs = OGR_L_GetSpatialRef(layer);
+  if (!lsrs || !info->crs_wkt || !*info->crs_wkt)
+    return 0;
+  OGRSpatialReferenceH rsrs = OSRNewSpatialReference(info->crs_wkt);
+  int other =
+      rsrs && !OSRIsSameEx(rsrs, lsrs, (const char *const *)same_opts);
+  if (rsrs)
+    OSRDestroySpatialReference(rsrs);
+  return other;
 }
 
 GDALDatasetH tt__app_open_vector(app_run *r, const char *path)
@@ -103,15 +132,41 @@ tt_status tt__app_eval(app_run *r)
   GDALRasterBandH band = NULL;
   tt_grid *grid = NULL;
   tt_raster_info *info = NULL;
-  double *xyz = NULL;
+  double *xyz = NULL, *err = NULL;
   size_t ntri = 0, rejected = 0, valid = 0;
   tt_eval_result ev;
-  OGRSpatialReferenceH rsrs = NULL;
+  tt_output *outp = NULL;
+  GDALDriverH rdrv = NULL;
   memset(&ev, 0, sizeof ev);
 
+  /* -error_raster: refused when it exists, before anything is read */
+  if (s->error_raster) {
+    if (tt__app_same_file(s->input, s->error_raster) ||
+        tt__app_same_file(s->tin, s->error_raster))
+      return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG,
+                          s->error_raster,
+                          "is an input; refusing to replace it");
+    if (!(rdrv = tt__app_raster_driver(r, NULL, NULL)))
+      return r->res->status;
+    st = tt_output_begin(r->ctx, s->error_raster, "GTiff", s->overwrite,
+                         &outp);
+    if (st == TT_ERR_EXISTS)
+      return tt__app_fail_exists(r, s->error_raster);
+    if (st != TT_OK)
+      return tt__app_fail_tt(r, st, s->error_raster);
+  }
+
   src = tt__app_open_raster(r, s->input, s->band, &band);
-  if (!src)
-    return r->res->status;
+  if (!src) {
+    st = r->res->status;
+    goto done;
+  }
+  if (outp &&
+      (st = tt_output_protect_dataset(r->ctx, outp, src, s->input)) !=
+          TT_OK) {
+    tt__app_fail_tt(r, st, s->error_raster);
+    goto done;
+  }
   /* No bar for eval, but the reading still polls for an interruption. */
   tt__app_phase_set(&r->prog, 0.0, 0.3);
   st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
@@ -131,6 +186,11 @@ tt_status tt__app_eval(app_run *r)
     st = r->res->status;
     goto done;
   }
+  if (outp &&
+      (st = tt_output_protect_dataset(r->ctx, outp, tds, s->tin)) != TT_OK) {
+    tt__app_fail_tt(r, st, s->error_raster);
+    goto done;
+  }
   OGRLayerH layer = tt__app_tin_layer(r, tds);
   if (!layer) {
     st = r->res->status;
@@ -139,16 +199,7 @@ tt_status tt__app_eval(app_run *r)
   const char *lname = OGR_L_GetName(layer);
 
   /* Triangles in another CRS would be measured in the wrong place. */
-  int other_crs = 0;
-  OGRSpatialReferenceH lsrs = OGR_L_GetSpatialRef(layer);
-  if (lsrs && info->crs_wkt && *info->crs_wkt) {
-    static const char *const same_opts[] = {
-        "IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
-        "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", NULL};
-    rsrs = OSRNewSpatialReference(info->crs_wkt);
-    other_crs =
-        rsrs && !OSRIsSameEx(rsrs, lsrs, (const char *const *)same_opts);
-  }
+  int other_crs = tt__app_layer_in_other_crs(layer, info);
 
   r->msg.last[0] = '\0';
   st = tt_ogr_read_triangles(r->ctx, layer, info->gt, &xyz, &ntri,
@@ -175,8 +226,15 @@ tt_status tt__app_eval(app_run *r)
                   lname, rejected, rejected == 1 ? "" : "s");
     goto done;
   }
+  const size_t ncells = info->width * info->height;
+  if (outp && !(err = malloc(ncells * sizeof *err))) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, s->error_raster,
+                      "out of memory for %zu x %zu errors", info->width,
+                      info->height);
+    goto done;
+  }
   double t = tt__app_now();
-  st = tt_eval_triangles(r->ctx, grid, ntri, xyz, &ev);
+  st = tt_eval_triangles_raster(r->ctx, grid, ntri, xyz, &ev, err);
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, s->tin);
     goto done;
@@ -200,6 +258,21 @@ tt_status tt__app_eval(app_run *r)
                  "%s: %zu of %zu valid samples lie in no triangle; their "
                  "error is not measured",
                  s->tin, ev.uncovered, ev.errors.samples);
+
+  /* TIN - DEM: NaN outside the TIN and at the DEM's nodata. */
+  double t_raster = 0.0;
+  if (outp) {
+    t = tt__app_now();
+    const float *zf = tt_grid_heights_const(grid);
+    const double *zd = tt_grid_heights_f64_const(grid);
+    for (size_t i = 0; i < ncells; i++)
+      err[i] -= zd ? zd[i] : (double)zf[i];
+    tt__app_phase_set(&r->prog, 0.5, 1.0);
+    st = tt__app_write_raster(r, outp, rdrv, grid, info, err);
+    if (st != TT_OK)
+      goto done;
+    t_raster = tt__app_now() - t;
+  }
 
   const tt_error_stats *e = &ev.errors;
   const double *gt = info->gt;
@@ -245,6 +318,7 @@ tt_status tt__app_eval(app_run *r)
     tt__json_num(&j, "l2", e->l2);
     tt__json_str(&j, "z_unit", tt__app_nonempty_or_null(info->z_unit));
     tt__json_str(&j, "crs", tt__app_nonempty_or_null(info->crs_name));
+    tt__json_str(&j, "error_raster", s->error_raster);
     if (checked) {
       tt__json_num(&j, "threshold", s->max_error);
       tt__json_bool(&j, "pass", pass);
@@ -255,6 +329,8 @@ tt_status tt__app_eval(app_run *r)
     tt__json_open(&j, "seconds");
     tt__json_num(&j, "read", t_read);
     tt__json_num(&j, "eval", t_eval);
+    if (outp)
+      tt__json_num(&j, "error_raster", t_raster);
     tt__json_num(&j, "total", tt__app_now() - r->t0);
     tt__json_close(&j);
     tt__json_close(&j);
@@ -280,6 +356,10 @@ tt_status tt__app_eval(app_run *r)
     fprintf(o, "coverage:        %zu of %zu valid samples covered, %zu "
                "uncovered, %zu overlapped\n",
             e->covered, e->samples, ev.uncovered, ev.overlapped);
+    if (outp)
+      fprintf(o, "error raster:    %s (TIN - DEM, %s)\n", s->error_raster,
+              tt_grid_precision(grid) == TT_PRECISION_FLOAT64 ? "Float64"
+                                                              : "Float32");
     if (checked)
       fprintf(o, "check:           max error %.9g %s -max_error %.9g: %s\n",
               e->max_error, pass ? "<=" : ">", s->max_error,
@@ -296,8 +376,8 @@ tt_status tt__app_eval(app_run *r)
   }
 
 done:
-  if (rsrs)
-    OSRDestroySpatialReference(rsrs);
+  tt_output_destroy(outp);
+  free(err);
   if (tds)
     GDALClose(tds);
   if (src)

@@ -18,6 +18,7 @@ static const char help_top[] =
     "  eval       measure the error of a triangle layer against a DEM\n"
     "  optimize   re-triangulate a TIN's vertices for a criterion\n"
     "  study      compare criteria, methods and optimisers over terrains\n"
+    "  rasterize  a TIN's surface on a DEM's grid, as a raster\n"
     "\n"
     "Options of every command:\n"
     "  --help              this help, or the help of COMMAND\n"
@@ -233,7 +234,8 @@ static const char help_generate[] =
 static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit m] [-json] [-q]\n"
-    "           [-max_memory SIZE]\n"
+    "           [-max_memory SIZE] [-error_raster OUT.tif [-co NAME=VALUE]...\n"
+    "           [-overwrite]]\n"
     "\n"
     "Measures a layer of triangles (POLYGON Z, MULTIPOLYGON Z or TIN, from\n"
     "terratin or any other tool) against band BAND of the raster DEM: the\n"
@@ -256,6 +258,11 @@ static const char help_eval[] =
     "  -q              print nothing on success (for scripts with -max_error)\n"
     "  -max_memory SIZE  memory the DEM's heights may take (500M, 2G, bytes;\n"
     "                  default: as for simplify)\n"
+    "  -error_raster OUT  write TIN - DEM on the DEM's grid as a GeoTIFF\n"
+    "                  (Float32, Float64 for a DEM of doubles; tiled, DEFLATE;\n"
+    "                  nodata NaN outside the TIN and at the DEM's nodata)\n"
+    "  -co NAME=VALUE  GeoTIFF creation option of OUT (repeatable)\n"
+    "  -overwrite      replace OUT when it exists (default: refuse)\n"
     "\n"
     "Exit codes: 0 success (and within -max_error), 1 processing failure,\n"
     "2 usage error, 3 the measured max error exceeds -max_error.\n"
@@ -346,6 +353,34 @@ static const char help_study[] =
     "  terratin study -terrain fault_smooth -terrain dem.tif -criteria\n"
     "      delaunay,minmax_angle,l2 -methods insert,decimate out/\n";
 
+static const char help_rasterize[] =
+    "Usage: terratin rasterize TIN DEM OUTPUT [-layer NAME] [-b BAND]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "           [-of FORMAT] [-co NAME=VALUE]... [-max_memory SIZE]\n"
+    "           [-overwrite] [-q] [-json]\n"
+    "\n"
+    "Writes the surface of a layer of triangles (read as eval reads it) on\n"
+    "the grid of band BAND of DEM: at every sample centre in a triangle, the\n"
+    "triangle's linear interpolation of its corners' heights; nodata (NaN)\n"
+    "outside the TIN. One band, Float32 (Float64 when DEM's heights are read\n"
+    "as doubles), the DEM's size, geotransform and CRS. The summary gives\n"
+    "the samples covered and the error against DEM, as eval measures it.\n"
+    "\n"
+    "Options:\n"
+    "  -layer NAME       layer of TIN (default as eval)\n"
+    "  -of FORMAT        a GDAL raster driver (default: the one OUTPUT's\n"
+    "                    extension names, else GTiff: tiled, DEFLATE)\n"
+    "  -co NAME=VALUE    creation option of the driver (repeatable)\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -max_memory   the DEM, as eval\n"
+    "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
+    "  -q, -json         no summary; one JSON object instead of the summary\n"
+    "\n"
+    "Exit codes: 0 success, 1 processing failure, 2 usage error.\n"
+    "\n"
+    "Example:\n"
+    "  terratin rasterize tin.gpkg dem.tif tin.tif\n"
+    "  terratin eval dem.tif tin.gpkg -error_raster diff.tif  (TIN - DEM)\n";
+
 const char *tt_app_help(tt_app_command topic)
 {
   switch (topic) {
@@ -354,6 +389,7 @@ const char *tt_app_help(tt_app_command topic)
   case TT_APP_EVAL: return help_eval;
   case TT_APP_OPTIMIZE: return help_optimize;
   case TT_APP_STUDY: return help_study;
+  case TT_APP_RASTERIZE: return help_rasterize;
   default: return help_top;
   }
 }
@@ -366,6 +402,7 @@ const char *tt__app_command_name(tt_app_command c)
   case TT_APP_EVAL: return "eval";
   case TT_APP_OPTIMIZE: return "optimize";
   case TT_APP_STUDY: return "study";
+  case TT_APP_RASTERIZE: return "rasterize";
   default: return "";
   }
 }

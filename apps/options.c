@@ -37,7 +37,7 @@ enum opt_id {
   O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
   O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START, O_IMPORTANCE,
   O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY, O_TERRAIN,
-  O_CRITERIA, O_METHODS, O_OPTIMIZERS
+  O_CRITERIA, O_METHODS, O_OPTIMIZERS, O_ERROR_RASTER, O_CO
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -45,6 +45,7 @@ enum opt_id {
 #define FOR_E (1u << TT_APP_EVAL)
 #define FOR_O (1u << TT_APP_OPTIMIZE)
 #define FOR_T (1u << TT_APP_STUDY)
+#define FOR_R (1u << TT_APP_RASTERIZE)
 
 static const struct opt_def {
   const char *name;
@@ -52,25 +53,26 @@ static const struct opt_def {
   int takes_value;
   unsigned commands;
 } opt_defs[] = {
-    {"-b", O_B, 1, FOR_S | FOR_E | FOR_O | FOR_T},
+    {"-b", O_B, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
     {"-max_error", O_MAX_ERROR, 1, FOR_S | FOR_E | FOR_O},
     {"-max_points", O_MAX_POINTS, 1, FOR_S},
     {"-max_triangles", O_MAX_TRIANGLES, 1, FOR_S},
     {"-percent", O_PERCENT, 1, FOR_S | FOR_T}, /* study: a list */
-    {"-of", O_OF, 1, FOR_S | FOR_O},
+    {"-of", O_OF, 1, FOR_S | FOR_O | FOR_R},
     {"-f", O_OF, 1, FOR_S | FOR_O}, /* ogr2ogr's spelling */
     {"-lco", O_LCO, 1, FOR_S | FOR_O},
     {"-dsco", O_DSCO, 1, FOR_S | FOR_O},
     {"-nln", O_NLN, 1, FOR_S | FOR_O},
-    {"-overwrite", O_OVERWRITE, 0, FOR_S | FOR_G | FOR_O | FOR_T},
+    {"-overwrite", O_OVERWRITE, 0,
+     FOR_S | FOR_G | FOR_E | FOR_O | FOR_T | FOR_R},
     {"-obj_local", O_OBJ_LOCAL, 0, FOR_S},
-    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T},
-    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T},
+    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T | FOR_R},
+    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T | FOR_R},
     {"-criterion", O_CRITERION, 1, FOR_S | FOR_O},
     {"-optimize", O_OPTIMIZE, 1, FOR_S | FOR_O},
     {"-repair", O_REPAIR, 1, FOR_S},
-    {"-json", O_JSON, 0, FOR_S | FOR_E | FOR_O},
-    {"-layer", O_LAYER, 1, FOR_E | FOR_O},
+    {"-json", O_JSON, 0, FOR_S | FOR_E | FOR_O | FOR_R},
+    {"-layer", O_LAYER, 1, FOR_E | FOR_O | FOR_R},
     {"-size", O_SIZE, 1, FOR_G},
     {"-seed", O_SEED, 1, FOR_G | FOR_S | FOR_O | FOR_T},
     {"-iterations", O_ITERATIONS, 1, FOR_G},
@@ -80,9 +82,9 @@ static const struct opt_def {
     {"-amplitude", O_AMPLITUDE, 1, FOR_G},
     {"-seeding", O_SEEDING, 1, FOR_G},
     {"-a_srs", O_A_SRS, 1, FOR_G},
-    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E | FOR_O | FOR_T},
-    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E | FOR_O | FOR_T},
-    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E | FOR_O | FOR_T},
+    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
+    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
+    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
     {"-work_srs", O_WORK_SRS, 1, FOR_S},
     {"-t_srs", O_T_SRS, 1, FOR_S},
     {"-anneal_t0", O_ANNEAL_T0, 1, FOR_S | FOR_O | FOR_T},
@@ -97,11 +99,13 @@ static const struct opt_def {
     {"-onepass", O_ONEPASS, 0, FOR_S},
     {"-hole", O_HOLE, 1, FOR_S},
     {"-threads", O_THREADS, 1, FOR_S | FOR_T},
-    {"-max_memory", O_MAX_MEMORY, 1, FOR_S | FOR_E},
+    {"-max_memory", O_MAX_MEMORY, 1, FOR_S | FOR_E | FOR_R},
     {"-terrain", O_TERRAIN, 1, FOR_T},
     {"-criteria", O_CRITERIA, 1, FOR_T},
     {"-methods", O_METHODS, 1, FOR_T},
     {"-optimizers", O_OPTIMIZERS, 1, FOR_T},
+    {"-error_raster", O_ERROR_RASTER, 1, FOR_E},
+    {"-co", O_CO, 1, FOR_E | FOR_R},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -209,6 +213,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       else if (tt__app_str_ieq(w, "eval")) first_cmd = TT_APP_EVAL;
       else if (tt__app_str_ieq(w, "optimize")) first_cmd = TT_APP_OPTIMIZE;
       else if (tt__app_str_ieq(w, "study")) first_cmd = TT_APP_STUDY;
+      else if (tt__app_str_ieq(w, "rasterize")) first_cmd = TT_APP_RASTERIZE;
       else if (tt__app_str_ieq(w, "help")) { want_help = 1; continue; }
       if (first_cmd == TT_APP_NONE)
         break; /* an unknown command: reported below */
@@ -285,15 +290,17 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (o->s.command == TT_APP_NONE) {
       if (w[0] == '-' && w[1] != '\0')
         USAGE("unknown option '%s' before the command; expected simplify, "
-              "generate, eval, optimize or study (see 'terratin --help')", w);
+              "generate, eval, optimize, study or rasterize (see 'terratin "
+              "--help')", w);
       if (tt__app_str_ieq(w, "simplify")) o->s.command = TT_APP_SIMPLIFY;
       else if (tt__app_str_ieq(w, "generate")) o->s.command = TT_APP_GENERATE;
       else if (tt__app_str_ieq(w, "eval")) o->s.command = TT_APP_EVAL;
       else if (tt__app_str_ieq(w, "optimize")) o->s.command = TT_APP_OPTIMIZE;
       else if (tt__app_str_ieq(w, "study")) o->s.command = TT_APP_STUDY;
+      else if (tt__app_str_ieq(w, "rasterize")) o->s.command = TT_APP_RASTERIZE;
       else
         USAGE("unknown command '%s'; expected simplify, generate, eval, "
-              "optimize or study (see 'terratin --help')", w);
+              "optimize, study or rasterize (see 'terratin --help')", w);
       cmdname = tt__app_command_name(o->s.command);
       snprintf(hint, sizeof hint, " (see 'terratin %s --help')", cmdname);
       continue;
@@ -316,7 +323,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         i++;
       }
     } else {
-      if (npos >= (o->s.command == TT_APP_OPTIMIZE ? 3u : 2u))
+      if (npos >= (o->s.command == TT_APP_OPTIMIZE ||
+                   o->s.command == TT_APP_RASTERIZE ? 3u : 2u))
         USAGE("%s: unexpected argument '%s'%s", cmdname, w, hint);
       pos[npos++] = w;
       continue;
@@ -376,12 +384,14 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
         NOMEM();
       break;
     case O_LCO:
-    case O_DSCO: {
+    case O_DSCO:
+    case O_CO: {
       const char *eq = strchr(v, '=');
       if (!eq || eq == v)
-        USAGE("%s: %s expects NAME=VALUE, got '%s'", cmdname,
-              d->id == O_LCO ? "-lco" : "-dsco", v);
-      if (!tt__app_strlist_add(d->id == O_LCO ? &o->lco : &o->dsco, v))
+        USAGE("%s: %s expects NAME=VALUE, got '%s'", cmdname, d->name, v);
+      if (!tt__app_strlist_add(d->id == O_LCO    ? &o->lco
+                               : d->id == O_DSCO ? &o->dsco
+                                                 : &o->co, v))
         NOMEM();
       break;
     }
@@ -625,6 +635,12 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
                                    : &o->s.optimizers) = keep(o, v)))
         NOMEM();
       break;
+    case O_ERROR_RASTER:
+      if (!*v)
+        USAGE("%s: -error_raster needs a file name%s", cmdname, hint);
+      if (!(o->s.error_raster = keep(o, v)))
+        NOMEM();
+      break;
     case O_A_SRS:
       if (!*v)
         USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);
@@ -641,7 +657,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
           cmdname);
   switch (o->s.command) {
   case TT_APP_NONE:
-    USAGE("missing command: simplify, generate, eval, optimize or study (see "
+    USAGE("missing command: simplify, generate, eval, optimize, study or "
+          "rasterize (see "
           "'terratin --help')");
   case TT_APP_SIMPLIFY:
     if (npos < 1)
@@ -681,6 +698,18 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     if (npos < 2)
       USAGE("eval: missing TIN after '%s'%s", pos[0], hint);
     if (!(o->s.input = keep(o, pos[0])) || !(o->s.tin = keep(o, pos[1])))
+      NOMEM();
+    if (!o->s.error_raster && (o->s.overwrite || o->co.n))
+      USAGE("eval: option %s does not apply without -error_raster%s",
+            o->s.overwrite ? "-overwrite" : "-co", hint);
+    break;
+  case TT_APP_RASTERIZE:
+    if (npos < 3)
+      USAGE("rasterize: missing %s%s", npos == 0 ? "TIN, DEM and OUTPUT"
+                                       : npos == 1 ? "DEM and OUTPUT"
+                                                   : "OUTPUT", hint);
+    if (!(o->s.tin = keep(o, pos[0])) || !(o->s.input = keep(o, pos[1])) ||
+        !(o->s.output = keep(o, pos[2])))
       NOMEM();
     break;
   case TT_APP_OPTIMIZE:
@@ -751,6 +780,7 @@ done:
       o->s.dsco = (const char *const *)o->dsco.v;
     o->s.terrains = o->terrains.n ? (const char *const *)o->terrains.v
                                   : empty_list;
+    o->s.co = o->co.n ? (const char *const *)o->co.v : empty_list;
   }
   tt_context_destroy(ctx);
   if (st != TT_OK) {

@@ -14,6 +14,17 @@ void tt_app_term_progress_init(tt_app_term_progress *bar, FILE *fp,
   bar->fp = fp;
   bar->ticks = -1;
   bar->stop = stop;
+  bar->line_ended = 0;
+}
+
+void tt_app_term_progress_break(tt_app_term_progress *bar)
+{
+  if (!bar || !bar->fp || bar->ticks < 0 || bar->ticks >= 40 ||
+      bar->line_ended)
+    return;
+  fputc('\n', bar->fp);
+  fflush(bar->fp);
+  bar->line_ended = 1;
 }
 
 /* 41 ticks, one per 2.5%: tick 0 prints "0", every fourth prints the tens,
@@ -40,6 +51,7 @@ int tt_app_term_progress_fn(double complete, const char *message, void *arg)
       if (target == 40)
         fputs(" - done.\n", bar->fp);
       bar->ticks = target;
+      bar->line_ended = 0;
       fflush(bar->fp);
     }
   }

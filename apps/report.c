@@ -327,12 +327,14 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
                                                           : "rounds");
   /* nodata outlines: what the TIN could not carry is said, not dropped */
   size_t lone = p->sum.errors.samples - p->sum.errors.covered;
-  if (lone || p->sum.components > 1)
+  if (p->sum.components > 1)
+    fprintf(r->out, "%s: %zu separate pieces%s", r->s->output,
+            p->sum.components, lone ? "; " : "\n");
+  else if (lone)
+    fprintf(r->out, "%s: ", r->s->output);
+  if (lone)
     fprintf(r->out,
-            "%s: %zu separate piece%s; %zu valid sample%s amid nodata "
-            "(in no cell with 3 valid corners) cannot carry a triangle and "
-            "%s left out\n",
-            r->s->output, p->sum.components,
-            p->sum.components == 1 ? "" : "s", lone, lone == 1 ? "" : "s",
-            lone == 1 ? "is" : "are");
+            "%zu valid sample%s amid nodata (in no cell with 3 valid "
+            "corners) cannot carry a triangle and %s left out\n",
+            lone, lone == 1 ? "" : "s", lone == 1 ? "is" : "are");
 }

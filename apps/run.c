@@ -113,21 +113,39 @@ static void one_line(char *s)
 
 void tt__app_warn(app_messages *m, const char *fmt, ...) TT_APP_PRINTF_(2, 3);
 
+/* FNV-1a: a warning said once is not said again (a driver warns about a
+ * creation option once per layer). */
+static uint64_t text_hash(const char *s)
+{
+  uint64_t h = 1469598103934665603ull;
+  for (; *s; s++)
+    h = (h ^ (unsigned char)*s) * 1099511628211ull;
+  return h;
+}
+
 void tt__app_warn(app_messages *m, const char *fmt, ...)
 {
   char buf[TT_APP_MESSAGE_MAX];
   va_list ap;
+  va_start(ap, fmt);
+  vformat_fit(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  uint64_t h = text_hash(buf);
+  for (size_t i = 0; i < m->nseen; i++)
+    if (m->seen[i] == h)
+      return;
+  if (m->nseen < sizeof m->seen / sizeof m->seen[0])
+    m->seen[m->nseen++] = h;
   m->warnings++;
   if (m->warnings > MAX_WARNINGS + 1)
     return;
   if (m->warnings == MAX_WARNINGS + 1) {
+    tt_app_term_progress_break(m->bar);
     fprintf(m->err, "terratin: warning: further warnings are not shown\n");
     return;
   }
-  va_start(ap, fmt);
-  vformat_fit(buf, sizeof buf, fmt, ap);
-  va_end(ap);
   one_line(buf);
+  tt_app_term_progress_break(m->bar);
   fprintf(m->err, "terratin: warning: %s\n", buf);
 }
 
@@ -135,9 +153,14 @@ static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
                                         const char *msg)
 {
   app_messages *m = CPLGetErrorHandlerUserData();
+  char named[TT_APP_MESSAGE_MAX];
   (void)num;
   if (!m || !msg)
     return;
+  /* GDAL names the dataset it was given: the temporary name of an output;
+   * the user knows it by its final name. */
+  if (tt_output_rename_in_text(msg, named, sizeof named))
+    msg = named;
   if (cls == CE_Debug) {
     fprintf(m->err, "terratin: debug: %s\n", msg);
   } else if (cls == CE_Warning) {
@@ -167,10 +190,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
 {
   char buf[TT_APP_MESSAGE_MAX], name[TT_TEXT_WORD_MAX + 1];
+  char named[TT_APP_MESSAGE_MAX];
   va_list ap;
   va_start(ap, fmt);
   vformat_fit(buf, sizeof buf, fmt, ap);
   va_end(ap);
+  /* a driver's message kept by the glue may name a temporary file */
+  if (tt_output_rename_in_text(buf, named, sizeof named))
+    memcpy(buf, named, sizeof buf);
   if (file)
     tt__app_result_set(r->res, exit_code, st, "%s: %s",
                        tt_text_fit(name, sizeof name, file), buf);
@@ -502,6 +529,8 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   r.out = o->out ? o->out : stdout;
   r.err = o->err ? o->err : stderr;
   r.msg.err = r.err;
+  if (o->progress == tt_app_term_progress_fn)
+    r.msg.bar = o->progress_arg;
   r.prog.fn = o->progress;
   r.prog.arg = o->progress_arg;
   r.t0 = tt__app_now();
@@ -520,6 +549,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   case TT_APP_EVAL:
   case TT_APP_OPTIMIZE:
   case TT_APP_STUDY:
+  case TT_APP_RASTERIZE:
     break;
   default:
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
@@ -545,6 +575,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   case TT_APP_GENERATE: st = tt__app_generate(&r); break;
   case TT_APP_OPTIMIZE: st = tt__app_optimize(&r); break;
   case TT_APP_STUDY: st = tt__app_study(&r); break;
+  case TT_APP_RASTERIZE: st = tt__app_rasterize(&r); break;
   default: st = tt__app_eval(&r); break;
   }
 done:

@@ -45,6 +45,7 @@ void tt_app_options_destroy(tt_app_options *o)
   tt__app_strlist_free(&o->lco);
   tt__app_strlist_free(&o->dsco);
   tt__app_strlist_free(&o->terrains);
+  tt__app_strlist_free(&o->co);
   free(o);
 }
 

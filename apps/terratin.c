@@ -19,8 +19,9 @@
  * run has not ended GRACE_MS after the signal (or at a second signal), the
  * watchdog removes the temporary files of every output not yet committed
  * (tt_output_abandon_all(), which a mutex orders with the run's own commit)
- * and ends the process by the signal. An output already committed is let
- * finish: its run is only printing its summary.
+ * and ends the process by the signal, after ending a half-drawn bar's line
+ * and naming the output it stopped, as the run itself would. An output
+ * already committed is let finish: its run is only printing its summary.
  */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* sigaction; the build sets it elsewhere */
@@ -45,6 +46,10 @@
 static volatile sig_atomic_t caught_signal = 0;
 static int wake_pipe[2] = {-1, -1};
 static atomic_int run_ended = 0;
+/* The bar, and the watchdog's line naming the output, made before the run
+ * so that the watchdog only calls write(). */
+static tt_app_term_progress bar;
+static char stop_msg[1100] = "terratin: interrupted; nothing written\n";
 
 static void on_signal(int sig)
 {
@@ -85,8 +90,12 @@ static void *watchdog(void *arg)
   if (atomic_load(&run_ended) || !tt_output_abandon_all())
     return NULL;
   int sig = (int)caught_signal;
-  static const char msg[] = "terratin: interrupted; nothing written\n";
-  ssize_t n = write(STDERR_FILENO, msg, sizeof msg - 1);
+  /* End a half-drawn bar (flushed at every tick, so nothing of it is
+   * left in stdout's buffer), then say what was stopped. */
+  ssize_t n = 0;
+  if (bar.fp && bar.ticks >= 0 && bar.ticks < 40 && !bar.line_ended)
+    n = write(STDOUT_FILENO, "\n", 1);
+  n = write(STDERR_FILENO, stop_msg, strlen(stop_msg));
   (void)n;
   signal(sig, SIG_DFL);
   kill(getpid(), sig); /* the main thread takes it: the process ends */
@@ -117,21 +126,25 @@ int main(int argc, char **argv)
 {
   tt_app_options *opts = NULL;
   tt_app_result res;
-  tt_app_term_progress bar;
   (void)argc;
+  tt_app_term_progress_init(&bar, NULL, &caught_signal);
 
   pthread_t dog;
   int have_dog = pipe(wake_pipe) == 0 &&
                  pthread_create(&dog, NULL, watchdog, NULL) == 0;
   install_handlers();
   if (tt_app_options_new(argv + 1, &opts, &res) == TT_OK) {
+    const tt_app_settings *s = tt_app_options_settings(opts);
+    const char *out = s->error_raster ? s->error_raster : s->output;
+    if (out && strlen(out) < sizeof stop_msg - 64)
+      snprintf(stop_msg, sizeof stop_msg,
+               "terratin: %s: interrupted; nothing written\n", out);
     tt_app_term_progress_init(
         &bar, tt_app_options_wants_progress_bar(opts) ? stdout : NULL,
         &caught_signal);
     tt_app_options_set_progress(opts, tt_app_term_progress_fn, &bar);
     tt_app_run(opts, &res);
-    if (bar.fp && bar.ticks >= 0 && bar.ticks < 40)
-      fputc('\n', stdout); /* end a bar cut short by a failure */
+    tt_app_term_progress_break(&bar); /* a bar cut short by a failure */
   }
   atomic_store(&run_ended, 1);
   if (have_dog) {

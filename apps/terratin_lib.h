@@ -48,7 +48,8 @@ typedef enum tt_app_command {
   TT_APP_GENERATE,
   TT_APP_EVAL,
   TT_APP_OPTIMIZE,           /* optimize DEM IN_TIN OUTPUT */
-  TT_APP_STUDY               /* study OUTDIR */
+  TT_APP_STUDY,              /* study OUTDIR */
+  TT_APP_RASTERIZE           /* rasterize TIN DEM OUTPUT */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
@@ -139,6 +140,11 @@ typedef struct tt_app_settings {
   const char *percents;      /* -percent P,P,...; NULL: 1,10,25,50 */
   uint64_t seed;             /* -seed (study: the generated terrains) */
   int seed_set;              /* -seed was given */
+
+  /* rasterize TIN DEM OUTPUT (tin, input, output; -of the raster driver);
+   * eval -error_raster */
+  const char *error_raster;  /* -error_raster: TIN - DEM as a GeoTIFF */
+  const char *const *co;     /* -co NAME=VALUE (raster creation options) */
 } tt_app_settings;
 
 typedef struct tt_app_options tt_app_options;
@@ -185,12 +191,17 @@ typedef struct tt_app_term_progress {
   FILE *fp;                        /* NULL: draw nothing */
   int ticks;                       /* ticks drawn, 0..41 (-1: none yet) */
   volatile sig_atomic_t *stop;     /* may be NULL */
+  int line_ended;                  /* a message ended the bar's line */
 } tt_app_term_progress;
 
 void tt_app_term_progress_init(tt_app_term_progress *bar, FILE *fp,
                                volatile sig_atomic_t *stop);
 /* A tt_progress_fn; arg is a tt_app_term_progress. */
 int tt_app_term_progress_fn(double complete, const char *message, void *arg);
+/* Ends the bar's line when it is half drawn, so that a warning or the
+ * failure printed next starts a line of its own (a bar that goes on, goes
+ * on on the next line). NULL: nothing. */
+void tt_app_term_progress_break(tt_app_term_progress *bar);
 
 #ifdef __cplusplus
 }

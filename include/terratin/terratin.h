@@ -641,6 +641,16 @@ typedef struct tt_eval_result {
 tt_status tt_eval_triangles(tt_context *ctx, const tt_grid *grid,
                             size_t ntriangles, const double *pix_xyz,
                             tt_eval_result *out_result);
+/* tt_eval_triangles, and the TIN on the grid: out_heights (width x height
+ * doubles, row by row, owned by the caller) receives at every sample
+ * within 1e-9 pixel of a triangle the height there of the first triangle
+ * (in input order) covering it -- the one its error is measured against,
+ * so TIN - DEM is exactly the difference measured -- nodata samples
+ * included, and NaN at every sample no triangle covers. */
+tt_status tt_eval_triangles_raster(tt_context *ctx, const tt_grid *grid,
+                                   size_t ntriangles, const double *pix_xyz,
+                                   tt_eval_result *out_result,
+                                   double *out_heights);
 
 /* ---------------------------------------------------------------------------
  * Synthetic terrains (SPEC section 4). All are seeded and bit-reproducible.

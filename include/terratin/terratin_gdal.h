@@ -192,6 +192,23 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
                              const char *path, const char *srs_wkt,
                              int overwrite);
 
+/* Writes nx x ny doubles (row by row, NaN: nodata, declared as the band's
+ * nodata value) as one band of type GDT_Float32 or GDT_Float64 to path
+ * with the raster driver drv (Create, or CreateCopy of an in-memory copy
+ * for drivers that only copy), the geotransform gt, srs_wkt ("" or NULL:
+ * none) and the creation options. path is created as given: pass the
+ * temporary name of a tt_output and commit it on success. name names the
+ * file in messages (NULL: path). progress may stop the write
+ * (TT_ERR_INTERRUPTED); on failure the caller's tt_output removes what
+ * was made. */
+tt_status tt_gdal_write_raster(tt_context *ctx, GDALDriverH drv,
+                               const char *path, const char *name,
+                               size_t nx, size_t ny, const double *values,
+                               GDALDataType type, const double gt[6],
+                               const char *srs_wkt,
+                               CSLConstList create_options,
+                               tt_progress_fn progress, void *progress_arg);
+
 /* ---------------------------------------------------------------------------
  * Mesh and survey files (not OGR drivers): SMS 2DM, binary little-endian
  * PLY, Wavefront OBJ, a LandXML 1.2 TIN surface and UGRID netCDF.
@@ -304,6 +321,13 @@ void tt_output_destroy(tt_output *out);
  * no live output was committed, 0 when one was (its run is finishing and
  * should be let finish). Thread-safe; not async-signal-safe. */
 int tt_output_abandon_all(void);
+/* Copies text (a driver's message) into buf (size bytes, truncated) with
+ * the temporary names of every live tt_output replaced by their final
+ * names, so that messages name the user's output: the temporary path (or
+ * its bare file name) reads as the final path, a file inside a temporary
+ * folder as that file in the final folder. Returns 1 when a name was
+ * replaced. Thread-safe. */
+int tt_output_rename_in_text(const char *text, char *buf, size_t size);
 
 #ifdef __cplusplus
 }

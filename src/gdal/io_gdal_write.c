@@ -10,13 +10,22 @@
  * error, so a failed write leaves nothing and an existing file is replaced
  * only with overwrite.
  *
- * Workload: one pass over the heights to look for NaN, one RasterIO; GDAL's
- * block cache holds dirty tiles up to its limit.
+ * tt_gdal_write_raster writes any array of doubles on a DEM's grid (the
+ * TIN rasterized, TIN - DEM) with any GDAL raster driver, into a file the
+ * caller named (the temporary name of its tt_output): Create and strips of
+ * rows, polling the progress callback between strips so an interrupt
+ * stops a slow write, or, for drivers that only copy (AAIGrid, XYZ), an
+ * in-memory dataset handed to CreateCopy with the same callback.
+ *
+ * Workload: one pass over the heights to look for NaN, one RasterIO (or
+ * one per strip of rows); GDAL's block cache holds dirty tiles up to its
+ * limit.
  */
 #include "base/internal.h"
 #include "terratin/terratin_gdal.h"
 
 #include <cpl_error.h>
+#include <cpl_string.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -94,5 +103,109 @@ tt_status tt_gdal_write_grid(tt_context *ctx, const tt_grid *grid,
 
 done:
   tt_output_destroy(out); /* removes the temporary file unless committed */
+  return s;
+}
+
+/* The app's progress callback as GDAL's (CreateCopy). */
+typedef struct write_progress {
+  tt_progress_fn fn;
+  void *arg;
+} write_progress;
+
+static int CPL_STDCALL gdal_progress(double complete, const char *message,
+                                     void *arg)
+{
+  const write_progress *p = arg;
+  (void)message;
+  return p->fn ? p->fn(complete, NULL, p->arg) : 1;
+}
+
+tt_status tt_gdal_write_raster(tt_context *ctx, GDALDriverH drv,
+                               const char *path, const char *name,
+                               size_t nx, size_t ny, const double *values,
+                               GDALDataType type, const double gt[6],
+                               const char *srs_wkt,
+                               CSLConstList create_options,
+                               tt_progress_fn progress, void *progress_arg)
+{
+  if (!drv || !path || !values || !gt || nx == 0 || ny == 0)
+    return tt__error(ctx, TT_ERR_ARG, "driver, path, values and "
+                     "geotransform must be given");
+  if (!name)
+    name = path;
+  if (nx > INT32_MAX || ny > INT32_MAX)
+    return tt__error(ctx, TT_ERR_LIMIT, "%s: %zu x %zu samples are more "
+                     "than GDAL's 2^31 - 1 a side", name, nx, ny);
+  if (type != GDT_Float32 && type != GDT_Float64)
+    return tt__error(ctx, TT_ERR_ARG, "%s: the band type must be Float32 "
+                     "or Float64", name);
+  const int can_create =
+      GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL) != NULL;
+  write_progress wp = {progress, progress_arg};
+  tt_status s = TT_OK;
+  GDALDatasetH ds = NULL, out = NULL;
+  CPLErrorReset();
+  if (can_create)
+    ds = GDALCreate(drv, path, (int)nx, (int)ny, 1, type,
+                    (char **)create_options);
+  else
+    ds = GDALCreate(GDALGetDriverByName("MEM"), "", (int)nx, (int)ny, 1,
+                    type, NULL);
+  if (!ds)
+    return tt__error(ctx, TT_ERR_IO, "cannot create %s: %s", name,
+                     gdal_msg());
+  GDALSetGeoTransform(ds, (double *)gt); /* only read: GDAL's signature */
+  if (srs_wkt && *srs_wkt && GDALSetProjection(ds, srs_wkt) != CE_None) {
+    s = tt__error(ctx, TT_ERR_ARG, "%s: the CRS could not be set: %s", name,
+                  gdal_msg());
+    goto done;
+  }
+  GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+  GDALSetRasterNoDataValue(band, NAN);
+  /* Strips of rows: a whole number of the driver's blocks, at least 64
+   * rows and 1 M samples, so that each strip writes whole tiles. */
+  int bx = 0, by = 0;
+  GDALGetBlockSize(band, &bx, &by);
+  size_t strip = by > 0 ? (size_t)by : 1;
+  while (strip < 64 || strip * nx < ((size_t)1 << 20))
+    strip *= 2;
+  for (size_t r0 = 0; r0 < ny; r0 += strip) {
+    size_t rows = ny - r0 < strip ? ny - r0 : strip;
+    if (can_create && progress &&
+        !progress((double)r0 / (double)ny, NULL, progress_arg)) {
+      s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: interrupted", name);
+      goto done;
+    }
+    /* GF_Write only reads the buffer (GDAL's signature drops const). */
+    if (GDALRasterIOEx(band, GF_Write, 0, (int)r0, (int)nx, (int)rows,
+                       (void *)(values + r0 * nx), (int)nx, (int)rows,
+                       GDT_Float64, (GSpacing)sizeof(double),
+                       (GSpacing)(nx * sizeof(double)), NULL) != CE_None) {
+      s = tt__error(ctx, TT_ERR_IO, "cannot write %s: %s", name, gdal_msg());
+      goto done;
+    }
+  }
+  if (!can_create) {
+    CPLErrorReset();
+    out = GDALCreateCopy(drv, path, ds, FALSE, (char **)create_options,
+                         gdal_progress, &wp);
+    if (!out) {
+      s = CPLGetLastErrorNo() == CPLE_UserInterrupt
+              ? tt__error(ctx, TT_ERR_INTERRUPTED, "%s: interrupted", name)
+              : tt__error(ctx, TT_ERR_IO, "cannot write %s: %s", name,
+                          gdal_msg());
+      goto done;
+    }
+  }
+
+done:
+  CPLErrorReset();
+  if (out)
+    GDALClose(out);
+  GDALClose(ds); /* flushes the tiles: errors show up here */
+  if (s == TT_OK && CPLGetLastErrorType() >= CE_Failure)
+    s = tt__error(ctx, TT_ERR_IO, "cannot write %s: %s", name, gdal_msg());
+  if (s == TT_OK && progress && !progress(1.0, NULL, progress_arg))
+    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: interrupted", name);
   return s;
 }

@@ -1090,3 +1090,85 @@ tt_status tt_output_commit(tt_context *ctx, tt_output *out)
   pthread_mutex_unlock(&live_lock);
   return s;
 }
+
+/* Appends src[0..n) to buf at *len, truncating. */
+static void put_text(char *buf, size_t size, size_t *len, const char *src,
+                     size_t n)
+{
+  if (*len + 1 >= size)
+    return;
+  if (n > size - 1 - *len)
+    n = size - 1 - *len;
+  memcpy(buf + *len, src, n);
+  *len += n;
+  buf[*len] = '\0';
+}
+
+/* buf = text with every `from` replaced by `to` (and, when `from_dir` is
+ * set, every "from/" by "to_dir/"); 1 when one was found. */
+static int replace_name(const char *text, const char *from, const char *to,
+                        const char *to_dir, char *buf, size_t size)
+{
+  size_t len = 0, n = strlen(from);
+  int found = 0;
+  buf[0] = '\0';
+  for (const char *p = text; *p;) {
+    const char *q = n ? strstr(p, from) : NULL;
+    if (!q) {
+      put_text(buf, size, &len, p, strlen(p));
+      break;
+    }
+    found = 1;
+    put_text(buf, size, &len, p, (size_t)(q - p));
+    if (to_dir && q[n] == '/') {
+      /* a file inside a temporary folder: it goes to the final folder */
+      if (strcmp(to_dir, ".") != 0) {
+        put_text(buf, size, &len, to_dir, strlen(to_dir));
+        put_text(buf, size, &len, "/", 1);
+      }
+      p = q + n + 1;
+    } else {
+      put_text(buf, size, &len, to, strlen(to));
+      p = q + n;
+    }
+  }
+  return found;
+}
+
+int tt_output_rename_in_text(const char *text, char *buf, size_t size)
+{
+  if (!buf || size == 0)
+    return 0;
+  buf[0] = '\0';
+  if (!text)
+    return 0;
+  char *tmp = malloc(size);
+  if (!tmp) {
+    snprintf(buf, size, "%s", text);
+    return 0;
+  }
+  snprintf(buf, size, "%s", text);
+  int found = 0;
+  pthread_mutex_lock(&live_lock);
+  for (tt_output *o = live_head; o; o = o->next) {
+    if (!o->temp_path || !o->final_path)
+      continue;
+    if (replace_name(buf, o->temp_path, o->final_path,
+                     o->shapefile ? o->dir : NULL, tmp, size)) {
+      found = 1;
+      snprintf(buf, size, "%s", tmp);
+    }
+    /* the bare temporary file name (a driver that names the file only) */
+    const char *tb = strrchr(o->temp_path, '/');
+    const char *fb = strrchr(o->final_path, '/');
+    tb = tb ? tb + 1 : o->temp_path;
+    fb = fb ? fb + 1 : o->final_path;
+    if (replace_name(buf, tb, fb, NULL, tmp, size)) {
+      found = 1;
+      snprintf(buf, size, "%s", tmp);
+    }
+  }
+  pthread_mutex_unlock(&live_lock);
+  free(tmp);
+  return found;
+}

@@ -27,7 +27,10 @@
  * edge segment). The ends move inward past samples that fail and outward
  * past neighbours that pass; by convexity every sample between the two ends
  * is covered. Heights are read at the grid's own precision (floats, or
- * doubles: tt_precision), and every error is computed in doubles. Workload:
+ * doubles: tt_precision), and every error is computed in doubles.
+ * tt_eval_triangles_raster also writes the TIN's height at every sample a
+ * triangle covers (the first triangle's, as the error is measured), which
+ * `terratin rasterize` and `eval -error_raster` write as rasters. Workload:
  * O(triangles + rows of the clipped bounding boxes + covered samples)
  * time; memory 2 bits per sample.
  */
@@ -134,6 +137,7 @@ typedef struct eval_acc {
   const tt_grid *g;
   size_t nx;
   uint64_t *cov, *mark;   /* the 2-bit sample states, see the header */
+  double *zout;           /* the TIN's heights (tt_eval_triangles_raster) */
   size_t covered, overlapped;
   double sum_abs, sum_sq, max_abs;
   int64_t max_col, max_row;
@@ -143,6 +147,15 @@ typedef struct eval_acc {
 static void eval_visit(eval_acc *acc, const eval_tri *t, size_t c, size_t r)
 {
   const size_t idx = r * acc->nx + c;
+  /* The TIN on the grid: the first triangle over the sample gives its
+   * height (at nodata samples too), with the formula of hp below, so the
+   * error raster holds exactly the differences measured here. */
+  if (acc->zout && isnan(acc->zout[idx])) {
+    const double px = (double)c, py = (double)r;
+    acc->zout[idx] = (eval_edge(t, 1, px, py) * t->z[0] +
+                      eval_edge(t, 2, px, py) * t->z[1] +
+                      eval_edge(t, 0, px, py) * t->z[2]) / t->a2;
+  }
   const double h = tt__grid_z(acc->g, idx);
   if (isnan(h))
     return;
@@ -268,6 +281,15 @@ tt_status tt_eval_triangles(tt_context *ctx, const tt_grid *grid,
                             size_t ntriangles, const double *pix_xyz,
                             tt_eval_result *out_result)
 {
+  return tt_eval_triangles_raster(ctx, grid, ntriangles, pix_xyz,
+                                  out_result, NULL);
+}
+
+tt_status tt_eval_triangles_raster(tt_context *ctx, const tt_grid *grid,
+                                   size_t ntriangles, const double *pix_xyz,
+                                   tt_eval_result *out_result,
+                                   double *out_heights)
+{
   tt_status status = TT_OK;
   eval_acc acc;
   memset(&acc, 0, sizeof acc);
@@ -310,6 +332,11 @@ tt_status tt_eval_triangles(tt_context *ctx, const tt_grid *grid,
     goto done;
   }
   acc.max_col = acc.max_row = -1;
+  if (out_heights) {
+    for (size_t i = 0; i < nx * ny; i++)
+      out_heights[i] = NAN;
+    acc.zout = out_heights;
+  }
 
   size_t degenerate = 0;
   for (size_t k = 0; k < ntriangles; k++) {

@@ -10,6 +10,7 @@
  * vertices in no triangle are left out of the TIN, so every TIN vertex is a
  * corner of a triangle (vertex indices keep their insertion order). Cost: O(samples + triangles); memory: the compact tin arrays
  * plus 12 bytes per vertex and 4 per triangle slot while building.
+ * Every RMS is clamped to its max (rounding could lift it by an ulp).
  */
 #include "mesh/raster_scan.h"
 #include "tin/tin.h"
@@ -304,8 +305,12 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     }
   }
   for (size_t t = 0; t < nt; t++) {
-    tin->t_rmse[t] = tin->t_n[t] ? (float)sqrt(t_sq[t] / (double)tin->t_n[t])
-                                 : 0.0f;
+    /* An RMS is at most the max, but sqrt(sum / n) of n equal errors may
+     * round one ulp above it: clamp, so rmse <= max_err holds in every
+     * row written. */
+    tin->t_rmse[t] = tin->t_n[t] ? fmin(sqrt(t_sq[t] / (double)tin->t_n[t]),
+                                        tin->t_max[t])
+                                 : 0.0;
     for (int k = 0; k < 3; k++) {
       int32_t v = tin->tv[3 * t + k];
       if (tin->t_max[t] > tin->v_star_max[v])
@@ -316,15 +321,16 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
   }
   for (size_t v = 0; v < nv; v++)
     tin->v_star_rmse[v] = tin->v_star_n[v]
-                              ? sqrt(tin->v_star_rmse[v] /
-                                     (double)tin->v_star_n[v])
+                              ? fmin(sqrt(tin->v_star_rmse[v] /
+                                          (double)tin->v_star_n[v]),
+                                     tin->v_star_max[v])
                               : 0.0;
   es->samples = count; /* the caller sets the valid count */
   es->covered = count;
   tin->summary.components = count_components(m);
   es->total_abs = sum_abs;
   es->l2 = sqrt(sum_sq);
-  es->rmse = count ? sqrt(sum_sq / (double)count) : 0;
+  es->rmse = count ? fmin(sqrt(sum_sq / (double)count), es->max_error) : 0;
   es->mean_abs = count ? sum_abs / (double)count : 0;
   if (max_index >= 0) {
     es->max_col = max_index % (int64_t)g->nx;

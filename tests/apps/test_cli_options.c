@@ -486,6 +486,28 @@ static void test_eval(void)
   CHECK_USAGE("missing TIN", "eval", "dem.tif");
   CHECK_USAGE("-max_error", "eval", "a", "b", "-max_error", "-0.1");
   CHECK_USAGE("does not apply", "eval", "a", "b", "-overwrite");
+  CHECK_USAGE("without -error_raster", "eval", "a", "b", "-co", "A=B");
+  CHECK_USAGE("does not apply", "eval", "a", "b", "-of", "GTiff");
+  CHECK_USAGE("missing DEM and OUTPUT", "rasterize", "tin.gpkg");
+  CHECK_USAGE("missing OUTPUT", "rasterize", "tin.gpkg", "dem.tif");
+  CHECK_USAGE("-co expects NAME=VALUE", "rasterize", "a", "b", "c", "-co",
+              "X");
+  CHECK_USAGE("does not apply", "rasterize", "a", "b", "c", "-lco", "A=B");
+  CHECK_USAGE("unexpected argument", "rasterize", "a", "b", "c", "d");
+  PARSE_OK(o, "rasterize", "t.gpkg", "d.tif", "o.tif", "-co", "A=1", "-co",
+           "B=2", "-of", "AAIGrid", "-layer", "tri");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->command == TT_APP_RASTERIZE && strcmp(s->tin, "t.gpkg") == 0 &&
+        strcmp(s->input, "d.tif") == 0 && strcmp(s->output, "o.tif") == 0 &&
+        strcmp(s->format, "AAIGrid") == 0 && s->co[0] && s->co[1] &&
+        !s->co[2] && strcmp(s->co[1], "B=2") == 0 &&
+        strcmp(s->layer, "tri") == 0);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "eval", "d.tif", "t.gpkg", "-error_raster", "e.tif",
+           "-overwrite");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->overwrite && strcmp(s->error_raster, "e.tif") == 0);
+  tt_app_options_destroy(o);
   CHECK_USAGE("does not apply", "eval", "a", "b", "-max_points", "5");
 }
 

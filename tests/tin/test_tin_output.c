@@ -5,7 +5,10 @@
  * south-up, east-left); every vertex is a corner of some triangle (the
  * starting corners of a raster with nodata specks included); a grid whose
  * valid samples make no triangle (a checkerboard of nodata) is refused with
- * TT_ERR_DATA instead of giving a TIN of lone vertices.
+ * TT_ERR_DATA instead of giving a TIN of lone vertices; a triangle's rmse
+ * never exceeds its max_err, nor a vertex's star_rmse its star_max (issue
+ * 17: rmse was a float, rounded above max_err in 1,929 of Mt Hood's
+ * triangles).
  */
 #include "tt_test.h"
 
@@ -131,9 +134,49 @@ static void test_checkerboard(tt_context *ctx)
   tt_tin_destroy(tin);
 }
 
+/* A 129^2 fractal at max error 5 has 3,007 triangles whose rmse equals
+ * their max_err (most own one sample); rounded to a float, 206 of them
+ * would exceed it. */
+static void test_rmse_le_max(tt_context *ctx)
+{
+  tt_synth_options so;
+  tt_synth_options_init(&so, TT_SYNTH_DIAMOND_SQUARE);
+  so.nx = so.ny = 129;
+  so.seed = 17;
+  tt_grid *g = NULL;
+  tt_tin *tin = NULL;
+  CHECK_OK(ctx, tt_synth_generate(ctx, &so, &g));
+  tt_refine_options ro;
+  tt_refine_options_init(&ro);
+  ro.max_error = 5;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &ro, &tin));
+  size_t above = 0, as_float = 0, star_above = 0, eq = 0;
+  for (size_t i = 0; tin && i < tt_tin_triangle_count(tin); i++) {
+    tt_triangle_info t;
+    CHECK_INT_EQ(tt_tin_triangle(tin, i, &t), TT_OK);
+    above += t.rmse > t.max_error;
+    as_float += (double)(float)t.rmse > t.max_error;
+    eq += t.rmse == t.max_error && t.max_error > 0;
+  }
+  for (size_t i = 0; tin && i < tt_tin_vertex_count(tin); i++) {
+    tt_vertex_info v;
+    CHECK_INT_EQ(tt_tin_vertex(tin, i, &v), TT_OK);
+    star_above += v.star_rmse > v.star_max_error;
+  }
+  printf("rmse > max_err: %zu of %zu triangles (%zu if stored as floats; "
+         "%zu with rmse = max_err > 0); star_rmse > star_max: %zu\n", above,
+         tin ? tt_tin_triangle_count(tin) : 0, as_float, eq, star_above);
+  CHECK(as_float > 0); /* the case is exercised */
+  CHECK_INT_EQ(above, 0);
+  CHECK_INT_EQ(star_above, 0);
+  tt_tin_destroy(tin);
+  tt_grid_destroy(g);
+}
+
 int main(void)
 {
   tt_context *ctx = tt_context_create();
+  test_rmse_le_max(ctx);
   test_orientation(ctx);
   test_speckled_corners(ctx);
   test_checkerboard(ctx);

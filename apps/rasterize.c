@@ -1,0 +1,359 @@
+/*
+ * rasterize.c -- `terratin rasterize TIN DEM OUTPUT`: a layer of triangles
+ * (read as eval reads it) drawn on the DEM's grid, each sample centre in a
+ * triangle given the triangle's linear interpolation of its corners'
+ * heights, NaN (the band's nodata) outside the TIN; and the raster writer
+ * that `eval -error_raster` shares (the driver, the band type, the
+ * creation options, the commit).
+ *
+ * The heights come from tt_eval_triangles_raster, the same pass eval
+ * measures with, so a sample's value is the height of the triangle its
+ * error is measured against, and the summary's errors are eval's.
+ * Invariants: neither input is written; OUTPUT is refused when it exists
+ * unless -overwrite, before anything is read; it is written under a
+ * temporary name and renamed when complete, so a failure or an interrupt
+ * leaves nothing behind.
+ *
+ * Workload: the DEM's heights, 8 bytes a sample for the TIN's, one pass
+ * over the covered samples, one write.
+ */
+#include "app.h"
+
+#include <cpl_conv.h>
+#include <cpl_string.h>
+#include <ogr_api.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* A raster driver that can write a float band. */
+static int can_write_floats(GDALDriverH drv)
+{
+  const char *types =
+      GDALGetMetadataItem(drv, GDAL_DMD_CREATIONDATATYPES, NULL);
+  return GDALGetMetadataItem(drv, GDAL_DCAP_RASTER, NULL) &&
+         (GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL) ||
+          GDALGetMetadataItem(drv, GDAL_DCAP_CREATECOPY, NULL)) &&
+         (!types || strstr(types, "Float32") || strstr(types, "Float64"));
+}
+
+/* Whether the space-separated list holds ext (any case). */
+static int has_ext(const char *list, const char *ext)
+{
+  size_t n = strlen(ext);
+  for (const char *p = list; p && *p;) {
+    while (*p == ' ')
+      p++;
+    const char *e = strchr(p, ' ');
+    size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (len == n && n && strncasecmp(p, ext, n) == 0)
+      return 1;
+    p = e;
+  }
+  return 0;
+}
+
+/* No -of: GTiff for .tif, .tiff or no extension, else the first driver
+ * that claims the extension and writes floats (as GDAL's utilities guess);
+ * an extension only drivers without floats claim (.png) is theirs, refused
+ * by the caller; an extension no driver claims gets GTiff and a warning. */
+static const char *guess_driver(app_run *r, const char *path)
+{
+  const char *claimed = NULL;
+  const char *base = strrchr(path, '/');
+  const char *dot = strrchr(base ? base + 1 : path, '.');
+  if (!dot || !dot[1] || strcasecmp(dot, ".tif") == 0 ||
+      strcasecmp(dot, ".tiff") == 0)
+    return "GTiff";
+  for (int i = 0; i < GDALGetDriverCount(); i++) {
+    GDALDriverH d = GDALGetDriver(i);
+    const char *exts = GDALGetMetadataItem(d, GDAL_DMD_EXTENSIONS, NULL);
+    if (!exts)
+      exts = GDALGetMetadataItem(d, GDAL_DMD_EXTENSION, NULL);
+    if (!exts || !has_ext(exts, dot + 1) ||
+        !GDALGetMetadataItem(d, GDAL_DCAP_RASTER, NULL) ||
+        strcmp(GDALGetDriverShortName(d), "MEM") == 0)
+      continue;
+    if (can_write_floats(d))
+      return GDALGetDriverShortName(d);
+    if (!claimed)
+      claimed = GDALGetDriverShortName(d);
+  }
+  if (claimed)
+    return claimed;
+  tt__app_warn(&r->msg, "%s: no raster driver that writes floats claims "
+               "the extension '%s'; writing a GeoTIFF (use -of to choose)",
+               path, dot);
+  return "GTiff";
+}
+
+GDALDriverH tt__app_raster_driver(app_run *r, const char *of,
+                                  const char *path)
+{
+  char what[300]; /* "-of 'X'", or the output whose extension chose X */
+  const char *cmd = tt__app_command_name(r->s->command);
+  if (of || !path) {
+    of = of ? of : "GTiff";
+    snprintf(what, sizeof what, "-of '%s'", of);
+  } else {
+    of = guess_driver(r, path);
+    snprintf(what, sizeof what, "%.200s (by its extension: %s)", path, of);
+  }
+  GDALDriverH drv = GDALGetDriverByName(of);
+  if (!drv) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                 "%s: %s: no such GDAL driver (see 'gdalinfo --formats')",
+                 cmd, what);
+    return NULL;
+  }
+  if (!GDALGetMetadataItem(drv, GDAL_DCAP_RASTER, NULL) ||
+      (!GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL) &&
+       !GDALGetMetadataItem(drv, GDAL_DCAP_CREATECOPY, NULL))) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                 "%s: %s: the driver cannot write rasters", cmd, what);
+    return NULL;
+  }
+  /* A driver that lists its band types must take floats. */
+  const char *types =
+      GDALGetMetadataItem(drv, GDAL_DMD_CREATIONDATATYPES, NULL);
+  if (types && !strstr(types, "Float32") && !strstr(types, "Float64")) {
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                 "%s: %s: the driver cannot write Float32 or Float64 bands "
+                 "(it takes %s); choose another with -of", cmd, what, types);
+    return NULL;
+  }
+  return drv;
+}
+
+tt_status tt__app_write_raster(app_run *r, tt_output *out, GDALDriverH drv,
+                               const tt_grid *grid,
+                               const tt_raster_info *info,
+                               const double *values)
+{
+  const char *path = tt_output_final_path(out);
+  const char *name = GDALGetDriverShortName(drv);
+  GDALDataType type = tt_grid_precision(grid) == TT_PRECISION_FLOAT64
+                          ? GDT_Float64
+                          : GDT_Float32;
+  /* Doubles only where a float cannot hold every height of the DEM. */
+  const char *types =
+      GDALGetMetadataItem(drv, GDAL_DMD_CREATIONDATATYPES, NULL);
+  if (types && type == GDT_Float64 && !strstr(types, "Float64"))
+    type = GDT_Float32;
+  if (types && type == GDT_Float32 && !strstr(types, "Float32"))
+    type = GDT_Float64;
+  char **co = NULL;
+  if (strcmp(name, "GTiff") == 0) {
+    co = CSLSetNameValue(co, "TILED", "YES");
+    co = CSLSetNameValue(co, "COMPRESS", "DEFLATE");
+    co = CSLSetNameValue(co, "PREDICTOR", "3"); /* floating point */
+    co = CSLSetNameValue(co, "BIGTIFF", "IF_SAFER");
+  }
+  for (size_t i = 0; r->s->co[i]; i++) {
+    char *key = NULL;
+    const char *value = CPLParseNameValue(r->s->co[i], &key);
+    if (key && value)
+      co = CSLSetNameValue(co, key, value);
+    CPLFree(key);
+  }
+  r->msg.last[0] = '\0';
+  unsigned failures = r->msg.failures;
+  tt_status st = tt_gdal_write_raster(
+      r->ctx, drv, tt_output_temp_path(out), path, tt_grid_width(grid),
+      tt_grid_height(grid), values, type, info->gt, info->crs_wkt,
+      (CSLConstList)co, tt__app_phase_fn, &r->prog);
+  CSLDestroy(co);
+  if (st != TT_OK)
+    return tt__app_fail_write(r, st, path, tt_output_temp_path(out), NULL);
+  if (r->msg.failures != failures) /* a driver's failure it survived */
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, path, "%s",
+                        r->msg.last);
+  st = tt_output_commit(r->ctx, out);
+  if (st == TT_ERR_EXISTS)
+    return tt__app_fail_exists(r, path);
+  if (st != TT_OK)
+    return tt__app_fail_tt(r, st, path);
+  return TT_OK;
+}
+
+tt_status tt__app_rasterize(app_run *r)
+{
+  const tt_app_settings *s = r->s;
+  tt_status st = TT_OK;
+  tt_output *outp = NULL;
+  GDALDatasetH src = NULL, tds = NULL;
+  GDALRasterBandH band = NULL;
+  tt_grid *grid = NULL;
+  tt_raster_info *info = NULL;
+  double *xyz = NULL, *z = NULL;
+  size_t ntri = 0, rejected = 0, valid = 0;
+  tt_eval_result ev;
+  memset(&ev, 0, sizeof ev);
+
+  if (tt__app_same_file(s->input, s->output) ||
+      tt__app_same_file(s->tin, s->output))
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
+                        "is an input; refusing to replace it");
+  GDALDriverH drv = tt__app_raster_driver(r, s->format, s->output);
+  if (!drv)
+    return r->res->status;
+  r->msg.last[0] = '\0';
+  st = tt_output_begin(r->ctx, s->output, GDALGetDriverShortName(drv),
+                       s->overwrite, &outp);
+  if (st == TT_ERR_EXISTS) {
+    tt__app_fail_exists(r, s->output);
+    goto done;
+  }
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
+
+  tt__app_phase_set(&r->prog, 0.0, 0.4);
+  src = tt__app_open_raster(r, s->input, s->band, &band);
+  if (!src) {
+    st = r->res->status;
+    goto done;
+  }
+  st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
+  st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
+                        &info, &valid);
+  if (st != TT_OK)
+    goto done;
+  GDALClose(src);
+  src = NULL;
+  tds = tt__app_open_vector(r, s->tin);
+  if (!tds) {
+    st = r->res->status;
+    goto done;
+  }
+  st = tt_output_protect_dataset(r->ctx, outp, tds, s->tin);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->output);
+    goto done;
+  }
+  OGRLayerH layer = tt__app_tin_layer(r, tds);
+  if (!layer) {
+    st = r->res->status;
+    goto done;
+  }
+  char lname[256];
+  snprintf(lname, sizeof lname, "%s", OGR_L_GetName(layer));
+  if (tt__app_layer_in_other_crs(layer, info))
+    tt__app_warn(&r->msg, "%s: layer '%s' is not in the CRS of %s; it is "
+                 "drawn as if it were", s->tin, lname, s->input);
+  r->msg.last[0] = '\0';
+  st = tt_ogr_read_triangles(r->ctx, layer, info->gt, &xyz, &ntri,
+                             &rejected);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->tin);
+    goto done;
+  }
+  GDALClose(tds);
+  tds = NULL;
+  if (ntri == 0) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, s->tin,
+                      "layer '%s' holds no triangles (%zu feature%s "
+                      "rejected)", lname, rejected, rejected == 1 ? "" : "s");
+    goto done;
+  }
+  /* corners a few 1e-9 pixel off their sample go back on it, as in eval */
+  for (size_t i = 0; i < ntri * 9; i++) {
+    double rounded = floor(xyz[i] + 0.5);
+    if (i % 3 != 2 && fabs(xyz[i] - rounded) <= 1e-6)
+      xyz[i] = rounded;
+  }
+  const size_t nx = tt_grid_width(grid), ny = tt_grid_height(grid);
+  double t_read = tt__app_now() - r->t0;
+  if (!tt__app_continue(r, 0.4)) {
+    st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
+    goto done;
+  }
+  z = malloc(nx * ny * sizeof *z);
+  if (!z) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, s->output,
+                      "out of memory for %zu x %zu heights", nx, ny);
+    goto done;
+  }
+  double t = tt__app_now();
+  st = tt_eval_triangles_raster(r->ctx, grid, ntri, xyz, &ev, z);
+  if (st != TT_OK) {
+    tt__app_fail_tt(r, st, s->tin);
+    goto done;
+  }
+  size_t in_tin = 0;
+  for (size_t i = 0; i < nx * ny; i++)
+    in_tin += !isnan(z[i]);
+  double t_raster = tt__app_now() - t;
+  if (in_tin == 0) {
+    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, s->tin,
+                      "no sample of %s lies in a triangle of layer '%s' "
+                      "(another extent, or another CRS?)", s->input, lname);
+    goto done;
+  }
+
+  t = tt__app_now();
+  tt__app_phase_set(&r->prog, 0.5, 1.0);
+  st = tt__app_write_raster(r, outp, drv, grid, info, z);
+  if (st != TT_OK)
+    goto done;
+  double t_write = tt__app_now() - t;
+
+  const char *unit = tt__app_unit_or(info, "z units");
+  const tt_error_stats *e = &ev.errors;
+  if (s->json) {
+    app_json j;
+    tt__json_begin(&j, r->out);
+    tt__json_str(&j, "tin", s->tin);
+    tt__json_str(&j, "layer", lname);
+    tt__json_str(&j, "dem", s->input);
+    tt__json_str(&j, "output", s->output);
+    tt__json_str(&j, "driver", GDALGetDriverShortName(drv));
+    tt__json_size(&j, "width", nx);
+    tt__json_size(&j, "height", ny);
+    tt__json_size(&j, "triangles", ev.triangles);
+    tt__json_size(&j, "rejected", rejected);
+    tt__json_size(&j, "cells_in_tin", in_tin);
+    tt__json_size(&j, "nodata_cells", nx * ny - in_tin);
+    tt__json_size(&j, "valid_samples", e->samples);
+    tt__json_size(&j, "covered", e->covered);
+    tt__json_num(&j, "max_error", e->max_error);
+    tt__json_num(&j, "rmse", e->rmse);
+    tt__json_str(&j, "z_unit", tt__app_nonempty_or_null(info->z_unit));
+    tt__json_open(&j, "seconds");
+    tt__json_num(&j, "read", t_read);
+    tt__json_num(&j, "rasterize", t_raster);
+    tt__json_num(&j, "write", t_write);
+    tt__json_num(&j, "total", tt__app_now() - r->t0);
+    tt__json_close(&j);
+    tt__json_close(&j);
+  } else if (!s->quiet) {
+    fprintf(r->out, "%s: %zux%zu, %zu samples in %zu triangles of %s "
+                    "layer %s, %zu nodata, in %.3f s\n",
+            s->output, nx, ny, in_tin, ev.triangles, s->tin, lname,
+            nx * ny - in_tin, t_raster + t_write);
+    fprintf(r->out, "against %s: max error %.9g %s, RMS error %.9g %s over "
+                    "%zu of %zu valid samples\n",
+            s->input, e->max_error, unit, e->rmse, unit, e->covered,
+            e->samples);
+  }
+  fflush(r->out);
+
+done:
+  if (tds)
+    GDALClose(tds);
+  if (src)
+    GDALClose(src);
+  tt_output_destroy(outp);
+  free(z);
+  free(xyz);
+  tt_grid_destroy(grid);
+  tt_raster_info_destroy(info);
+  return st;
+}
