@@ -12,6 +12,7 @@
  * Workload: a single pass over a few dozen words.
  */
 #include "app.h"
+#include "option_table.h"
 
 #include <errno.h>
 #include <math.h>
@@ -26,99 +27,6 @@ static const char *const empty_list[] = {NULL};
 /* ===========================================================================
  * Parsing
  * ========================================================================= */
-
-/* Which option applies to which command: one table, so the parser, the
- * error messages and the tests agree. */
-enum opt_id {
-  O_B, O_MAX_ERROR, O_MAX_POINTS, O_MAX_TRIANGLES, O_PERCENT, O_OF, O_LCO,
-  O_DSCO, O_NLN, O_OVERWRITE, O_OBJ_LOCAL, O_Q, O_CRITERION, O_OPTIMIZE,
-  O_REPAIR, O_JSON, O_LAYER, O_SIZE, O_SEED, O_ITERATIONS, O_DISPLACEMENT,
-  O_WAVE_SIZE, O_ROUGHNESS, O_AMPLITUDE, O_SEEDING, O_A_SRS, O_SRCNODATA,
-  O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
-  O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START, O_IMPORTANCE,
-  O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY, O_TERRAIN,
-  O_CRITERIA, O_METHODS, O_OPTIMIZERS, O_ERROR_RASTER, O_CO
-};
-
-#define FOR_S (1u << TT_APP_SIMPLIFY)
-#define FOR_G (1u << TT_APP_GENERATE)
-#define FOR_E (1u << TT_APP_EVAL)
-#define FOR_O (1u << TT_APP_OPTIMIZE)
-#define FOR_T (1u << TT_APP_STUDY)
-#define FOR_R (1u << TT_APP_RASTERIZE)
-
-static const struct opt_def {
-  const char *name;
-  enum opt_id id;
-  int takes_value;
-  unsigned commands;
-} opt_defs[] = {
-    {"-b", O_B, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-max_error", O_MAX_ERROR, 1, FOR_S | FOR_E | FOR_O},
-    {"-max_points", O_MAX_POINTS, 1, FOR_S},
-    {"-max_triangles", O_MAX_TRIANGLES, 1, FOR_S},
-    {"-percent", O_PERCENT, 1, FOR_S | FOR_T}, /* study: a list */
-    {"-of", O_OF, 1, FOR_S | FOR_O | FOR_R},
-    {"-f", O_OF, 1, FOR_S | FOR_O}, /* ogr2ogr's spelling */
-    {"-lco", O_LCO, 1, FOR_S | FOR_O},
-    {"-dsco", O_DSCO, 1, FOR_S | FOR_O},
-    {"-nln", O_NLN, 1, FOR_S | FOR_O},
-    {"-overwrite", O_OVERWRITE, 0,
-     FOR_S | FOR_G | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-obj_local", O_OBJ_LOCAL, 0, FOR_S},
-    {"-q", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-quiet", O_Q, 0, FOR_S | FOR_G | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-criterion", O_CRITERION, 1, FOR_S | FOR_O},
-    {"-optimize", O_OPTIMIZE, 1, FOR_S | FOR_O},
-    {"-repair", O_REPAIR, 1, FOR_S},
-    {"-json", O_JSON, 0, FOR_S | FOR_E | FOR_O | FOR_R},
-    {"-layer", O_LAYER, 1, FOR_E | FOR_O | FOR_R},
-    {"-size", O_SIZE, 1, FOR_G},
-    {"-seed", O_SEED, 1, FOR_G | FOR_S | FOR_O | FOR_T},
-    {"-iterations", O_ITERATIONS, 1, FOR_G},
-    {"-displacement", O_DISPLACEMENT, 1, FOR_G},
-    {"-wave_size", O_WAVE_SIZE, 1, FOR_G},
-    {"-roughness", O_ROUGHNESS, 1, FOR_G},
-    {"-amplitude", O_AMPLITUDE, 1, FOR_G},
-    {"-seeding", O_SEEDING, 1, FOR_G},
-    {"-a_srs", O_A_SRS, 1, FOR_G},
-    {"-srcnodata", O_SRCNODATA, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-z_factor", O_Z_FACTOR, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-z_unit", O_Z_UNIT, 1, FOR_S | FOR_E | FOR_O | FOR_T | FOR_R},
-    {"-work_srs", O_WORK_SRS, 1, FOR_S},
-    {"-t_srs", O_T_SRS, 1, FOR_S},
-    {"-anneal_t0", O_ANNEAL_T0, 1, FOR_S | FOR_O | FOR_T},
-    {"-anneal_stages", O_ANNEAL_STAGES, 1, FOR_S | FOR_O | FOR_T},
-    {"-anneal_swaps", O_ANNEAL_SWAPS, 1, FOR_S | FOR_O | FOR_T},
-    {"-anneal_good", O_ANNEAL_GOOD, 1, FOR_S | FOR_O | FOR_T},
-    {"-anneal_r", O_ANNEAL_R, 1, FOR_S | FOR_O | FOR_T},
-    {"-method", O_METHOD, 1, FOR_S},
-    {"-start", O_START, 1, FOR_S | FOR_T},
-    {"-importance", O_IMPORTANCE, 1, FOR_S | FOR_T},
-    {"-selection", O_SELECTION, 1, FOR_S},
-    {"-onepass", O_ONEPASS, 0, FOR_S},
-    {"-hole", O_HOLE, 1, FOR_S},
-    {"-threads", O_THREADS, 1, FOR_S | FOR_T},
-    {"-max_memory", O_MAX_MEMORY, 1, FOR_S | FOR_E | FOR_R},
-    {"-terrain", O_TERRAIN, 1, FOR_T},
-    {"-criteria", O_CRITERIA, 1, FOR_T},
-    {"-methods", O_METHODS, 1, FOR_T},
-    {"-optimizers", O_OPTIMIZERS, 1, FOR_T},
-    {"-error_raster", O_ERROR_RASTER, 1, FOR_E},
-    {"-co", O_CO, 1, FOR_E | FOR_R},
-};
-
-static const struct opt_def *find_opt(const char *w)
-{
-  for (size_t i = 0; i < sizeof opt_defs / sizeof opt_defs[0]; i++)
-    if (tt__app_str_ieq(w, opt_defs[i].name))
-      return &opt_defs[i];
-  /* GDAL accepts --of as well as -of for its own options: do the same,
-   * with exactly two dashes ("---of" is a typo, not an option). */
-  if (w[0] == '-' && w[1] == '-' && w[2] != '\0' && w[2] != '-')
-    return find_opt(w + 1);
-  return NULL;
-}
 
 /* What generate was told, applied after tt_synth_options_init(kind). */
 typedef struct synth_flags {
@@ -307,10 +215,10 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
     }
 
     /* "-" alone and negative numbers are positional words. */
-    const struct opt_def *d = NULL;
+    const tt__app_opt_def *d = NULL;
     double dummy;
     if (w[0] == '-' && w[1] != '\0' && !tt__app_parse_double(w, &dummy)) {
-      d = find_opt(w);
+      d = tt__app_find_opt(w);
       if (!d)
         USAGE("%s: unknown option '%s'%s", cmdname, w, hint);
       if (!(d->commands & (1u << o->s.command)))
