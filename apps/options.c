@@ -37,7 +37,8 @@ enum opt_id {
   O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
   O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START, O_IMPORTANCE,
   O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY, O_TERRAIN,
-  O_CRITERIA, O_METHODS, O_OPTIMIZERS
+  O_CRITERIA, O_METHODS, O_OPTIMIZERS,
+  O_POINTS
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -102,6 +103,7 @@ static const struct opt_def {
     {"-criteria", O_CRITERIA, 1, FOR_T},
     {"-methods", O_METHODS, 1, FOR_T},
     {"-optimizers", O_OPTIMIZERS, 1, FOR_T},
+    {"-points", O_POINTS, 1, FOR_T},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -624,6 +626,14 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
               : d->id == O_METHODS ? &o->s.methods
                                    : &o->s.optimizers) = keep(o, v)))
         NOMEM();
+      break;
+    case O_POINTS: /* study: a row at every point count up to N */
+      if ((k = tt__app_parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+        USAGE("%s: -points must be an integer >= 1, got '%s'", cmdname, v);
+      if (k != NUM_OK || z > TT_MAX_VERTICES)
+        USAGE("%s: -points %s is above the limit of %zu vertices", cmdname,
+              v, (size_t)TT_MAX_VERTICES);
+      o->s.points = z;
       break;
     case O_A_SRS:
       if (!*v)
