@@ -13,7 +13,11 @@
  *
  * Each checkpoint is its own run from the start, so its numbers are those
  * of a single simplify run at that percentage (the final optimisation
- * pass included); per-insertion curves (-points) are not offered yet.
+ * pass included). With -points N, study_curves.c adds the curves: a row at
+ * every point count up to N (insertion) or after every round (decimation)
+ * from one recorded run each. Insertion uses the study's repair
+ * (tt__study_repair: Delaunay's flips for the criteria it optimised after
+ * Delaunay insertion).
  *
  * Invariants: everything is checked (lists, combinations, every terrain
  * read) before the first run; an existing non-empty OUTDIR is refused
