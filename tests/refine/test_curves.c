@@ -8,7 +8,8 @@
  *    pass (those steps are measured on an optimised copy);
  *  - recording changes no TIN; the last step is the TIN returned;
  *  - the running totals do not drift: a run to zero error ends at zero;
- *  - the callback stops a run; step_at without step_until;
+ *  - the callback stops a run; step_at without step_until; the same
+ *    sums with and without threads;
  *  - decimation reports every round, its last step is the TIN returned. */
 #include "terratin/terratin.h"
 #include "tt_test.h"
@@ -343,9 +344,48 @@ static void test_stop_and_at(void)
   CHECK_INT_EQ(l.s[1].points, 100);
   CHECK_INT_EQ(l.s[2].points, 300);
   CHECK(l.s[2].last && !l.s[1].last);
+  tt_tin_destroy(tin);
+  tin = NULL;
   o.step_at = NULL;
   CHECK_INT_EQ(tt_refine_run(ctx, g, &o, &tin), TT_ERR_ARG);
   tt_tin_destroy(tin);
+  tt_grid_destroy(g);
+}
+
+/* Threads: large triangles are scanned in bands, the same bands with and
+ * without threads, so the sums are the same bit for bit. */
+static void test_threads(void)
+{
+  tt_grid *g = terrain(530, 520, 8, 5.0, false, false);
+  static log_t a, b;
+  memset(&a, 0, sizeof a);
+  memset(&b, 0, sizeof b);
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.max_error = -1;
+  o.max_points = 80;
+  o.step = record;
+  o.step_until = SIZE_MAX;
+  o.threads = 1;
+  o.step_arg = &a;
+  tt_tin *t1 = NULL, *t2 = NULL;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &o, &t1));
+  o.threads = 3;
+  o.step_arg = &b;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &o, &t2));
+  CHECK_INT_EQ(a.n, b.n);
+  for (size_t i = 0; i < a.n && i < b.n; i++)
+    if (memcmp(&a.s[i].errors, &b.s[i].errors, sizeof a.s[i].errors) != 0)
+      TT_FAIL_("step %zu: 1 thread and 3 give other measures (l2 %.17g, "
+               "%.17g)", i, a.s[i].errors.l2, b.s[i].errors.l2);
+  if (t1) {
+    tt_tin_summary sum;
+    tt_tin_get_summary(t1, &sum);
+    check_errors("threads", sum.vertices, &a.s[a.n - 1].errors, &sum.errors,
+                 1e-12, true);
+  }
+  tt_tin_destroy(t1);
+  tt_tin_destroy(t2);
   tt_grid_destroy(g);
 }
 
@@ -393,6 +433,7 @@ int main(void)
   test_synth();
   test_no_drift();
   test_stop_and_at();
+  test_threads();
   test_decimate();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
