@@ -10,7 +10,8 @@
  *  - the running totals do not drift: a run to zero error ends at zero;
  *  - the callback stops a run; step_at without step_until; the same
  *    sums with and without threads;
- *  - decimation reports every round, its last step is the TIN returned. */
+ *  - decimation reports every round (every removal, sequential), its last
+ *    step is the TIN returned. */
 #include "terratin/terratin.h"
 #include "tt_test.h"
 
@@ -419,6 +420,24 @@ static void test_decimate(void)
     CHECK_INT_EQ(l.s[i].step, i);
     CHECK(l.s[i].points < l.s[i - 1].points);
     CHECK_INT_EQ(l.s[i].errors.covered, l.s[0].errors.covered);
+  }
+  tt_tin_destroy(tin);
+  /* sequential selection: a step per removal */
+  memset(&l, 0, sizeof l);
+  o.selection = TT_SELECTION_SEQUENTIAL;
+  o.max_points = 1400;
+  tin = NULL;
+  CHECK_OK(ctx, tt_decimate_run(ctx, g, &o, &tin));
+  if (tin) {
+    tt_tin_get_summary(tin, &sum);
+    CHECK_INT_EQ(l.s[l.n - 1].points, 1400);
+    CHECK_INT_EQ(l.s[l.n - 1].step, sum.rounds);
+    check_errors("sequential last", sum.vertices, &l.s[l.n - 1].errors,
+                 &sum.errors, 1e-12, true);
+    for (size_t i = 1; i + 1 < l.n; i++) {
+      CHECK_INT_EQ(l.s[i].step, i);
+      CHECK_INT_EQ(l.s[i].points + 1, l.s[i - 1].points);
+    }
   }
   tt_tin_destroy(tin);
   tt_grid_destroy(g);
