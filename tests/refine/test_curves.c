@@ -313,6 +313,25 @@ static void test_no_drift(void)
   CHECK(e->max_error == 0);
   CHECK_INT_EQ(e->max_col, -1);
   tt_tin_destroy(tin);
+  /* with an error limit, recording keeps every candidate in the heap (its
+   * top is then the worst error of the mesh): the same TIN all the same */
+  o.max_error = 2.5;
+  o.criterion = TT_CRITERION_L2;
+  tin = NULL;
+  tt_tin *plain = NULL;
+  memset(&l, 0, sizeof l);
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &o, &tin));
+  o.step = NULL;
+  CHECK_OK(ctx, tt_refine_run(ctx, g, &o, &plain));
+  if (tin && plain) {
+    CHECK(same_tin(tin, plain));
+    tt_tin_summary sum;
+    tt_tin_get_summary(plain, &sum);
+    check_errors("max_error 2.5", sum.vertices, &l.s[l.n - 1].errors,
+                 &sum.errors, 1e-12, true);
+  }
+  tt_tin_destroy(plain);
+  tt_tin_destroy(tin);
   tt_grid_destroy(g);
 }
 
