@@ -620,6 +620,9 @@ static tt_status report_step(refine *r, size_t iter, bool last)
     bool any = tt__heap_size(&r->heap) > 0;
     double top = any ? tt__heap_top(&r->heap).key : 0.0;
     int64_t at = any ? r->cand[tt__heap_top(&r->heap).item] : -1;
+    /* the run's time so far, the reports' own left out; plus, below,
+     * this step's final pass */
+    si.seconds = t0 - r->t_start - r->rec_seconds;
     if (r->final != TT_OPTIMIZE_NONE) {
       /* the bound of the run's own final pass */
       if (!tt__curve_final(&r->curve, &r->m, r->cerr, r->cand, r->crit,
@@ -628,11 +631,11 @@ static tt_status report_step(refine *r, size_t iter, bool last)
                            r->valid, &si.errors))
         return oom(r);
       si.optimized = 1;
+      si.seconds += tt__now() - t0;
     } else {
       tt__curve_errors(&r->curve, r->g, r->linked, r->valid, top, at,
                        &si.errors);
     }
-    si.seconds = tt__now() - r->t_start - r->rec_seconds;
   }
   si.last = last;
   r->prev = si;
