@@ -386,8 +386,9 @@ typedef struct tt_refine_options {
    * (tt_step_info.last), with the measures of the TIN the run would return
    * had it stopped there. They come from per-triangle sums of |H - H'| and
    * (H - H')^2 kept up to date as the triangles are rescanned (24 bytes per
-   * triangle slot, and a second pass over the samples of each rescanned
-   * triangle), not from a pass over every sample. When the final pass
+   * triangle slot; each rescan reads every sample of its triangle, where
+   * an unrecorded one skips the tiles that cannot hold its candidate),
+   * not from a pass over every sample. When the final pass
    * (optimize, resolved) is not none, each reported step applies it to a
    * copy of the mesh and measures the copy (only the triangles it changed
    * are scanned), as a run stopped there would. NULL (the default): none

@@ -228,10 +228,19 @@ static void scan_job(void *arg, size_t i)
   refine *r = arg;
   scan_job_t *j = &r->jobs[i];
   const tt__scan_tri st = j->st;
+  if (r->rec) {
+    /* recording: one pass gives both, the sums and the candidate (the
+     * statistics' largest error is the candidate search's, bit for bit:
+     * the same plane expression, the first sample in row-major order on
+     * ties; an exact triangle has none) */
+    tt__scan_stats_rows(r->g, &st, j->ylo, j->yhi, &j->ss);
+    bool any = j->ss.max_err > 0 && j->ss.max_index >= 0;
+    j->err = any ? j->ss.max_err : 0;
+    j->index = any ? j->ss.max_index : -1;
+    return;
+  }
   tt__scan_candidate_rows(r->g, &r->tiles, &st, j->ylo, j->yhi, &j->err,
                           &j->index);
-  if (r->rec)
-    tt__scan_stats_rows(r->g, &st, j->ylo, j->yhi, &j->ss);
 }
 
 /* Appends the jobs of live triangle t. */

@@ -3,9 +3,10 @@
  * (issue 15's curves), kept up to date instead of measured afresh.
  *
  * Greedy insertion rescans every triangle it writes (refine.c); with a
- * recorder it also sums |H - H'| and (H - H')^2 over the samples each
- * rescanned triangle owns and keeps them per slot here, with their totals
- * over the live triangles. A step's L2, RMS, mean and total then cost
+ * recorder that rescan is the statistics scan (raster_scan.h), which also
+ * sums |H - H'| and (H - H')^2 over the samples the triangle owns and
+ * gives the same candidate, and the sums are kept per slot here, with
+ * their totals over the live triangles. A step's L2, RMS, mean and total then cost
  * nothing more, and its L-infinity is the top of the candidate heap.
  *
  * Drift: the totals only ever add and subtract the per-slot doubles, so
