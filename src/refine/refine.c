@@ -23,8 +23,13 @@
  * TIN covers exactly the valid samples that a valid cell part holds (the
  * others, lone samples amid nodata, are counted as uncovered).
  *
+ * Curves (opt->step, curve.h): each rescan also keeps its triangle's sums
+ * of |H - H'| and (H - H')^2, so every step's measures are known without a
+ * pass over the samples; with a final pass, a reported step applies it to
+ * a copy of the mesh. Without a recorder none of that runs.
+ *
  * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 4
- * (+ 16 per triangle above max_error);
+ * (+ 16 per triangle above max_error; + 24 for the sums when recording);
  * per sample, while inserting: the scans' tile bounds, 0.25 bytes.
  * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
  */
