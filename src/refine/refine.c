@@ -741,7 +741,8 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.pool = tt__pool_create(tt__pool_threads(nthreads));
   /* the scans' error bounds per tile: without them (out of memory) large
    * triangles are scanned row by row, with the same results */
-  (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
+  if (!opt->step) /* recording scans every sample: no use for them */
+    (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
   r.max_error = opt->max_error;
   r.rec = opt->step != NULL;
   r.heap_floor = r.rec ? -1.0 : opt->max_error;
