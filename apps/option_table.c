@@ -61,6 +61,7 @@ static const tt__app_opt_def opt_defs[] = {
     {"-optimizers", O_OPTIMIZERS, 1, FOR_T},
     {"-error_raster", O_ERROR_RASTER, 1, FOR_E},
     {"-co", O_CO, 1, FOR_E | FOR_R},
+    {"-points", O_POINTS, 1, FOR_T},
 };
 
 const tt__app_opt_def *tt__app_find_opt(const char *w)

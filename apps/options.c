@@ -549,6 +549,14 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       if (!(o->s.error_raster = keep(o, v)))
         NOMEM();
       break;
+    case O_POINTS: /* study: a row at every point count up to N */
+      if ((k = tt__app_parse_size(v, &z)) == NUM_BAD || (k == NUM_OK && z < 1))
+        USAGE("%s: -points must be an integer >= 1, got '%s'", cmdname, v);
+      if (k != NUM_OK || z > TT_MAX_VERTICES)
+        USAGE("%s: -points %s is above the limit of %zu vertices", cmdname,
+              v, (size_t)TT_MAX_VERTICES);
+      o->s.points = z;
+      break;
     case O_A_SRS:
       if (!*v)
         USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);

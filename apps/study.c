@@ -13,7 +13,11 @@
  *
  * Each checkpoint is its own run from the start, so its numbers are those
  * of a single simplify run at that percentage (the final optimisation
- * pass included); per-insertion curves (-points) are not offered yet.
+ * pass included). With -points N, study_curves.c adds the curves: a row at
+ * every point count up to N (insertion) or after every round (decimation)
+ * from one recorded run each. Insertion uses the study's repair
+ * (tt__study_repair: Delaunay's flips for the criteria it optimised after
+ * Delaunay insertion).
  *
  * Invariants: everything is checked (lists, combinations, every terrain
  * read) before the first run; an existing non-empty OUTDIR is refused
@@ -22,6 +26,7 @@
  * OUTDIR the run created is removed again).
  */
 #include "app.h"
+#include "study.h"
 
 #include <cpl_conv.h>
 #include <cpl_string.h>
@@ -32,8 +37,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-#define STUDY_MAX_LIST 64
 
 /* The study's generated terrains (SPEC section 4): nx = 0 keeps the
  * kind's default size; the fault and diamond-square fields apply to their
@@ -59,37 +62,6 @@ static const struct named_terrain {
     {"bump", TT_SYNTH_BUMP, 0, 0, 0, 0, 0, TT_SEED_NONE},
 };
 #define NAMED_COUNT (sizeof named_terrains / sizeof named_terrains[0])
-
-/* A terrain of the study, read or generated before the first run. */
-typedef struct study_terrain {
-  const char *arg;   /* as given to -terrain */
-  const char *label; /* the generator's name or the DEM's file name */
-  const struct named_terrain *named; /* NULL: a DEM file */
-  tt_synth_options synth;            /* named terrains */
-  tt_grid *grid;
-  size_t valid;
-} study_terrain;
-
-/* One run's outcome: a row of curves.csv. */
-typedef struct study_row {
-  size_t terrain, method, criterion, optimizer, percent; /* plan indices */
-  size_t points;
-  tt_error_stats e;
-  double seconds;
-} study_row;
-
-/* What the lists said. */
-typedef struct study_plan {
-  tt_criterion crit[STUDY_MAX_LIST];
-  size_t ncrit;
-  int decimate[2]; /* per method: 0 insert, 1 decimate */
-  size_t nmeth;
-  tt_optimize opt[STUDY_MAX_LIST];
-  size_t nopt;
-  double pct[STUDY_MAX_LIST];
-  char pct_text[STUDY_MAX_LIST][32]; /* the checkpoint as given */
-  size_t npct;
-} study_plan;
 
 /* Splits list (comma-separated, no empty items) into items of at most
  * size - 1 bytes each, calling item() on each; 0 with a usage failure
@@ -208,12 +180,15 @@ static int make_plan(app_run *r, study_plan *p)
   } else if (!split_list(r, p, "-criteria", s->criteria, add_criterion)) {
     return 0;
   }
+  p->points = s->points;
   if (!split_list(r, p, "-methods", s->methods ? s->methods : "insert",
                   add_method) ||
       !split_list(r, p, "-optimizers", s->optimizers ? s->optimizers : "auto",
                   add_optimizer) ||
-      !split_list(r, p, "-percent", s->percents ? s->percents : "1,10,25,50",
-                  add_percent))
+      /* -points alone: no -percent checkpoints */
+      (!(s->points && !s->percents) &&
+       !split_list(r, p, "-percent", s->percents ? s->percents : "1,10,25,50",
+                   add_percent)))
     return 0;
   for (size_t o = 0; o < p->nopt; o++)
     for (size_t c = 0; c < p->ncrit; c++)
@@ -312,6 +287,7 @@ static tt_status run_one(app_run *r, const study_terrain *t,
     o.max_error = -1.0;
     o.percent = p->pct[row->percent];
     o.criterion = p->crit[row->criterion];
+    o.repair = tt__study_repair(o.criterion);
     o.optimize = p->opt[row->optimizer];
     o.anneal = s->anneal;
     o.threads = tt__app_threads(r);
@@ -355,23 +331,43 @@ static void csv_field(FILE *fp, const char *v)
   fputc('"', fp);
 }
 
-/* The final pass a run made: auto resolved as the engine resolves it. */
+/* The final pass a run made: auto resolved as the engine resolves it
+ * (with the study's repair for insertion, study_curves.c). */
 static const char *optimizer_used(const study_plan *p, const study_row *w)
 {
   tt_criterion c = p->crit[w->criterion];
+  tt_repair rep = p->decimate[w->method] ? TT_REPAIR_AUTO
+                                         : tt__study_repair(c);
   return tt_optimize_name(tt_optimize_resolve(
-      p->opt[w->optimizer], c, tt_repair_resolve(TT_REPAIR_AUTO, c)));
+      p->opt[w->optimizer], c, tt_repair_resolve(rep, c)));
 }
 
-static void write_curves(FILE *fp, const study_terrain *ts,
-                         const study_plan *p, const study_row *rows,
-                         size_t nrows)
+/* Whether a -points row repeats a -percent row (the same run at the same
+ * count: the -percent run, a TIN of its own, is kept). */
+static int repeats(const study_row *w, const study_row *rows, size_t nrows)
+{
+  for (size_t i = 0; i < nrows; i++)
+    if (rows[i].points == w->points && rows[i].terrain == w->terrain &&
+        rows[i].method == w->method && rows[i].optimizer == w->optimizer &&
+        rows[i].criterion == w->criterion)
+      return 1;
+  return 0;
+}
+
+/* The -percent rows, then the -points rows (in run order, each run's
+ * steps in the order the run took them). */
+static size_t write_curves(FILE *fp, const study_terrain *ts,
+                           const study_plan *p, const study_row *rows,
+                           size_t nrows, const study_rows *steps)
 {
   char b[6][40];
+  size_t written = 0;
   fputs("terrain,method,criterion,optimizer,points,max_error,l2,rmse,"
         "mean_abs_error,total_abs_error,seconds\n", fp);
-  for (size_t i = 0; i < nrows; i++) {
-    const study_row *w = &rows[i];
+  for (size_t i = 0; i < nrows + steps->n; i++) {
+    const study_row *w = i < nrows ? &rows[i] : &steps->w[i - nrows];
+    if (i >= nrows && repeats(w, rows, nrows))
+      continue;
     csv_field(fp, ts[w->terrain].label);
     tt__app_format_double(b[0], sizeof b[0], w->e.max_error);
     tt__app_format_double(b[1], sizeof b[1], w->e.l2);
@@ -384,7 +380,9 @@ static void write_curves(FILE *fp, const study_terrain *ts,
             tt_criterion_name(p->crit[w->criterion]),
             optimizer_used(p, w), w->points, b[0], b[1],
             b[2], b[3], b[4], b[5]);
+    written++;
   }
+  return written;
 }
 
 /* The study's tables: rows are laid out terrain, method, optimiser,
@@ -398,6 +396,11 @@ static void write_tables(FILE *fp, const study_terrain *ts, size_t nterr,
         "Mean absolute error (z units) of the TIN at each percentage of "
         "the valid samples; the best criterion of each row in bold.\n",
         fp);
+  if (!p->npct) {
+    fputs("\nNo -percent checkpoints were asked for: the curves are in "
+          "curves.csv.\n", fp);
+    return;
+  }
   for (size_t t = 0; t < nterr; t++)
     for (size_t m = 0; m < p->nmeth; m++)
       for (size_t o = 0; o < p->nopt; o++, at += block) {
@@ -438,7 +441,7 @@ static const char *seeding_name(tt_synth_seeding s)
 }
 
 static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
-                       size_t nterr, size_t nrows)
+                       size_t nterr, size_t nrows, size_t nruns)
 {
   const tt_app_settings *s = r->s;
   app_json j;
@@ -485,7 +488,13 @@ static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
   tt__json_str(&j, "criteria", s->criteria ? s->criteria : "all");
   tt__json_str(&j, "methods", s->methods ? s->methods : "insert");
   tt__json_str(&j, "optimizers", s->optimizers ? s->optimizers : "auto");
-  tt__json_str(&j, "percent", s->percents ? s->percents : "1,10,25,50");
+  tt__json_str(&j, "percent", s->percents   ? s->percents
+                              : s->points ? ""
+                                          : "1,10,25,50");
+  if (s->points)
+    tt__json_size(&j, "points", s->points);
+  else
+    tt__json_null(&j, "points");
   if (s->seed_set)
     tt__json_i64(&j, "seed", (int64_t)s->seed);
   else
@@ -507,7 +516,8 @@ static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
   tt__json_num(&j, "r", s->anneal.r);
   tt__json_i64(&j, "seed", (int64_t)s->anneal.seed);
   tt__json_close(&j);
-  tt__json_size(&j, "runs", nrows);
+  tt__json_size(&j, "runs", nruns);
+  tt__json_size(&j, "rows", nrows);
   tt__json_str(&j, "seconds", "mesh: tt_tin_summary.seconds_mesh");
   tt__json_close(&j);
 }
@@ -556,12 +566,14 @@ static const char *const out_names[F_COUNT] = {"curves.csv", "tables.md",
 /* Writes the three files under temporary names, then renames them. */
 static tt_status write_outputs(app_run *r, int exists, const study_terrain *ts,
                                size_t nterr, const study_plan *p,
-                               const study_row *rows, size_t nrows)
+                               const study_row *rows, size_t nrows,
+                               const study_rows *steps, size_t nruns)
 {
   const char *dir = r->s->output;
   tt_status st = TT_OK;
   char *tmp[F_COUNT] = {NULL, NULL, NULL}, *fin[F_COUNT] = {NULL, NULL, NULL};
   int created = 0, renamed = 0;
+  size_t written = 0;
   if (!exists) {
     if (mkdir(dir, 0777) != 0) {
       st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir,
@@ -581,11 +593,11 @@ static tt_status write_outputs(app_run *r, int exists, const study_terrain *ts,
       goto done;
     }
     if (f == F_CURVES)
-      write_curves(fp, ts, p, rows, nrows);
+      written = write_curves(fp, ts, p, rows, nrows, steps);
     else if (f == F_TABLES)
       write_tables(fp, ts, nterr, p, rows);
     else
-      write_runs(r, fp, ts, nterr, nrows);
+      write_runs(r, fp, ts, nterr, written, nruns);
     int bad = ferror(fp);
     if (fclose(fp) != 0 || bad) {
       st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, tmp[f],
@@ -621,7 +633,8 @@ tt_status tt__app_study(app_run *r)
   study_plan plan;
   study_terrain *ts = NULL;
   study_row *rows = NULL;
-  size_t nterr = 0, nrows = 0;
+  study_rows steps = {NULL, 0, 0};
+  size_t nterr = 0, nrows = 0, nruns = 0;
   while (s->terrains[nterr])
     nterr++;
 
@@ -636,7 +649,7 @@ tt_status tt__app_study(app_run *r)
   }
   size_t per_terrain = plan.nmeth * plan.nopt * plan.npct * plan.ncrit;
   ts = calloc(nterr, sizeof *ts);
-  rows = calloc(nterr * per_terrain, sizeof *rows);
+  rows = calloc(per_terrain ? nterr * per_terrain : 1, sizeof *rows);
   if (!ts || !rows) {
     st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
                       "out of memory");
@@ -656,8 +669,12 @@ tt_status tt__app_study(app_run *r)
     }
   }
 
-  /* The runs (5 - 99%), in the order the tables read them. */
-  size_t total = nterr * per_terrain;
+  /* The runs (5 - 99%), in the order the tables read them; then the
+   * -points runs (study_curves.c), one per terrain, method, optimiser and
+   * criterion. */
+  size_t ncurves = plan.points ? nterr * plan.nmeth * plan.nopt * plan.ncrit
+                               : 0;
+  size_t total = nterr * per_terrain + ncurves;
   for (size_t t = 0; t < nterr; t++)
     for (size_t m = 0; m < plan.nmeth; m++)
       for (size_t o = 0; o < plan.nopt; o++)
@@ -680,15 +697,33 @@ tt_status tt__app_study(app_run *r)
               goto done;
             nrows++;
           }
+  for (size_t t = 0; t < nterr && plan.points; t++)
+    for (size_t m = 0; m < plan.nmeth; m++)
+      for (size_t o = 0; o < plan.nopt; o++)
+        for (size_t c = 0; c < plan.ncrit; c++) {
+          study_row key = {t, m, c, o, SIZE_MAX, 0, {0}, 0};
+          double lo = 0.05 + 0.94 * (double)(nrows + nruns) / (double)total;
+          tt__app_phase_set(&r->prog, lo, lo + 0.94 / (double)total);
+          if (!tt__app_continue(r, lo)) {
+            st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
+            goto done;
+          }
+          st = tt__study_curve_run(r, &ts[t], &plan, &key, &steps);
+          if (st != TT_OK)
+            goto done;
+          nruns++;
+        }
+  nruns += nrows;
 
-  st = write_outputs(r, exists, ts, nterr, &plan, rows, nrows);
+  st = write_outputs(r, exists, ts, nterr, &plan, rows, nrows, &steps,
+                     nruns);
   if (st != TT_OK)
     goto done;
   /* Draws 100%; a stop asked now is too late: the files are committed. */
   (void)tt__app_continue(r, 1.0);
   if (!s->quiet) {
     fprintf(r->out, "%s: %zu runs over %zu terrain%s (curves.csv, tables.md, "
-            "runs.json); %.2f s\n", s->output, nrows, nterr,
+            "runs.json); %.2f s\n", s->output, nruns, nterr,
             nterr == 1 ? "" : "s", tt__app_now() - r->t0);
     fflush(r->out);
   }
@@ -697,5 +732,6 @@ done:
     tt_grid_destroy(ts[t].grid);
   free(ts);
   free(rows);
+  free(steps.w);
   return st;
 }

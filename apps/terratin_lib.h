@@ -137,7 +137,9 @@ typedef struct tt_app_settings {
   const char *methods;       /* -methods insert,decimate; NULL: insert */
   const char *optimizers;    /* -optimizers auto,none,local,...; NULL:
                                 auto */
-  const char *percents;      /* -percent P,P,...; NULL: 1,10,25,50 */
+  const char *percents;      /* -percent P,P,...; NULL: 1,10,25,50 (none
+                                with -points alone) */
+  size_t points;             /* -points N: curves up to N points; 0: none */
   uint64_t seed;             /* -seed (study: the generated terrains) */
   int seed_set;              /* -seed was given */
 

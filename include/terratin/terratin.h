@@ -342,6 +342,12 @@ tt_status tt_optimize_check(tt_context *ctx, tt_optimize optimize,
 tt_optimize tt_optimize_resolve(tt_optimize optimize, tt_criterion criterion,
                                 tt_repair repair);
 
+/* Curves (issue 15): a run can report the error measures of its TIN after
+ * every step (tt_step_info, below the error measures), through this
+ * callback; returning 0 stops the run with TT_ERR_INTERRUPTED. */
+typedef struct tt_step_info tt_step_info;
+typedef int (*tt_step_fn)(const tt_step_info *step, void *arg);
+
 typedef struct tt_refine_options {
   /* Stop when the worst remaining sample error is <= max_error (z units).
    * Negative: no error limit. */
@@ -373,6 +379,25 @@ typedef struct tt_refine_options {
    * grow, and a run that would pass the limit stops with TT_ERR_NOMEM and
    * a message naming the phase and the size it needed. 0: no limit. */
   size_t max_memory;
+  /* Curves: when step is set, it is called after the starting
+   * triangulation and after each insertion whose vertex count is at most
+   * step_until (SIZE_MAX: every one) or one of the nstep_at counts of
+   * step_at (any order), and once more for the step the run ends at
+   * (tt_step_info.last), with the measures of the TIN the run would return
+   * had it stopped there. They come from per-triangle sums of |H - H'| and
+   * (H - H')^2 kept up to date as the triangles are rescanned (24 bytes per
+   * triangle slot; each rescan reads every sample of its triangle, where
+   * an unrecorded one skips the tiles that cannot hold its candidate),
+   * not from a pass over every sample. When the final pass
+   * (optimize, resolved) is not none, each reported step applies it to a
+   * copy of the mesh and measures the copy (only the triangles it changed
+   * are scanned), as a run stopped there would. NULL (the default): none
+   * of this, and the run costs what it always did. */
+  tt_step_fn step;
+  void *step_arg;
+  size_t step_until;
+  const size_t *step_at;
+  size_t nstep_at;
 } tt_refine_options;
 
 /* Default: max_error 1 z unit, no other limit, Delaunay, no progress. */
@@ -461,6 +486,26 @@ typedef struct tt_error_stats {
   int64_t max_col;      /* where max_error was found (-1 if none) */
   int64_t max_row;
 } tt_error_stats;
+
+/* One step of a recorded run (tt_refine_options.step,
+ * tt_decimate_options.step). */
+struct tt_step_info {
+  size_t step;          /* insertions done (refinement); rounds done
+                           (decimation: independent sets, or removals with
+                           sequential selection); 0: the start */
+  size_t points;        /* vertices of the TIN at this step */
+  size_t triangles;
+  /* The measures, as tt_tin_summary.errors would give them for the TIN of
+   * this step (samples = the valid samples); max_col, max_row: a sample
+   * where max_error is reached (-1 when every sample is exact). */
+  tt_error_stats errors;
+  /* Seconds of the run up to this step, the time spent reporting earlier
+   * steps left out (this step's final pass on a copy counted). */
+  double seconds;
+  int optimized;        /* non-zero: measured on a copy after the final
+                           pass */
+  int last;             /* non-zero: the step the run ends at */
+};
 
 typedef struct tt_tin_summary {
   size_t vertices;
@@ -612,6 +657,13 @@ typedef struct tt_decimate_options {
   int threads;             /* as in tt_refine_options */
   tt_progress_fn progress;
   void *progress_arg;
+  /* Curves: when step is set, it is called with the measures of the mesh
+   * after the start and after every round (every removal with sequential
+   * selection), before the final pass, and once more at the end
+   * (tt_step_info.last, after the final pass), each from one pass over
+   * every sample (decimation keeps no running sums). NULL: none. */
+  tt_step_fn step;
+  void *step_arg;
 } tt_decimate_options;
 
 /* Default: no limit at all (set one), Delaunay, start all, importance

@@ -39,6 +39,7 @@
 #include "base/heap.h"
 #include "base/parallel.h"
 #include "optimize/optimize.h"
+#include "tin/curve.h"
 #include "tin/tin.h"
 
 #include <math.h>
@@ -223,6 +224,9 @@ typedef struct run {
   size_t since_progress;
   tt__dec_check_fn check;     /* tests only */
   void *check_arg;
+  /* curves (opt->step): measured by a full pass at each report */
+  size_t valid;
+  double t_start, rec_seconds;
 } run;
 
 static tt_status oom(run *r)
@@ -243,6 +247,31 @@ static bool count_stop(run *r)
     return true;
   }
   return false;
+}
+
+/* Reports the mesh as it stands after `rounds` rounds (opt->step): one
+ * pass over every sample. TT_ERR_INTERRUPTED when the callback says
+ * stop. */
+static tt_status report_step(run *r, bool last)
+{
+  const tt_decimate_options *o = r->d.opt;
+  if (!o->step)
+    return TT_OK;
+  double t0 = tt__now();
+  tt_step_info si;
+  memset(&si, 0, sizeof si);
+  si.step = r->rounds;
+  si.points = r->d.nvert;
+  si.triangles = r->d.m.nlive;
+  tt__curve_measure(&r->d.m, r->d.g, r->valid, &si.errors);
+  si.seconds = t0 - r->t_start - r->rec_seconds;
+  si.last = last;
+  int go = o->step(&si, o->step_arg);
+  r->rec_seconds += tt__now() - t0;
+  if (!go)
+    return tt__error(r->d.ctx, TT_ERR_INTERRUPTED, "interrupted by the step "
+                     "callback after %zu removals", r->removed);
+  return TT_OK;
 }
 
 /* The corners of every slot written since the last call: their stars
@@ -643,6 +672,9 @@ static tt_status run_independent(run *r)
       r->reason = d->max_error >= 0 ? TT_STOP_MAX_ERROR : TT_STOP_EXHAUSTED;
       break;
     }
+    status = report_step(r, false);
+    if (status != TT_OK)
+      goto done;
   }
 done:
   free(c);
@@ -697,8 +729,12 @@ static tt_status run_sequential(run *r)
         tt__heap_remove(hp, w);
       }
     }
-    if (ok > 0)
+    if (ok > 0) {
       r->rounds++;
+      tt_status st = report_step(r, false);
+      if (st != TT_OK)
+        return st;
+    }
     if (!progress(r))
       return tt__error(d->ctx, TT_ERR_INTERRUPTED, "interrupted after %zu "
                        "removals", r->removed);
@@ -890,6 +926,11 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
   }
   pin(d);
   size_t start_vertices = d->nvert;
+  r.valid = valid;
+  r.t_start = t_start;
+  status = report_step(&r, false);
+  if (status != TT_OK)
+    goto done;
   if (opt->progress && !opt->progress(0.0, "decimating", opt->progress_arg)) {
     status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
     goto done;
@@ -907,6 +948,9 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
     status = oom(&r);
     goto done;
   }
+  status = report_step(&r, true);
+  if (status != TT_OK)
+    goto done;
   /* the importance each vertex has now */
   {
     int32_t *all = malloc((d->m.nv ? d->m.nv : 1) * sizeof *all);

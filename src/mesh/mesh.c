@@ -987,6 +987,48 @@ void tt__mesh_snapshot_free(tt__mesh_snapshot *s)
   memset(s, 0, sizeof *s);
 }
 
+/* --- copies (curve.c) ------------------------------------------------- */
+
+/* malloc of n elements of size elem copied from src (n = 0: one element,
+ * so that NULL means only out of memory). */
+static void *dup_array(const void *src, size_t n, size_t elem)
+{
+  void *p = malloc((n ? n : 1) * elem);
+  if (p && n)
+    memcpy(p, src, n * elem);
+  return p;
+}
+
+bool tt__mesh_copy(tt__mesh *dst, const tt__mesh *src)
+{
+  tt__mesh_init(dst, &src->metric);
+  dst->gxy = src->gxy;
+  dst->gnx = src->gnx;
+  size_t nh = 3 * src->nslots;
+  dst->v = dup_array(src->v, src->nv, sizeof *src->v);
+  dst->hv = dup_array(src->hv, nh, sizeof *src->hv);
+  dst->twin = dup_array(src->twin, nh, sizeof *src->twin);
+  dst->eflag = dup_array(src->eflag, nh, sizeof *src->eflag);
+  dst->freelist = dup_array(src->freelist, src->nfree, sizeof *src->freelist);
+  bool ok = dst->v && dst->hv && dst->twin && dst->eflag && dst->freelist;
+  if (ok && src->vz)
+    ok = (dst->vz = dup_array(src->vz, src->nv, sizeof *src->vz)) != NULL;
+  if (ok && src->vver)
+    ok = (dst->vver = dup_array(src->vver, src->nv, sizeof *src->vver)) !=
+         NULL;
+  if (!ok) {
+    tt__mesh_free(dst);
+    return false;
+  }
+  dst->nv = dst->vcap = src->nv;
+  dst->vzcap = src->vz ? src->nv : 0;
+  dst->vvercap = src->vver ? src->nv : 0;
+  dst->nslots = dst->tcap = src->nslots;
+  dst->nlive = src->nlive;
+  dst->nfree = dst->freecap = src->nfree;
+  return true;
+}
+
 /* The counter-clockwise walk of tt__mesh_star from half-edge e (leaving
  * v): the triangle of e is (v, a, b); the next one around v holds
  * twin(prev(e)) = v -> b. Stops at the boundary or back at e. */

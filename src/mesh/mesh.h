@@ -262,6 +262,14 @@ TT_HIDDEN bool tt__mesh_snapshot_restore(tt__mesh *m,
                                          const tt__mesh_snapshot *s);
 TT_HIDDEN void tt__mesh_snapshot_free(tt__mesh_snapshot *s);
 
+/* A whole copy of src into dst (uninitialised or freed before): the same
+ * vertices, slots, free list, constraint flags and star versions, an empty
+ * touched log and a serial of its own, so that an optimiser may change the
+ * copy (curve.c: the final pass at a step of a recorded run) while src
+ * stays as it was. False when out of memory (dst then holds nothing). The
+ * caller frees dst with tt__mesh_free(). */
+TT_HIDDEN bool tt__mesh_copy(tt__mesh *dst, const tt__mesh *src);
+
 /* The star of vertex v: its triangles in counter-clockwise order around
  * it and the link, the other ends of its edges (ring) in the same order. An
  * interior vertex (a closed fan) has n neighbours and n triangles;

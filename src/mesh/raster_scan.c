@@ -468,8 +468,14 @@ void tt__scan_candidate_rows(const tt_grid *g, const tt__scan_tiles *tiles,
 void tt__scan_stats_run(const tt_grid *g, const tt__scan_tri *st,
                         tt__scan_stats *out)
 {
+  tt__scan_stats_rows(g, st, INT64_MIN, INT64_MAX, out);
+}
+
+void tt__scan_stats_rows(const tt_grid *g, const tt__scan_tri *st,
+                         int64_t ylo, int64_t yhi, tt__scan_stats *out)
+{
   if (g->zd)
-    stats_run_f64(g, st, out);
+    stats_run_f64(g, st, ylo, yhi, out);
   else
-    stats_run_f32(g, st, out);
+    stats_run_f32(g, st, ylo, yhi, out);
 }

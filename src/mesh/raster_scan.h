@@ -140,5 +140,11 @@ typedef struct tt__scan_stats {
 /* Statistics of the valid owned samples (reset, then filled). */
 TT_HIDDEN void tt__scan_stats_run(const tt_grid *g, const tt__scan_tri *st,
                                   tt__scan_stats *out);
+/* The same over rows [ylo, yhi] of the triangle only (the bands of a
+ * large triangle, refine.c); the statistics of the whole are the sums of
+ * its bands' (the largest error: the first band's on ties). */
+TT_HIDDEN void tt__scan_stats_rows(const tt_grid *g, const tt__scan_tri *st,
+                                   int64_t ylo, int64_t yhi,
+                                   tt__scan_stats *out);
 
 #endif /* TT_RASTER_SCAN_H */

@@ -732,13 +732,15 @@ static void candidate_rows(const tt_grid *g, const tt__scan_tiles *tiles,
 }
 
 static void stats_run(const tt_grid *g, const tt__scan_tri *st,
-                      tt__scan_stats *out)
+                      int64_t ylo, int64_t yhi, tt__scan_stats *out)
 {
   plane p;
   rows r;
   kern kn;
   plane_of(st, &p);
-  rows_init(st, (int64_t)g->nx, INT64_MIN, &r);
+  rows_init(st, (int64_t)g->nx, ylo, &r);
+  if (yhi < r.ymax)
+    r.ymax = yhi;
   kern_init(&kn, p.gx);
   row_acc acc = {0, 0, 0, 0};
   int64_t max_y = -1, max_xl = 0, max_xr = -1;

@@ -23,8 +23,13 @@
  * TIN covers exactly the valid samples that a valid cell part holds (the
  * others, lone samples amid nodata, are counted as uncovered).
  *
+ * Curves (opt->step, curve.h): each rescan also keeps its triangle's sums
+ * of |H - H'| and (H - H')^2, so every step's measures are known without a
+ * pass over the samples; with a final pass, a reported step applies it to
+ * a copy of the mesh. Without a recorder none of that runs.
+ *
  * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 4
- * (+ 16 per triangle above max_error);
+ * (+ 16 per triangle above max_error; + 24 for the sums when recording);
  * per sample, while inserting: the scans' tile bounds, 0.25 bytes.
  * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
  */
@@ -37,6 +42,7 @@
 #include "base/predicates.h"
 #include "mesh/raster_scan.h"
 #include "optimize/swap.h"
+#include "tin/curve.h"
 #include "tin/tin.h"
 
 #include <float.h>
@@ -77,6 +83,17 @@ typedef struct refine {
   const char *phase;   /* for messages: "inserting", ... */
   /* progress */
   double e0, frac;
+  /* curves (opt->step): the running sums, and what a step report needs */
+  bool rec;            /* opt->step is set */
+  tt__curve curve;
+  double heap_floor;   /* candidates above this enter the heap: max_error,
+                          or -1 (all) when recording, so that the heap's top
+                          is the worst error of the whole mesh */
+  size_t valid;        /* valid samples of the grid */
+  size_t linked;       /* vertices in some triangle */
+  tt_optimize final;   /* the final pass, resolved */
+  double t_start, rec_seconds; /* the time spent reporting steps */
+  tt_step_info prev;   /* the last step reported (prev.points 0: none) */
 } refine;
 
 /* --- memory ------------------------------------------------------------
@@ -103,7 +120,8 @@ static void mem_count(const refine *r, size_t nv, size_t nt, mem_use *u)
   uint64_t per_v = sizeof(tt__mesh_vertex) + sizeof(double) +
                    (m->vver ? sizeof(uint32_t) : 0);
   uint64_t per_t = 6 * sizeof(int32_t) + 3 + sizeof(int64_t) +
-                   sizeof(double) + sizeof(int32_t) + sizeof(tt__heap_entry);
+                   sizeof(double) + sizeof(int32_t) + sizeof(tt__heap_entry) +
+                   (r->rec ? 2 * sizeof(double) + sizeof(size_t) : 0);
   u->mesh = per_v * nv + per_t * nt +
             (uint64_t)(m->freecap + m->touchedcap + r->stack.cap) *
                 sizeof(int32_t);
@@ -171,6 +189,8 @@ static bool fit_slots(refine *r)
       !tt__grow((void **)&r->cerr, &c2, need, sizeof(double)))
     return false;
   r->ccap = c1 < c2 ? c1 : c2;
+  if (r->rec && !tt__curve_fit(&r->curve, r->ccap))
+    return false;
   return tt__heap_reserve_items(&r->heap, r->ccap);
 }
 
@@ -196,6 +216,7 @@ typedef struct scan_job_t {
   tt__scan_tri st;      /* the triangle, read once from the mesh */
   double err;
   int64_t index;
+  tt__scan_stats ss;    /* when recording: the band's sums */
 } scan_job_t;
 
 /* Triangles with more rows than this and a large area are cut into bands
@@ -212,6 +233,17 @@ static void scan_job(void *arg, size_t i)
   refine *r = arg;
   scan_job_t *j = &r->jobs[i];
   const tt__scan_tri st = j->st;
+  if (r->rec) {
+    /* recording: one pass gives both, the sums and the candidate (the
+     * statistics' largest error is the candidate search's, bit for bit:
+     * the same plane expression, the first sample in row-major order on
+     * ties; an exact triangle has none) */
+    tt__scan_stats_rows(r->g, &st, j->ylo, j->yhi, &j->ss);
+    bool any = j->ss.max_err > 0 && j->ss.max_index >= 0;
+    j->err = any ? j->ss.max_err : 0;
+    j->index = any ? j->ss.max_index : -1;
+    return;
+  }
   tt__scan_candidate_rows(r->g, &r->tiles, &st, j->ylo, j->yhi, &j->err,
                           &j->index);
 }
@@ -228,8 +260,11 @@ static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
   if (area2 < 0)
     area2 = -area2;
   *samples += area2 / 2;
-  int64_t band = (r->pool && area2 / 2 >= BAND_MIN_AREA) ? BAND_ROWS
-                                                         : yhi - ylo + 1;
+  /* recording, the bands are the same with or without threads, so that
+   * the sums are too (the candidates are the same either way) */
+  int64_t band = ((r->pool || r->rec) && area2 / 2 >= BAND_MIN_AREA)
+                     ? BAND_ROWS
+                     : yhi - ylo + 1;
   for (int64_t y0 = ylo; y0 <= yhi; y0 += band) {
     if (!tt__grow((void **)&r->jobs, &r->jobcap, *njobs + 1,
                   sizeof(scan_job_t)))
@@ -278,9 +313,11 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
     int32_t t = slots[i];
     if (i > 0 && t == slots[i - 1])
       continue;
-    if (!tt__mesh_live(&r->m, t))
+    if (!tt__mesh_live(&r->m, t)) {
       tt__heap_remove(&r->heap, t);
-    else if (!add_jobs(r, t, &njobs, &samples))
+      if (r->rec)
+        tt__curve_set(&r->curve, t, NULL);
+    } else if (!add_jobs(r, t, &njobs, &samples))
       return false;
   }
   if (samples < PARALLEL_MIN_SAMPLES) {
@@ -298,6 +335,7 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
     int32_t t = r->jobs[i].t;
     double err = r->jobs[i].err;
     int64_t index = r->jobs[i].index;
+    size_t first = i;
     for (i++; i < njobs && r->jobs[i].t == t; i++)
       if (r->jobs[i].err > err) {
         err = r->jobs[i].err;
@@ -305,8 +343,18 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
       }
     r->cand[t] = index;
     r->cerr[t] = err;
+    if (r->rec) {
+      /* the bands' sums, in row order */
+      tt__scan_stats ss = r->jobs[first].ss;
+      for (size_t k = first + 1; k < i; k++) {
+        ss.sum_abs += r->jobs[k].ss.sum_abs;
+        ss.sum_sq += r->jobs[k].ss.sum_sq;
+        ss.count += r->jobs[k].ss.count;
+      }
+      tt__curve_set(&r->curve, t, &ss);
+    }
     /* (max_error < 0, none: every candidate enters) */
-    if (index < 0 || err <= r->max_error)
+    if (index < 0 || err <= r->heap_floor)
       tt__heap_remove(&r->heap, t);
     else if (!tt__heap_set(&r->heap, t, err))
       return false;
@@ -550,6 +598,69 @@ static void prefetch_next(const refine *r, int32_t *ahead)
 #endif
 }
 
+/* --- curves (opt->step) --------------------------------------------------
+ * A step is reported with the measures of the TIN a run stopped there
+ * would return: the running sums and the heap's top, or, with a final
+ * pass, a copy of the mesh after that pass (curve.c). */
+
+static bool step_wanted(const refine *r, size_t points)
+{
+  const tt_refine_options *o = r->opt;
+  if (points <= o->step_until)
+    return true;
+  for (size_t i = 0; i < o->nstep_at; i++)
+    if (o->step_at[i] == points)
+      return true;
+  return false;
+}
+
+/* Reports step `iter` (insertions done) when it is wanted, or when last
+ * (the step the run ends at; the previous report again when it was this
+ * one). */
+static tt_status report_step(refine *r, size_t iter, bool last)
+{
+  const tt_refine_options *o = r->opt;
+  if (!r->rec || (!last && !step_wanted(r, r->linked)))
+    return TT_OK;
+  double t0 = tt__now();
+  tt_step_info si;
+  if (last && r->prev.points && r->prev.step == iter) {
+    si = r->prev;
+  } else {
+    memset(&si, 0, sizeof si);
+    si.step = iter;
+    si.points = r->linked;
+    si.triangles = r->m.nlive;
+    bool any = tt__heap_size(&r->heap) > 0;
+    double top = any ? tt__heap_top(&r->heap).key : 0.0;
+    int64_t at = any ? r->cand[tt__heap_top(&r->heap).item] : -1;
+    /* the run's time so far, the reports' own left out; plus, below,
+     * this step's final pass */
+    si.seconds = t0 - r->t_start - r->rec_seconds;
+    if (r->final != TT_OPTIMIZE_NONE) {
+      /* the bound of the run's own final pass */
+      if (!tt__curve_final(&r->curve, &r->m, r->cerr, r->cand, r->crit,
+                           &r->env, r->final, r->repair,
+                           fmax(r->max_error, top), &o->anneal, r->linked,
+                           r->valid, &si.errors))
+        return oom(r);
+      si.optimized = 1;
+      si.seconds += tt__now() - t0;
+    } else {
+      tt__curve_errors(&r->curve, r->g, r->linked, r->valid, top, at,
+                       &si.errors);
+    }
+  }
+  si.last = last;
+  r->prev = si;
+  int go = o->step(&si, o->step_arg);
+  r->rec_seconds += tt__now() - t0;
+  if (!go)
+    return tt__error(r->ctx, TT_ERR_INTERRUPTED, "interrupted by the step "
+                     "callback after %zu vertices", r->linked);
+  return TT_OK;
+}
+
 static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
 {
   if (isnan(o->max_error) || isinf(o->max_error))
@@ -574,6 +685,9 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
     return st;
   if (!tt_repair_name(o->repair))
     return tt__error(ctx, TT_ERR_ARG, "unknown repair %d", (int)o->repair);
+  if (o->nstep_at && !o->step_at)
+    return tt__error(ctx, TT_ERR_ARG, "step_at is NULL with nstep_at %zu",
+                     o->nstep_at);
   return TT_OK;
 }
 
@@ -627,8 +741,14 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.pool = tt__pool_create(tt__pool_threads(nthreads));
   /* the scans' error bounds per tile: without them (out of memory) large
    * triangles are scanned row by row, with the same results */
-  (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
+  if (!opt->step) /* recording scans every sample: no use for them */
+    (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
   r.max_error = opt->max_error;
+  r.rec = opt->step != NULL;
+  r.heap_floor = r.rec ? -1.0 : opt->max_error;
+  r.valid = valid;
+  r.t_start = t_start;
+  r.final = tt_optimize_resolve(opt->optimize, opt->criterion, r.repair);
   r.max_points = opt->max_points;
   r.max_tris = opt->max_triangles;
   if (opt->percent > 0) {
@@ -676,6 +796,12 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   }
   r.phase = "while inserting";
   r.e0 = tt__heap_size(&r.heap) ? tt__heap_top(&r.heap).key : 0;
+  size_t nv0 = r.m.nv; /* vertices before the first insertion */
+  for (size_t v = 0; v < r.m.nv; v++)
+    r.linked += r.m.v[v].edge >= 0;
+  status = report_step(&r, 0, false);
+  if (status != TT_OK)
+    goto done;
   if (opt->progress && !opt->progress(0.0, "inserting", opt->progress_arg)) {
     status = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
     goto done;
@@ -736,6 +862,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       status = oom(&r);
       goto done;
     }
+    r.linked++;
+    status = report_step(&r, iter, false);
+    if (status != TT_OK)
+      goto done;
     if (opt->progress && (iter & 255) == 0 &&
         !opt->progress(progress_fraction(&r, err), "inserting",
                        opt->progress_arg)) {
@@ -744,6 +874,9 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
       goto done;
     }
   }
+  status = report_step(&r, r.m.nv - nv0, true);
+  if (status != TT_OK)
+    goto done;
   /* [optimize.c hook] the final whole-mesh pass (opt->optimize). Flips
    * of unconstrained edges keep every triangle in the domain. A move that
    * would give one of its triangles an error above the larger of max_error
@@ -800,5 +933,6 @@ done:
   free(r.ins_err);
   tt__edge_stack_free(&r.stack);
   tt__mesh_free(&r.m);
+  tt__curve_free(&r.curve);
   return status;
 }

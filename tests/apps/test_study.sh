@@ -10,6 +10,8 @@
 #    columns and a row per run; tables.md has a table per terrain and
 #    method, a row per percentage, the smallest mean absolute error of each
 #    row in bold; runs.json parses and names the version;
+#  - -points N: a row at every count up to N (insertion) or per round
+#    (decimation), equal to single `simplify -max_points K` runs;
 #  - a terrain that cannot be read, an existing non-empty OUTDIR, an
 #    unknown criterion and edge insertion with another criterion fail with
 #    one line and leave nothing behind; -overwrite writes into OUTDIR.
@@ -180,6 +182,99 @@ assert d["version"] and d["runs"] == 72 and d["terrains"]["2"]["generator"] == "
 else
   fail "runs.json"
 fi
+
+# -points N (the curves): one recorded run per terrain, method, optimiser
+# and criterion. Insertion: a row at every count from the start's (the
+# grid's 4 corners) to N, each equal to a single `simplify -max_points K`
+# run with the study's repair (Delaunay's for the criteria the study
+# optimised after Delaunay insertion: l2, mean_curvature) and optimiser
+# (auto: the local swap for those, on a copy at each count), the counts and
+# max exactly, the sums to 1e-12 relative (running sums against a full
+# pass). Decimation: a row per round, from every sample down to N, the last
+# one the TIN `simplify -method decimate -max_points N` returns. The
+# -percent rows stay those of single runs, exactly.
+PCRIT=delaunay,min_area,l2,mean_curvature
+run study -q -terrain tiny.tif -terrain bump -criteria "$PCRIT" \
+  -methods insert,decimate -points 30 -percent 20 outp
+if [ "$rc" -eq 0 ] && [ -f outp/curves.csv ]; then pass; else fail "study -points: rc $rc, $(cat err.txt)"; fi
+if python3 - outp/curves.csv >pcases.txt <<'EOF'; then pass; else fail "study -points: curves.csv rows"; fi
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1], newline="")))
+valid = {"tiny.tif": 480, "bump": 600}
+pct = {"tiny.tif": 96, "bump": 120}
+seen = {}
+for r in rows:
+    k = (r["terrain"], r["method"], r["criterion"], r["optimizer"])
+    seen.setdefault(k, []).append(int(r["points"]))
+    [float(r[c]) for c in ("max_error", "l2", "rmse", "mean_abs_error",
+                           "total_abs_error", "seconds")]
+if len(seen) != 16:
+    sys.exit("%d curves: %r" % (len(seen), sorted(seen)))
+for (terr, meth, crit, opt), pts in seen.items():
+    # decimation resolves the repair as the engine does (flip but for l2)
+    want_opt = "local" if crit == "l2" or (
+        meth == "insert" and crit == "mean_curvature") else "none"
+    if opt != want_opt:
+        sys.exit("%s %s %s: optimizer %s" % (terr, meth, crit, opt))
+    if pts[0] != pct[terr]:
+        sys.exit("%s %s %s: the -percent row first, got %r" % (terr, meth, crit, pts[:3]))
+    curve = pts[1:]
+    if meth == "insert" and curve != list(range(4, 31)):
+        sys.exit("%s insert %s: points %r" % (terr, crit, curve))
+    if meth == "decimate" and (curve[0] != valid[terr] or curve[-1] != 30 or
+                               any(a <= b for a, b in zip(curve, curve[1:]))):
+        sys.exit("%s decimate %s: points %r" % (terr, crit, curve))
+    for r in rows:
+        if (r["terrain"], r["method"], r["criterion"]) == (terr, meth, crit):
+            p = int(r["points"])
+            if (meth == "insert" and p in (4, 5, 17, 30)) or \
+               (meth == "decimate" and p == 30):
+                print(terr, meth, crit, p, r["max_error"], r["l2"], r["rmse"],
+                      r["mean_abs_error"], r["total_abs_error"])
+EOF
+mismatch=0
+checked=0
+while read -r terr meth crit points mx l2 rmse mae tae; do
+  dem=$terr
+  [ "$terr" = bump ] && dem=bump.tif
+  rep=auto
+  case $crit in l2 | mean_curvature) [ "$meth" = insert ] && rep=delaunay ;; esac
+  "$T" simplify "$dem" one.gpkg -overwrite -json -max_points "$points" \
+    -method "$meth" -criterion "$crit" -repair "$rep" >one.json 2>one.err ||
+    { mismatch=$((mismatch + 1)); echo "simplify failed: $terr $meth $crit $points: $(cat one.err)" >&2; continue; }
+  if ! python3 - one.json "$points" "$mx" "$l2" "$rmse" "$mae" "$tae" <<'EOF'; then
+import json, sys
+d = json.load(open(sys.argv[1]))
+want = [float(x) for x in sys.argv[3:]]
+got = [d["max_error"], d["l2"], d["rmse"], d["mean_abs_error"],
+       d["total_abs_error"]]
+if d["vertices"] != int(sys.argv[2]) or got[0] != want[0] or any(
+        abs(a - b) > 1e-12 * max(abs(a), abs(b)) for a, b in zip(got, want)):
+    sys.exit("simplify %r %r, study %r %r" % (d["vertices"], got, sys.argv[2], want))
+EOF
+    mismatch=$((mismatch + 1))
+    echo "  at $terr $meth $crit $points points" >&2
+  fi
+  checked=$((checked + 1))
+done <pcases.txt
+if [ "$mismatch" -eq 0 ] && [ "$checked" -eq 40 ]; then
+  pass
+else
+  fail "study -points vs simplify: $mismatch of $checked rows differ"
+fi
+# -points alone: no -percent checkpoints, tables.md says so.
+run study -q -terrain bump -criteria delaunay -points 12 outq
+if [ "$rc" -eq 0 ] && [ "$(lines outq/curves.csv)" -eq 10 ] &&
+  grep -q "No -percent checkpoints" outq/tables.md &&
+  python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["points"] == 12 and d["rows"] == 9 and d["runs"] == 1, d' outq/runs.json; then
+  pass
+else
+  fail "-points alone: rc $rc, $(cat err.txt), $(head -3 outq/curves.csv 2>/dev/null)"
+fi
+expect_failure "points 0" 2 "-points" bad10 \
+  study -q -terrain bump -points 0 bad10
+expect_failure "points below the start" 2 "point limit" bad11 \
+  study -q -terrain bump -criteria delaunay -points 3 bad11
 
 # Failures: one line, nothing left.
 expect_failure "unreadable terrain" 1 "nosuch.tif" bad1 \

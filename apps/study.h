@@ -1,0 +1,69 @@
+/*
+ * study.h -- what the two files of `terratin study` share (internal):
+ * study.c (the plan, the -percent runs, the files) and study_curves.c
+ * (the -points runs: a row at every step, from the engine's recorder).
+ */
+#ifndef TT_APP_STUDY_H
+#define TT_APP_STUDY_H
+
+#include "app.h"
+
+#define STUDY_MAX_LIST 64
+
+struct named_terrain; /* study.c */
+
+/* A terrain of the study, read or generated before the first run. */
+typedef struct study_terrain {
+  const char *arg;   /* as given to -terrain */
+  const char *label; /* the generator's name or the DEM's file name */
+  const struct named_terrain *named; /* NULL: a DEM file */
+  tt_synth_options synth;            /* named terrains */
+  tt_grid *grid;
+  size_t valid;
+} study_terrain;
+
+/* One run's outcome, or one step of a recorded run: a row of curves.csv. */
+typedef struct study_row {
+  size_t terrain, method, criterion, optimizer, percent; /* plan indices */
+  size_t points;
+  tt_error_stats e;
+  double seconds;
+} study_row;
+
+/* What the lists said. */
+typedef struct study_plan {
+  tt_criterion crit[STUDY_MAX_LIST];
+  size_t ncrit;
+  int decimate[2]; /* per method: 0 insert, 1 decimate */
+  size_t nmeth;
+  tt_optimize opt[STUDY_MAX_LIST];
+  size_t nopt;
+  double pct[STUDY_MAX_LIST];
+  char pct_text[STUDY_MAX_LIST][32]; /* the checkpoint as given */
+  size_t npct;
+  size_t points;   /* -points N: a row at every step up to N; 0: none */
+} study_plan;
+
+/* A growing list of rows. */
+typedef struct study_rows {
+  study_row *w;
+  size_t n, cap;
+} study_rows;
+
+/* The repair an insertion run of the study uses for criterion c: the
+ * criteria that the study optimised after Delaunay insertion (SPEC
+ * section 6: every data-dependent one but min_area) are inserted by
+ * Delaunay's flips (TT_REPAIR_DELAUNAY, so that the optimiser 'auto' is
+ * the local swap); the others as the engine resolves them. */
+tt_repair tt__study_repair(tt_criterion c);
+
+/* The -points run of one terrain, method, optimiser and criterion (plan
+ * indices in `key`: terrain, method, optimizer, criterion): insertion up to
+ * p->points vertices with a row at every step, or decimation down to
+ * p->points with a row after every round; the rows are appended to out.
+ * TT_OK, or the failure recorded. */
+tt_status tt__study_curve_run(app_run *r, const study_terrain *t,
+                              const study_plan *p, const study_row *key,
+                              study_rows *out);
+
+#endif /* TT_APP_STUDY_H */
