@@ -37,7 +37,8 @@ enum opt_id {
   O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS, O_T_SRS, O_ANNEAL_T0, O_ANNEAL_STAGES,
   O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R, O_METHOD, O_START, O_IMPORTANCE,
   O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY, O_TERRAIN,
-  O_CRITERIA, O_METHODS, O_OPTIMIZERS
+  O_CRITERIA, O_METHODS, O_OPTIMIZERS,
+  O_PLOT, O_TIN_POINTS
 };
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
@@ -102,6 +103,8 @@ static const struct opt_def {
     {"-criteria", O_CRITERIA, 1, FOR_T},
     {"-methods", O_METHODS, 1, FOR_T},
     {"-optimizers", O_OPTIMIZERS, 1, FOR_T},
+    {"-plot", O_PLOT, 0, FOR_T},
+    {"-tin_points", O_TIN_POINTS, 1, FOR_T},
 };
 
 static const struct opt_def *find_opt(const char *w)
@@ -624,6 +627,15 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
               : d->id == O_METHODS ? &o->s.methods
                                    : &o->s.optimizers) = keep(o, v)))
         NOMEM();
+      break;
+    case O_PLOT:
+      o->s.plot = 1;
+      break;
+    case O_TIN_POINTS:
+      if (tt__app_parse_size(v, &z) != NUM_OK || z < 3)
+        USAGE("%s: -tin_points must be an integer >= 3 (the points of the "
+              "TINs to draw), got '%s'", cmdname, v);
+      o->s.tin_points = z;
       break;
     case O_A_SRS:
       if (!*v)

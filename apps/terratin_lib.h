@@ -139,6 +139,9 @@ typedef struct tt_app_settings {
   const char *percents;      /* -percent P,P,...; NULL: 1,10,25,50 */
   uint64_t seed;             /* -seed (study: the generated terrains) */
   int seed_set;              /* -seed was given */
+  int plot;                  /* -plot: tools/plot_study.py afterwards */
+  size_t tin_points;         /* -tin_points N: each criterion's TIN at N
+                                points into OUTDIR/tins; 0: none */
 } tt_app_settings;
 
 typedef struct tt_app_options tt_app_options;
