@@ -240,7 +240,11 @@ int tt__app_study_plot_check(app_run *r, char **out_python,
                              char **out_script);
 tt_status tt__app_study_plot_run(app_run *r, const char *python,
                                  const char *script, const char *outdir);
-/* study_tins.c: the TINs of -tin_points, written into a temporary folder
+/* study_files.c: whether the study's OUTDIR exists (1), not (0), or is in
+ * the way (not a folder, not empty without -overwrite) or not readable
+ * (-1, failure recorded). */
+int tt__app_study_check_outdir(app_run *r, const char *dir);
+/* study_files.c: the TINs of -tin_points, written into a temporary folder
  * that commit renames to OUTDIR/tins; free removes it when not committed
  * (and accepts NULL). */
 typedef struct app_study_tins app_study_tins;

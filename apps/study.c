@@ -15,8 +15,14 @@
  * of a single simplify run at that percentage (the final optimisation
  * pass included); per-insertion curves (-points) are not offered yet.
  *
+ * `-terrain crater` is Crater Lake from the shared test data
+ * (study_crater.c); -tin_points N adds a run per terrain, method,
+ * criterion and optimiser stopped at N points whose TIN goes to
+ * OUTDIR/tins (study_files.c); -plot runs tools/plot_study.py on OUTDIR
+ * at the end (study_plot.c).
+ *
  * Invariants: everything is checked (lists, combinations, every terrain
- * read) before the first run; an existing non-empty OUTDIR is refused
+ * read, python and matplotlib for -plot) before the first run; an existing non-empty OUTDIR is refused
  * without -overwrite; the files are written under temporary names and
  * renamed once all three are complete, and a failure leaves nothing (an
  * OUTDIR the run created is removed again).
@@ -26,7 +32,6 @@
 #include <cpl_conv.h>
 #include <cpl_string.h>
 
-#include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -544,43 +549,6 @@ static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
   tt__json_close(&j);
 }
 
-/* Whether dir exists (1), not (0), or is in the way or not readable (-1,
- * failure recorded). */
-static int check_outdir(app_run *r, const char *dir)
-{
-  struct stat sb;
-  if (stat(dir, &sb) != 0) {
-    if (errno == ENOENT)
-      return 0;
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir, "%s",
-                 strerror(errno));
-    return -1;
-  }
-  if (!S_ISDIR(sb.st_mode)) {
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, dir,
-                 "exists and is not a directory");
-    return -1;
-  }
-  DIR *d = opendir(dir);
-  if (!d) {
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir, "%s",
-                 strerror(errno));
-    return -1;
-  }
-  int empty = 1;
-  struct dirent *e;
-  while (empty && (e = readdir(d)))
-    if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-      empty = 0;
-  closedir(d);
-  if (!empty && !r->s->overwrite) {
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, dir,
-                 "is not empty; use -overwrite to write into it");
-    return -1;
-  }
-  return 1;
-}
-
 enum { F_CURVES, F_TABLES, F_RUNS, F_COUNT };
 static const char *const out_names[F_COUNT] = {"curves.csv", "tables.md",
                                                "runs.json"};
@@ -663,7 +631,7 @@ tt_status tt__app_study(app_run *r)
     st = r->res->status;
     goto done;
   }
-  int exists = check_outdir(r, s->output);
+  int exists = tt__app_study_check_outdir(r, s->output);
   if (exists < 0 || (s->plot && !tt__app_study_plot_check(r, &python,
                                                            &script))) {
     st = r->res->status;

@@ -1,8 +1,10 @@
 /*
- * study_tins.c -- `terratin study -tin_points N`: the TINs the pictures of
- * plot_study.py draw (the study's Figures 10-11). For every terrain,
- * method, criterion and optimiser the study makes one more run stopped at
- * N points and hands the TIN here; this file writes, into OUTDIR/tins/:
+ * study_files.c -- the folder `terratin study` writes: OUTDIR checked
+ * before the first run (a folder, empty unless -overwrite), and with
+ * -tin_points N the TINs the pictures of plot_study.py draw (the study's
+ * Figures 10-11). For every terrain, method, criterion and optimiser the
+ * study makes one more run stopped at N points and hands the TIN here;
+ * this file writes, into OUTDIR/tins/:
  *   - t<k>_<label>_<method>_<criterion>_<optimizer>.obj: the TIN in pixel
  *     space (x = column, y = row, z = the height; faces 1-based);
  *   - t<k>_<label>.asc: terrain k's grid as an ESRI ASCII grid, pixel
@@ -26,6 +28,43 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* OUTDIR: refused when it is not a folder, or not empty without
+ * -overwrite. */
+int tt__app_study_check_outdir(app_run *r, const char *dir)
+{
+  struct stat sb;
+  if (stat(dir, &sb) != 0) {
+    if (errno == ENOENT)
+      return 0;
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir, "%s",
+                 strerror(errno));
+    return -1;
+  }
+  if (!S_ISDIR(sb.st_mode)) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, dir,
+                 "exists and is not a directory");
+    return -1;
+  }
+  DIR *d = opendir(dir);
+  if (!d) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir, "%s",
+                 strerror(errno));
+    return -1;
+  }
+  int empty = 1;
+  struct dirent *e;
+  while (empty && (e = readdir(d)))
+    if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+      empty = 0;
+  closedir(d);
+  if (!empty && !r->s->overwrite) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, dir,
+                 "is not empty; use -overwrite to write into it");
+    return -1;
+  }
+  return 1;
+}
 
 struct app_study_tins {
   char *tmp;   /* the temporary folder */
