@@ -22,10 +22,11 @@
  * at the end (study_plot.c).
  *
  * Invariants: everything is checked (lists, combinations, every terrain
- * read, python and matplotlib for -plot) before the first run; an existing non-empty OUTDIR is refused
- * without -overwrite; the files are written under temporary names and
- * renamed once all three are complete, and a failure leaves nothing (an
- * OUTDIR the run created is removed again).
+ * read, python and matplotlib for -plot) before the first run; an
+ * existing non-empty OUTDIR is refused without -overwrite; the files are
+ * written under temporary names and renamed once all three are complete,
+ * and a failure leaves nothing (an OUTDIR the run created is removed
+ * again) but the study's files when the plotting after them fails.
  */
 #include "app.h"
 
@@ -730,6 +731,8 @@ tt_status tt__app_study(app_run *r)
             "runs.json%s%s); %.2f s\n", s->output, nrows + ntin, nterr,
             nterr == 1 ? "" : "s", tins ? ", tins/" : "",
             python ? ", plots/" : "", tt__app_now() - r->t0);
+    if (python)
+      fprintf(r->out, "plots drawn by %s %s\n", python, script);
     fflush(r->out);
   }
 done:

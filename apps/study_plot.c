@@ -96,10 +96,10 @@ static int run_child(char *const argv[], char *last, size_t size)
   return WEXITSTATUS(status);
 }
 
-/* The installed script beside the executable, else the source tree's. */
-static const char *find_script(void)
+/* The installed script beside the executable, else the source tree's,
+ * into path (of size bytes); NULL when neither is there. */
+static const char *find_script(char *path, size_t size)
 {
-  static char path[PATH_MAX + 64];
   char exe[PATH_MAX];
   ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
   if (n > 0) {
@@ -107,19 +107,20 @@ static const char *find_script(void)
     char *slash = strrchr(exe, '/');
     if (slash) {
       *slash = '\0';
-      snprintf(path, sizeof path, "%s/../share/terratin/plot_study.py", exe);
+      snprintf(path, size, "%s/../share/terratin/plot_study.py", exe);
       if (access(path, R_OK) == 0)
         return path;
     }
   }
-  snprintf(path, sizeof path, "%s/tools/plot_study.py", TT_SOURCE_DIR);
+  snprintf(path, size, "%s/tools/plot_study.py", TT_SOURCE_DIR);
   return access(path, R_OK) == 0 ? path : NULL;
 }
 
 int tt__app_study_plot_check(app_run *r, char **out_python, char **out_script)
 {
   *out_python = *out_script = NULL;
-  const char *script = find_script();
+  char buf[PATH_MAX + 64];
+  const char *script = find_script(buf, sizeof buf);
   if (!script) {
     tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, NULL,
                  "study: -plot: plot_study.py is neither installed beside "

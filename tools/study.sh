@@ -29,8 +29,12 @@ set -eu
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 T=${1:-$ROOT/build/terratin}
-OUT=${STUDY_OUT:-$ROOT/build/study}
-DOCS=${STUDY_DOCS:-$ROOT/docs/study}
+case "$T" in /*) ;; *) T=$(pwd)/$T ;; esac
+# From the repository's root, so that the paths in the runs.json files
+# (OUTDIR, Crater Lake's ../shared/testdata/...) are relative to it.
+cd "$ROOT"
+OUT=${STUDY_OUT:-build/study}
+DOCS=${STUDY_DOCS:-docs/study}
 PY=${TT_PYTHON:-/usr/bin/python3}
 CRATER_ARG=crater
 [ -n "${CRATER:-}" ] && CRATER_ARG="crater=$CRATER"
@@ -39,7 +43,7 @@ if [ ! -x "$T" ]; then
   echo "study.sh: $T is not an executable terratin (run make build)" >&2
   exit 1
 fi
-if ! "$PY" "$ROOT/tools/plot_study.py" --check; then
+if ! "$PY" tools/plot_study.py --check; then
   echo "study.sh: $PY has no matplotlib (apt-get install python3-matplotlib)" >&2
   exit 1
 fi
@@ -93,13 +97,13 @@ fi
 
 echo "== plots and docs/study/README.md"
 mkdir -p "$DOCS"
-"$PY" "$ROOT/tools/plot_study.py" --measures "" --out "$DOCS" --dpi 80 \
+"$PY" tools/plot_study.py" --measures "" --out "$DOCS" --dpi 72 \
   "$OUT/crater_insert"
-"$PY" "$ROOT/tools/plot_study.py" --no-tins --out "$DOCS" \
+"$PY" tools/plot_study.py" --no-tins --out "$DOCS" \
   --measures mean_abs_error,total_abs_error,l2,max_error "$OUT/crater_curves"
-"$PY" "$ROOT/tools/plot_study.py" --no-tins --out "$DOCS" \
+"$PY" tools/plot_study.py" --no-tins --out "$DOCS" \
   --measures mean_abs_error,total_abs_error,l2 "$OUT/crater_decimate"
-"$PY" "$ROOT/tools/plot_study.py" --no-tins --out "$DOCS" \
+"$PY" tools/plot_study.py" --no-tins --out "$DOCS" \
   --measures mean_abs_error "$OUT/generated"
-"$PY" "$ROOT/tools/study_report.py" --out "$DOCS" "$OUT"
+"$PY" tools/study_report.py" --out "$DOCS" "$OUT"
 echo "== study: $(($(date +%s) - t0)) s in all; docs in $DOCS"

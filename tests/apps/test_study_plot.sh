@@ -138,6 +138,22 @@ if [ "$HAVE_MPL" -eq 1 ]; then
     fail "-overwrite of tins/: rc $rc, $(cat err.txt), $(ls out/tins)"; fi
 fi
 
+# --- the installed command finds the installed script ----------------------
+if [ "$HAVE_MPL" -eq 1 ] && [ -n "${TT_BUILD_DIR:-}" ] &&
+  cmake --install "$TT_BUILD_DIR" --prefix "$W/prefix" >/dev/null 2>&1; then
+  run env TT_PYTHON=$PY "$W/prefix/bin/terratin" study -terrain bump \
+    -criteria delaunay -percent 50 -plot inst
+  if [ "$rc" -eq 0 ] &&
+    grep -q "plots drawn by $PY $W/prefix/bin/../share/terratin/plot_study.py" out.txt &&
+    is_png inst/plots/bump_insert_l2.png 5000; then pass; else
+    fail "installed -plot: rc $rc, $(cat out.txt err.txt)"; fi
+  run env TT_PYTHON=$PY "$T" study -terrain bump -criteria delaunay \
+    -percent 50 -plot src
+  if [ "$rc" -eq 0 ] &&
+    grep -q "plots drawn by $PY $SRC/tools/plot_study.py" out.txt; then pass
+  else fail "build tree -plot: rc $rc, $(cat out.txt err.txt)"; fi
+fi
+
 # --- plot_study.py on dense rows (one per point count) --------------------
 mkdir -p dense
 "$PY" - >dense/curves.csv <<'EOF2'
