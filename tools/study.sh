@@ -97,13 +97,13 @@ fi
 
 echo "== plots and docs/study/README.md"
 mkdir -p "$DOCS"
-"$PY" tools/plot_study.py" --measures "" --out "$DOCS" --dpi 72 \
+"$PY" tools/plot_study.py --measures "" --out "$DOCS" --dpi 72 \
   "$OUT/crater_insert"
-"$PY" tools/plot_study.py" --no-tins --out "$DOCS" \
+"$PY" tools/plot_study.py --no-tins --out "$DOCS" \
   --measures mean_abs_error,total_abs_error,l2,max_error "$OUT/crater_curves"
-"$PY" tools/plot_study.py" --no-tins --out "$DOCS" \
+"$PY" tools/plot_study.py --no-tins --out "$DOCS" \
   --measures mean_abs_error,total_abs_error,l2 "$OUT/crater_decimate"
-"$PY" tools/plot_study.py" --no-tins --out "$DOCS" \
+"$PY" tools/plot_study.py --no-tins --out "$DOCS" \
   --measures mean_abs_error "$OUT/generated"
-"$PY" tools/study_report.py" --out "$DOCS" "$OUT"
+"$PY" tools/study_report.py --out "$DOCS" "$OUT"
 echo "== study: $(($(date +%s) - t0)) s in all; docs in $DOCS"
