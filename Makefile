@@ -58,9 +58,9 @@ check: test test-san
 bench: build
 	bench/run.sh
 
-# The 2004 study reproduced into docs/study/ (tools/study.sh; about 5
-# minutes on 2 cores): needs Crater Lake in ../shared/testdata (or
-# CRATER=PATH).
+# The 2004 study reproduced into docs/study/ (tools/study.sh; 5.5 to 7
+# minutes measured on 2 cores shared with other work): needs Crater Lake
+# in ../shared/testdata (or CRATER=PATH).
 study: build
 	tools/study.sh $(BUILD)/terratin
 

@@ -145,7 +145,7 @@ if [ "$HAVE_MPL" -eq 1 ] && [ -n "${TT_BUILD_DIR:-}" ] &&
     -criteria delaunay -percent 50 -plot inst
   if [ "$rc" -eq 0 ] &&
     grep -q "plots drawn by $PY $W/prefix/bin/../share/terratin/plot_study.py" out.txt &&
-    is_png inst/plots/bump_insert_l2.png 5000; then pass; else
+    is_png inst/plots/bump_insert_l2.png 2000; then pass; else
     fail "installed -plot: rc $rc, $(cat out.txt err.txt)"; fi
   run env TT_PYTHON=$PY "$T" study -terrain bump -criteria delaunay \
     -percent 50 -plot src
