@@ -214,15 +214,20 @@ def report(study_out, out_dir):
       "hold every parameter). terratin %s, %s; %d runs."
       % (ins_meta["version"], ins_meta["created"], nruns))
     w("")
-    w("Each criterion is run as `terratin simplify -criterion C` runs it by "
-      "default (`-optimizers auto`): Delaunay, Min-Max angle, mean and "
-      "Gaussian curvature and ABN by greedy insertion with edge swaps for "
-      "the criterion around each new point, min area with the exact "
-      "dynamic programme over the hole, L2 by Delaunay insertion and a "
-      "final local swap pass. The study ran the curvature criteria and "
-      "ABN as Delaunay insertion followed by the local swap (SPEC "
-      "section 6); ours swap during the insertion. The error measure of "
-      "the tables is the average absolute error over the valid samples.")
+    seen = {}
+    for r in ins_rows:
+        seen.setdefault(r["criterion"], set()).add(r["optimizer"])
+    opts = ["%s %s" % (SHORT.get(c, c), "/".join(sorted(seen[c])))
+            for c in C7 if c in seen]
+    w("Each criterion is run as `terratin study` runs it by default "
+      "(`-optimizers auto`, [docs/cli.md](../cli.md) says how each is "
+      "inserted); the final pass of each (the `optimizer` column of the "
+      "CSVs): %s. The study inserted Delaunay and Min-Max angle with "
+      "their flips, min area with the dynamic programme over the hole, "
+      "and every other criterion by Delaunay insertion followed by the "
+      "local swap (SPEC section 6). The error measure of the tables is "
+      "the average absolute error over the valid samples."
+      % ", ".join(opts))
     w("")
     w("A finding that is checked over many rows is **confirmed** when it "
       "holds in at least %d %% of them, **refuted** otherwise; the counts "
@@ -608,8 +613,9 @@ def report(study_out, out_dir):
     os.makedirs(out_dir, exist_ok=True)
     for n in RUNS:
         src = os.path.join(study_out, n)
-        shutil.copyfile(os.path.join(src, "tables.md"),
-                        os.path.join(out_dir, n + "_tables.md"))
+        if os.path.exists(os.path.join(src, "tables.md")):
+            shutil.copyfile(os.path.join(src, "tables.md"),
+                            os.path.join(out_dir, n + "_tables.md"))
         shutil.copyfile(os.path.join(src, "runs.json"),
                         os.path.join(out_dir, n + "_runs.json"))
         if n != "crater_curves":
