@@ -9,11 +9,12 @@ BUILD      ?= build
 BUILD_SAN  ?= build-asan
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 DEB_PKGS   := cmake make gcc g++ pkg-config libgdal-dev libproj-dev gdal-bin libxml2-dev \
-              python3 python3-cffi python3-dev zip libsqlite3-dev libnetcdf-dev
+              python3 python3-cffi python3-dev zip libsqlite3-dev libnetcdf-dev \
+              python3-matplotlib
 DEMO_IN    ?= testdata/jacksboro_fault_dem.tif
 DEMO_OUT   ?= demo-out/jacksboro_tin.gpkg
 
-.PHONY: all deps build build-san demo check test test-san bench clean
+.PHONY: all deps build build-san demo check test test-san bench clean study
 
 all: build
 
@@ -56,6 +57,12 @@ check: test test-san
 
 bench: build
 	bench/run.sh
+
+# The 2004 study reproduced into docs/study/ (tools/study.sh; 5.5 to 7
+# minutes measured on 2 cores shared with other work): needs Crater Lake
+# in ../shared/testdata (or CRATER=PATH).
+study: build
+	tools/study.sh $(BUILD)/terratin
 
 clean:
 	rm -rf $(BUILD) $(BUILD_SAN) demo-out

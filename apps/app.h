@@ -246,6 +246,35 @@ tt_status tt__app_write_raster(app_run *r, tt_output *out, GDALDriverH drv,
                                const tt_grid *grid,
                                const tt_raster_info *info,
                                const double *values);
+/* study_crater.c: whether a -terrain names Crater Lake ("crater", found in
+ * the shared test data, or "crater=PATH"): 1 with *out_path (CPLFree) the
+ * DEM to read, 0 when it is another terrain, -1 with the failure recorded
+ * when Crater Lake is not found. */
+int tt__app_study_crater(app_run *r, const char *arg, char **out_path);
+/* study_plot.c: finds the python (with matplotlib) and plot_study.py for
+ * -plot: 1 with both (CPLFree), 0 with the failure recorded, saying how
+ * to get matplotlib. Then runs the script on OUTDIR. */
+int tt__app_study_plot_check(app_run *r, char **out_python,
+                             char **out_script);
+tt_status tt__app_study_plot_run(app_run *r, const char *python,
+                                 const char *script, const char *outdir);
+/* study_files.c: whether the study's OUTDIR exists (1), not (0), or is in
+ * the way (not a folder, not empty without -overwrite) or not readable
+ * (-1, failure recorded). */
+int tt__app_study_check_outdir(app_run *r, const char *dir);
+/* study_files.c: the TINs of -tin_points, written into a temporary folder
+ * that commit renames to OUTDIR/tins; free removes it when not committed
+ * (and accepts NULL). */
+typedef struct app_study_tins app_study_tins;
+tt_status tt__app_study_tins_begin(app_run *r, const char *outdir,
+                                   app_study_tins **out);
+tt_status tt__app_study_tins_add(app_run *r, app_study_tins *w,
+                                 size_t terrain, const char *label,
+                                 const tt_grid *grid, const char *method,
+                                 const char *criterion, const char *optimizer,
+                                 const tt_tin *tin);
+tt_status tt__app_study_tins_commit(app_run *r, app_study_tins *w);
+void tt__app_study_tins_free(app_study_tins *w);
 /* eval.c, for optimize too: opens r->s->tin's kind of dataset (a vector
  * dataset, explaining in one line why not), and picks its triangle layer
  * (-layer, else "triangles" or "*_triangles", else the first polygon

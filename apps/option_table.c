@@ -62,6 +62,8 @@ static const tt__app_opt_def opt_defs[] = {
     {"-error_raster", O_ERROR_RASTER, 1, FOR_E},
     {"-co", O_CO, 1, FOR_E | FOR_R},
     {"-points", O_POINTS, 1, FOR_T},
+    {"-plot", O_PLOT, 0, FOR_T},
+    {"-tin_points", O_TIN_POINTS, 1, FOR_T},
 };
 
 const tt__app_opt_def *tt__app_find_opt(const char *w)

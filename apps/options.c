@@ -557,6 +557,15 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
               v, (size_t)TT_MAX_VERTICES);
       o->s.points = z;
       break;
+    case O_PLOT:
+      o->s.plot = 1;
+      break;
+    case O_TIN_POINTS:
+      if (tt__app_parse_size(v, &z) != NUM_OK || z < 3)
+        USAGE("%s: -tin_points must be an integer >= 3 (the points of the "
+              "TINs to draw), got '%s'", cmdname, v);
+      o->s.tin_points = z;
+      break;
     case O_A_SRS:
       if (!*v)
         USAGE("%s: -a_srs needs a CRS (EPSG:n, WKT, ...)", cmdname);

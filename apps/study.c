@@ -19,11 +19,18 @@
  * (tt__study_repair: Delaunay's flips for the criteria it optimised after
  * Delaunay insertion).
  *
+ * `-terrain crater` is Crater Lake from the shared test data
+ * (study_crater.c); -tin_points N adds a run per terrain, method,
+ * criterion and optimiser stopped at N points whose TIN goes to
+ * OUTDIR/tins (study_files.c); -plot runs tools/plot_study.py on OUTDIR
+ * at the end (study_plot.c).
+ *
  * Invariants: everything is checked (lists, combinations, every terrain
- * read) before the first run; an existing non-empty OUTDIR is refused
- * without -overwrite; the files are written under temporary names and
- * renamed once all three are complete, and a failure leaves nothing (an
- * OUTDIR the run created is removed again).
+ * read, python and matplotlib for -plot) before the first run; an
+ * existing non-empty OUTDIR is refused without -overwrite; the files are
+ * written under temporary names and renamed once all three are complete,
+ * and a failure leaves nothing (an OUTDIR the run created is removed
+ * again) but the study's files when the plotting after them fails.
  */
 #include "app.h"
 #include "study.h"
@@ -31,7 +38,6 @@
 #include <cpl_conv.h>
 #include <cpl_string.h>
 
-#include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -239,17 +245,35 @@ static int load_terrain(app_run *r, study_terrain *t)
                    tt__app_why(r, st, n->name));
     else
       t->valid = tt_grid_width(t->grid) * tt_grid_height(t->grid);
+    if (st == TT_OK && s->tin_points > t->valid)
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "study: -tin_points %zu is more than the %zu "
+                        "samples of %s", s->tin_points, t->valid, n->name);
     goto done;
   }
   const char *slash = strrchr(t->arg, '/');
+  const char *path = t->arg;
   t->label = slash && slash[1] ? slash + 1 : t->arg;
-  ds = tt__app_open_raster(r, t->arg, s->band, &band);
+  int crater = tt__app_study_crater(r, t->arg, &t->path);
+  if (crater < 0) {
+    st = r->res->status;
+    goto done;
+  }
+  if (crater) {
+    t->label = "crater";
+    path = t->path;
+  }
+  ds = tt__app_open_raster(r, path, s->band, &band);
   if (!ds) {
     st = r->res->status;
     goto done;
   }
-  st = tt__app_read_dem(r, band, t->arg, NULL, NULL, &t->grid, &info,
+  st = tt__app_read_dem(r, band, path, NULL, NULL, &t->grid, &info,
                         &t->valid);
+  if (st == TT_OK && s->tin_points > t->valid)
+    st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                      "study: -tin_points %zu is more than the %zu valid "
+                      "samples of %s", s->tin_points, t->valid, path);
 done:
   tt_raster_info_destroy(info);
   if (ds)
@@ -257,9 +281,11 @@ done:
   return st == TT_OK;
 }
 
-/* One run, as `terratin simplify -percent P` with the same options. */
+/* One run, as `terratin simplify -percent P` with the same options (or
+ * -max_points N when max_points is not 0; *out_tin then keeps the TIN). */
 static tt_status run_one(app_run *r, const study_terrain *t,
-                         const study_plan *p, study_row *row)
+                         const study_plan *p, study_row *row,
+                         size_t max_points, tt_tin **out_tin)
 {
   const tt_app_settings *s = r->s;
   tt_tin *tin = NULL;
@@ -270,7 +296,8 @@ static tt_status run_one(app_run *r, const study_terrain *t,
     tt_decimate_options d;
     tt_decimate_options_init(&d);
     d.max_error = -1.0;
-    d.percent = p->pct[row->percent];
+    d.percent = max_points ? 0 : p->pct[row->percent];
+    d.max_points = max_points;
     d.criterion = p->crit[row->criterion];
     d.optimize = p->opt[row->optimizer];
     d.anneal = s->anneal;
@@ -285,7 +312,8 @@ static tt_status run_one(app_run *r, const study_terrain *t,
     tt_refine_options o;
     tt_refine_options_init(&o);
     o.max_error = -1.0;
-    o.percent = p->pct[row->percent];
+    o.percent = max_points ? 0 : p->pct[row->percent];
+    o.max_points = max_points;
     o.criterion = p->crit[row->criterion];
     o.repair = tt__study_repair(o.criterion);
     o.optimize = p->opt[row->optimizer];
@@ -300,18 +328,23 @@ static tt_status run_one(app_run *r, const study_terrain *t,
   } else if (st != TT_OK) {
     tt__app_fail(r, st == TT_ERR_LIMIT ? TT_APP_EXIT_USAGE
                                        : TT_APP_EXIT_FAILURE,
-                 st, NULL, "study: %s, %s, %s, optimizer %s, %s%%: %s",
+                 st, NULL, "study: %s, %s, %s, optimizer %s, %s%s: %s",
                  t->label, dec ? "decimate" : "insert",
                  tt_criterion_name(p->crit[row->criterion]),
                  tt_optimize_name(p->opt[row->optimizer]),
-                 p->pct_text[row->percent], tt__app_why(r, st, t->arg));
+                 max_points ? CPLSPrintf("%zu", max_points)
+                            : p->pct_text[row->percent],
+                 max_points ? " points" : "%", tt__app_why(r, st, t->arg));
   } else {
     tt_tin_get_summary(tin, &sum);
     row->points = sum.vertices;
     row->e = sum.errors;
     row->seconds = sum.seconds_mesh;
   }
-  tt_tin_destroy(tin);
+  if (st == TT_OK && out_tin)
+    *out_tin = tin;
+  else
+    tt_tin_destroy(tin);
   return st;
 }
 
@@ -477,6 +510,8 @@ static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
       }
     } else {
       tt__json_null(&j, "generator");
+      if (x->path)
+        tt__json_str(&j, "path", x->path);
       tt__json_i64(&j, "band", s->band);
       tt__json_str(&j, "srcnodata", s->srcnodata);
       tt__json_num(&j, "z_factor", s->z_factor);
@@ -516,47 +551,12 @@ static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
   tt__json_num(&j, "r", s->anneal.r);
   tt__json_i64(&j, "seed", (int64_t)s->anneal.seed);
   tt__json_close(&j);
+  tt__json_size(&j, "tin_points", s->tin_points);
+  tt__json_bool(&j, "plot", s->plot);
   tt__json_size(&j, "runs", nruns);
   tt__json_size(&j, "rows", nrows);
   tt__json_str(&j, "seconds", "mesh: tt_tin_summary.seconds_mesh");
   tt__json_close(&j);
-}
-
-/* Whether dir exists (1), not (0), or is in the way or not readable (-1,
- * failure recorded). */
-static int check_outdir(app_run *r, const char *dir)
-{
-  struct stat sb;
-  if (stat(dir, &sb) != 0) {
-    if (errno == ENOENT)
-      return 0;
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir, "%s",
-                 strerror(errno));
-    return -1;
-  }
-  if (!S_ISDIR(sb.st_mode)) {
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, dir,
-                 "exists and is not a directory");
-    return -1;
-  }
-  DIR *d = opendir(dir);
-  if (!d) {
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir, "%s",
-                 strerror(errno));
-    return -1;
-  }
-  int empty = 1;
-  struct dirent *e;
-  while (empty && (e = readdir(d)))
-    if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-      empty = 0;
-  closedir(d);
-  if (!empty && !r->s->overwrite) {
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, dir,
-                 "is not empty; use -overwrite to write into it");
-    return -1;
-  }
-  return 1;
 }
 
 enum { F_CURVES, F_TABLES, F_RUNS, F_COUNT };
@@ -635,6 +635,8 @@ tt_status tt__app_study(app_run *r)
   study_row *rows = NULL;
   study_rows steps = {NULL, 0, 0};
   size_t nterr = 0, nrows = 0, nruns = 0;
+  char *python = NULL, *script = NULL;
+  app_study_tins *tins = NULL;
   while (s->terrains[nterr])
     nterr++;
 
@@ -642,8 +644,9 @@ tt_status tt__app_study(app_run *r)
     st = r->res->status;
     goto done;
   }
-  int exists = check_outdir(r, s->output);
-  if (exists < 0) {
+  int exists = tt__app_study_check_outdir(r, s->output);
+  if (exists < 0 || (s->plot && !tt__app_study_plot_check(r, &python,
+                                                           &script))) {
     st = r->res->status;
     goto done;
   }
@@ -671,10 +674,13 @@ tt_status tt__app_study(app_run *r)
 
   /* The runs (5 - 99%), in the order the tables read them; then the
    * -points runs (study_curves.c), one per terrain, method, optimiser and
-   * criterion. */
+   * criterion; then the runs of -tin_points, as many (the percentages
+   * aside). */
   size_t ncurves = plan.points ? nterr * plan.nmeth * plan.nopt * plan.ncrit
                                : 0;
-  size_t total = nterr * per_terrain + ncurves;
+  size_t total = nterr * per_terrain + ncurves, ntin = 0;
+  if (s->tin_points)
+    total += nterr * plan.nmeth * plan.nopt * plan.ncrit;
   for (size_t t = 0; t < nterr; t++)
     for (size_t m = 0; m < plan.nmeth; m++)
       for (size_t o = 0; o < plan.nopt; o++)
@@ -692,7 +698,7 @@ tt_status tt__app_study(app_run *r)
               st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
               goto done;
             }
-            st = run_one(r, &ts[t], &plan, w);
+            st = run_one(r, &ts[t], &plan, w, 0, NULL);
             if (st != TT_OK)
               goto done;
             nrows++;
@@ -713,23 +719,64 @@ tt_status tt__app_study(app_run *r)
             goto done;
           nruns++;
         }
+  if (s->tin_points &&
+      (st = tt__app_study_tins_begin(r, s->output, &tins)) != TT_OK)
+    goto done;
+  for (size_t t = 0; s->tin_points && t < nterr; t++)
+    for (size_t m = 0; m < plan.nmeth; m++)
+      for (size_t o = 0; o < plan.nopt; o++)
+        for (size_t c = 0; c < plan.ncrit; c++, ntin++) {
+          study_row w = {t, m, c, o, 0, 0, {0}, 0};
+          tt_tin *tin = NULL;
+          double lo =
+              0.05 + 0.94 * (double)(nrows + nruns + ntin) / (double)total;
+          tt__app_phase_set(&r->prog, lo, lo + 0.94 / (double)total);
+          if (!tt__app_continue(r, lo)) {
+            st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
+            goto done;
+          }
+          st = run_one(r, &ts[t], &plan, &w, s->tin_points, &tin);
+          if (st == TT_OK)
+            st = tt__app_study_tins_add(
+                r, tins, t, ts[t].label, ts[t].grid,
+                plan.decimate[m] ? "decimate" : "insert",
+                tt_criterion_name(plan.crit[c]), optimizer_used(&plan, &w),
+                tin);
+          tt_tin_destroy(tin);
+          if (st != TT_OK)
+            goto done;
+        }
   nruns += nrows;
 
   st = write_outputs(r, exists, ts, nterr, &plan, rows, nrows, &steps,
                      nruns);
   if (st != TT_OK)
     goto done;
+  /* The TINs, then the pictures, once the tables are committed. */
+  if (tins && (st = tt__app_study_tins_commit(r, tins)) != TT_OK)
+    goto done;
+  if (python &&
+      (st = tt__app_study_plot_run(r, python, script, s->output)) != TT_OK)
+    goto done;
   /* Draws 100%; a stop asked now is too late: the files are committed. */
   (void)tt__app_continue(r, 1.0);
   if (!s->quiet) {
     fprintf(r->out, "%s: %zu runs over %zu terrain%s (curves.csv, tables.md, "
-            "runs.json); %.2f s\n", s->output, nruns, nterr,
-            nterr == 1 ? "" : "s", tt__app_now() - r->t0);
+            "runs.json%s%s); %.2f s\n", s->output, nruns + ntin, nterr,
+            nterr == 1 ? "" : "s", tins ? ", tins/" : "",
+            python ? ", plots/" : "", tt__app_now() - r->t0);
+    if (python)
+      fprintf(r->out, "plots drawn by %s %s\n", python, script);
     fflush(r->out);
   }
 done:
-  for (size_t t = 0; ts && t < nterr; t++)
+  for (size_t t = 0; ts && t < nterr; t++) {
     tt_grid_destroy(ts[t].grid);
+    CPLFree(ts[t].path);
+  }
+  tt__app_study_tins_free(tins);
+  CPLFree(python);
+  CPLFree(script);
   free(ts);
   free(rows);
   free(steps.w);

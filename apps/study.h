@@ -17,6 +17,7 @@ typedef struct study_terrain {
   const char *arg;   /* as given to -terrain */
   const char *label; /* the generator's name or the DEM's file name */
   const struct named_terrain *named; /* NULL: a DEM file */
+  char *path;                        /* crater: the DEM read (CPLFree) */
   tt_synth_options synth;            /* named terrains */
   tt_grid *grid;
   size_t valid;

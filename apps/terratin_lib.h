@@ -147,6 +147,9 @@ typedef struct tt_app_settings {
    * eval -error_raster */
   const char *error_raster;  /* -error_raster: TIN - DEM as a GeoTIFF */
   const char *const *co;     /* -co NAME=VALUE (raster creation options) */
+  int plot;                  /* -plot: tools/plot_study.py afterwards */
+  size_t tin_points;         /* -tin_points N: each criterion's TIN at N
+                                points into OUTDIR/tins; 0: none */
 } tt_app_settings;
 
 typedef struct tt_app_options tt_app_options;
