@@ -8,14 +8,18 @@
  * useAsDefault = 1, f_table_schema = '' and the layer's table and
  * geometry column), one row for each geometry layer written.
  *
- * The QML holds a graduated renderer: max_err for the triangles, ins_err
- * for the vertices (NULL for the starting corners, the forced outline
- * vertices and every vertex of a decimated TIN: mapped to -1 by coalesce()
- * and drawn grey in a class of their own, so no vertex disappears), five
- * quantile classes from the TIN's own values, yellow to red (ColorBrewer
- * YlOrRd). Quantiles rather than equal intervals: insertion errors span
- * orders of magnitude (the first points inserted are the worst), and equal
- * intervals would put nearly every vertex in the first class.
+ * The QML holds a graduated renderer, five classes from the TIN's own
+ * values coloured yellow to red (ColorBrewer YlOrRd): max_err for the
+ * triangles in equal intervals from the smallest to the largest (the
+ * errors lie under the bound, and an integer DEM gives most triangles an
+ * error of 0, which would merge quantile classes into one); ins_err for
+ * the vertices in quantiles (insertion errors span orders of magnitude, the
+ * first points inserted being the worst: equal intervals would put nearly
+ * every vertex in the first class), falling back to equal intervals when
+ * repeated values leave fewer than three. ins_err is NULL for the starting
+ * corners, the forced outline vertices and every vertex of a decimated
+ * TIN: coalesce() maps it to -1, drawn grey in a class of its own, so no
+ * vertex disappears.
  *
  * Workload: one sort of the triangles' and vertices' errors (8 bytes
  * each), a QML of a few kilobytes per layer.
@@ -142,8 +146,23 @@ static void add_symbol(text *t, int name, const char *colour, int point)
         name, colour);
 }
 
+/* Equal intervals from v[0] to v[m-1] (sorted, m > 0) into breaks. */
+static int equal_breaks(const double *v, size_t m, double *breaks)
+{
+  int nb = 0;
+  breaks[nb++] = v[0];
+  for (int k = 1; k <= N_CLASSES; k++) {
+    double b = k == N_CLASSES ? v[m - 1]
+                              : v[0] + (v[m - 1] - v[0]) * k / N_CLASSES;
+    if (b > breaks[nb - 1])
+      breaks[nb++] = b;
+  }
+  return nb;
+}
+
 char *tt__style_graduated_qml(const char *attr, const double *values,
-                              size_t n, int point, int nan_class)
+                              size_t n, int point, int nan_class,
+                              int quantiles)
 {
   /* The finite values, sorted: the quantile breaks. */
   double *v = malloc((n ? n : 1) * sizeof *v);
@@ -156,7 +175,7 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
   qsort(v, m, sizeof *v, cmp_double);
   double breaks[N_CLASSES + 1];
   int nb = 0;
-  if (m > 0) {
+  if (m > 0 && quantiles) {
     breaks[nb++] = v[0];
     for (int k = 1; k <= N_CLASSES; k++) {
       size_t at = k == N_CLASSES ? m - 1 : (size_t)((double)(m - 1) * k /
@@ -164,9 +183,13 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
       if (v[at] > breaks[nb - 1])
         breaks[nb++] = v[at];
     }
-    if (nb == 1) /* every value the same: one class around it */
-      breaks[nb++] = v[0];
+    if (nb < 4) /* fewer than three classes */
+      quantiles = 0;
   }
+  if (m > 0 && !quantiles)
+    nb = equal_breaks(v, m, breaks);
+  if (nb == 1) /* every value the same: one class around it */
+    breaks[nb++] = v[0];
   free(v);
 
   text t;
@@ -198,7 +221,7 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
     add_symbol(&t, sym++, ramp[c], point);
   }
   add(&t, "    </symbols>\n"
-          "    <classificationMethod id=\"Quantile\">\n"
+          "    <classificationMethod id=\"%s\">\n"
           "      <symmetricMode enabled=\"0\" symmetrypoint=\"0\" "
           "astride=\"0\"/>\n"
           "      <labelFormat format=\"%%1 - %%2\" labelprecision=\"4\" "
@@ -207,7 +230,7 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
           "  </renderer-v2>\n"
           "  <layerGeometryType>%d</layerGeometryType>\n"
           "</qgis>\n",
-      point ? 0 : 2);
+      quantiles ? "Quantile" : "EqualInterval", point ? 0 : 2);
   if (t.failed) {
     free(t.s);
     return NULL;
@@ -306,7 +329,8 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
       }
     }
     char *qml = tt__style_graduated_qml(
-        tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri);
+        tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri,
+        !tri);
     free(values);
     if (!qml)
       return tt__error(ctx, TT_ERR_NOMEM, "out of memory for a style");
@@ -314,7 +338,7 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                                        tri ? "triangles" : "vertices"));
     s = insert_row(ctx, layer, table, tri ? tri_geom : vtx_geom, qml,
                    tri ? "terratin: triangles by their max error (max_err), "
-                         "quantile classes"
+                         "equal intervals"
                        : "terratin: vertices by their insertion error "
                          "(ins_err), quantile classes; grey: none");
     CPLFree(table);

@@ -26,12 +26,15 @@ TT_HIDDEN tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                                      const char *vtx_geom);
 
 /* The QML of a graduated renderer on the expression attr (XML-escaped
- * here) over values (NaN ignored; n may be 0), five quantile classes (fewer
- * when values repeat) coloured yellow to red; points when point is set,
- * else polygons. nan_class adds a grey first class for NULL values, which
- * attr must map to -1 (coalesce). The caller frees the result with
- * CPLFree(); NULL when out of memory. */
+ * here) over values (NaN ignored; n may be 0): five classes coloured
+ * yellow to red, equal intervals from the smallest value to the largest,
+ * or quantiles when quantiles is set (equal intervals when repeated values
+ * leave fewer than three; fewer classes when values repeat); points when
+ * point is set, else polygons. nan_class adds a grey first class for NULL
+ * values, which attr must map to -1 (coalesce). The caller frees the
+ * result with CPLFree(); NULL when out of memory. */
 TT_HIDDEN char *tt__style_graduated_qml(const char *attr, const double *values,
-                                        size_t n, int point, int nan_class);
+                                        size_t n, int point, int nan_class,
+                                        int quantiles);
 
 #endif
