@@ -209,10 +209,16 @@ static tt_status delete_existing(write_state *w, const char *name)
                              ? CPLSPrintf("%s.%s", schema, name)
                              : name);
   tt_status s = TT_OK;
-  int n = GDALDatasetGetLayerCount(w->dst);
+  /* by name first: PostgreSQL lists no table without geometry, and adds
+   * one to its list when it is asked for by name */
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  OGRLayerH named = GDALDatasetGetLayerByName(w->dst, full);
+  CPLPopErrorHandler();
+  CPLErrorReset();
+  int n = named ? GDALDatasetGetLayerCount(w->dst) : 0;
   for (int i = 0; i < n; i++) {
     OGRLayerH l = GDALDatasetGetLayer(w->dst, i);
-    if (l && strcasecmp(OGR_L_GetName(l), full) == 0) {
+    if (l == named) {
       CPLErrorReset();
       if (GDALDatasetDeleteLayer(w->dst, i) != OGRERR_NONE)
         s = tt__error(w->ctx, TT_ERR_IO, "cannot replace layer %s: %s",
