@@ -16,14 +16,29 @@
  * that are NaN (aspect of a flat triangle, insertion error of a starting
  * vertex) are written as NULL.
  *
+ * LAYERS says which of the three are written (single-layer formats take
+ * one).
+ *
  * The rows are written in one transaction when the driver has them (GPKG,
  * SQLite, PostgreSQL): nothing is visible until the commit, and an error or
- * an interruption rolls it back. The layers themselves are created just
- * before it and deleted again on failure: GDAL 3.6's GPKG driver keeps the
- * layer objects of a rolled-back CREATE TABLE and then writes triggers for
- * tables that do not exist when the dataset closes. Drivers without
- * transactions (Shapefile) get their layers deleted on failure too; the
- * temporary names of tt_output guard the final files either way.
+ * an interruption rolls it back. For GPKG and SQLite the layers themselves
+ * are created just before it and deleted again on failure: GDAL 3.6's GPKG
+ * driver keeps the layer objects of a rolled-back CREATE TABLE and then
+ * writes triggers for tables that do not exist when the dataset closes. A
+ * database (PostgreSQL) creates its tables inside the transaction, and
+ * OVERWRITE drops the old ones there too: a failure, an interruption or a
+ * connection lost before the commit (the process killed) leaves the
+ * database as it was. Drivers without transactions (Shapefile, KML) get
+ * each layer made and filled before the next (KML takes features only into
+ * its last layer: "Interleaved feature adding to different layers is not
+ * supported"), and their layers deleted on failure; the temporary names of
+ * tt_output guard the final files either way.
+ *
+ * Fields: Integer64 becomes Integer where the driver has no Integer64
+ * (MapInfo); a layer that creates no fields (DXF's fixed set) gets the
+ * features without attributes, warned once. STYLE=YES writes QGIS's
+ * layer_styles table of a GeoPackage (layer_style.c) in the same
+ * transaction.
  *
  * Spatial index: GPKG layers are created with SPATIAL_INDEX=NO (its R-tree
  * triggers would update the index per insert) and the R-tree is built once,
@@ -32,7 +47,8 @@
  * RTREE=DEFERRED leaves it to the caller (tt_gpkg_build_rtree() on the
  * closed file, several times faster than GDAL 3.6's one-by-one inserts). Other
  * drivers index as their own options say (Shapefile: .qix at close with
- * LCO=SPATIAL_INDEX=YES). Shapefile layers default to ENCODING=UTF-8 (.cpg).
+ * LCO=SPATIAL_INDEX=YES, the default here). Shapefile layers default to
+ * ENCODING=UTF-8 (.cpg).
  *
  * Output CRS and areas: tin_records.c (the layers get srs, or T_SRS with
  * every vertex transformed once; geodesic areas for a geographic output).
