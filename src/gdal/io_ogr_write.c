@@ -737,7 +737,8 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
     for (int k = 0; k < 3 && s == TT_OK; k++)
       if (w.layers & order[k])
         s = make_layer(&w, tin, order[k], fields, nfields);
-    if (s == TT_OK && w.style && w.gpkg) {
+    if (s == TT_OK && w.style && w.gpkg &&
+        (w.layers & (TT__LAYER_TRIANGLES | TT__LAYER_VERTICES))) {
       /* as QGIS makes it: the FID column is "id" */
       char **style_lco = CSLSetNameValue(NULL, "FID", "id");
       s = create_named_layer(&w, TT__STYLE_TABLE, NULL, wkbNone, style_lco,
