@@ -188,6 +188,28 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
     goto done; /* it holds them, or it cannot be judged */
   char why_all[TT_APP_MESSAGE_MAX];
   snprintf(why_all, sizeof why_all, "%s", p.why);
+  {
+    /* The same into a GeoPackage, which holds everything: when that fails
+     * too, the fault is not the driver's (a -t_srs the DEM's CRS cannot
+     * reach): said now, as the write would say it after the work. */
+    probe g = p;
+    static const char *const none[] = {NULL};
+    GDALDriverH gpkg = GDALGetDriverByName("GPKG");
+    g.drv = gpkg;
+    g.wopts = NULL;
+    for (char **o = p.wopts; o && *o; o++)
+      if (strncasecmp(*o, "LCO=", 4) != 0 && strncasecmp(*o, "STYLE=", 6))
+        g.wopts = CSLAddString(g.wopts, *o);
+    g.dsco = (char **)none;
+    int control = gpkg ? probe_run(&g, want, ".gpkg") : -1;
+    CSLDestroy(g.wopts);
+    if (control == 0) {
+      ok = 0;
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output, "%s",
+                   g.why);
+      goto done;
+    }
+  }
   if ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0])) {
     /* Without the user's -lco and -dsco? Then those are at fault. */
     probe q = p;

@@ -155,6 +155,12 @@ refused_early "DXF, two geometry layers" "-layers triangles or -layers vertices"
   simplify -max_error 1 -layers triangles,vertices dem.tif ref/o.dxf
 refused_early "a -lco the driver refuses" "-lco" \
   simplify -max_error 1 -lco FID=v0 dem.tif ref/o.gpkg
+# a failure that is not the driver's is said as the write would say it
+run generate bump nocrs.tif -size 30 -q
+run simplify -q -t_srs EPSG:4326 -layers triangles nocrs.tif ref/n.geojson
+check "no CRS to transform from: exit 1, not a driver refusal ($rc)" [ "$rc" -eq 1 ]
+check "no CRS to transform from: says so" grep -q "no CRS" err.txt
+check "no CRS to transform from: nothing left" [ -z "$(ls -A ref)" ]
 # the folder forms hold them all
 run simplify -q -max_error 1 -of FlatGeobuf dem.tif ref/fg
 check "FlatGeobuf folder: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
