@@ -82,6 +82,12 @@ int tt__app_is_gdal_bool(const char *w);
 /* "N" or "NXxNY". */
 int tt__app_parse_grid_size(const char *w, size_t *nx, size_t *ny);
 int tt__app_is_pow2_plus1(size_t n);
+/* The TT_APP_LAYER_* bit of the layer named by the n bytes at w
+ * (triangles, vertices, run_parameters; case-insensitive), else 0. */
+unsigned tt__app_layer_bit(const char *w, size_t n);
+/* The names of the layers of mask, comma-separated, in the writer's order
+ * ("triangles,run_parameters"), into buf. */
+const char *tt__app_layer_list(unsigned mask, char *buf, size_t size);
 
 /* "simplify", "generate", "eval" or "" (help.c). */
 const char *tt__app_command_name(tt_app_command c);
@@ -183,6 +189,29 @@ void tt__app_iso8601_utc(char *buf, size_t size);
 int tt__app_threads(app_run *r);
 /* The output driver of simplify: -of, else OUTPUT's extension, else GPKG. */
 GDALDriverH tt__app_output_driver(app_run *r);
+/* ogr_output.c: the dry run of the OGR writer on a two-triangle TIN in
+ * /vsimem/ with drv, -layers, the creation options dsco and the writer's
+ * options wopts, after
+ * the DEM src is opened and before it is read: 1 when the driver holds the
+ * layers (or cannot be judged), else 0 with the refusal recorded (a usage
+ * error naming the -layers or OUTPUT form that works). */
+int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
+                             char **dsco, char **wopts);
+/* The dataset creation options of an OGR output: -dsco, and the defaults
+ * terratin adds (GPX: GPX_USE_EXTENSIONS=YES, or it keeps no attribute).
+ * The caller frees the list with CSLDestroy(). */
+char **tt__app_output_dsco(const char *drvname, const char *const *dsco);
+/* The driver of a database output (-of PostgreSQL, or OUTPUT "PG:..."; a
+ * driver that writes no file and has a connection prefix), else NULL. */
+GDALDriverH tt__app_database_driver(app_run *r);
+/* Opens the database OUTPUT for writing and checks it before any work:
+ * transactions, layer creation, and (without -overwrite) none of the
+ * layers to write there already (in the schema of -lco SCHEMA). shown
+ * names it in messages. NULL with the failure recorded. */
+GDALDatasetH tt__app_database_open(app_run *r, GDALDriverH drv,
+                                   const char *shown);
+/* name with the value of every password= replaced by ***. */
+void tt__app_mask_password(const char *name, char *buf, size_t size);
 /* Whether two paths name the same existing file. */
 int tt__app_same_file(const char *a, const char *b);
 

@@ -64,6 +64,8 @@ static const tt__app_opt_def opt_defs[] = {
     {"-points", O_POINTS, 1, FOR_T},
     {"-plot", O_PLOT, 0, FOR_T},
     {"-tin_points", O_TIN_POINTS, 1, FOR_T},
+    {"-layers", O_LAYERS, 1, FOR_S},
+    {"-nostyle", O_NOSTYLE, 0, FOR_S},
 };
 
 const tt__app_opt_def *tt__app_find_opt(const char *w)

@@ -97,6 +97,7 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
   o->s.max_error = -1.0;
   o->s.criterion = TT_CRITERION_DELAUNAY;
   o->s.nln = "";
+  o->s.layers = TT_APP_LAYERS_ALL;
   o->s.config = empty_list;
   o->s.lco = empty_list;
   o->s.dsco = empty_list;
@@ -309,6 +310,29 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
       break;
     case O_OVERWRITE: o->s.overwrite = 1; break;
     case O_OBJ_LOCAL: o->s.obj_local = 1; break;
+    case O_NOSTYLE: o->s.nostyle = 1; break;
+    case O_LAYERS: {
+      /* a comma-separated subset of the three layers, each once */
+      unsigned mask = 0;
+      const char *p = v;
+      for (;;) {
+        const char *e = strchr(p, ',');
+        size_t n = e ? (size_t)(e - p) : strlen(p);
+        unsigned bit = tt__app_layer_bit(p, n);
+        if (!bit)
+          USAGE("%s: -layers '%s': '%.*s' is not a layer (triangles, "
+                "vertices, run_parameters)", cmdname, v, (int)n, p);
+        if (mask & bit)
+          USAGE("%s: -layers '%s': %.*s is named twice", cmdname, v,
+                (int)n, p);
+        mask |= bit;
+        if (!e)
+          break;
+        p = e + 1;
+      }
+      o->s.layers = mask;
+      break;
+    }
     case O_Q: o->s.quiet = 1; break;
     case O_JSON: o->s.json = 1; break;
     case O_CRITERION: {

@@ -169,7 +169,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_begin(&j, r->out);
   tt__json_str(&j, "input", r->s->input);
   tt__json_size(&j, "band", (size_t)r->s->band);
-  tt__json_str(&j, "output", r->s->output);
+  char shown[TT_APP_MESSAGE_MAX]; /* a connection's password masked */
+  tt__app_mask_password(r->s->output, shown, sizeof shown);
+  tt__json_str(&j, "output", shown);
   tt__json_str(&j, "format", p->driver);
   tt__json_str(&j, "method", p->dopt ? "decimate" : "insert");
   tt__json_str(&j, "criterion", tt_criterion_name(p->sum.criterion));
@@ -306,11 +308,13 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
     snprintf(zu, sizeof zu, "%s (%s)", unit, in->z_unit_source);
   else
     snprintf(zu, sizeof zu, "unknown");
+  char shown[TT_APP_MESSAGE_MAX]; /* a connection's password masked */
+  tt__app_mask_password(r->s->output, shown, sizeof shown);
   fprintf(r->out,
           "%s: %zu cells, %zu valid samples -> %zu vertices, %zu triangles; "
           "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s; "
           "frame %s; z unit %s; mesh %.2f s, write %.2f s (%s); %.2f s\n",
-          r->s->output, p->cells, p->valid, p->sum.vertices,
+          shown, p->cells, p->valid, p->sum.vertices,
           p->sum.triangles, p->sum.errors.max_error, unit,
           p->sum.errors.rmse, unit, lim,
           tt_stop_reason_name(p->sum.stop_reason),
@@ -321,17 +325,17 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
   if (p->dopt)
     fprintf(r->out,
             "%s: decimated from %zu vertices: %zu removed in %zu %s\n",
-            r->s->output, p->sum.start_vertices, p->sum.removed_vertices,
+            shown, p->sum.start_vertices, p->sum.removed_vertices,
             p->sum.rounds,
             p->dopt->selection == TT_SELECTION_SEQUENTIAL ? "steps"
                                                           : "rounds");
   /* nodata outlines: what the TIN could not carry is said, not dropped */
   size_t lone = p->sum.errors.samples - p->sum.errors.covered;
   if (p->sum.components > 1)
-    fprintf(r->out, "%s: %zu separate pieces%s", r->s->output,
-            p->sum.components, lone ? "; " : "\n");
+    fprintf(r->out, "%s: %zu separate pieces%s", shown, p->sum.components,
+            lone ? "; " : "\n");
   else if (lone)
-    fprintf(r->out, "%s: ", r->s->output);
+    fprintf(r->out, "%s: ", shown);
   if (lone)
     fprintf(r->out,
             "%zu valid sample%s amid nodata (in no cell with 3 valid "

@@ -58,7 +58,7 @@ tt_status tt__app_simplify(app_run *r)
   tt_raster_info *info = NULL;
   tt_tin *tin = NULL;
   OGRSpatialReferenceH srs = NULL;
-  char **wopts = NULL;
+  char **wopts = NULL, **dsco = NULL;
   app_simplify_report rep;
   tt_refine_options ro;
   size_t valid = 0;
@@ -77,6 +77,13 @@ tt_status tt__app_simplify(app_run *r)
                                   : tt_mesh_format_from_path(s->output);
   GDALDriverH drv = NULL;
   const char *drvname = tt_mesh_format_name(mesh);
+  int database = 0; /* a datasource that is no file: PG:... */
+  char shown[TT_APP_MESSAGE_MAX]; /* OUTPUT without its password */
+  tt__app_mask_password(s->output, shown, sizeof shown);
+  if (mesh && s->layers != TT_APP_LAYERS_ALL)
+    return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -layers is for OGR outputs; %s writes "
+                        "the whole mesh", drvname);
   if (mesh && ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0])))
     return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
                         "simplify: -lco and -dsco are for OGR drivers; %s "
@@ -85,12 +92,23 @@ tt_status tt__app_simplify(app_run *r)
     return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
                         "simplify: -obj_local is for -of OBJ outputs");
   if (!mesh) {
-    drv = tt__app_output_driver(r);
+    drv = tt__app_database_driver(r);
+    database = drv != NULL;
+    if (!drv)
+      drv = tt__app_output_driver(r);
     if (!drv)
       return r->res->status;
     drvname = GDALGetDriverShortName(drv);
   }
 
+  /* A database is opened and checked now (its tables are made in the
+   * write's transaction); it has no temporary name. */
+  if (database) {
+    dst = tt__app_database_open(r, drv, shown);
+    if (!dst)
+      return r->res->status;
+    goto planned;
+  }
   /* Plan the output first: a refusal costs nothing yet. */
   r->msg.last[0] = '\0';
   st = tt_output_begin(r->ctx, s->output, drvname, s->overwrite, &outp);
@@ -139,6 +157,7 @@ tt_status tt__app_simplify(app_run *r)
     goto done;
   }
 
+planned:;
   /* The memory the run may hold: -max_memory, else what the system allows,
    * asked before the DEM is read (the heights count against it). */
   const char *mem_source = "-max_memory";
@@ -164,10 +183,37 @@ tt_status tt__app_simplify(app_run *r)
   }
   /* Every file the input is read from (the container of a /vsizip/ or
    * GPKG: name, VRT sources, sidecars) is out of the output's reach. */
-  st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
+  st = outp ? tt_output_protect_dataset(r->ctx, outp, src, s->input)
+              : TT_OK;
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, s->output);
     goto done;
+  }
+  /* The writer's options, and its dry run: a driver that cannot hold the
+   * layers is refused before the DEM is read. */
+  if (!mesh) {
+    /* Shapefile outputs name their files "<name>_<layer>": the planned
+     * prefix comes first, then the user's -nln. */
+    char *prefix = CPLStrdup(CPLSPrintf(
+        "%s%s", outp ? tt_output_layer_prefix(outp) : "", s->nln));
+    wopts = CSLSetNameValue(wopts, "NLN_PREFIX", prefix);
+    CPLFree(prefix);
+    for (size_t i = 0; s->lco[i]; i++)
+      wopts = CSLAddNameValue(wopts, "LCO", s->lco[i]);
+    if (s->t_srs)
+      wopts = CSLSetNameValue(wopts, "T_SRS", s->t_srs);
+    char list[64];
+    wopts = CSLSetNameValue(wopts, "LAYERS",
+                            tt__app_layer_list(s->layers, list, sizeof list));
+    if (!s->nostyle && tt__app_str_ieq(drvname, "GPKG"))
+      wopts = CSLSetNameValue(wopts, "STYLE", "YES");
+    if (database && s->overwrite)
+      wopts = CSLSetNameValue(wopts, "OVERWRITE", "YES");
+    dsco = tt__app_output_dsco(drvname, s->dsco);
+    if (!database && !tt__app_check_ogr_output(r, drv, src, dsco, wopts)) {
+      st = r->res->status;
+      goto done;
+    }
   }
   if (!tt__app_continue(r, 0.0)) {
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
@@ -290,8 +336,9 @@ tt_status tt__app_simplify(app_run *r)
     goto commit;
   }
   r->msg.last[0] = '\0';
-  dst = GDALCreate(drv, tt_output_temp_path(outp), 0, 0, 0, GDT_Unknown,
-                   (CSLConstList)s->dsco);
+  if (!database)
+    dst = GDALCreate(drv, tt_output_temp_path(outp), 0, 0, 0, GDT_Unknown,
+                     (CSLConstList)dsco);
   if (!dst) {
     st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, s->output,
                   "cannot create %s dataset: %s", drvname,
@@ -386,16 +433,6 @@ tt_status tt__app_simplify(app_run *r)
   memcpy(allf, fields, sizeof fields);
   memcpy(allf + NF, dfields, sizeof dfields);
   size_t nallf = NF + (s->decimate ? ND : 0);
-  /* Shapefile outputs name their files "<name>_<layer>": the planned
-   * prefix comes first, then the user's -nln. */
-  char *prefix = CPLStrdup(CPLSPrintf("%s%s", tt_output_layer_prefix(outp),
-                                      s->nln));
-  wopts = CSLSetNameValue(wopts, "NLN_PREFIX", prefix);
-  CPLFree(prefix);
-  for (size_t i = 0; s->lco[i]; i++)
-    wopts = CSLAddNameValue(wopts, "LCO", s->lco[i]);
-  if (s->t_srs)
-    wopts = CSLSetNameValue(wopts, "T_SRS", s->t_srs);
   /* GPKG: the layers through OGR, then their rows and R-trees straight
    * into the closed file by tt_gpkg_write_rows() (OGR writes a feature at a
    * time and GDAL 3.6 inserts R-tree entries one by one). */
@@ -416,8 +453,14 @@ tt_status tt__app_simplify(app_run *r)
   st = tt_ogr_write_tin(r->ctx, dst, tin, srs, allf, nallf, wopts,
                         tt__app_phase_fn, &r->prog);
   if (st != TT_OK) {
-    tt__app_fail_write(r, st, s->output, tt_output_temp_path(outp), NULL);
+    tt__app_fail_write(r, st, shown, tt_output_temp_path(outp), NULL);
     goto done;
+  }
+  if (database) {
+    /* committed: the tables are in place */
+    GDALClose(dst);
+    dst = NULL;
+    goto written;
   }
   /* Around the close, which may flush for long (a stop during it is seen
    * by the watchdog of terratin.c, which removes the temporary files). */
@@ -465,6 +508,7 @@ commit:
     tt__app_fail_tt(r, st, s->output);
     goto done;
   }
+written:
   rep.t_write = tt__app_now() - t;
   rep.t_total = tt__app_now() - r->t0;
   tt__app_continue(r, 1.0);
@@ -484,6 +528,7 @@ done:
   if (srs)
     OSRDestroySpatialReference(srs);
   CSLDestroy(wopts);
+  CSLDestroy(dsco);
   tt_tin_destroy(tin);
   tt_grid_destroy(grid);
   tt_raster_info_destroy(info);

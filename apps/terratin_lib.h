@@ -67,6 +67,14 @@ typedef struct tt_app_result {
 /* What the command line said, read-only for callers. Strings and lists are
  * owned by the options object; lists are NULL-terminated. A field that does
  * not apply to the command keeps its default. */
+/* The layers simplify writes (-layers), as bits of tt_app_settings.layers. */
+enum {
+  TT_APP_LAYER_TRIANGLES = 1u,
+  TT_APP_LAYER_VERTICES = 2u,
+  TT_APP_LAYER_RUN_PARAMETERS = 4u,
+  TT_APP_LAYERS_ALL = 7u
+};
+
 typedef struct tt_app_settings {
   tt_app_command command;
   tt_app_command help_topic; /* TT_APP_HELP: TT_APP_NONE = top level */
@@ -110,6 +118,8 @@ typedef struct tt_app_settings {
   int obj_local;             /* -obj_local: OBJ vertices around the
                                 centre of the extent */
   const char *nln;           /* -nln layer name prefix; "" by default */
+  unsigned layers;           /* -layers: TT_APP_LAYER_* bits; default all */
+  int nostyle;               /* -nostyle: no layer_styles in a GeoPackage */
   /* simplify -method decimate (docs/decimation.md); the options below
    * apply to it only */
   int decimate;              /* -method: 0 insert (default), 1 decimate */

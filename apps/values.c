@@ -10,7 +10,9 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 /* A finite decimal number, the whole word: [+-]digits[.digits][e[+-]digits].
  * strtod alone would also take hex ("0x10" is 16), "inf", "nan" and
@@ -154,4 +156,30 @@ int tt__app_is_pow2_plus1(size_t n)
 {
   size_t m = n - 1;
   return n >= 3 && (m & (m - 1)) == 0;
+}
+
+static const char *const layer_names[] = {"triangles", "vertices",
+                                          "run_parameters"};
+
+unsigned tt__app_layer_bit(const char *w, size_t n)
+{
+  for (unsigned i = 0; i < 3; i++)
+    if (strlen(layer_names[i]) == n && strncasecmp(w, layer_names[i], n) == 0)
+      return 1u << i;
+  return 0;
+}
+
+const char *tt__app_layer_list(unsigned mask, char *buf, size_t size)
+{
+  size_t len = 0;
+  if (size)
+    buf[0] = '\0';
+  for (unsigned i = 0; i < 3; i++)
+    if (mask & (1u << i)) {
+      int k = snprintf(buf + len, size > len ? size - len : 0, "%s%s",
+                       len ? "," : "", layer_names[i]);
+      if (k > 0)
+        len += (size_t)k;
+    }
+  return buf;
 }

@@ -130,7 +130,18 @@ typedef struct tt_run_field {
  * builds them with tt_gpkg_build_rtree() on the closed file (layers
  * <prefix>triangles and <prefix>vertices, geometry column "geom" unless
  * LCO=GEOMETRY_NAME says otherwise); shapefiles default to LCO
- * ENCODING=UTF-8. */
+ * ENCODING=UTF-8 and SPATIAL_INDEX=YES (.qix). LAYERS=<list>: the layers
+ * to write, a comma-separated subset of triangles,vertices,run_parameters
+ * (default all). A driver without transactions gets each layer complete
+ * before the next is made (KML); a database (a driver with transactions
+ * other than GPKG and SQLite: PostgreSQL) gets its tables made inside the
+ * transaction, so that a rollback or a lost connection leaves none;
+ * OVERWRITE=YES drops the dataset's layers of those names first (inside
+ * that transaction; LCO=SCHEMA=<s> looks for s.<name>). STYLE=YES (GPKG):
+ * QGIS's layer_styles table with a default graduated style for each
+ * geometry layer. Integer64 fields become Integer for drivers without them
+ * (MapInfo); a layer that cannot create fields (DXF) is written without
+ * attributes, with one warning. */
 tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            const tt_tin *tin, OGRSpatialReferenceH srs,
                            const tt_run_field *fields, size_t nfields,

@@ -599,6 +599,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.progress_arg = progress_arg;
   const char *prefix = "", *t_srs = NULL;
   int in_transaction = 0, rtree = 1, rtree_check = 0;
+  unsigned layers = TT__LAYERS_ALL;
   char *tri_name = NULL, *vtx_name = NULL;
   tt_status s = TT_OK;
 
@@ -620,14 +621,24 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       CPLFree(lkey);
     } else if (strcasecmp(key, "RTREE_CHECK") == 0)
       rtree_check = CPLTestBool(value);
-    else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0)
+    else if (strcasecmp(key, "LAYERS") == 0)
+      s = tt__records_parse_layers(ctx, value, &layers);
+    else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0 &&
+             strcasecmp(key, "STYLE") != 0 &&
+             strcasecmp(key, "OVERWRITE") != 0)
       s = tt__error(ctx, TT_ERR_ARG, "unknown write option \"%s\" (known: "
-                    "NLN_PREFIX, LCO, ROWS, RTREE, RTREE_CHECK, T_SRS)", key);
+                    "NLN_PREFIX, LAYERS, LCO, OVERWRITE, ROWS, RTREE, "
+                    "RTREE_CHECK, STYLE, T_SRS)", key);
     CPLFree(key);
     if (s != TT_OK)
       return s;
   }
-  const size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
+  /* Only the layers asked for (LAYERS) were made: the others count as
+   * empty here. */
+  const int do_tri = (layers & TT__LAYER_TRIANGLES) != 0;
+  const int do_vtx = (layers & TT__LAYER_VERTICES) != 0;
+  const size_t nv = do_vtx ? tt_tin_vertex_count(tin) : 0;
+  const size_t nt = do_tri ? tt_tin_triangle_count(tin) : 0;
   w.total = nv + nt;
   w.step = (w.total + 99) / 100;
   w.next_report = w.step;
@@ -654,8 +665,9 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   if (s != TT_OK)
     goto done;
   in_transaction = 1;
-  s = layer_find(&w, tri_name, &tri);
-  if (s == TT_OK)
+  if (do_tri)
+    s = layer_find(&w, tri_name, &tri);
+  if (s == TT_OK && do_vtx)
     s = layer_find(&w, vtx_name, &vtx);
   if (s == TT_OK && rtree) {
     tri.boxes = malloc((nt ? nt : 1) * sizeof *tri.boxes);
@@ -664,32 +676,32 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
                     "index of %zu features", gpkg_path, nt + nv);
   }
-  if (s == TT_OK)
+  if (s == TT_OK && do_tri)
     s = triggers_drop(&w, &tri);
-  if (s == TT_OK)
+  if (s == TT_OK && do_vtx)
     s = triggers_drop(&w, &vtx);
-  if (s == TT_OK)
+  if (s == TT_OK && do_tri)
     s = write_triangles(&w, &rec, &tri);
-  if (s == TT_OK)
+  if (s == TT_OK && do_vtx)
     s = write_vertices(&w, &rec, &vtx);
-  if (s == TT_OK)
+  if (s == TT_OK && do_tri)
     s = triggers_restore(&w, &tri);
-  if (s == TT_OK)
+  if (s == TT_OK && do_vtx)
     s = triggers_restore(&w, &vtx);
-  if (s == TT_OK)
+  if (s == TT_OK && do_tri)
     s = finish_layer(&w, &tri, nt);
-  if (s == TT_OK)
+  if (s == TT_OK && do_vtx)
     s = finish_layer(&w, &vtx, nv);
   /* The R-trees from the boxes just written, in the same transaction. */
   w.lo = 0.7;
   w.hi = 0.93;
-  if (s == TT_OK && rtree)
+  if (s == TT_OK && rtree && do_tri)
     s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, tri.name, tri.geom,
                                   tri.boxes, nt, rtree_check, rtree_progress,
                                   &w);
   w.lo = 0.93;
   w.hi = 0.99;
-  if (s == TT_OK && rtree)
+  if (s == TT_OK && rtree && do_vtx)
     s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, vtx.name, vtx.geom,
                                   vtx.boxes, nv, rtree_check, rtree_progress,
                                   &w);

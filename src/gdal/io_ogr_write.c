@@ -16,14 +16,29 @@
  * that are NaN (aspect of a flat triangle, insertion error of a starting
  * vertex) are written as NULL.
  *
+ * LAYERS says which of the three are written (single-layer formats take
+ * one).
+ *
  * The rows are written in one transaction when the driver has them (GPKG,
  * SQLite, PostgreSQL): nothing is visible until the commit, and an error or
- * an interruption rolls it back. The layers themselves are created just
- * before it and deleted again on failure: GDAL 3.6's GPKG driver keeps the
- * layer objects of a rolled-back CREATE TABLE and then writes triggers for
- * tables that do not exist when the dataset closes. Drivers without
- * transactions (Shapefile) get their layers deleted on failure too; the
- * temporary names of tt_output guard the final files either way.
+ * an interruption rolls it back. For GPKG and SQLite the layers themselves
+ * are created just before it and deleted again on failure: GDAL 3.6's GPKG
+ * driver keeps the layer objects of a rolled-back CREATE TABLE and then
+ * writes triggers for tables that do not exist when the dataset closes. A
+ * database (PostgreSQL) creates its tables inside the transaction, and
+ * OVERWRITE drops the old ones there too: a failure, an interruption or a
+ * connection lost before the commit (the process killed) leaves the
+ * database as it was. Drivers without transactions (Shapefile, KML) get
+ * each layer made and filled before the next (KML takes features only into
+ * its last layer: "Interleaved feature adding to different layers is not
+ * supported"), and their layers deleted on failure; the temporary names of
+ * tt_output guard the final files either way.
+ *
+ * Fields: Integer64 becomes Integer where the driver has no Integer64
+ * (MapInfo); a layer that creates no fields (DXF's fixed set) gets the
+ * features without attributes, warned once. STYLE=YES writes QGIS's
+ * layer_styles table of a GeoPackage (layer_style.c) in the same
+ * transaction.
  *
  * Spatial index: GPKG layers are created with SPATIAL_INDEX=NO (its R-tree
  * triggers would update the index per insert) and the R-tree is built once,
@@ -32,7 +47,8 @@
  * RTREE=DEFERRED leaves it to the caller (tt_gpkg_build_rtree() on the
  * closed file, several times faster than GDAL 3.6's one-by-one inserts). Other
  * drivers index as their own options say (Shapefile: .qix at close with
- * LCO=SPATIAL_INDEX=YES). Shapefile layers default to ENCODING=UTF-8 (.cpg).
+ * LCO=SPATIAL_INDEX=YES, the default here). Shapefile layers default to
+ * ENCODING=UTF-8 (.cpg).
  *
  * Output CRS and areas: tin_records.c (the layers get srs, or T_SRS with
  * every vertex transformed once; geodesic areas for a geographic output).
@@ -49,6 +65,7 @@
  * Workload: O(vertices + triangles) feature inserts (about 16 us each into
  * GPKG, R-tree included); memory O(1) beyond what the driver buffers.
  */
+#include "gdal/layer_style.h"
 #include "gdal/tin_records.h"
 
 #include <cpl_conv.h>
@@ -70,14 +87,19 @@ typedef struct write_state {
   int shapefile;
   char *prefix;
   char **lco;              /* layer creation options */
-  char *created[3];        /* names of the layers made, for cleanup */
+  char *created[4];        /* names of the layers made, for cleanup */
   int ncreated;
   int gpkg;
+  unsigned layers;         /* LAYERS: the TT__LAYER_* bits to write */
+  int overwrite;           /* OVERWRITE=YES: drop layers of those names */
+  int style;               /* STYLE=YES: QGIS's layer_styles (GPKG) */
+  int no_int64;            /* the driver has no Integer64 fields */
+  int warned_fields;       /* a field the driver dropped, said once */
   int build_rtree;         /* GPKG: bulk-build the R-trees before commit */
   int rtree_deferred;      /* RTREE=DEFERRED: the caller builds them */
   int rows_deferred;       /* ROWS=DEFERRED: tt_gpkg_write_rows() writes
                               the triangles and vertices */
-  OGRLayerH tri_layer, vtx_layer, run_layer;
+  OGRLayerH tri_layer, vtx_layer, run_layer, style_layer;
   int tri_idx[TT__TF_COUNT], vtx_idx[TT__VF_COUNT];
   int *run_idx;
   tt_progress_fn progress;
@@ -121,6 +143,12 @@ static tt_status parse_options(write_state *w, char **options)
     } else if (strcasecmp(key, "T_SRS") == 0) {
       CPLFree(w->t_srs);
       w->t_srs = *value ? CPLStrdup(value) : NULL;
+    } else if (strcasecmp(key, "LAYERS") == 0) {
+      s = tt__records_parse_layers(w->ctx, value, &w->layers);
+    } else if (strcasecmp(key, "OVERWRITE") == 0) {
+      w->overwrite = CPLTestBool(value);
+    } else if (strcasecmp(key, "STYLE") == 0) {
+      w->style = CPLTestBool(value);
     } else if (strcasecmp(key, "ROWS") == 0) {
       if (strcasecmp(value, "DEFERRED") == 0)
         w->rows_deferred = 1;
@@ -139,7 +167,8 @@ static tt_status parse_options(write_state *w, char **options)
                       "DEFERRED", value);
     } else {
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
-                    "(known: NLN_PREFIX, LCO, ROWS, RTREE, T_SRS)", key);
+                    "(known: NLN_PREFIX, LAYERS, LCO, OVERWRITE, ROWS, "
+                    "RTREE, STYLE, T_SRS)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -162,9 +191,12 @@ static tt_status parse_options(write_state *w, char **options)
     w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "NO");
   }
   /* DBF strings are Latin-1 unless told otherwise; CRS names and paths may
-   * not be. A .cpg file tells QGIS. */
+   * not be. A .cpg file tells QGIS. And a spatial index (.qix, written at
+   * close), as QGIS would otherwise build none. */
   if (w->shapefile && !CSLFetchNameValue(w->lco, "ENCODING"))
     w->lco = CSLSetNameValue(w->lco, "ENCODING", "UTF-8");
+  if (w->shapefile && !CSLFetchNameValue(w->lco, "SPATIAL_INDEX"))
+    w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "YES");
   return TT_OK;
 }
 
@@ -184,15 +216,56 @@ static tt_status report(write_state *w)
   return TT_OK;
 }
 
-static tt_status create_layer(write_state *w, const char *suffix,
-                              OGRSpatialReferenceH srs,
-                              OGRwkbGeometryType type, OGRLayerH *out_layer)
+/* OVERWRITE=YES: drops the dataset's layer of that name (in a database,
+ * in the schema LCO=SCHEMA names, where GDAL lists it as schema.name). */
+static tt_status delete_existing(write_state *w, const char *name)
 {
-  char *name = CPLStrdup(CPLSPrintf("%s%s", w->prefix, suffix));
+  const char *schema = CSLFetchNameValue(w->lco, "SCHEMA");
+  char *full = CPLStrdup(schema && *schema
+                             ? CPLSPrintf("%s.%s", schema, name)
+                             : name);
+  tt_status s = TT_OK;
+  /* by name first: PostgreSQL lists no table without geometry, and adds
+   * one to its list when it is asked for by name */
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  OGRLayerH named = GDALDatasetGetLayerByName(w->dst, full);
+  CPLPopErrorHandler();
+  CPLErrorReset();
+  int n = named ? GDALDatasetGetLayerCount(w->dst) : 0;
+  for (int i = 0; i < n; i++) {
+    OGRLayerH l = GDALDatasetGetLayer(w->dst, i);
+    if (l == named) {
+      CPLErrorReset();
+      if (GDALDatasetDeleteLayer(w->dst, i) != OGRERR_NONE)
+        s = tt__error(w->ctx, TT_ERR_IO, "cannot replace layer %s: %s",
+                      full, ogr_msg());
+      break;
+    }
+  }
+  CPLFree(full);
+  return s;
+}
+
+/* A layer of that name (prefixed by the caller), with lco (the user's -lco
+ * for the TIN's layers, none for layer_styles). */
+static tt_status create_named_layer(write_state *w, const char *layer_name,
+                                    OGRSpatialReferenceH srs,
+                                    OGRwkbGeometryType type, char **lco,
+                                    OGRLayerH *out_layer)
+{
+  char *name = CPLStrdup(layer_name);
+  if (w->overwrite) {
+    /* inside the transaction (databases): a failure puts it back */
+    tt_status s = delete_existing(w, name);
+    if (s != TT_OK) {
+      CPLFree(name);
+      return s;
+    }
+  }
   CPLErrorReset();
   OGRLayerH layer = GDALDatasetCreateLayer(w->dst, name,
                                            type == wkbNone ? NULL : srs,
-                                           type, w->lco);
+                                           type, lco);
   if (!layer) {
     tt_status s = tt__error(w->ctx, TT_ERR_IO, "cannot create layer %s: %s",
                             name, ogr_msg());
@@ -204,30 +277,87 @@ static tt_status create_layer(write_state *w, const char *suffix,
   return TT_OK;
 }
 
+static tt_status create_layer(write_state *w, const char *suffix,
+                              OGRSpatialReferenceH srs,
+                              OGRwkbGeometryType type, OGRLayerH *out_layer)
+{
+  char *name = CPLStrdup(CPLSPrintf("%s%s", w->prefix, suffix));
+  tt_status s = create_named_layer(w, name, srs, type, w->lco, out_layer);
+  CPLFree(name);
+  return s;
+}
+
+/* Integer64 where the driver has it; else Integer (MapInfo, whose counts
+ * here stay below 2^31: the writer refuses larger TINs, and a triangle's
+ * samples are fewer than the DEM's). */
+static OGRFieldType field_type(const write_state *w, OGRFieldType t)
+{
+  return t == OFTInteger64 && w->no_int64 ? OFTInteger : t;
+}
+
+/* The index of a field just created; -1 when the layer keeps no such
+ * attribute (DXF has a fixed set and creates none): said once, and its
+ * values are then skipped. */
+static int field_index(write_state *w, OGRLayerH layer, const char *name)
+{
+  int idx = OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer), name);
+  if (idx < 0 && !w->warned_fields) {
+    w->warned_fields = 1;
+    GDALDriverH drv = GDALGetDatasetDriver(w->dst);
+    tt__warn(w->ctx, "the %s driver keeps no attribute fields such as %s "
+             "(layer %s): the features are written without them",
+             drv ? GDALGetDriverShortName(drv) : "output", name,
+             OGR_L_GetName(layer));
+  }
+  return idx;
+}
+
 /* Creates the fields and returns their indices in the layer definition. */
 static tt_status create_fields(write_state *w, OGRLayerH layer,
                                const tt__field_spec *spec, int n, int *out_index)
 {
+  if (!OGR_L_TestCapability(layer, OLCCreateField)) {
+    /* DXF: a fixed set of fields, none of ours */
+    for (int i = 0; i < n; i++)
+      out_index[i] = field_index(w, layer, spec[i].name);
+    return TT_OK;
+  }
   for (int i = 0; i < n; i++) {
-    OGRFieldDefnH fd = OGR_Fld_Create(spec[i].name, spec[i].type);
+    OGRFieldDefnH fd = OGR_Fld_Create(spec[i].name, field_type(w, spec[i].type));
     CPLErrorReset();
     OGRErr err = OGR_L_CreateField(layer, fd, TRUE);
     OGR_Fld_Destroy(fd);
-    int idx = err == OGRERR_NONE
-                  ? OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer),
-                                         spec[i].name)
-                  : -1;
-    if (idx < 0)
+    if (err != OGRERR_NONE)
       return tt__error(w->ctx, TT_ERR_IO, "cannot create field %s in layer "
                        "%s: %s", spec[i].name, OGR_L_GetName(layer),
                        ogr_msg());
-    out_index[i] = idx;
+    out_index[i] = field_index(w, layer, spec[i].name);
   }
   return TT_OK;
 }
 
+static void set_int(OGRFeatureH f, int idx, int v)
+{
+  if (idx >= 0)
+    OGR_F_SetFieldInteger(f, idx, v);
+}
+
+static void set_int64(OGRFeatureH f, int idx, int64_t v)
+{
+  if (idx >= 0)
+    OGR_F_SetFieldInteger64(f, idx, (GIntBig)v);
+}
+
+static void set_null(OGRFeatureH f, int idx)
+{
+  if (idx >= 0)
+    OGR_F_SetFieldNull(f, idx);
+}
+
 static void set_real(OGRFeatureH f, int idx, double v)
 {
+  if (idx < 0)
+    return;
   if (isfinite(v))
     OGR_F_SetFieldDouble(f, idx, v);
   else
@@ -268,12 +398,12 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
     for (int k = 0; k < 4; k++)
       OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], v[k % 3].z);
     OGR_F_SetGeometry(f, poly);
-    OGR_F_SetFieldInteger(f, idx[TT__TF_V0], t.v[0]);
-    OGR_F_SetFieldInteger(f, idx[TT__TF_V1], t.v[1]);
-    OGR_F_SetFieldInteger(f, idx[TT__TF_V2], t.v[2]);
+    set_int(f, idx[TT__TF_V0], t.v[0]);
+    set_int(f, idx[TT__TF_V1], t.v[1]);
+    set_int(f, idx[TT__TF_V2], t.v[2]);
     set_real(f, idx[TT__TF_MAX_ERR], t.max_error);
     set_real(f, idx[TT__TF_RMSE], t.rmse);
-    OGR_F_SetFieldInteger64(f, idx[TT__TF_N_SAMPLES], (GIntBig)t.samples);
+    set_int64(f, idx[TT__TF_N_SAMPLES], (int64_t)t.samples);
     set_real(f, idx[TT__TF_AREA_2D], t.area_2d);
     set_real(f, idx[TT__TF_AREA_3D], t.area_3d);
     set_real(f, idx[TT__TF_SLOPE], t.slope_deg);
@@ -305,17 +435,17 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
       break;
     OGR_G_SetPoint(pt, 0, x, y, v.z);
     OGR_F_SetGeometry(f, pt);
-    OGR_F_SetFieldInteger(f, idx[TT__VF_ID], (int)i);
-    OGR_F_SetFieldInteger(f, idx[TT__VF_COL], v.col);
-    OGR_F_SetFieldInteger(f, idx[TT__VF_ROW], v.row);
+    set_int(f, idx[TT__VF_ID], (int)i);
+    set_int(f, idx[TT__VF_COL], v.col);
+    set_int(f, idx[TT__VF_ROW], v.row);
     set_real(f, idx[TT__VF_INS_ERR], v.insert_error);
     if (decimated)
-      OGR_F_SetFieldNull(f, idx[TT__VF_INS_RANK]);
+      set_null(f, idx[TT__VF_INS_RANK]);
     else
-      OGR_F_SetFieldInteger64(f, idx[TT__VF_INS_RANK], (GIntBig)v.rank);
+      set_int64(f, idx[TT__VF_INS_RANK], (int64_t)v.rank);
     set_real(f, idx[TT__VF_STAR_MAX], v.star_max_error);
     set_real(f, idx[TT__VF_STAR_RMSE], v.star_rmse);
-    OGR_F_SetFieldInteger64(f, idx[TT__VF_STAR_N], (GIntBig)v.star_samples);
+    set_int64(f, idx[TT__VF_STAR_N], (int64_t)v.star_samples);
     if (decimated)
       set_real(f, idx[TT__VF_IMPORTANCE], v.importance);
     s = insert(w, layer, f, i);
@@ -335,9 +465,14 @@ static tt_status create_run_fields(write_state *w,
     return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
   for (size_t i = 0; i < nfields; i++) {
     const tt_run_field *rf = &fields[i];
-    OGRFieldType type = rf->type == TT_FIELD_STRING    ? OFTString
-                        : rf->type == TT_FIELD_INTEGER ? OFTInteger64
-                                                       : OFTReal;
+    if (!OGR_L_TestCapability(layer, OLCCreateField)) {
+      w->run_idx[i] = field_index(w, layer, rf->name);
+      continue;
+    }
+    OGRFieldType type = rf->type == TT_FIELD_STRING ? OFTString
+                        : rf->type == TT_FIELD_INTEGER
+                            ? field_type(w, OFTInteger64)
+                            : OFTReal;
     OGRFieldDefnH fd = OGR_Fld_Create(rf->name, type);
     if (w->shapefile && type == OFTString) {
       /* DBF strings are fixed-width: as wide as the value, at most 254. */
@@ -353,13 +488,10 @@ static tt_status create_run_fields(write_state *w,
     CPLErrorReset();
     OGRErr err = OGR_L_CreateField(layer, fd, TRUE);
     OGR_Fld_Destroy(fd);
-    w->run_idx[i] =
-        err == OGRERR_NONE
-            ? OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer), rf->name)
-            : -1;
-    if (w->run_idx[i] < 0)
+    if (err != OGRERR_NONE)
       return tt__error(w->ctx, TT_ERR_IO, "cannot create field %s in layer "
                        "%s: %s", rf->name, OGR_L_GetName(layer), ogr_msg());
+    w->run_idx[i] = field_index(w, layer, rf->name);
   }
   return TT_OK;
 }
@@ -372,6 +504,8 @@ static tt_status write_run_parameters(write_state *w,
   for (size_t i = 0; i < nfields; i++) {
     const tt_run_field *rf = &fields[i];
     int idx = w->run_idx[i];
+    if (idx < 0)
+      continue;
     if (rf->type == TT_FIELD_STRING) {
       if (rf->s)
         OGR_F_SetFieldString(f, idx, rf->s);
@@ -465,6 +599,54 @@ static void delete_created_layers(write_state *w)
   }
 }
 
+/* A layer and its fields. */
+static tt_status make_layer(write_state *w, const tt_tin *tin,
+                            unsigned which, const tt_run_field *fields,
+                            size_t nfields)
+{
+  tt_status s;
+  if (which == TT__LAYER_TRIANGLES) {
+    s = create_layer(w, "triangles", w->rec.out_srs, wkbPolygon25D,
+                     &w->tri_layer);
+    if (s == TT_OK)
+      s = create_fields(w, w->tri_layer, tt__triangle_fields, TT__TF_COUNT,
+                        w->tri_idx);
+  } else if (which == TT__LAYER_VERTICES) {
+    s = create_layer(w, "vertices", w->rec.out_srs, wkbPoint25D,
+                     &w->vtx_layer);
+    if (s == TT_OK)
+      s = create_fields(w, w->vtx_layer, tt__vertex_fields,
+                        tt__records_vertex_fields(tin), w->vtx_idx);
+  } else {
+    s = create_layer(w, "run_parameters", NULL, wkbNone, &w->run_layer);
+    if (s == TT_OK)
+      s = create_run_fields(w, fields, nfields);
+  }
+  return s;
+}
+
+/* A layer's rows (the triangles and vertices unless ROWS=DEFERRED). */
+static tt_status fill_layer(write_state *w, const tt_tin *tin,
+                            unsigned which, const tt_run_field *fields,
+                            size_t nfields)
+{
+  if (which == TT__LAYER_RUN_PARAMETERS)
+    return write_run_parameters(w, fields, nfields);
+  if (w->rows_deferred)
+    return TT_OK;
+  return which == TT__LAYER_TRIANGLES ? write_triangles(w, tin)
+                                      : write_vertices(w, tin);
+}
+
+static tt_status start_transaction(write_state *w)
+{
+  CPLErrorReset();
+  if (GDALDatasetStartTransaction(w->dst, FALSE) != OGRERR_NONE)
+    return tt__error(w->ctx, TT_ERR_IO, "cannot start a transaction: %s",
+                     ogr_msg());
+  return TT_OK;
+}
+
 tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            const tt_tin *tin, OGRSpatialReferenceH srs,
                            const tt_run_field *fields, size_t nfields,
@@ -480,13 +662,20 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   memset(&w, 0, sizeof w);
   w.ctx = ctx;
   w.dst = dst;
+  w.layers = TT__LAYERS_ALL;
   GDALDriverH drv = GDALGetDatasetDriver(dst);
   const char *drv_name = drv ? GDALGetDriverShortName(drv) : "";
   w.shapefile = strcasecmp(drv_name, "ESRI Shapefile") == 0;
   w.gpkg = strcasecmp(drv_name, "GPKG") == 0;
+  const char *types =
+      drv ? GDALGetMetadataItem(drv, GDAL_DMD_CREATIONFIELDDATATYPES, NULL)
+          : NULL;
+  w.no_int64 = types && !strstr(types, "Integer64");
   w.progress = progress;
   w.progress_arg = progress_arg;
-  int in_transaction = 0;
+  int in_transaction = 0, rolled_back = 0;
+  static const unsigned order[3] = {TT__LAYER_TRIANGLES, TT__LAYER_VERTICES,
+                                    TT__LAYER_RUN_PARAMETERS};
 
   tt_status s = parse_options(&w, options);
   if (s == TT_OK)
@@ -504,7 +693,12 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   s = tt__records_init(&w.rec, ctx, tin, srs, w.t_srs);
   if (s != TT_OK)
     goto done;
-  w.total = w.rows_deferred ? 1 : nv + nt + 1;
+  w.total = (w.layers & TT__LAYER_RUN_PARAMETERS) ? 1 : 0;
+  if (!w.rows_deferred)
+    w.total += ((w.layers & TT__LAYER_TRIANGLES) ? nt : 0) +
+               ((w.layers & TT__LAYER_VERTICES) ? nv : 0);
+  if (w.total == 0)
+    w.total = 1;
   w.scale = w.build_rtree ? 0.75 : 1.0; /* the R-trees take about a quarter */
   if (progress && !progress(0.0, "writing", progress_arg)) {
     s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
@@ -512,64 +706,88 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
     goto done;
   }
 
-  /* The layers and their fields first, outside the transaction: GDAL 3.6's
-   * GPKG driver keeps the layer objects of a rolled-back CREATE TABLE and
-   * then breaks the file at close. On failure they are deleted instead. */
-  s = create_layer(&w, "triangles", w.rec.out_srs, wkbPolygon25D, &w.tri_layer);
-  if (s == TT_OK)
-    s = create_layer(&w, "vertices", w.rec.out_srs, wkbPoint25D, &w.vtx_layer);
-  if (s == TT_OK)
-    s = create_layer(&w, "run_parameters", NULL, wkbNone, &w.run_layer);
-  if (s == TT_OK)
-    s = create_fields(&w, w.tri_layer, tt__triangle_fields, TT__TF_COUNT, w.tri_idx);
-  if (s == TT_OK)
-    s = create_fields(&w, w.vtx_layer, tt__vertex_fields,
-                      tt__records_vertex_fields(tin), w.vtx_idx);
-  if (s == TT_OK)
-    s = create_run_fields(&w, fields, nfields);
-  if (s != TT_OK)
-    goto done;
+  const int transactions = GDALDatasetTestCapability(dst, ODsCTransactions);
+  /* A database (PostgreSQL): its tables are made inside the transaction
+   * too, so that a failure, an interruption or the end of the process
+   * before the commit leaves none. The SQLite formats make theirs before
+   * it: GDAL 3.6's GPKG driver keeps the layer objects of a rolled-back
+   * CREATE TABLE and then breaks the file at close; on failure they are
+   * deleted instead (the temporary name guards the file either way). */
+  const int database = transactions && !w.gpkg &&
+                       strcasecmp(drv_name, "SQLite") != 0;
 
-  if (GDALDatasetTestCapability(dst, ODsCTransactions)) {
-    /* Drivers that create tables lazily (GPKG) make them now, so that the
-     * transaction holds only rows (and the R-trees). */
-    CPLErrorReset();
-    GDALFlushCache(dst);
-    if (CPLGetLastErrorType() >= CE_Failure) {
-      s = tt__error(ctx, TT_ERR_IO, "cannot create the layers: %s",
-                    ogr_msg());
+  if (!transactions) {
+    /* One layer after the other, each complete before the next is made:
+     * KML takes features only into its last layer. */
+    for (int k = 0; k < 3 && s == TT_OK; k++)
+      if (w.layers & order[k]) {
+        s = make_layer(&w, tin, order[k], fields, nfields);
+        if (s == TT_OK)
+          s = fill_layer(&w, tin, order[k], fields, nfields);
+      }
+    if (s != TT_OK)
       goto done;
+  } else {
+    if (database) {
+      s = start_transaction(&w);
+      if (s != TT_OK)
+        goto done;
+      in_transaction = 1;
     }
-    if (GDALDatasetStartTransaction(dst, FALSE) != OGRERR_NONE) {
-      s = tt__error(ctx, TT_ERR_IO, "cannot start a transaction: %s",
-                    ogr_msg());
+    for (int k = 0; k < 3 && s == TT_OK; k++)
+      if (w.layers & order[k])
+        s = make_layer(&w, tin, order[k], fields, nfields);
+    if (s == TT_OK && w.style && w.gpkg &&
+        (w.layers & (TT__LAYER_TRIANGLES | TT__LAYER_VERTICES))) {
+      /* as QGIS makes it: the FID column is "id" */
+      char **style_lco = CSLSetNameValue(NULL, "FID", "id");
+      s = create_named_layer(&w, TT__STYLE_TABLE, NULL, wkbNone, style_lco,
+                             &w.style_layer);
+      CSLDestroy(style_lco);
+      if (s == TT_OK)
+        s = tt__style_create_fields(ctx, w.style_layer);
+    }
+    if (s != TT_OK)
       goto done;
+    if (!database) {
+      /* Drivers that create tables lazily (GPKG) make them now, so that
+       * the transaction holds only rows (and the R-trees). */
+      CPLErrorReset();
+      GDALFlushCache(dst);
+      if (CPLGetLastErrorType() >= CE_Failure) {
+        s = tt__error(ctx, TT_ERR_IO, "cannot create the layers: %s",
+                      ogr_msg());
+        goto done;
+      }
+      s = start_transaction(&w);
+      if (s != TT_OK)
+        goto done;
+      in_transaction = 1;
     }
-    in_transaction = 1;
-  }
-
-  if (!w.rows_deferred)
-    s = write_triangles(&w, tin);
-  if (s == TT_OK && !w.rows_deferred)
-    s = write_vertices(&w, tin);
-  if (s == TT_OK)
-    s = write_run_parameters(&w, fields, nfields);
-  if (s == TT_OK && w.build_rtree) {
-    s = build_rtree(&w, w.tri_layer);
-    if (s == TT_OK && progress && !progress(0.95, "indexing", progress_arg))
+    for (int k = 0; k < 3 && s == TT_OK; k++)
+      if (w.layers & order[k])
+        s = fill_layer(&w, tin, order[k], fields, nfields);
+    if (s == TT_OK && w.style_layer)
+      s = tt__style_insert(ctx, w.style_layer, tin, w.prefix, w.layers,
+                           w.tri_layer ? OGR_L_GetGeometryColumn(w.tri_layer)
+                                       : NULL,
+                           w.vtx_layer ? OGR_L_GetGeometryColumn(w.vtx_layer)
+                                       : NULL);
+    if (s == TT_OK && w.build_rtree && w.tri_layer)
+      s = build_rtree(&w, w.tri_layer);
+    if (s == TT_OK && w.build_rtree && progress &&
+        !progress(0.95, "indexing", progress_arg))
       s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
                     "interrupted while indexing");
-    if (s == TT_OK)
+    if (s == TT_OK && w.build_rtree && w.vtx_layer)
       s = build_rtree(&w, w.vtx_layer);
-  }
-  if (s != TT_OK)
-    goto done;
-
-  if (in_transaction) {
+    if (s != TT_OK)
+      goto done;
     CPLErrorReset();
     in_transaction = 0; /* a failed commit leaves nothing to roll back */
     if (GDALDatasetCommitTransaction(dst) != OGRERR_NONE) {
       s = tt__error(ctx, TT_ERR_IO, "cannot commit the TIN: %s", ogr_msg());
+      rolled_back = database; /* the tables went with the rows */
       goto done;
     }
   }
@@ -584,9 +802,14 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
 
 done:
   if (s != TT_OK) {
-    if (in_transaction)
+    if (in_transaction) {
       GDALDatasetRollbackTransaction(dst);
-    delete_created_layers(&w);
+      /* a database's tables went with the rollback; its layers that
+       * OVERWRITE dropped came back */
+      rolled_back = database;
+    }
+    if (!rolled_back)
+      delete_created_layers(&w);
   }
   for (int k = 0; k < w.ncreated; k++)
     CPLFree(w.created[k]);

@@ -37,6 +37,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 const tt__field_spec tt__triangle_fields[TT__TF_COUNT] = {
     {"v0", OFTInteger},         {"v1", OFTInteger},
@@ -300,5 +301,32 @@ tt_status tt__records_vertex(const tt__records *r, tt_context *ctx, size_t i,
                      "read from the TIN", i, tt_tin_vertex_count(r->tin));
   *out_x = r->xy ? r->xy[2 * i] : out_v->x;
   *out_y = r->xy ? r->xy[2 * i + 1] : out_v->y;
+  return TT_OK;
+}
+
+tt_status tt__records_parse_layers(tt_context *ctx, const char *value,
+                                   unsigned *out_mask)
+{
+  static const char *const names[] = {"triangles", "vertices",
+                                      "run_parameters"};
+  unsigned mask = 0;
+  const char *p = value;
+  for (;;) {
+    const char *e = strchr(p, ',');
+    size_t n = e ? (size_t)(e - p) : strlen(p);
+    unsigned bit = 0;
+    for (unsigned i = 0; i < 3 && !bit; i++)
+      if (strlen(names[i]) == n && strncasecmp(p, names[i], n) == 0)
+        bit = 1u << i;
+    if (!bit || (mask & bit))
+      return tt__error(ctx, TT_ERR_ARG, "LAYERS=%s: '%.*s' is %s", value,
+                       (int)n, p, bit ? "named twice" : "not a layer "
+                       "(triangles, vertices, run_parameters)");
+    mask |= bit;
+    if (!e)
+      break;
+    p = e + 1;
+  }
+  *out_mask = mask;
   return TT_OK;
 }

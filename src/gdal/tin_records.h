@@ -42,6 +42,15 @@ TT_HIDDEN extern const tt__field_spec tt__vertex_fields[TT__VF_COUNT];
 TT_HIDDEN int tt__records_decimated(const tt_tin *tin);
 TT_HIDDEN int tt__records_vertex_fields(const tt_tin *tin);
 
+/* The layers a writer makes (option LAYERS=triangles,vertices,
+ * run_parameters, any subset in any order; default all three). */
+enum { TT__LAYER_TRIANGLES = 1, TT__LAYER_VERTICES = 2,
+       TT__LAYER_RUN_PARAMETERS = 4, TT__LAYERS_ALL = 7 };
+/* The bits of a LAYERS value; TT_ERR_ARG naming the word at fault. */
+TT_HIDDEN tt_status tt__records_parse_layers(tt_context *ctx,
+                                             const char *value,
+                                             unsigned *out_mask);
+
 /* The layers' CRS and the transformed vertices. */
 typedef struct tt__records {
   const tt_tin *tin;

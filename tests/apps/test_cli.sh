@@ -180,12 +180,15 @@ run simplify -overwrite keep/same.tif keep/same.tif
 check "input as output: refused" [ "$rc" -eq 1 ]
 check "input as output: input intact" cmp -s in/fault.tif keep/same.tif
 
-# a write that fails half way (a GPKG FID column clashing with a field)
-expect_failure "failed write" 1 out simplify -lco FID=v0 in/fault.tif \
+# a write that would fail half way (a GPKG FID column clashing with a
+# field): the writer's dry run refuses it before the work, naming -lco
+expect_failure "failed write" 2 out simplify -lco FID=v0 in/fault.tif \
   out/o.gpkg
-# a driver that cannot hold three layers fails cleanly too
-expect_failure "GeoJSON (one layer only)" 1 out simplify -of GeoJSON \
+check "failed write: the -lco named" grep -q -- "-lco" err.txt
+# a driver that cannot hold three layers is refused before the work too
+expect_failure "GeoJSON (one layer only)" 2 out simplify -of GeoJSON \
   in/fault.tif out/o.geojson
+check "GeoJSON: -layers named" grep -q -- "-layers triangles" err.txt
 
 # --- a good run ---------------------------------------------------------------
 run simplify -json -max_error 2 in/fault.tif out/tin.gpkg

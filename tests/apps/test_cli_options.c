@@ -216,6 +216,41 @@ static void test_simplify_usage_errors(void)
   CHECK_USAGE("before the command", "-max_error", "1", "simplify", "a", "b");
 }
 
+/* Issue 17: -layers (any subset, each once, any case) and -nostyle. */
+static void test_layers(void)
+{
+  tt_app_options *o = NULL;
+  PARSE_OK(o, "simplify", "a.tif", "b.gpkg");
+  const tt_app_settings *s = tt_app_options_settings(o);
+  if (s) {
+    CHECK_INT_EQ(s->layers, TT_APP_LAYERS_ALL);
+    CHECK_INT_EQ(s->nostyle, 0);
+  }
+  tt_app_options_destroy(o);
+  o = NULL;
+  PARSE_OK(o, "simplify", "-layers", "Run_Parameters,triangles", "-nostyle",
+           "a.tif", "b.geojson");
+  s = tt_app_options_settings(o);
+  if (s) {
+    CHECK_INT_EQ(s->layers,
+                 TT_APP_LAYER_TRIANGLES | TT_APP_LAYER_RUN_PARAMETERS);
+    CHECK_INT_EQ(s->nostyle, 1);
+  }
+  tt_app_options_destroy(o);
+  o = NULL;
+  PARSE_OK(o, "simplify", "-layers", "vertices", "a.tif", "b.gpx");
+  s = tt_app_options_settings(o);
+  if (s)
+    CHECK_INT_EQ(s->layers, TT_APP_LAYER_VERTICES);
+  tt_app_options_destroy(o);
+  CHECK_USAGE("'tri' is not a layer", "simplify", "-layers", "tri", "a", "b");
+  CHECK_USAGE("is not a layer", "simplify", "-layers", "", "a", "b");
+  CHECK_USAGE("is not a layer", "simplify", "-layers", "vertices,", "a", "b");
+  CHECK_USAGE("Vertices is named twice", "simplify", "-layers",
+              "vertices,Vertices", "a", "b");
+  CHECK_USAGE("does not apply", "eval", "-layers", "vertices", "a", "b");
+}
+
 /* Issue 11, "Messages and limits": each message says the true cause, and
  * the parser is as strict as the docs say. */
 static void test_issue11_parsing(void)
@@ -786,6 +821,7 @@ int main(void)
   test_simplify_defaults();
   test_simplify_all_options();
   test_simplify_usage_errors();
+  test_layers();
   test_issue11_parsing();
   test_help_and_version();
   test_generate();

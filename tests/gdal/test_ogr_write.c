@@ -372,9 +372,9 @@ static void test_round_trip(tt_context *ctx, const tt_tin *tin,
     CHECK_STR_EQ(listing,
                  "tin_run_parameters.cpg tin_run_parameters.dbf "
                  "tin_triangles.cpg tin_triangles.dbf tin_triangles.prj "
-                 "tin_triangles.shp tin_triangles.shx tin_vertices.cpg "
-                 "tin_vertices.dbf tin_vertices.prj tin_vertices.shp "
-                 "tin_vertices.shx");
+                 "tin_triangles.qix tin_triangles.shp tin_triangles.shx "
+                 "tin_vertices.cpg tin_vertices.dbf tin_vertices.prj "
+                 "tin_vertices.qix tin_vertices.shp tin_vertices.shx");
   else
     CHECK_STR_EQ(listing, "tin.gpkg");
 
