@@ -80,6 +80,7 @@ typedef struct rt_build {
   int64_t next_nodeno;
   unsigned char *blob;
   sqlite3_stmt *ins_node, *ins_parent, *ins_rowid, *ins_rowid_batch;
+  sqlite3_stmt *ins_node_batch; /* %_rowid rows of implicit rowids */
   size_t nodes_written, nodes_total;
   int gpkg_version; /* PRAGMA user_version: 10400 for 1.4.0 */
 } rt_build;
@@ -731,7 +732,19 @@ done:
     return s;
   /* %_rowid rows in rowid order: appends to its B-tree. */
   sort_links(b->links, b->nlinks);
+  /* Rowids 1..n (the row writer's fids) into the empty %_rowid table: each
+   * is SQLite's next one, so the inserts leave it to SQLite's append path
+   * (no seek per row); others are given explicitly. */
+  const int dense = b->nlinks && b->links[0].rowid == 1 &&
+                    b->links[b->nlinks - 1].rowid == (int64_t)b->nlinks;
   size_t i = 0;
+  for (; dense && i + LINK_BATCH <= b->nlinks && s == TT_OK;
+       i += LINK_BATCH) {
+    for (int k = 0; k < LINK_BATCH; k++)
+      sqlite3_bind_int64(b->ins_node_batch, k + 1,
+                         b->links[i + (size_t)k].nodeno);
+    s = step_reset(b, b->ins_node_batch, "cannot write the index rowid map");
+  }
   for (; i + LINK_BATCH <= b->nlinks && s == TT_OK; i += LINK_BATCH) {
     for (int k = 0; k < LINK_BATCH; k++) {
       const rt_link *l = &b->links[i + (size_t)k];
@@ -965,6 +978,16 @@ static tt_status create_schema(rt_build *b)
     }
     s = prepare_owned(b, sql, &b->ins_rowid_batch, "cannot write the R-tree");
   }
+  if (s == TT_OK) {
+    char *sql = sqlite3_mprintf("INSERT INTO \"%w_rowid\" (nodeno) VALUES "
+                                "(?)", b->rtree);
+    for (int k = 1; sql && k < LINK_BATCH; k++) {
+      char *more = sqlite3_mprintf("%s, (?)", sql);
+      sqlite3_free(sql);
+      sql = more;
+    }
+    s = prepare_owned(b, sql, &b->ins_node_batch, "cannot write the R-tree");
+  }
   return s;
 }
 
@@ -1026,7 +1049,9 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
   sqlite3_finalize(b->ins_parent);
   sqlite3_finalize(b->ins_rowid);
   sqlite3_finalize(b->ins_rowid_batch);
+  sqlite3_finalize(b->ins_node_batch);
   b->ins_node = b->ins_parent = b->ins_rowid = b->ins_rowid_batch = NULL;
+  b->ins_node_batch = NULL;
   return s;
 }
 
@@ -1036,6 +1061,7 @@ static void build_free(rt_build *b)
   sqlite3_finalize(b->ins_parent);
   sqlite3_finalize(b->ins_rowid);
   sqlite3_finalize(b->ins_rowid_batch);
+  sqlite3_finalize(b->ins_node_batch);
   free(b->table);
   free(b->column);
   free(b->fid);
