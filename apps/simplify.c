@@ -402,6 +402,9 @@ tt_status tt__app_simplify(app_run *r)
   int direct_rows = tt__app_str_ieq(drvname, "GPKG");
   if (direct_rows) {
     wopts = CSLSetNameValue(wopts, "ROWS", "DEFERRED");
+    if (ro.threads > 0) /* -threads 1: no thread making the rows either */
+      wopts = CSLSetNameValue(wopts, "THREADS",
+                              CPLSPrintf("%d", ro.threads));
     tt__app_phase_set(&r->prog, 0.85, 0.86);
   }
   /* GDAL's LIBKML writer takes time growing as n^2.7 with the features

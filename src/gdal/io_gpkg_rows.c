@@ -45,6 +45,8 @@
 #include <sqlite3.h>
 
 #include <math.h>
+#include <pthread.h>
+#include <stdio.h>
 #include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -63,7 +65,8 @@ typedef struct rows_state {
   void *progress_arg;
   size_t done, total, next_report, step;
   double lo, hi;    /* the share of progress the present phase takes */
-  struct row_source *src; /* the rows tt__rows gives now */
+  struct rows_pipe *pipe; /* the rows tt__rows gives */
+  tt_status status;       /* why the rows stopped */
 } rows_state;
 
 /* One saved trigger, re-created after the inserts. */
@@ -307,15 +310,25 @@ static tt_status triggers_restore(rows_state *w, layer_table *t)
 /* --- the rows as a virtual table ------------------------------------------
  * One INSERT INTO t (geom, fields...) SELECT c0, c1... FROM tt__rows writes
  * a whole layer: tt__rows is an eponymous virtual table of this connection
- * whose cursor makes row i on the way (row_source.fill), so SQLite reads the
- * values straight from here, with no bound parameters to copy, and updates
- * sqlite_sequence once per layer. (Batches of 64 rows of bound parameters,
- * the earlier way, took 5,500 instructions a triangle in SQLite's bind and
- * VDBE code.) A failure in fill (an interruption) is kept in
- * row_source.status and ends the statement with an error. */
+ * whose cursor hands SQLite the rows of the layer being written, so SQLite
+ * reads the values straight from here, with no bound parameters to copy,
+ * and updates sqlite_sequence once per layer. (Batches of 64 rows of bound
+ * parameters, the earlier way, took 5,500 instructions a triangle in
+ * SQLite's bind and VDBE code.)
+ *
+ * The rows are made (tt__records_*, the geometry blobs, the R-tree boxes,
+ * the extents) by a second thread, a chunk of CHUNK_ROWS rows at a time,
+ * through a ring of NCHUNKS chunks, while SQLite inserts the previous ones:
+ * the triangles' rows, then the vertices'. With one thread (THREADS=1, or
+ * no second CPU) the cursor makes each chunk itself when it needs it. Only
+ * the SQLite thread reports progress; a failure on either side (an
+ * interruption, a row the TIN cannot give) stops the other and ends the
+ * statement with an error, kept in rows_pipe.status. */
 
 #define MAX_COLS (1 + TT__TF_COUNT) /* the geometry and the fields */
 #define ROWS_MODULE "tt__rows"
+#define CHUNK_ROWS 1024
+#define NCHUNKS 4
 
 enum { V_NULL, V_INT, V_REAL };
 
@@ -325,20 +338,308 @@ typedef struct row_value {
   double d;
 } row_value;
 
-typedef struct row_source row_source;
-struct row_source {
-  rows_state *w;
+static void set_int(row_value *v, sqlite3_int64 i)
+{
+  v->type = V_INT;
+  v->i = i;
+}
+
+static void set_real(row_value *v, double d)
+{
+  v->type = isfinite(d) ? V_REAL : V_NULL; /* NaN as NULL */
+  v->d = d;
+}
+
+typedef struct chunk {
+  int layer;         /* 0: triangles, 1: vertices */
+  size_t first, n;   /* rows [first, first + n) of the layer */
+  int full;          /* made, not yet inserted */
+  row_value v[CHUNK_ROWS][MAX_COLS];
+  unsigned char blob[CHUNK_ROWS][TRI_BLOB_BYTES];
+  int blob_len[CHUNK_ROWS];
+} chunk;
+
+typedef struct rows_pipe {
   const tt__records *rec;
-  layer_table *t;
-  size_t count;
-  int ncols;                     /* the geometry and the fields */
-  int decimated;                 /* vertices: the TIN was decimated */
-  tt_status (*fill)(row_source *src, size_t i);
-  row_value v[MAX_COLS];         /* v[1...]: the fields of the row */
-  unsigned char blob[2][TRI_BLOB_BYTES]; /* the geometry (column 0), */
-  int blob_len, cur;                     /* alternating between rows */
-  tt_status status;
-};
+  layer_table *layer[2];
+  size_t count[2];
+  int ncols[2];
+  int decimated;
+  chunk *ring;       /* NCHUNKS */
+  /* the maker's side */
+  int m_layer;
+  size_t m_first;
+  size_t m_slot;
+  tt_context *m_ctx; /* the maker thread's own messages */
+  /* the SQLite side */
+  int layer_now;     /* the layer being inserted */
+  size_t c_slot;     /* the chunk being read, when c_held */
+  int c_held;
+  size_t row;        /* the row being read */
+  const row_value *vals;
+  const unsigned char *blob;
+  int blob_len;
+  /* shared */
+  int threaded;
+  pthread_t thread;
+  pthread_mutex_t lock;
+  pthread_cond_t cond;
+  int stop;          /* the SQLite side gave up */
+  int failed;        /* the maker failed: message in m_ctx */
+} rows_pipe;
+
+static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
+                               size_t i, row_value *vals,
+                               unsigned char *blob, int *blob_len)
+{
+  layer_table *t = p->layer[0];
+  tt_triangle_info tr;
+  tt_vertex_info v[3];
+  double px[3], py[3];
+  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, v, px, py);
+  if (s != TT_OK)
+    return s;
+  double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
+  for (int k = 1; k < 3; k++) {
+    double c[3] = {px[k], py[k], v[k].z};
+    for (int d = 0; d < 3; d++) {
+      if (c[d] < lo[d]) lo[d] = c[d];
+      if (c[d] > hi[d]) hi[d] = c[d];
+    }
+  }
+  unsigned char *q = put_header(blob, 0x05, t->srs_id);
+  for (int d = 0; d < 3; d++) {
+    q = put_f64(q, lo[d]);
+    q = put_f64(q, hi[d]);
+  }
+  *q++ = 1; /* WKB little endian */
+  q = put_u32(q, 1003);
+  q = put_u32(q, 1);
+  q = put_u32(q, 4);
+  for (int k = 0; k < 4; k++) {
+    q = put_f64(q, px[k % 3]);
+    q = put_f64(q, py[k % 3]);
+    q = put_f64(q, v[k % 3].z);
+  }
+  *blob_len = (int)(q - blob);
+  extend(t, lo[0], lo[1]);
+  extend(t, hi[0], hi[1]);
+  if (t->boxes)
+    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, lo[0], hi[0], lo[1],
+                                  hi[1]};
+  row_value *f = vals + 1;
+  set_int(&f[TT__TF_V0], tr.v[0]);
+  set_int(&f[TT__TF_V1], tr.v[1]);
+  set_int(&f[TT__TF_V2], tr.v[2]);
+  set_real(&f[TT__TF_MAX_ERR], tr.max_error);
+  set_real(&f[TT__TF_RMSE], tr.rmse);
+  set_int(&f[TT__TF_N_SAMPLES], (sqlite3_int64)tr.samples);
+  set_real(&f[TT__TF_AREA_2D], tr.area_2d);
+  set_real(&f[TT__TF_AREA_3D], tr.area_3d);
+  set_real(&f[TT__TF_SLOPE], tr.slope_deg);
+  set_real(&f[TT__TF_ASPECT], tr.aspect_deg);
+  set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
+  set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
+  return TT_OK;
+}
+
+static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
+                             row_value *vals, unsigned char *blob,
+                             int *blob_len)
+{
+  layer_table *t = p->layer[1];
+  tt_vertex_info v;
+  double x, y;
+  tt_status s = tt__records_vertex(p->rec, ctx, i, &v, &x, &y);
+  if (s != TT_OK)
+    return s;
+  unsigned char *q = put_header(blob, 0x01, t->srs_id);
+  *q++ = 1;
+  q = put_u32(q, 1001);
+  q = put_f64(q, x);
+  q = put_f64(q, y);
+  q = put_f64(q, v.z);
+  *blob_len = (int)(q - blob);
+  extend(t, x, y);
+  if (t->boxes)
+    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, x, x, y, y};
+  row_value *f = vals + 1;
+  set_int(&f[TT__VF_ID], (sqlite3_int64)i);
+  set_int(&f[TT__VF_COL], v.col);
+  set_int(&f[TT__VF_ROW], v.row);
+  set_real(&f[TT__VF_INS_ERR], v.insert_error);
+  if (p->decimated)
+    f[TT__VF_INS_RANK].type = V_NULL;
+  else
+    set_int(&f[TT__VF_INS_RANK], (sqlite3_int64)v.rank);
+  set_real(&f[TT__VF_STAR_MAX], v.star_max_error);
+  set_real(&f[TT__VF_STAR_RMSE], v.star_rmse);
+  set_int(&f[TT__VF_STAR_N], (sqlite3_int64)v.star_samples);
+  if (p->decimated)
+    set_real(&f[TT__VF_IMPORTANCE], v.importance);
+  return TT_OK;
+}
+
+/* Makes the next chunk (the maker's position) into ch; 0 when every row is
+ * made. Errors go to ctx. */
+static int make_chunk(rows_pipe *p, chunk *ch, tt_context *ctx,
+                      tt_status *out_s)
+{
+  *out_s = TT_OK;
+  while (p->m_layer < 2 && p->m_first >= p->count[p->m_layer]) {
+    p->m_layer++;
+    p->m_first = 0;
+  }
+  if (p->m_layer >= 2)
+    return 0;
+  size_t left = p->count[p->m_layer] - p->m_first;
+  ch->layer = p->m_layer;
+  ch->first = p->m_first;
+  ch->n = left < CHUNK_ROWS ? left : CHUNK_ROWS;
+  for (size_t r = 0; r < ch->n && *out_s == TT_OK; r++)
+    *out_s = (ch->layer == 0 ? fill_triangle : fill_vertex)(
+        p, ctx, ch->first + r, ch->v[r], ch->blob[r], &ch->blob_len[r]);
+  p->m_first += ch->n;
+  return 1;
+}
+
+static void *maker_main(void *arg)
+{
+  rows_pipe *p = arg;
+  for (;;) {
+    chunk *ch = &p->ring[p->m_slot % NCHUNKS];
+    pthread_mutex_lock(&p->lock);
+    while (ch->full && !p->stop)
+      pthread_cond_wait(&p->cond, &p->lock);
+    int stop = p->stop;
+    pthread_mutex_unlock(&p->lock);
+    if (stop)
+      break;
+    tt_status s;
+    int more = make_chunk(p, ch, p->m_ctx, &s);
+    pthread_mutex_lock(&p->lock);
+    if (s != TT_OK)
+      p->failed = 1;
+    else if (more) {
+      ch->full = 1;
+      p->m_slot++;
+    }
+    pthread_cond_broadcast(&p->cond);
+    pthread_mutex_unlock(&p->lock);
+    if (s != TT_OK || !more)
+      break;
+  }
+  return NULL;
+}
+
+/* The SQLite side: points p at row i of layer p->layer_now, taking the
+ * next chunk when row i is past the one held. */
+static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
+{
+  chunk *ch = p->c_held ? &p->ring[p->c_slot % NCHUNKS] : NULL;
+  if (!ch || ch->layer != p->layer_now || i < ch->first ||
+      i >= ch->first + ch->n) {
+    if (ch) { /* done with it */
+      if (p->threaded)
+        pthread_mutex_lock(&p->lock);
+      ch->full = 0;
+      p->c_slot++;
+      p->c_held = 0;
+      if (p->threaded) {
+        pthread_cond_broadcast(&p->cond);
+        pthread_mutex_unlock(&p->lock);
+      }
+    }
+    ch = &p->ring[p->c_slot % NCHUNKS];
+    if (p->threaded) {
+      pthread_mutex_lock(&p->lock);
+      while (!ch->full && !p->failed)
+        pthread_cond_wait(&p->cond, &p->lock);
+      int failed = !ch->full && p->failed;
+      pthread_mutex_unlock(&p->lock);
+      if (failed)
+        return tt__error(w->ctx, TT_ERR_INTERNAL, "%s",
+                         tt_context_errmsg(p->m_ctx));
+    } else {
+      tt_status s;
+      if (!make_chunk(p, ch, w->ctx, &s))
+        return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: row %zu of layer %s "
+                         "asked for past its end", w->path, i,
+                         p->layer[p->layer_now]->name);
+      if (s != TT_OK)
+        return s;
+      ch->full = 1;
+    }
+    p->c_held = 1;
+    if (ch->layer != p->layer_now || i != ch->first)
+      return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: rows of layer %s out "
+                       "of order (%zu)", w->path,
+                       p->layer[p->layer_now]->name, i);
+  }
+  size_t r = i - ch->first;
+  p->vals = ch->v[r];
+  p->blob = ch->blob[r];
+  p->blob_len = ch->blob_len[r];
+  p->row = i;
+  return report(w);
+}
+
+/* Stops and joins the maker (its work done or not). */
+static void pipe_end(rows_pipe *p)
+{
+  if (p->threaded) {
+    pthread_mutex_lock(&p->lock);
+    p->stop = 1;
+    pthread_cond_broadcast(&p->cond);
+    pthread_mutex_unlock(&p->lock);
+    pthread_join(p->thread, NULL);
+    pthread_cond_destroy(&p->cond);
+    pthread_mutex_destroy(&p->lock);
+    p->threaded = 0;
+  }
+  free(p->ring);
+  p->ring = NULL;
+  if (p->m_ctx)
+    tt_context_destroy(p->m_ctx);
+  p->m_ctx = NULL;
+}
+
+/* Sets up the rows of both layers; a maker thread when threads allow. */
+static tt_status pipe_begin(rows_pipe *p, rows_state *w,
+                            const tt__records *rec, layer_table *tri,
+                            layer_table *vtx, int threads)
+{
+  memset(p, 0, sizeof *p);
+  p->rec = rec;
+  p->layer[0] = tri;
+  p->layer[1] = vtx;
+  p->count[0] = tt_tin_triangle_count(rec->tin);
+  p->count[1] = tt_tin_vertex_count(rec->tin);
+  p->ncols[0] = 1 + TT__TF_COUNT;
+  p->ncols[1] = 1 + tt__records_vertex_fields(rec->tin);
+  p->decimated = tt__records_decimated(rec->tin);
+  p->ring = calloc(NCHUNKS, sizeof *p->ring);
+  if (!p->ring)
+    return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
+  if (threads == 1 || p->count[0] + p->count[1] <= CHUNK_ROWS)
+    return TT_OK;
+  p->m_ctx = tt_context_create();
+  if (!p->m_ctx)
+    return TT_OK;
+  if (pthread_mutex_init(&p->lock, NULL) != 0)
+    return TT_OK;
+  if (pthread_cond_init(&p->cond, NULL) != 0) {
+    pthread_mutex_destroy(&p->lock);
+    return TT_OK;
+  }
+  if (pthread_create(&p->thread, NULL, maker_main, p) != 0) {
+    pthread_cond_destroy(&p->cond);
+    pthread_mutex_destroy(&p->lock);
+    return TT_OK; /* the SQLite thread makes the rows itself */
+  }
+  p->threaded = 1;
+  return TT_OK;
+}
 
 typedef struct rows_vtab {
   sqlite3_vtab base;
@@ -380,11 +681,15 @@ static int vt_disconnect(sqlite3_vtab *vt)
   return SQLITE_OK;
 }
 
+static size_t vt_count(const rows_state *w)
+{
+  return w->pipe ? w->pipe->count[w->pipe->layer_now] : 0;
+}
+
 static int vt_best_index(sqlite3_vtab *vt, sqlite3_index_info *info)
 {
-  rows_vtab *v = (rows_vtab *)vt;
   info->estimatedCost = 1e6;
-  info->estimatedRows = v->w->src ? (sqlite3_int64)v->w->src->count : 1;
+  info->estimatedRows = (sqlite3_int64)vt_count(((rows_vtab *)vt)->w);
   return SQLITE_OK;
 }
 
@@ -405,19 +710,18 @@ static int vt_close(sqlite3_vtab_cursor *cur)
   return SQLITE_OK;
 }
 
-/* Makes row c->row of the source, or ends the statement on failure. */
+/* Takes row c->row, or ends the statement on failure. */
 static int vt_fill(rows_cursor *c)
 {
   rows_vtab *vt = (rows_vtab *)c->base.pVtab;
-  row_source *src = vt->w->src;
-  if (!src || c->row >= src->count)
+  rows_state *w = vt->w;
+  if (c->row >= vt_count(w))
     return SQLITE_OK;
-  src->cur ^= 1;
-  src->status = src->fill(src, c->row);
-  if (src->status == TT_OK)
+  w->status = pipe_row(w->pipe, w, c->row);
+  if (w->status == TT_OK)
     return SQLITE_OK;
   sqlite3_free(vt->base.zErrMsg);
-  vt->base.zErrMsg = sqlite3_mprintf("%s", tt_context_errmsg(vt->w->ctx));
+  vt->base.zErrMsg = sqlite3_mprintf("%s", tt_context_errmsg(w->ctx));
   return SQLITE_ERROR;
 }
 
@@ -442,21 +746,19 @@ static int vt_next(sqlite3_vtab_cursor *cur)
 
 static int vt_eof(sqlite3_vtab_cursor *cur)
 {
-  rows_cursor *c = (rows_cursor *)cur;
-  row_source *src = ((rows_vtab *)cur->pVtab)->w->src;
-  return !src || c->row >= src->count;
+  return ((rows_cursor *)cur)->row >= vt_count(((rows_vtab *)cur->pVtab)->w);
 }
 
 static int vt_column(sqlite3_vtab_cursor *cur, sqlite3_context *ctx, int col)
 {
-  row_source *src = ((rows_vtab *)cur->pVtab)->w->src;
+  const rows_pipe *p = ((rows_vtab *)cur->pVtab)->w->pipe;
   if (col == 0) {
-    sqlite3_result_blob(ctx, src->blob[src->cur], src->blob_len,
-                        SQLITE_STATIC);
+    /* SQLite copies it into the record before the cursor moves on */
+    sqlite3_result_blob(ctx, p->blob, p->blob_len, SQLITE_STATIC);
     return SQLITE_OK;
   }
-  const row_value *v = &src->v[col < src->ncols ? col : 0];
-  if (col >= src->ncols || v->type == V_NULL)
+  const row_value *v = col < p->ncols[p->layer_now] ? &p->vals[col] : NULL;
+  if (!v || v->type == V_NULL)
     sqlite3_result_null(ctx);
   else if (v->type == V_INT)
     sqlite3_result_int64(ctx, v->i);
@@ -487,31 +789,22 @@ static const sqlite3_module rows_module = {
     .xRowid = vt_rowid,
 };
 
-static void set_int(row_value *v, sqlite3_int64 i)
-{
-  v->type = V_INT;
-  v->i = i;
-}
-
-static void set_real(row_value *v, double d)
-{
-  v->type = isfinite(d) ? V_REAL : V_NULL; /* NaN as NULL */
-  v->d = d;
-}
-
-/* Writes src->count rows of src->t: INSERT ... SELECT from tt__rows. */
-static tt_status insert_rows(rows_state *w, row_source *src,
+/* Writes the rows of layer (0: triangles, 1: vertices): INSERT ... SELECT
+ * from tt__rows. */
+static tt_status insert_rows(rows_state *w, int layer,
                              const tt__field_spec *fields)
 {
-  const layer_table *t = src->t;
+  rows_pipe *p = w->pipe;
+  layer_table *t = p->layer[layer];
+  const int ncols = p->ncols[layer];
   char *sql = sqlite3_mprintf("INSERT INTO \"%w\" (\"%w\"", t->name,
                               t->geom);
-  for (int i = 0; sql && i + 1 < src->ncols; i++) {
+  for (int i = 0; sql && i + 1 < ncols; i++) {
     char *more = sqlite3_mprintf("%s, \"%w\"", sql, fields[i].name);
     sqlite3_free(sql);
     sql = more;
   }
-  for (int i = 0; sql && i < src->ncols; i++) {
+  for (int i = 0; sql && i < ncols; i++) {
     char *more = sqlite3_mprintf("%s%sc%d", sql, i ? ", " : ") SELECT ", i);
     sqlite3_free(sql);
     sql = more;
@@ -526,141 +819,17 @@ static tt_status insert_rows(rows_state *w, row_source *src,
   sqlite3_free(sql);
   if (rc != SQLITE_OK)
     return db_error(w, "cannot prepare the inserts");
-  src->w = w;
-  src->status = TT_OK;
-  w->src = src;
-  rc = src->count ? sqlite3_step(st) : SQLITE_DONE;
+  p->layer_now = layer;
+  w->status = TT_OK;
+  rc = p->count[layer] ? sqlite3_step(st) : SQLITE_DONE;
   tt_status s = TT_OK;
-  if (src->status != TT_OK)
-    s = src->status;
+  if (w->status != TT_OK)
+    s = w->status;
   else if (rc != SQLITE_DONE)
     s = tt__error(w->ctx, TT_ERR_IO, "%s: cannot write the %zu features of "
-                  "layer %s: %s", w->path, src->count, t->name,
+                  "layer %s: %s", w->path, p->count[layer], t->name,
                   sqlite3_errmsg(w->db));
   sqlite3_finalize(st);
-  w->src = NULL;
-  return s;
-}
-
-static tt_status fill_triangle(row_source *src, size_t i)
-{
-  rows_state *w = src->w;
-  layer_table *t = src->t;
-  tt_triangle_info tr;
-  tt_vertex_info v[3];
-  double px[3], py[3];
-  tt_status s = tt__records_triangle(src->rec, w->ctx, i, &tr, v, px, py);
-  if (s != TT_OK)
-    return s;
-  double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
-  for (int k = 1; k < 3; k++) {
-    double c[3] = {px[k], py[k], v[k].z};
-    for (int d = 0; d < 3; d++) {
-      if (c[d] < lo[d]) lo[d] = c[d];
-      if (c[d] > hi[d]) hi[d] = c[d];
-    }
-  }
-  unsigned char *blob = src->blob[src->cur];
-  unsigned char *p = put_header(blob, 0x05, t->srs_id);
-  for (int d = 0; d < 3; d++) {
-    p = put_f64(p, lo[d]);
-    p = put_f64(p, hi[d]);
-  }
-  *p++ = 1; /* WKB little endian */
-  p = put_u32(p, 1003);
-  p = put_u32(p, 1);
-  p = put_u32(p, 4);
-  for (int k = 0; k < 4; k++) {
-    p = put_f64(p, px[k % 3]);
-    p = put_f64(p, py[k % 3]);
-    p = put_f64(p, v[k % 3].z);
-  }
-  src->blob_len = (int)(p - blob);
-  extend(t, lo[0], lo[1]);
-  extend(t, hi[0], hi[1]);
-  if (t->boxes)
-    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, lo[0], hi[0], lo[1],
-                                  hi[1]};
-  row_value *f = src->v + 1;
-  set_int(&f[TT__TF_V0], tr.v[0]);
-  set_int(&f[TT__TF_V1], tr.v[1]);
-  set_int(&f[TT__TF_V2], tr.v[2]);
-  set_real(&f[TT__TF_MAX_ERR], tr.max_error);
-  set_real(&f[TT__TF_RMSE], tr.rmse);
-  set_int(&f[TT__TF_N_SAMPLES], (sqlite3_int64)tr.samples);
-  set_real(&f[TT__TF_AREA_2D], tr.area_2d);
-  set_real(&f[TT__TF_AREA_3D], tr.area_3d);
-  set_real(&f[TT__TF_SLOPE], tr.slope_deg);
-  set_real(&f[TT__TF_ASPECT], tr.aspect_deg);
-  set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
-  set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
-  return report(w);
-}
-
-static tt_status fill_vertex(row_source *src, size_t i)
-{
-  rows_state *w = src->w;
-  layer_table *t = src->t;
-  tt_vertex_info v;
-  double x, y;
-  tt_status s = tt__records_vertex(src->rec, w->ctx, i, &v, &x, &y);
-  if (s != TT_OK)
-    return s;
-  unsigned char *blob = src->blob[src->cur];
-  unsigned char *p = put_header(blob, 0x01, t->srs_id);
-  *p++ = 1;
-  p = put_u32(p, 1001);
-  p = put_f64(p, x);
-  p = put_f64(p, y);
-  p = put_f64(p, v.z);
-  src->blob_len = (int)(p - blob);
-  extend(t, x, y);
-  if (t->boxes)
-    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, x, x, y, y};
-  row_value *f = src->v + 1;
-  set_int(&f[TT__VF_ID], (sqlite3_int64)i);
-  set_int(&f[TT__VF_COL], v.col);
-  set_int(&f[TT__VF_ROW], v.row);
-  set_real(&f[TT__VF_INS_ERR], v.insert_error);
-  if (src->decimated)
-    f[TT__VF_INS_RANK].type = V_NULL;
-  else
-    set_int(&f[TT__VF_INS_RANK], (sqlite3_int64)v.rank);
-  set_real(&f[TT__VF_STAR_MAX], v.star_max_error);
-  set_real(&f[TT__VF_STAR_RMSE], v.star_rmse);
-  set_int(&f[TT__VF_STAR_N], (sqlite3_int64)v.star_samples);
-  if (src->decimated)
-    set_real(&f[TT__VF_IMPORTANCE], v.importance);
-  return report(w);
-}
-
-static tt_status write_triangles(rows_state *w, const tt__records *rec,
-                                 layer_table *t)
-{
-  row_source src;
-  memset(&src, 0, sizeof src);
-  src.rec = rec;
-  src.t = t;
-  src.count = tt_tin_triangle_count(rec->tin);
-  src.ncols = 1 + TT__TF_COUNT;
-  src.fill = fill_triangle;
-  tt_status s = insert_rows(w, &src, tt__triangle_fields);
-  t->last_fid = sqlite3_last_insert_rowid(w->db);
-  return s;
-}
-
-static tt_status write_vertices(rows_state *w, const tt__records *rec,
-                                layer_table *t)
-{
-  row_source src;
-  memset(&src, 0, sizeof src);
-  src.rec = rec;
-  src.t = t;
-  src.count = tt_tin_vertex_count(rec->tin);
-  src.ncols = 1 + tt__records_vertex_fields(rec->tin);
-  src.decimated = tt__records_decimated(rec->tin);
-  src.fill = fill_vertex;
-  tt_status s = insert_rows(w, &src, tt__vertex_fields);
   t->last_fid = sqlite3_last_insert_rowid(w->db);
   return s;
 }
@@ -732,7 +901,9 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.progress = progress;
   w.progress_arg = progress_arg;
   const char *prefix = "", *t_srs = NULL;
-  int in_transaction = 0, rtree = 1, rtree_check = 0;
+  int in_transaction = 0, rtree = 1, rtree_check = 0, threads = 0;
+  rows_pipe pipe;
+  memset(&pipe, 0, sizeof pipe);
   char *tri_name = NULL, *vtx_name = NULL;
   tt_status s = TT_OK;
 
@@ -754,9 +925,12 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       CPLFree(lkey);
     } else if (strcasecmp(key, "RTREE_CHECK") == 0)
       rtree_check = CPLTestBool(value);
+    else if (strcasecmp(key, "THREADS") == 0)
+      threads = atoi(value);
     else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0)
       s = tt__error(ctx, TT_ERR_ARG, "unknown write option \"%s\" (known: "
-                    "NLN_PREFIX, LCO, ROWS, RTREE, RTREE_CHECK, T_SRS)", key);
+                    "NLN_PREFIX, LCO, ROWS, RTREE, RTREE_CHECK, T_SRS, "
+                    "THREADS)", key);
     CPLFree(key);
     if (s != TT_OK)
       return s;
@@ -807,10 +981,16 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     s = triggers_drop(&w, &tri);
   if (s == TT_OK)
     s = triggers_drop(&w, &vtx);
+  if (s == TT_OK) {
+    s = pipe_begin(&pipe, &w, &rec, &tri, &vtx, threads);
+    w.pipe = &pipe;
+  }
   if (s == TT_OK)
-    s = write_triangles(&w, &rec, &tri);
+    s = insert_rows(&w, 0, tt__triangle_fields);
   if (s == TT_OK)
-    s = write_vertices(&w, &rec, &vtx);
+    s = insert_rows(&w, 1, tt__vertex_fields);
+  pipe_end(&pipe); /* the maker's boxes and extents are complete */
+  w.pipe = NULL;
   if (s == TT_OK)
     s = triggers_restore(&w, &tri);
   if (s == TT_OK)
