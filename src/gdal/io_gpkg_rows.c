@@ -386,6 +386,10 @@ typedef struct rows_pipe {
   pthread_cond_t cond;
   int stop;          /* the SQLite side gave up */
   int failed;        /* the maker failed: message in m_ctx */
+  /* the R-trees, packed by the maker once the rows are made (0 cells: not
+   * here; the SQLite thread packs what is not packed) */
+  size_t node_cap;
+  tt__rtree_packed *packed[2];
 } rows_pipe;
 
 static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
@@ -529,6 +533,21 @@ static void *maker_main(void *arg)
     if (s != TT_OK || !more)
       break;
   }
+  /* Every row made: the R-trees' packing (sorts) goes on here while SQLite
+   * inserts the last rows. The boxes are not needed after it. */
+  for (int k = 0; k < 2 && p->node_cap && !p->failed; k++) {
+    pthread_mutex_lock(&p->lock);
+    int stop = p->stop;
+    pthread_mutex_unlock(&p->lock);
+    layer_table *t = p->layer[k];
+    if (stop || !t->boxes)
+      break;
+    if (tt__rtree_pack(p->m_ctx, t->name, t->boxes, p->count[k],
+                       p->node_cap, &p->packed[k]) != TT_OK)
+      break; /* the SQLite thread packs from the boxes */
+    free(t->boxes);
+    t->boxes = NULL;
+  }
   return NULL;
 }
 
@@ -584,12 +603,13 @@ static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
   return report(w);
 }
 
-/* Stops and joins the maker (its work done or not). */
-static void pipe_end(rows_pipe *p)
+/* Joins the maker: after its packing when the rows went in (ok), else
+ * stopping it first. */
+static void pipe_join(rows_pipe *p, int ok)
 {
   if (p->threaded) {
     pthread_mutex_lock(&p->lock);
-    p->stop = 1;
+    p->stop = !ok;
     pthread_cond_broadcast(&p->cond);
     pthread_mutex_unlock(&p->lock);
     pthread_join(p->thread, NULL);
@@ -599,15 +619,22 @@ static void pipe_end(rows_pipe *p)
   }
   free(p->ring);
   p->ring = NULL;
+}
+
+static void pipe_free(rows_pipe *p)
+{
+  pipe_join(p, 0);
+  for (int k = 0; k < 2; k++)
+    tt__rtree_packed_free(p->packed[k]);
   if (p->m_ctx)
     tt_context_destroy(p->m_ctx);
-  p->m_ctx = NULL;
+  memset(p, 0, sizeof *p);
 }
 
 /* Sets up the rows of both layers; a maker thread when threads allow. */
 static tt_status pipe_begin(rows_pipe *p, rows_state *w,
                             const tt__records *rec, layer_table *tri,
-                            layer_table *vtx, int threads)
+                            layer_table *vtx, int threads, size_t node_cap)
 {
   memset(p, 0, sizeof *p);
   p->rec = rec;
@@ -632,7 +659,9 @@ static tt_status pipe_begin(rows_pipe *p, rows_state *w,
     pthread_mutex_destroy(&p->lock);
     return TT_OK;
   }
+  p->node_cap = node_cap; /* read by the maker */
   if (pthread_create(&p->thread, NULL, maker_main, p) != 0) {
+    p->node_cap = 0;
     pthread_cond_destroy(&p->cond);
     pthread_mutex_destroy(&p->lock);
     return TT_OK; /* the SQLite thread makes the rows itself */
@@ -982,14 +1011,15 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   if (s == TT_OK)
     s = triggers_drop(&w, &vtx);
   if (s == TT_OK) {
-    s = pipe_begin(&pipe, &w, &rec, &tri, &vtx, threads);
+    s = pipe_begin(&pipe, &w, &rec, &tri, &vtx, threads,
+                   rtree ? tt__gpkg_rtree_node_cap(w.db) : 0);
     w.pipe = &pipe;
   }
   if (s == TT_OK)
     s = insert_rows(&w, 0, tt__triangle_fields);
   if (s == TT_OK)
     s = insert_rows(&w, 1, tt__vertex_fields);
-  pipe_end(&pipe); /* the maker's boxes and extents are complete */
+  pipe_join(&pipe, s == TT_OK); /* the boxes and extents are complete */
   w.pipe = NULL;
   if (s == TT_OK)
     s = triggers_restore(&w, &tri);
@@ -1004,13 +1034,15 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.hi = 0.93;
   if (s == TT_OK && rtree)
     s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, tri.name, tri.geom,
-                                  tri.boxes, nt, rtree_check, rtree_progress,
+                                  tri.boxes, nt, pipe.packed[0], rtree_check,
+                                  rtree_progress,
                                   &w);
   w.lo = 0.93;
   w.hi = 0.99;
   if (s == TT_OK && rtree)
     s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, vtx.name, vtx.geom,
-                                  vtx.boxes, nv, rtree_check, rtree_progress,
+                                  vtx.boxes, nv, pipe.packed[1], rtree_check,
+                                  rtree_progress,
                                   &w);
   if (s == TT_OK) {
     s = exec(&w, "COMMIT", "cannot commit the TIN");
@@ -1020,6 +1052,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   if (s == TT_OK && progress)
     progress(1.0, "writing", progress_arg); /* done: too late to stop */
 done:
+  pipe_free(&pipe); /* before the tables the maker fills */
   if (in_transaction)
     sqlite3_exec(w.db, "ROLLBACK", NULL, NULL, NULL);
   if (w.db && sqlite3_close(w.db) != SQLITE_OK && s == TT_OK)
