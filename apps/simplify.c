@@ -402,6 +402,8 @@ tt_status tt__app_simplify(app_run *r)
   int direct_rows = tt__app_str_ieq(drvname, "GPKG");
   if (direct_rows) {
     wopts = CSLSetNameValue(wopts, "ROWS", "DEFERRED");
+    /* a temporary file: removed on failure, renamed only when complete */
+    wopts = CSLSetNameValue(wopts, "JOURNAL", "MEMORY");
     if (ro.threads > 0) /* -threads 1: no thread making the rows either */
       wopts = CSLSetNameValue(wopts, "THREADS",
                               CPLSPrintf("%d", ro.threads));

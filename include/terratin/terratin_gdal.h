@@ -147,7 +147,9 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
  * accepted and ignored, so the same list can be passed). THREADS=1 makes
  * the rows on the calling thread only; otherwise a second thread makes
  * them while SQLite inserts (tt_ogr_write_tin() accepts and ignores
- * THREADS too). Any failure or an interruption (progress returns 0:
+ * THREADS too). JOURNAL=MEMORY keeps SQLite's rollback journal in memory
+ * (for a file that is deleted unless the write completes). Any failure or
+ * an interruption (progress returns 0:
  * TT_ERR_INTERRUPTED) rolls back and leaves the layers empty. */
 tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
                              const tt_tin *tin, OGRSpatialReferenceH srs,

@@ -5,10 +5,13 @@
  * tt_ogr_write_tin(ROWS=DEFERRED) makes the layers through OGR (tables,
  * fields, gpkg_contents, gpkg_geometry_columns, the feature-count triggers
  * and gpkg_ogr_contents: the metadata GDAL knows how to get right) and the
- * run_parameters row; this file then fills the two big tables with
- * prepared INSERTs of 64 rows each, as OGR would have filled them feature
- * by feature but without a feature object, a geometry object and a
- * statement per row. The content is the same: the same fids (1..n in TIN
+ * run_parameters row; this file then fills the two big tables, one
+ * INSERT ... SELECT a layer from a virtual table whose cursor hands SQLite
+ * the rows (see "the rows as a virtual table" below), as OGR would have
+ * filled them feature by feature but without a feature object, a geometry
+ * object and a statement per row. A second thread makes the rows while
+ * SQLite inserts them, then packs the R-trees. The content is the same:
+ * the same fids (1..n in TIN
  * order, given by SQLite's append path in a table that never had rows),
  * the same columns and values (NaN as NULL), the same geometry
  * blobs, which are the GeoPackage binary header ("GP", version 0, flags,
@@ -25,16 +28,25 @@
  * are dropped for the inserts and re-created from their own SQL, as GDAL
  * itself does around bulk writes.
  *
- * The R-trees of both layers are then packed from the boxes just written
+ * The R-trees of both layers are then written from the boxes of the rows
  * (gpkg_rtree.h), unless LCO=SPATIAL_INDEX=NO. Everything happens in one
  * IMMEDIATE transaction: a failure (disk full, an interruption through
  * progress) rolls back and leaves the file with its empty layers, as it
  * was. tests/gdal/test_gpkg_rows.c compares every row, blob and index
  * table with the OGR writer's.
  *
+ * JOURNAL=MEMORY (the command's temporary files, which a failure removes
+ * and only a finished write renames to the output) keeps SQLite's rollback
+ * journal in memory: the roll-back still works, only a crash in the middle
+ * of the write could leave the file unsound, and that file is never
+ * renamed. Otherwise the journal is SQLite's default, on disk.
+ *
  * Workload: O(triangles + vertices) inserts of fixed-size rows (a 165-byte
- * and a 37-byte blob); memory 40 bytes a feature for the boxes, SQLite's
- * page cache and, with T_SRS, 16 bytes a vertex.
+ * and a 37-byte blob); about 5,000 instructions a triangle in SQLite
+ * (Crater Lake, 108 k triangles), which no bind, batch or page size
+ * lowered much: the floor of this path. Memory 40 bytes a feature for the
+ * boxes, 2 MB of rows in flight, SQLite's page cache and, with T_SRS, 16
+ * bytes a vertex.
  */
 #include "gdal/gpkg_rtree.h"
 #include "gdal/tin_records.h"
@@ -931,6 +943,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.progress_arg = progress_arg;
   const char *prefix = "", *t_srs = NULL;
   int in_transaction = 0, rtree = 1, rtree_check = 0, threads = 0;
+  int journal_memory = 0;
   rows_pipe pipe;
   memset(&pipe, 0, sizeof pipe);
   char *tri_name = NULL, *vtx_name = NULL;
@@ -956,10 +969,12 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       rtree_check = CPLTestBool(value);
     else if (strcasecmp(key, "THREADS") == 0)
       threads = atoi(value);
+    else if (strcasecmp(key, "JOURNAL") == 0)
+      journal_memory = strcasecmp(value, "MEMORY") == 0;
     else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0)
       s = tt__error(ctx, TT_ERR_ARG, "unknown write option \"%s\" (known: "
-                    "NLN_PREFIX, LCO, ROWS, RTREE, RTREE_CHECK, T_SRS, "
-                    "THREADS)", key);
+                    "JOURNAL, NLN_PREFIX, LCO, ROWS, RTREE, RTREE_CHECK, "
+                    "T_SRS, THREADS)", key);
     CPLFree(key);
     if (s != TT_OK)
       return s;
@@ -991,6 +1006,11 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       SQLITE_OK) {
     s = db_error(&w, "cannot register the row source");
     goto done;
+  }
+  if (journal_memory) {
+    s = exec(&w, "PRAGMA journal_mode = MEMORY", "cannot set the journal");
+    if (s != TT_OK)
+      goto done;
   }
   s = exec(&w, "BEGIN IMMEDIATE", "cannot start a transaction");
   if (s != TT_OK)

@@ -137,11 +137,12 @@ static tt_status parse_options(write_state *w, char **options)
       else
         s = tt__error(w->ctx, TT_ERR_ARG, "RTREE=%s: expected NOW or "
                       "DEFERRED", value);
-    } else if (strcasecmp(key, "THREADS") != 0) {
-      /* THREADS is tt_gpkg_write_rows()'s */
+    } else if (strcasecmp(key, "THREADS") != 0 &&
+               strcasecmp(key, "JOURNAL") != 0) {
+      /* THREADS and JOURNAL are tt_gpkg_write_rows()'s */
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
-                    "(known: NLN_PREFIX, LCO, ROWS, RTREE, T_SRS, THREADS)",
-                    key);
+                    "(known: JOURNAL, NLN_PREFIX, LCO, ROWS, RTREE, T_SRS, "
+                    "THREADS)", key);
     }
     CPLFree(key);
     if (s != TT_OK)

@@ -340,6 +340,9 @@ int main(void)
   o = CSLSetNameValue(NULL, "THREADS", "1");
   one_case(ctx, fine, srs, o, "", "fid", "geom", 1);
   CSLDestroy(o);
+  o = CSLSetNameValue(NULL, "JOURNAL", "MEMORY");
+  one_case(ctx, fine, srs, o, "", "fid", "geom", 1);
+  CSLDestroy(o);
 
   /* Interrupted at the first, a middle and a late progress call: rolled
    * back, a sound file with empty layers and no index. */
@@ -367,11 +370,14 @@ int main(void)
   }
 
   /* The fine TIN stopped in its rows while the second thread makes them
-   * (and with THREADS=1): the same roll-back. */
+   * (and with THREADS=1, and with the journal in memory): the same
+   * roll-back. */
   stopper fcount = {0, 0};
   CHECK_OK(ctx, write_gpkg(ctx, fine, path, srs, NULL, 1, 1, &fcount));
-  for (int k = 0; k < 2; k++) {
-    char **to = k ? CSLSetNameValue(NULL, "THREADS", "1") : NULL;
+  for (int k = 0; k < 3; k++) {
+    char **to = k == 1   ? CSLSetNameValue(NULL, "THREADS", "1")
+                : k == 2 ? CSLSetNameValue(NULL, "JOURNAL", "MEMORY")
+                         : NULL;
     stopper st = {0, fcount.calls / 3};
     CHECK_INT_EQ(write_gpkg(ctx, fine, path, srs, to, 1, 1, &st),
                  TT_ERR_INTERRUPTED);
