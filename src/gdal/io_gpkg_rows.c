@@ -59,11 +59,11 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
-#include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #define TRI_BLOB_BYTES (8 + 48 + 1 + 4 + 4 + 4 + 4 * 24) /* 165 */
 #define PT_BLOB_BYTES (8 + 1 + 4 + 24)                   /* 37 */
@@ -660,7 +660,8 @@ static tt_status pipe_begin(rows_pipe *p, rows_state *w,
   p->ring = calloc(NCHUNKS, sizeof *p->ring);
   if (!p->ring)
     return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
-  if (threads == 1 || p->count[0] + p->count[1] <= CHUNK_ROWS)
+  if (threads == 1 || p->count[0] + p->count[1] <= CHUNK_ROWS ||
+      (threads <= 0 && sysconf(_SC_NPROCESSORS_ONLN) < 2))
     return TT_OK;
   p->m_ctx = tt_context_create();
   if (!p->m_ctx)
