@@ -36,7 +36,10 @@
  * leaves the file as it was. tt__gpkg_rtree_from_boxes() (gpkg_rtree.h)
  * does the same inside a transaction of its caller's, from boxes its caller
  * knows, with rtreecheck() only on request: the row writer builds the
- * indexes of its own rows that way, and the tests run the check.
+ * indexes of its own rows that way, and the tests run the check. The
+ * packing needs no database (tt__rtree_pack()): the row writer packs on
+ * its second thread while SQLite inserts rows, and hands the packed tree
+ * over.
  *
  * Workload: one sequential scan of the table, an O(n log n) sort, one blob
  * per 51 features and one %_rowid row per feature; memory about 40 bytes per
