@@ -155,9 +155,13 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
  * as tt_ogr_write_tin() without ROWS=DEFERRED writes through OGR, and the
  * layers' extents and feature counts. srs and the options NLN_PREFIX and
  * T_SRS must be those given to tt_ogr_write_tin() (LCO, ROWS and RTREE are
- * accepted and ignored, so the same list can be passed). Any failure or an
- * interruption (progress returns 0: TT_ERR_INTERRUPTED) rolls back and
- * leaves the layers empty. */
+ * accepted and ignored, so the same list can be passed). THREADS=1 makes
+ * the rows on the calling thread only; otherwise a second thread makes
+ * them while SQLite inserts (tt_ogr_write_tin() accepts and ignores
+ * THREADS too). JOURNAL=MEMORY keeps SQLite's rollback journal in memory
+ * (for a file that is deleted unless the write completes). Any failure or
+ * an interruption (progress returns 0:
+ * TT_ERR_INTERRUPTED) rolls back and leaves the layers empty. */
 tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
                              const tt_tin *tin, OGRSpatialReferenceH srs,
                              char **options, tt_progress_fn progress,

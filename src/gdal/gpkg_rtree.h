@@ -18,16 +18,36 @@ typedef struct tt__rtree_box {
   double minx, maxx, miny, maxy;
 } tt__rtree_box;
 
+/* A tree packed beforehand (Sort-Tile-Recursive, see io_gpkg_rtree.c),
+ * without a database: the row writer packs on its second thread while
+ * SQLite inserts rows. */
+typedef struct tt__rtree_packed tt__rtree_packed;
+
+/* Packs the n boxes into nodes of node_cap cells; what names the index in
+ * messages. */
+TT_HIDDEN tt_status tt__rtree_pack(tt_context *ctx, const char *what,
+                                   const tt__rtree_box *boxes, size_t n,
+                                   size_t node_cap,
+                                   tt__rtree_packed **out);
+TT_HIDDEN void tt__rtree_packed_free(tt__rtree_packed *pk);
+
+/* The cells a node of an R-tree created now in db will hold, from the page
+ * size as SQLite's R*Tree module sizes its nodes (the loader checks it
+ * against the root it creates, and packs again if it differs). */
+TT_HIDDEN size_t tt__gpkg_rtree_node_cap(sqlite3 *db);
+
 /* Builds the gpkg_rtree_index of table.geom_column in db, whose caller
  * holds an open write transaction, from the n boxes (every feature with a
- * non-empty geometry, each once), exactly as tt_gpkg_build_rtree() would
+ * non-empty geometry, each once; or packed, the same boxes packed by
+ * tt__rtree_pack(), boxes then unused), exactly as tt_gpkg_build_rtree() would
  * from the table: the virtual table, its nodes, the standard's triggers and
  * the gpkg_extensions row. check: run SQLite's rtreecheck() on the result
  * too (about a fifth of the build's time; the tests do). gpkg_path names
  * the file in messages. The caller commits or rolls back. */
 TT_HIDDEN tt_status tt__gpkg_rtree_from_boxes(
     tt_context *ctx, sqlite3 *db, const char *gpkg_path, const char *table,
-    const char *geom_column, const tt__rtree_box *boxes, size_t n, int check,
-    tt_progress_fn progress, void *progress_arg);
+    const char *geom_column, const tt__rtree_box *boxes, size_t n,
+    const tt__rtree_packed *packed, int check, tt_progress_fn progress,
+    void *progress_arg);
 
 #endif /* TERRATIN_GPKG_RTREE_H */

@@ -5,10 +5,13 @@
  * tt_ogr_write_tin(ROWS=DEFERRED) makes the layers through OGR (tables,
  * fields, gpkg_contents, gpkg_geometry_columns, the feature-count triggers
  * and gpkg_ogr_contents: the metadata GDAL knows how to get right) and the
- * run_parameters row; this file then fills the two big tables with
- * prepared INSERTs of 64 rows each, as OGR would have filled them feature
- * by feature but without a feature object, a geometry object and a
- * statement per row. The content is the same: the same fids (1..n in TIN
+ * run_parameters row; this file then fills the two big tables, one
+ * INSERT ... SELECT a layer from a virtual table whose cursor hands SQLite
+ * the rows (see "the rows as a virtual table" below), as OGR would have
+ * filled them feature by feature but without a feature object, a geometry
+ * object and a statement per row. A second thread makes the rows while
+ * SQLite inserts them, then packs the R-trees. The content is the same:
+ * the same fids (1..n in TIN
  * order, given by SQLite's append path in a table that never had rows),
  * the same columns and values (NaN as NULL), the same geometry
  * blobs, which are the GeoPackage binary header ("GP", version 0, flags,
@@ -25,16 +28,25 @@
  * are dropped for the inserts and re-created from their own SQL, as GDAL
  * itself does around bulk writes.
  *
- * The R-trees of both layers are then packed from the boxes just written
+ * The R-trees of both layers are then written from the boxes of the rows
  * (gpkg_rtree.h), unless LCO=SPATIAL_INDEX=NO. Everything happens in one
  * IMMEDIATE transaction: a failure (disk full, an interruption through
  * progress) rolls back and leaves the file with its empty layers, as it
  * was. tests/gdal/test_gpkg_rows.c compares every row, blob and index
  * table with the OGR writer's.
  *
+ * JOURNAL=MEMORY (the command's temporary files, which a failure removes
+ * and only a finished write renames to the output) keeps SQLite's rollback
+ * journal in memory: the roll-back still works, only a crash in the middle
+ * of the write could leave the file unsound, and that file is never
+ * renamed. Otherwise the journal is SQLite's default, on disk.
+ *
  * Workload: O(triangles + vertices) inserts of fixed-size rows (a 165-byte
- * and a 37-byte blob); memory 40 bytes a feature for the boxes, SQLite's
- * page cache and, with T_SRS, 16 bytes a vertex.
+ * and a 37-byte blob); about 5,000 instructions a triangle in SQLite
+ * (Crater Lake, 108 k triangles), which no bind, batch or page size
+ * lowered much: the floor of this path. Memory 40 bytes a feature for the
+ * boxes, 2 MB of rows in flight, SQLite's page cache and, with T_SRS, 16
+ * bytes a vertex.
  */
 #include "gdal/gpkg_rtree.h"
 #include "gdal/tin_records.h"
@@ -45,10 +57,13 @@
 #include <sqlite3.h>
 
 #include <math.h>
+#include <pthread.h>
+#include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #define TRI_BLOB_BYTES (8 + 48 + 1 + 4 + 4 + 4 + 4 * 24) /* 165 */
 #define PT_BLOB_BYTES (8 + 1 + 4 + 24)                   /* 37 */
@@ -62,6 +77,8 @@ typedef struct rows_state {
   void *progress_arg;
   size_t done, total, next_report, step;
   double lo, hi;    /* the share of progress the present phase takes */
+  struct rows_pipe *pipe; /* the rows tt__rows gives */
+  tt_status status;       /* why the rows stopped */
 } rows_state;
 
 /* One saved trigger, re-created after the inserts. */
@@ -156,14 +173,6 @@ static int rtree_progress(double complete, const char *message, void *arg)
     return 1;
   return w->progress(w->lo + (w->hi - w->lo) * complete, message,
                      w->progress_arg);
-}
-
-static void bind_real(sqlite3_stmt *st, int col, double v)
-{
-  if (isfinite(v))
-    sqlite3_bind_double(st, col, v);
-  else
-    sqlite3_bind_null(st, col);
 }
 
 static void layer_free(layer_table *t)
@@ -310,224 +319,564 @@ static tt_status triggers_restore(rows_state *w, layer_table *t)
   return TT_OK;
 }
 
-/* INSERT INTO t (fid, geom, field...) VALUES (?, ?, ?...), (...) with
- * nrows rows of values: one statement per batch of rows, since each
- * statement also ends by updating sqlite_sequence (the tables are
- * AUTOINCREMENT) and that costs as much as a row. */
-static tt_status prepare_insert(rows_state *w, const layer_table *t,
-                                const tt__field_spec *fields, int nfields,
-                                int nrows, sqlite3_stmt **out_st)
+/* --- the rows as a virtual table ------------------------------------------
+ * One INSERT INTO t (geom, fields...) SELECT c0, c1... FROM tt__rows writes
+ * a whole layer: tt__rows is an eponymous virtual table of this connection
+ * whose cursor hands SQLite the rows of the layer being written, so SQLite
+ * reads the values straight from here, with no bound parameters to copy,
+ * and updates sqlite_sequence once per layer. (Batches of 64 rows of bound
+ * parameters, the earlier way, took 5,500 instructions a triangle in
+ * SQLite's bind and VDBE code.)
+ *
+ * The rows are made (tt__records_*, the geometry blobs, the R-tree boxes,
+ * the extents) by a second thread, a chunk of CHUNK_ROWS rows at a time,
+ * through a ring of NCHUNKS chunks, while SQLite inserts the previous ones:
+ * the triangles' rows, then the vertices'. With one thread (THREADS=1, or
+ * no second CPU) the cursor makes each chunk itself when it needs it. Only
+ * the SQLite thread reports progress; a failure on either side (an
+ * interruption, a row the TIN cannot give) stops the other and ends the
+ * statement with an error, kept in rows_pipe.status. */
+
+#define MAX_COLS (1 + TT__TF_COUNT) /* the geometry and the fields */
+#define ROWS_MODULE "tt__rows"
+#define CHUNK_ROWS 1024
+#define NCHUNKS 4
+
+enum { V_NULL, V_INT, V_REAL };
+
+typedef struct row_value {
+  int type;
+  sqlite3_int64 i;
+  double d;
+} row_value;
+
+static void set_int(row_value *v, sqlite3_int64 i)
 {
+  v->type = V_INT;
+  v->i = i;
+}
+
+static void set_real(row_value *v, double d)
+{
+  v->type = isfinite(d) ? V_REAL : V_NULL; /* NaN as NULL */
+  v->d = d;
+}
+
+typedef struct chunk {
+  int layer;         /* 0: triangles, 1: vertices */
+  size_t first, n;   /* rows [first, first + n) of the layer */
+  int full;          /* made, not yet inserted */
+  row_value v[CHUNK_ROWS][MAX_COLS];
+  unsigned char blob[CHUNK_ROWS][TRI_BLOB_BYTES];
+  int blob_len[CHUNK_ROWS];
+} chunk;
+
+typedef struct rows_pipe {
+  const tt__records *rec;
+  layer_table *layer[2];
+  size_t count[2];
+  int ncols[2];
+  int decimated;
+  chunk *ring;       /* NCHUNKS */
+  /* the maker's side */
+  int m_layer;
+  size_t m_first;
+  size_t m_slot;
+  tt_context *m_ctx; /* the maker thread's own messages */
+  /* the SQLite side */
+  int layer_now;     /* the layer being inserted */
+  size_t c_slot;     /* the chunk being read, when c_held */
+  int c_held;
+  size_t row;        /* the row being read */
+  const row_value *vals;
+  const unsigned char *blob;
+  int blob_len;
+  /* shared */
+  int threaded;
+  pthread_t thread;
+  pthread_mutex_t lock;
+  pthread_cond_t cond;
+  int stop;          /* the SQLite side gave up */
+  int failed;        /* the maker failed: message in m_ctx */
+  /* the R-trees, packed by the maker once the rows are made (0 cells: not
+   * here; the SQLite thread packs what is not packed) */
+  size_t node_cap;
+  tt__rtree_packed *packed[2];
+} rows_pipe;
+
+static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
+                               size_t i, row_value *vals,
+                               unsigned char *blob, int *blob_len)
+{
+  layer_table *t = p->layer[0];
+  tt_triangle_info tr;
+  tt_vertex_info v[3];
+  double px[3], py[3];
+  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, v, px, py);
+  if (s != TT_OK)
+    return s;
+  double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
+  for (int k = 1; k < 3; k++) {
+    double c[3] = {px[k], py[k], v[k].z};
+    for (int d = 0; d < 3; d++) {
+      if (c[d] < lo[d]) lo[d] = c[d];
+      if (c[d] > hi[d]) hi[d] = c[d];
+    }
+  }
+  unsigned char *q = put_header(blob, 0x05, t->srs_id);
+  for (int d = 0; d < 3; d++) {
+    q = put_f64(q, lo[d]);
+    q = put_f64(q, hi[d]);
+  }
+  *q++ = 1; /* WKB little endian */
+  q = put_u32(q, 1003);
+  q = put_u32(q, 1);
+  q = put_u32(q, 4);
+  for (int k = 0; k < 4; k++) {
+    q = put_f64(q, px[k % 3]);
+    q = put_f64(q, py[k % 3]);
+    q = put_f64(q, v[k % 3].z);
+  }
+  *blob_len = (int)(q - blob);
+  extend(t, lo[0], lo[1]);
+  extend(t, hi[0], hi[1]);
+  if (t->boxes)
+    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, lo[0], hi[0], lo[1],
+                                  hi[1]};
+  row_value *f = vals + 1;
+  set_int(&f[TT__TF_V0], tr.v[0]);
+  set_int(&f[TT__TF_V1], tr.v[1]);
+  set_int(&f[TT__TF_V2], tr.v[2]);
+  set_real(&f[TT__TF_MAX_ERR], tr.max_error);
+  set_real(&f[TT__TF_RMSE], tr.rmse);
+  set_int(&f[TT__TF_N_SAMPLES], (sqlite3_int64)tr.samples);
+  set_real(&f[TT__TF_AREA_2D], tr.area_2d);
+  set_real(&f[TT__TF_AREA_3D], tr.area_3d);
+  set_real(&f[TT__TF_SLOPE], tr.slope_deg);
+  set_real(&f[TT__TF_ASPECT], tr.aspect_deg);
+  set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
+  set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
+  return TT_OK;
+}
+
+static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
+                             row_value *vals, unsigned char *blob,
+                             int *blob_len)
+{
+  layer_table *t = p->layer[1];
+  tt_vertex_info v;
+  double x, y;
+  tt_status s = tt__records_vertex(p->rec, ctx, i, &v, &x, &y);
+  if (s != TT_OK)
+    return s;
+  unsigned char *q = put_header(blob, 0x01, t->srs_id);
+  *q++ = 1;
+  q = put_u32(q, 1001);
+  q = put_f64(q, x);
+  q = put_f64(q, y);
+  q = put_f64(q, v.z);
+  *blob_len = (int)(q - blob);
+  extend(t, x, y);
+  if (t->boxes)
+    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, x, x, y, y};
+  row_value *f = vals + 1;
+  set_int(&f[TT__VF_ID], (sqlite3_int64)i);
+  set_int(&f[TT__VF_COL], v.col);
+  set_int(&f[TT__VF_ROW], v.row);
+  set_real(&f[TT__VF_INS_ERR], v.insert_error);
+  if (p->decimated)
+    f[TT__VF_INS_RANK].type = V_NULL;
+  else
+    set_int(&f[TT__VF_INS_RANK], (sqlite3_int64)v.rank);
+  set_real(&f[TT__VF_STAR_MAX], v.star_max_error);
+  set_real(&f[TT__VF_STAR_RMSE], v.star_rmse);
+  set_int(&f[TT__VF_STAR_N], (sqlite3_int64)v.star_samples);
+  if (p->decimated)
+    set_real(&f[TT__VF_IMPORTANCE], v.importance);
+  return TT_OK;
+}
+
+/* Makes the next chunk (the maker's position) into ch; 0 when every row is
+ * made. Errors go to ctx. */
+static int make_chunk(rows_pipe *p, chunk *ch, tt_context *ctx,
+                      tt_status *out_s)
+{
+  *out_s = TT_OK;
+  while (p->m_layer < 2 && p->m_first >= p->count[p->m_layer]) {
+    p->m_layer++;
+    p->m_first = 0;
+  }
+  if (p->m_layer >= 2)
+    return 0;
+  size_t left = p->count[p->m_layer] - p->m_first;
+  ch->layer = p->m_layer;
+  ch->first = p->m_first;
+  ch->n = left < CHUNK_ROWS ? left : CHUNK_ROWS;
+  for (size_t r = 0; r < ch->n && *out_s == TT_OK; r++)
+    *out_s = (ch->layer == 0 ? fill_triangle : fill_vertex)(
+        p, ctx, ch->first + r, ch->v[r], ch->blob[r], &ch->blob_len[r]);
+  p->m_first += ch->n;
+  return 1;
+}
+
+static void *maker_main(void *arg)
+{
+  rows_pipe *p = arg;
+  for (;;) {
+    chunk *ch = &p->ring[p->m_slot % NCHUNKS];
+    pthread_mutex_lock(&p->lock);
+    while (ch->full && !p->stop)
+      pthread_cond_wait(&p->cond, &p->lock);
+    int stop = p->stop;
+    pthread_mutex_unlock(&p->lock);
+    if (stop)
+      break;
+    tt_status s;
+    int more = make_chunk(p, ch, p->m_ctx, &s);
+    pthread_mutex_lock(&p->lock);
+    if (s != TT_OK)
+      p->failed = 1;
+    else if (more) {
+      ch->full = 1;
+      p->m_slot++;
+    }
+    pthread_cond_broadcast(&p->cond);
+    pthread_mutex_unlock(&p->lock);
+    if (s != TT_OK || !more)
+      break;
+  }
+  /* Every row made: the R-trees' packing (sorts) goes on here while SQLite
+   * inserts the last rows. The boxes are not needed after it. */
+  for (int k = 0; k < 2 && p->node_cap && !p->failed; k++) {
+    pthread_mutex_lock(&p->lock);
+    int stop = p->stop;
+    pthread_mutex_unlock(&p->lock);
+    layer_table *t = p->layer[k];
+    if (stop)
+      break;
+    if (!t->boxes || p->count[k] == 0)
+      continue; /* a layer left out by LAYERS */
+    if (tt__rtree_pack(p->m_ctx, t->name, t->boxes, p->count[k],
+                       p->node_cap, &p->packed[k]) != TT_OK)
+      break; /* the SQLite thread packs from the boxes */
+    free(t->boxes);
+    t->boxes = NULL;
+  }
+  return NULL;
+}
+
+/* The SQLite side: points p at row i of layer p->layer_now, taking the
+ * next chunk when row i is past the one held. */
+static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
+{
+  chunk *ch = p->c_held ? &p->ring[p->c_slot % NCHUNKS] : NULL;
+  if (!ch || ch->layer != p->layer_now || i < ch->first ||
+      i >= ch->first + ch->n) {
+    if (ch) { /* done with it */
+      if (p->threaded)
+        pthread_mutex_lock(&p->lock);
+      ch->full = 0;
+      p->c_slot++;
+      p->c_held = 0;
+      if (p->threaded) {
+        pthread_cond_broadcast(&p->cond);
+        pthread_mutex_unlock(&p->lock);
+      }
+    }
+    ch = &p->ring[p->c_slot % NCHUNKS];
+    if (p->threaded) {
+      pthread_mutex_lock(&p->lock);
+      while (!ch->full && !p->failed)
+        pthread_cond_wait(&p->cond, &p->lock);
+      int failed = !ch->full && p->failed;
+      pthread_mutex_unlock(&p->lock);
+      if (failed)
+        return tt__error(w->ctx, TT_ERR_INTERNAL, "%s",
+                         tt_context_errmsg(p->m_ctx));
+    } else {
+      tt_status s;
+      if (!make_chunk(p, ch, w->ctx, &s))
+        return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: row %zu of layer %s "
+                         "asked for past its end", w->path, i,
+                         p->layer[p->layer_now]->name);
+      if (s != TT_OK)
+        return s;
+      ch->full = 1;
+    }
+    p->c_held = 1;
+    if (ch->layer != p->layer_now || i != ch->first)
+      return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: rows of layer %s out "
+                       "of order (%zu)", w->path,
+                       p->layer[p->layer_now]->name, i);
+  }
+  size_t r = i - ch->first;
+  p->vals = ch->v[r];
+  p->blob = ch->blob[r];
+  p->blob_len = ch->blob_len[r];
+  p->row = i;
+  return report(w);
+}
+
+/* Joins the maker: after its packing when the rows went in (ok), else
+ * stopping it first. */
+static void pipe_join(rows_pipe *p, int ok)
+{
+  if (p->threaded) {
+    pthread_mutex_lock(&p->lock);
+    p->stop = !ok;
+    pthread_cond_broadcast(&p->cond);
+    pthread_mutex_unlock(&p->lock);
+    pthread_join(p->thread, NULL);
+    pthread_cond_destroy(&p->cond);
+    pthread_mutex_destroy(&p->lock);
+    p->threaded = 0;
+  }
+  free(p->ring);
+  p->ring = NULL;
+}
+
+static void pipe_free(rows_pipe *p)
+{
+  pipe_join(p, 0);
+  for (int k = 0; k < 2; k++)
+    tt__rtree_packed_free(p->packed[k]);
+  if (p->m_ctx)
+    tt_context_destroy(p->m_ctx);
+  memset(p, 0, sizeof *p);
+}
+
+/* Sets up the rows of both layers (nt triangles, nv vertices: 0 for a layer
+ * left out by LAYERS); a maker thread when threads allow. */
+static tt_status pipe_begin(rows_pipe *p, rows_state *w,
+                            const tt__records *rec, layer_table *tri,
+                            layer_table *vtx, size_t nt, size_t nv,
+                            int threads, size_t node_cap)
+{
+  memset(p, 0, sizeof *p);
+  p->rec = rec;
+  p->layer[0] = tri;
+  p->layer[1] = vtx;
+  p->count[0] = nt;
+  p->count[1] = nv;
+  p->ncols[0] = 1 + TT__TF_COUNT;
+  p->ncols[1] = 1 + tt__records_vertex_fields(rec->tin);
+  p->decimated = tt__records_decimated(rec->tin);
+  p->ring = calloc(NCHUNKS, sizeof *p->ring);
+  if (!p->ring)
+    return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
+  if (threads == 1 || p->count[0] + p->count[1] <= CHUNK_ROWS ||
+      (threads <= 0 && sysconf(_SC_NPROCESSORS_ONLN) < 2))
+    return TT_OK;
+  p->m_ctx = tt_context_create();
+  if (!p->m_ctx)
+    return TT_OK;
+  if (pthread_mutex_init(&p->lock, NULL) != 0)
+    return TT_OK;
+  if (pthread_cond_init(&p->cond, NULL) != 0) {
+    pthread_mutex_destroy(&p->lock);
+    return TT_OK;
+  }
+  p->node_cap = node_cap; /* read by the maker */
+  if (pthread_create(&p->thread, NULL, maker_main, p) != 0) {
+    p->node_cap = 0;
+    pthread_cond_destroy(&p->cond);
+    pthread_mutex_destroy(&p->lock);
+    return TT_OK; /* the SQLite thread makes the rows itself */
+  }
+  p->threaded = 1;
+  return TT_OK;
+}
+
+typedef struct rows_vtab {
+  sqlite3_vtab base;
+  rows_state *w;
+} rows_vtab;
+
+typedef struct rows_cursor {
+  sqlite3_vtab_cursor base;
+  size_t row;
+} rows_cursor;
+
+static int vt_connect(sqlite3 *db, void *aux, int argc,
+                      const char *const *argv, sqlite3_vtab **out,
+                      char **err)
+{
+  (void)argc;
+  (void)argv;
+  (void)err;
+  char decl[16 + 5 * MAX_COLS] = "CREATE TABLE x(";
+  for (int k = 0; k < MAX_COLS; k++)
+    snprintf(decl + strlen(decl), sizeof decl - strlen(decl), "%sc%d",
+             k ? "," : "", k);
+  strcat(decl, ")");
+  int rc = sqlite3_declare_vtab(db, decl);
+  if (rc != SQLITE_OK)
+    return rc;
+  rows_vtab *vt = sqlite3_malloc(sizeof *vt);
+  if (!vt)
+    return SQLITE_NOMEM;
+  memset(vt, 0, sizeof *vt);
+  vt->w = aux;
+  *out = &vt->base;
+  return SQLITE_OK;
+}
+
+static int vt_disconnect(sqlite3_vtab *vt)
+{
+  sqlite3_free(vt);
+  return SQLITE_OK;
+}
+
+static size_t vt_count(const rows_state *w)
+{
+  return w->pipe ? w->pipe->count[w->pipe->layer_now] : 0;
+}
+
+static int vt_best_index(sqlite3_vtab *vt, sqlite3_index_info *info)
+{
+  info->estimatedCost = 1e6;
+  info->estimatedRows = (sqlite3_int64)vt_count(((rows_vtab *)vt)->w);
+  return SQLITE_OK;
+}
+
+static int vt_open(sqlite3_vtab *vt, sqlite3_vtab_cursor **out)
+{
+  (void)vt;
+  rows_cursor *c = sqlite3_malloc(sizeof *c);
+  if (!c)
+    return SQLITE_NOMEM;
+  memset(c, 0, sizeof *c);
+  *out = &c->base;
+  return SQLITE_OK;
+}
+
+static int vt_close(sqlite3_vtab_cursor *cur)
+{
+  sqlite3_free(cur);
+  return SQLITE_OK;
+}
+
+/* Takes row c->row, or ends the statement on failure. */
+static int vt_fill(rows_cursor *c)
+{
+  rows_vtab *vt = (rows_vtab *)c->base.pVtab;
+  rows_state *w = vt->w;
+  if (c->row >= vt_count(w))
+    return SQLITE_OK;
+  w->status = pipe_row(w->pipe, w, c->row);
+  if (w->status == TT_OK)
+    return SQLITE_OK;
+  sqlite3_free(vt->base.zErrMsg);
+  vt->base.zErrMsg = sqlite3_mprintf("%s", tt_context_errmsg(w->ctx));
+  return SQLITE_ERROR;
+}
+
+static int vt_filter(sqlite3_vtab_cursor *cur, int idx, const char *idxstr,
+                     int argc, sqlite3_value **argv)
+{
+  (void)idx;
+  (void)idxstr;
+  (void)argc;
+  (void)argv;
+  rows_cursor *c = (rows_cursor *)cur;
+  c->row = 0;
+  return vt_fill(c);
+}
+
+static int vt_next(sqlite3_vtab_cursor *cur)
+{
+  rows_cursor *c = (rows_cursor *)cur;
+  c->row++;
+  return vt_fill(c);
+}
+
+static int vt_eof(sqlite3_vtab_cursor *cur)
+{
+  return ((rows_cursor *)cur)->row >= vt_count(((rows_vtab *)cur->pVtab)->w);
+}
+
+static int vt_column(sqlite3_vtab_cursor *cur, sqlite3_context *ctx, int col)
+{
+  const rows_pipe *p = ((rows_vtab *)cur->pVtab)->w->pipe;
+  if (col == 0) {
+    /* SQLite copies it into the record before the cursor moves on */
+    sqlite3_result_blob(ctx, p->blob, p->blob_len, SQLITE_STATIC);
+    return SQLITE_OK;
+  }
+  const row_value *v = col < p->ncols[p->layer_now] ? &p->vals[col] : NULL;
+  if (!v || v->type == V_NULL)
+    sqlite3_result_null(ctx);
+  else if (v->type == V_INT)
+    sqlite3_result_int64(ctx, v->i);
+  else
+    sqlite3_result_double(ctx, v->d);
+  return SQLITE_OK;
+}
+
+static int vt_rowid(sqlite3_vtab_cursor *cur, sqlite3_int64 *out)
+{
+  *out = (sqlite3_int64)((rows_cursor *)cur)->row + 1;
+  return SQLITE_OK;
+}
+
+static const sqlite3_module rows_module = {
+    .iVersion = 0,
+    .xCreate = NULL, /* eponymous only: nothing in the file's schema */
+    .xConnect = vt_connect,
+    .xBestIndex = vt_best_index,
+    .xDisconnect = vt_disconnect,
+    .xDestroy = vt_disconnect,
+    .xOpen = vt_open,
+    .xClose = vt_close,
+    .xFilter = vt_filter,
+    .xNext = vt_next,
+    .xEof = vt_eof,
+    .xColumn = vt_column,
+    .xRowid = vt_rowid,
+};
+
+/* Writes the rows of layer (0: triangles, 1: vertices): INSERT ... SELECT
+ * from tt__rows. */
+static tt_status insert_rows(rows_state *w, int layer,
+                             const tt__field_spec *fields)
+{
+  rows_pipe *p = w->pipe;
+  layer_table *t = p->layer[layer];
+  const int ncols = p->ncols[layer];
   char *sql = sqlite3_mprintf("INSERT INTO \"%w\" (\"%w\"", t->name,
                               t->geom);
-  for (int i = 0; sql && i < nfields; i++) {
+  for (int i = 0; sql && i + 1 < ncols; i++) {
     char *more = sqlite3_mprintf("%s, \"%w\"", sql, fields[i].name);
     sqlite3_free(sql);
     sql = more;
   }
-  for (int r = 0; sql && r < nrows; r++)
-    for (int i = 0; sql && i < nfields + 2; i++) {
-      const char *part = i == nfields + 1 ? ")"
-                         : i == 0         ? (r ? ", (?" : ") VALUES (?")
-                                          : ", ?";
-      char *more = sqlite3_mprintf("%s%s", sql, part);
-      sqlite3_free(sql);
-      sql = more;
-    }
+  for (int i = 0; sql && i < ncols; i++) {
+    char *more = sqlite3_mprintf("%s%sc%d", sql, i ? ", " : ") SELECT ", i);
+    sqlite3_free(sql);
+    sql = more;
+  }
+  char *more = sql ? sqlite3_mprintf("%s FROM " ROWS_MODULE, sql) : NULL;
+  sqlite3_free(sql);
+  sql = more;
   if (!sql)
     return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
-  int rc = sqlite3_prepare_v2(w->db, sql, -1, out_st, NULL);
+  sqlite3_stmt *st = NULL;
+  int rc = sqlite3_prepare_v2(w->db, sql, -1, &st, NULL);
   sqlite3_free(sql);
   if (rc != SQLITE_OK)
     return db_error(w, "cannot prepare the inserts");
-  return TT_OK;
-}
-
-/* Rows go in batches of BATCH_ROWS per statement; the last batch gets a
- * statement of its own size. */
-#define BATCH_ROWS 64
-
-typedef struct batch {
-  rows_state *w;
-  const layer_table *t;
-  const tt__field_spec *fields;
-  int nfields, ncols;
-  sqlite3_stmt *full, *tail;
-} batch;
-
-/* The statement for the rows [first, first + n) and n itself. */
-static tt_status batch_statement(batch *b, size_t first, size_t count,
-                                 sqlite3_stmt **out_st, int *out_n)
-{
-  size_t n = count - first < BATCH_ROWS ? count - first : BATCH_ROWS;
-  *out_n = (int)n;
-  if (n == BATCH_ROWS) {
-    if (!b->full) {
-      tt_status s = prepare_insert(b->w, b->t, b->fields, b->nfields,
-                                   BATCH_ROWS, &b->full);
-      if (s != TT_OK)
-        return s;
-    }
-    *out_st = b->full;
-    return TT_OK;
-  }
-  sqlite3_finalize(b->tail);
-  b->tail = NULL;
-  tt_status s = prepare_insert(b->w, b->t, b->fields, b->nfields, (int)n,
-                               &b->tail);
-  *out_st = b->tail;
-  return s;
-}
-
-static tt_status batch_step(batch *b, sqlite3_stmt *st, size_t first, int n)
-{
-  int rc = sqlite3_step(st);
-  sqlite3_reset(st);
-  if (rc != SQLITE_DONE)
-    return tt__error(b->w->ctx, TT_ERR_IO, "%s: cannot write features %zu "
-                     "to %zu of layer %s: %s", b->w->path, first,
-                     first + (size_t)n - 1, b->t->name,
-                     sqlite3_errmsg(b->w->db));
-  for (int k = 0; k < n; k++) {
-    tt_status s = report(b->w);
-    if (s != TT_OK)
-      return s;
-  }
-  return TT_OK;
-}
-
-static void batch_free(batch *b)
-{
-  sqlite3_finalize(b->full);
-  sqlite3_finalize(b->tail);
-}
-
-static tt_status write_triangles(rows_state *w, const tt__records *rec,
-                                 layer_table *t)
-{
-  batch b = {w, t, tt__triangle_fields, TT__TF_COUNT, TT__TF_COUNT + 1,
-             NULL, NULL};
-  unsigned char blobs[BATCH_ROWS][TRI_BLOB_BYTES];
+  p->layer_now = layer;
+  w->status = TT_OK;
+  rc = p->count[layer] ? sqlite3_step(st) : SQLITE_DONE;
   tt_status s = TT_OK;
-  const size_t nt = tt_tin_triangle_count(rec->tin);
-  for (size_t first = 0; s == TT_OK && first < nt; first += BATCH_ROWS) {
-    sqlite3_stmt *st = NULL;
-    int n = 0;
-    s = batch_statement(&b, first, nt, &st, &n);
-    for (int r = 0; s == TT_OK && r < n; r++) {
-      size_t i = first + (size_t)r;
-      tt_triangle_info tr;
-      tt_vertex_info v[3];
-      double px[3], py[3];
-      s = tt__records_triangle(rec, w->ctx, i, &tr, v, px, py);
-      if (s != TT_OK)
-        break;
-      double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
-      for (int k = 1; k < 3; k++) {
-        double c[3] = {px[k], py[k], v[k].z};
-        for (int d = 0; d < 3; d++) {
-          if (c[d] < lo[d]) lo[d] = c[d];
-          if (c[d] > hi[d]) hi[d] = c[d];
-        }
-      }
-      unsigned char *blob = blobs[r];
-      unsigned char *p = put_header(blob, 0x05, t->srs_id);
-      for (int d = 0; d < 3; d++) {
-        p = put_f64(p, lo[d]);
-        p = put_f64(p, hi[d]);
-      }
-      *p++ = 1; /* WKB little endian */
-      p = put_u32(p, 1003);
-      p = put_u32(p, 1);
-      p = put_u32(p, 4);
-      for (int k = 0; k < 4; k++) {
-        p = put_f64(p, px[k % 3]);
-        p = put_f64(p, py[k % 3]);
-        p = put_f64(p, v[k % 3].z);
-      }
-      extend(t, lo[0], lo[1]);
-      extend(t, hi[0], hi[1]);
-      if (t->boxes)
-        t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, lo[0], hi[0], lo[1],
-                                      hi[1]};
-      int c = r * b.ncols + 1;
-      sqlite3_bind_blob(st, c, blob, (int)(p - blob), SQLITE_STATIC);
-      c += 1;
-      sqlite3_bind_int64(st, c + TT__TF_V0, tr.v[0]);
-      sqlite3_bind_int64(st, c + TT__TF_V1, tr.v[1]);
-      sqlite3_bind_int64(st, c + TT__TF_V2, tr.v[2]);
-      bind_real(st, c + TT__TF_MAX_ERR, tr.max_error);
-      bind_real(st, c + TT__TF_RMSE, tr.rmse);
-      sqlite3_bind_int64(st, c + TT__TF_N_SAMPLES,
-                         (sqlite3_int64)tr.samples);
-      bind_real(st, c + TT__TF_AREA_2D, tr.area_2d);
-      bind_real(st, c + TT__TF_AREA_3D, tr.area_3d);
-      bind_real(st, c + TT__TF_SLOPE, tr.slope_deg);
-      bind_real(st, c + TT__TF_ASPECT, tr.aspect_deg);
-      bind_real(st, c + TT__TF_MIN_ANGLE, tr.min_angle_deg);
-      bind_real(st, c + TT__TF_MAX_ANGLE, tr.max_angle_deg);
-    }
-    if (s == TT_OK)
-      s = batch_step(&b, st, first, n);
-  }
+  if (w->status != TT_OK)
+    s = w->status;
+  else if (rc != SQLITE_DONE)
+    s = tt__error(w->ctx, TT_ERR_IO, "%s: cannot write the %zu features of "
+                  "layer %s: %s", w->path, p->count[layer], t->name,
+                  sqlite3_errmsg(w->db));
+  sqlite3_finalize(st);
   t->last_fid = sqlite3_last_insert_rowid(w->db);
-  batch_free(&b);
-  return s;
-}
-
-static tt_status write_vertices(rows_state *w, const tt__records *rec,
-                                layer_table *t)
-{
-  const int nf = tt__records_vertex_fields(rec->tin);
-  const int decimated = tt__records_decimated(rec->tin);
-  batch b = {w, t, tt__vertex_fields, nf, nf + 1, NULL, NULL};
-  unsigned char blobs[BATCH_ROWS][PT_BLOB_BYTES];
-  tt_status s = TT_OK;
-  const size_t nv = tt_tin_vertex_count(rec->tin);
-  for (size_t first = 0; s == TT_OK && first < nv; first += BATCH_ROWS) {
-    sqlite3_stmt *st = NULL;
-    int n = 0;
-    s = batch_statement(&b, first, nv, &st, &n);
-    for (int r = 0; s == TT_OK && r < n; r++) {
-      size_t i = first + (size_t)r;
-      tt_vertex_info v;
-      double x, y;
-      s = tt__records_vertex(rec, w->ctx, i, &v, &x, &y);
-      if (s != TT_OK)
-        break;
-      unsigned char *blob = blobs[r];
-      unsigned char *p = put_header(blob, 0x01, t->srs_id);
-      *p++ = 1;
-      p = put_u32(p, 1001);
-      p = put_f64(p, x);
-      p = put_f64(p, y);
-      p = put_f64(p, v.z);
-      extend(t, x, y);
-      if (t->boxes)
-        t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, x, x, y, y};
-      int c = r * b.ncols + 1;
-      sqlite3_bind_blob(st, c, blob, (int)(p - blob), SQLITE_STATIC);
-      c += 1;
-      sqlite3_bind_int64(st, c + TT__VF_ID, (sqlite3_int64)i);
-      sqlite3_bind_int64(st, c + TT__VF_COL, v.col);
-      sqlite3_bind_int64(st, c + TT__VF_ROW, v.row);
-      bind_real(st, c + TT__VF_INS_ERR, v.insert_error);
-      if (decimated)
-        sqlite3_bind_null(st, c + TT__VF_INS_RANK);
-      else
-        sqlite3_bind_int64(st, c + TT__VF_INS_RANK, (sqlite3_int64)v.rank);
-      bind_real(st, c + TT__VF_STAR_MAX, v.star_max_error);
-      bind_real(st, c + TT__VF_STAR_RMSE, v.star_rmse);
-      sqlite3_bind_int64(st, c + TT__VF_STAR_N,
-                         (sqlite3_int64)v.star_samples);
-      if (decimated)
-        bind_real(st, c + TT__VF_IMPORTANCE, v.importance);
-    }
-    if (s == TT_OK)
-      s = batch_step(&b, st, first, n);
-  }
-  t->last_fid = sqlite3_last_insert_rowid(w->db);
-  batch_free(&b);
   return s;
 }
 
@@ -598,8 +947,11 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.progress = progress;
   w.progress_arg = progress_arg;
   const char *prefix = "", *t_srs = NULL;
-  int in_transaction = 0, rtree = 1, rtree_check = 0;
+  int in_transaction = 0, rtree = 1, rtree_check = 0, threads = 0;
+  int journal_memory = 0;
   unsigned layers = TT__LAYERS_ALL;
+  rows_pipe pipe;
+  memset(&pipe, 0, sizeof pipe);
   char *tri_name = NULL, *vtx_name = NULL;
   tt_status s = TT_OK;
 
@@ -623,12 +975,16 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       rtree_check = CPLTestBool(value);
     else if (strcasecmp(key, "LAYERS") == 0)
       s = tt__records_parse_layers(ctx, value, &layers);
+    else if (strcasecmp(key, "THREADS") == 0)
+      threads = atoi(value);
+    else if (strcasecmp(key, "JOURNAL") == 0)
+      journal_memory = strcasecmp(value, "MEMORY") == 0;
     else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0 &&
              strcasecmp(key, "STYLE") != 0 &&
              strcasecmp(key, "OVERWRITE") != 0)
       s = tt__error(ctx, TT_ERR_ARG, "unknown write option \"%s\" (known: "
-                    "NLN_PREFIX, LAYERS, LCO, OVERWRITE, ROWS, RTREE, "
-                    "RTREE_CHECK, STYLE, T_SRS)", key);
+                    "JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, ROWS, "
+                    "RTREE, RTREE_CHECK, STYLE, T_SRS, THREADS)", key);
     CPLFree(key);
     if (s != TT_OK)
       return s;
@@ -661,6 +1017,16 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     goto done;
   }
   sqlite3_extended_result_codes(w.db, 1);
+  if (sqlite3_create_module_v2(w.db, ROWS_MODULE, &rows_module, &w, NULL) !=
+      SQLITE_OK) {
+    s = db_error(&w, "cannot register the row source");
+    goto done;
+  }
+  if (journal_memory) {
+    s = exec(&w, "PRAGMA journal_mode = MEMORY", "cannot set the journal");
+    if (s != TT_OK)
+      goto done;
+  }
   s = exec(&w, "BEGIN IMMEDIATE", "cannot start a transaction");
   if (s != TT_OK)
     goto done;
@@ -680,10 +1046,17 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     s = triggers_drop(&w, &tri);
   if (s == TT_OK && do_vtx)
     s = triggers_drop(&w, &vtx);
+  if (s == TT_OK) {
+    s = pipe_begin(&pipe, &w, &rec, &tri, &vtx, nt, nv, threads,
+                   rtree ? tt__gpkg_rtree_node_cap(w.db) : 0);
+    w.pipe = &pipe;
+  }
   if (s == TT_OK && do_tri)
-    s = write_triangles(&w, &rec, &tri);
+    s = insert_rows(&w, 0, tt__triangle_fields);
   if (s == TT_OK && do_vtx)
-    s = write_vertices(&w, &rec, &vtx);
+    s = insert_rows(&w, 1, tt__vertex_fields);
+  pipe_join(&pipe, s == TT_OK); /* the boxes and extents are complete */
+  w.pipe = NULL;
   if (s == TT_OK && do_tri)
     s = triggers_restore(&w, &tri);
   if (s == TT_OK && do_vtx)
@@ -697,13 +1070,15 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.hi = 0.93;
   if (s == TT_OK && rtree && do_tri)
     s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, tri.name, tri.geom,
-                                  tri.boxes, nt, rtree_check, rtree_progress,
+                                  tri.boxes, nt, pipe.packed[0], rtree_check,
+                                  rtree_progress,
                                   &w);
   w.lo = 0.93;
   w.hi = 0.99;
   if (s == TT_OK && rtree && do_vtx)
     s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, vtx.name, vtx.geom,
-                                  vtx.boxes, nv, rtree_check, rtree_progress,
+                                  vtx.boxes, nv, pipe.packed[1], rtree_check,
+                                  rtree_progress,
                                   &w);
   if (s == TT_OK) {
     s = exec(&w, "COMMIT", "cannot commit the TIN");
@@ -713,6 +1088,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   if (s == TT_OK && progress)
     progress(1.0, "writing", progress_arg); /* done: too late to stop */
 done:
+  pipe_free(&pipe); /* before the tables the maker fills */
   if (in_transaction)
     sqlite3_exec(w.db, "ROLLBACK", NULL, NULL, NULL);
   if (w.db && sqlite3_close(w.db) != SQLITE_OK && s == TT_OK)

@@ -36,7 +36,10 @@
  * leaves the file as it was. tt__gpkg_rtree_from_boxes() (gpkg_rtree.h)
  * does the same inside a transaction of its caller's, from boxes its caller
  * knows, with rtreecheck() only on request: the row writer builds the
- * indexes of its own rows that way, and the tests run the check.
+ * indexes of its own rows that way, and the tests run the check. The
+ * packing needs no database (tt__rtree_pack()): the row writer packs on
+ * its second thread while SQLite inserts rows, and hands the packed tree
+ * over.
  *
  * Workload: one sequential scan of the table, an O(n log n) sort, one blob
  * per 51 features and one %_rowid row per feature; memory about 40 bytes per
@@ -77,9 +80,9 @@ typedef struct rt_build {
   rt_link *links; /* %_rowid rows */
   size_t nlinks;
   size_t node_size, node_cap; /* bytes per node blob, cells per node */
-  int64_t next_nodeno;
   unsigned char *blob;
   sqlite3_stmt *ins_node, *ins_parent, *ins_rowid, *ins_rowid_batch;
+  sqlite3_stmt *ins_node_batch; /* %_rowid rows of implicit rowids */
   size_t nodes_written, nodes_total;
   int gpkg_version; /* PRAGMA user_version: 10400 for 1.4.0 */
 } rt_build;
@@ -660,50 +663,76 @@ static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
   return s;
 }
 
-/* Packs b->items level by level into nodes and writes them. */
-static tt_status pack_and_write(rt_build *b)
-{
-  rt_item *level = b->items, *next = NULL, *tmp = NULL;
-  size_t n = b->nitems;
-  tt_status s = TT_OK;
-  b->links = n ? malloc(n * sizeof *b->links) : NULL;
-  if (n && !b->links)
-    return tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
-                     b->path, b->table);
-  /* Node count, for progress. */
-  b->nodes_total = 1;
-  for (size_t k = n; k > b->node_cap; k = (k + b->node_cap - 1) / b->node_cap)
-    b->nodes_total += (k + b->node_cap - 1) / b->node_cap;
+/* The packed tree: every level's items in node order, the leaves first
+ * (b->items itself, reordered), each level's groups the items of the one
+ * above; the last level fits in the root. Computing needs no database. */
+struct tt__rtree_packed {
+  rt_item *items;    /* the leaves' cells (level 0), owned */
+  size_t nitems;
+  size_t node_cap;
+  int nlevels;
+  rt_item *level[RT_MAX_DEPTH + 1]; /* level[0] == items; others owned */
+  size_t n[RT_MAX_DEPTH + 1];
+  int64_t base[RT_MAX_DEPTH + 1]; /* node of level d's group g: base[d] + g
+                                     (the upper levels get reordered) */
+  size_t nodes_total;
+};
 
-  b->next_nodeno = 2;
-  for (int depth = 0;; depth++) {
-    if (depth > RT_MAX_DEPTH) {
-      s = tt__error(b->ctx, TT_ERR_INTERNAL, "%s: table %s: index deeper "
-                    "than %d levels", b->path, b->table, RT_MAX_DEPTH);
-      goto done;
+void tt__rtree_packed_free(tt__rtree_packed *pk)
+{
+  if (!pk)
+    return;
+  for (int d = 1; d < pk->nlevels; d++)
+    free(pk->level[d]);
+  free(pk->items);
+  free(pk);
+}
+
+/* Packs items (n, taken over) into nodes of node_cap cells. */
+static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
+                            size_t n, size_t node_cap,
+                            tt__rtree_packed **out)
+{
+  *out = NULL;
+  tt__rtree_packed *pk = calloc(1, sizeof *pk);
+  rt_item *tmp = n > node_cap ? malloc(n * sizeof *tmp) : NULL;
+  if (!pk || (n > node_cap && !tmp)) {
+    free(pk);
+    free(tmp);
+    free(items);
+    return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
+                     "index", what);
+  }
+  pk->items = items;
+  pk->nitems = n;
+  pk->node_cap = node_cap;
+  pk->level[0] = items;
+  pk->n[0] = n;
+  pk->nlevels = 1;
+  pk->nodes_total = 1;
+  int64_t next_nodeno = 2;
+  tt_status s = TT_OK;
+  for (int depth = 0; n > node_cap; depth++) {
+    if (depth >= RT_MAX_DEPTH) {
+      s = tt__error(ctx, TT_ERR_INTERNAL, "%s: index deeper than %d "
+                    "levels", what, RT_MAX_DEPTH);
+      break;
     }
-    if (n <= b->node_cap) {
-      s = write_node(b, 1, level, n, depth == 0, depth);
-      goto done;
-    }
-    size_t ngroups = (n + b->node_cap - 1) / b->node_cap;
-    if (!tmp && !(tmp = malloc(n * sizeof *tmp))) {
-      s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
-                    b->path, b->table);
-      goto done;
-    }
+    rt_item *level = pk->level[depth];
+    size_t ngroups = (n + node_cap - 1) / node_cap;
     str_order(level, n, ngroups, tmp);
-    next = malloc(ngroups * sizeof *next);
+    rt_item *next = malloc(ngroups * sizeof *next);
     if (!next) {
-      s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
-                    b->path, b->table);
-      goto done;
+      s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
+                    "index", what);
+      break;
     }
+    pk->base[depth] = next_nodeno;
     for (size_t g = 0; g < ngroups; g++) {
       size_t e0 = group_start(g, n, ngroups);
       size_t e1 = group_start(g + 1, n, ngroups);
       rt_item *up = &next[g];
-      up->id = b->next_nodeno++;
+      up->id = next_nodeno++;
       memcpy(up->box, level[e0].box, sizeof up->box);
       for (size_t i = e0 + 1; i < e1; i++) {
         const float *bx = level[i].box;
@@ -712,26 +741,103 @@ static tt_status pack_and_write(rt_build *b)
         if (bx[2] < up->box[2]) up->box[2] = bx[2];
         if (bx[3] > up->box[3]) up->box[3] = bx[3];
       }
-      s = write_node(b, up->id, level + e0, e1 - e0, depth == 0, depth);
-      if (s != TT_OK)
-        goto done;
     }
-    if (level != b->items)
-      free(level);
-    level = next;
-    next = NULL;
+    pk->nodes_total += ngroups;
+    pk->level[depth + 1] = next;
+    pk->n[depth + 1] = ngroups;
+    pk->nlevels = depth + 2;
     n = ngroups;
   }
-done:
-  if (level != b->items)
-    free(level);
-  free(next);
   free(tmp);
+  if (s != TT_OK) {
+    tt__rtree_packed_free(pk);
+    return s;
+  }
+  *out = pk;
+  return TT_OK;
+}
+
+tt_status tt__rtree_pack(tt_context *ctx, const char *what,
+                         const tt__rtree_box *boxes, size_t n,
+                         size_t node_cap, tt__rtree_packed **out)
+{
+  *out = NULL;
+  if (node_cap < 2)
+    return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells",
+                     what, node_cap);
+  rt_item *items = malloc((n ? n : 1) * sizeof *items);
+  if (!items)
+    return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for %zu index "
+                     "entries", what, n);
+  for (size_t i = 0; i < n; i++) {
+    items[i].id = boxes[i].id;
+    items[i].box[0] = round_down(boxes[i].minx);
+    items[i].box[1] = round_up(boxes[i].maxx);
+    items[i].box[2] = round_down(boxes[i].miny);
+    items[i].box[3] = round_up(boxes[i].maxy);
+  }
+  return pack_items(ctx, what, items, n, node_cap, out);
+}
+
+size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
+{
+  sqlite3_stmt *st = NULL;
+  int page = 0;
+  if (sqlite3_prepare_v2(db, "PRAGMA page_size", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    page = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  /* SQLite's R*Tree: nodes of the page size less 64 bytes, at most 51
+   * cells (RTREE_MAXCELLS) */
+  size_t size = page > 64 ? (size_t)page - 64 : 4 + 2 * RT_CELL_BYTES;
+  if (size > 4 + 51 * RT_CELL_BYTES)
+    size = 4 + 51 * RT_CELL_BYTES;
+  return (size - 4) / RT_CELL_BYTES;
+}
+
+/* Writes the packed tree's nodes, parents and rowid map. */
+static tt_status write_packed(rt_build *b, const tt__rtree_packed *pk)
+{
+  tt_status s = TT_OK;
+  b->nlinks = 0;
+  b->links = pk->nitems ? malloc(pk->nitems * sizeof *b->links) : NULL;
+  if (pk->nitems && !b->links)
+    return tt__error(b->ctx, TT_ERR_NOMEM, "%s: table %s: out of memory",
+                     b->path, b->table);
+  b->nodes_total = pk->nodes_total;
+  for (int d = 0; d < pk->nlevels && s == TT_OK; d++) {
+    const rt_item *level = pk->level[d];
+    size_t n = pk->n[d];
+    if (d == pk->nlevels - 1) { /* the root */
+      s = write_node(b, 1, level, n, d == 0, d);
+      break;
+    }
+    size_t ngroups = pk->n[d + 1];
+    for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
+      size_t e0 = group_start(g, n, ngroups);
+      size_t e1 = group_start(g + 1, n, ngroups);
+      s = write_node(b, pk->base[d] + (int64_t)g, level + e0, e1 - e0,
+                     d == 0, d);
+    }
+  }
   if (s != TT_OK)
     return s;
   /* %_rowid rows in rowid order: appends to its B-tree. */
   sort_links(b->links, b->nlinks);
+  /* Rowids 1..n (the row writer's fids) into the empty %_rowid table: each
+   * is SQLite's next one, so the inserts leave it to SQLite's append path
+   * (no seek per row); others are given explicitly. */
+  const int dense = b->nlinks && b->links[0].rowid == 1 &&
+                    b->links[b->nlinks - 1].rowid == (int64_t)b->nlinks;
   size_t i = 0;
+  for (; dense && i + LINK_BATCH <= b->nlinks && s == TT_OK;
+       i += LINK_BATCH) {
+    for (int k = 0; k < LINK_BATCH; k++)
+      sqlite3_bind_int64(b->ins_node_batch, k + 1,
+                         b->links[i + (size_t)k].nodeno);
+    s = step_reset(b, b->ins_node_batch, "cannot write the index rowid map");
+  }
   for (; i + LINK_BATCH <= b->nlinks && s == TT_OK; i += LINK_BATCH) {
     for (int k = 0; k < LINK_BATCH; k++) {
       const rt_link *l = &b->links[i + (size_t)k];
@@ -965,6 +1071,16 @@ static tt_status create_schema(rt_build *b)
     }
     s = prepare_owned(b, sql, &b->ins_rowid_batch, "cannot write the R-tree");
   }
+  if (s == TT_OK) {
+    char *sql = sqlite3_mprintf("INSERT INTO \"%w_rowid\" (nodeno) VALUES "
+                                "(?)", b->rtree);
+    for (int k = 1; sql && k < LINK_BATCH; k++) {
+      char *more = sqlite3_mprintf("%s, (?)", sql);
+      sqlite3_free(sql);
+      sql = more;
+    }
+    s = prepare_owned(b, sql, &b->ins_node_batch, "cannot write the R-tree");
+  }
   return s;
 }
 
@@ -995,10 +1111,11 @@ static tt_status check_tree(rt_build *b)
   return s;
 }
 
-/* The index of b->table's column from b->items (read from the table when
- * from_table), in the open transaction of b->db. */
+/* The index of b->table's column from packed, else from b->items (read
+ * from the table when from_table), in the open transaction of b->db. */
 static tt_status build_in_transaction(rt_build *b, const char *table,
                                       const char *column, int from_table,
+                                      const tt__rtree_packed *packed,
                                       int check)
 {
   sqlite3_stmt *uv = NULL;
@@ -1014,8 +1131,28 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
     s = report(b, 0.6);
   if (s == TT_OK)
     s = create_schema(b);
+  /* Packed beforehand for nodes of another size (tt__gpkg_rtree_node_cap()
+   * guessed wrong): packed again from its leaves (the order is total, so
+   * the same tree as from the boxes). */
+  tt__rtree_packed *own = NULL;
+  if (s == TT_OK && packed && packed->node_cap != b->node_cap) {
+    b->items = malloc((packed->nitems ? packed->nitems : 1) *
+                      sizeof *b->items);
+    if (!b->items)
+      s = tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
+    else
+      memcpy(b->items, packed->items, packed->nitems * sizeof *b->items);
+    b->nitems = packed->nitems;
+    packed = NULL;
+  }
+  if (s == TT_OK && !packed) {
+    s = pack_items(b->ctx, b->path, b->items, b->nitems, b->node_cap, &own);
+    b->items = NULL; /* taken over */
+    packed = own;
+  }
   if (s == TT_OK)
-    s = pack_and_write(b);
+    s = write_packed(b, packed);
+  tt__rtree_packed_free(own);
   if (s == TT_OK)
     s = report(b, 0.9);
   if (s == TT_OK && check)
@@ -1026,7 +1163,9 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
   sqlite3_finalize(b->ins_parent);
   sqlite3_finalize(b->ins_rowid);
   sqlite3_finalize(b->ins_rowid_batch);
+  sqlite3_finalize(b->ins_node_batch);
   b->ins_node = b->ins_parent = b->ins_rowid = b->ins_rowid_batch = NULL;
+  b->ins_node_batch = NULL;
   return s;
 }
 
@@ -1036,6 +1175,7 @@ static void build_free(rt_build *b)
   sqlite3_finalize(b->ins_parent);
   sqlite3_finalize(b->ins_rowid);
   sqlite3_finalize(b->ins_rowid_batch);
+  sqlite3_finalize(b->ins_node_batch);
   free(b->table);
   free(b->column);
   free(b->fid);
@@ -1049,6 +1189,7 @@ tt_status tt__gpkg_rtree_from_boxes(tt_context *ctx, sqlite3 *db,
                                     const char *gpkg_path, const char *table,
                                     const char *geom_column,
                                     const tt__rtree_box *boxes, size_t n,
+                                    const tt__rtree_packed *packed,
                                     int check, tt_progress_fn progress,
                                     void *progress_arg)
 {
@@ -1061,15 +1202,15 @@ tt_status tt__gpkg_rtree_from_boxes(tt_context *ctx, sqlite3 *db,
   b.progress_arg = progress_arg;
   tt_status s = TT_OK;
   b.table = malloc(strlen(table) + 1);
-  b.items = malloc((n ? n : 1) * sizeof *b.items);
-  if (!b.table || !b.items) {
+  b.items = packed ? NULL : malloc((n ? n : 1) * sizeof *b.items);
+  if (!b.table || (!packed && !b.items)) {
     s = tt__error(ctx, TT_ERR_NOMEM, "%s: table %s: out of memory for %zu "
                   "index entries", gpkg_path, table, n);
     goto done;
   }
   memcpy(b.table, table, strlen(table) + 1);
   b.cap_items = n ? n : 1;
-  for (size_t i = 0; i < n; i++) {
+  for (size_t i = 0; !packed && i < n; i++) {
     rt_item *it = &b.items[b.nitems++];
     it->id = boxes[i].id;
     it->box[0] = round_down(boxes[i].minx);
@@ -1077,7 +1218,7 @@ tt_status tt__gpkg_rtree_from_boxes(tt_context *ctx, sqlite3 *db,
     it->box[2] = round_down(boxes[i].miny);
     it->box[3] = round_up(boxes[i].maxy);
   }
-  s = build_in_transaction(&b, table, geom_column, 0, check);
+  s = build_in_transaction(&b, table, geom_column, 0, packed, check);
 done:
   build_free(&b);
   return s;
@@ -1119,7 +1260,7 @@ tt_status tt_gpkg_build_rtree(tt_context *ctx, const char *gpkg_path,
   }
   in_transaction = 1;
 
-  s = build_in_transaction(&b, table, geom_column, 1, 1);
+  s = build_in_transaction(&b, table, geom_column, 1, NULL, 1);
   if (s != TT_OK)
     goto done;
   if (sqlite3_exec(b.db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) {

@@ -8,7 +8,9 @@
  * gpkg_ogr_contents, gpkg_geometry_columns, gpkg_extensions, the R-tree's
  * virtual and shadow tables, and the schema (tables, triggers, their SQL).
  * Cases: a projected CRS; T_SRS to a geographic CRS (geodesic areas); a
- * layer prefix with a renamed fid and geometry column; no spatial index.
+ * layer prefix with a renamed fid and geometry column; no spatial index;
+ * the rows made on the SQLite thread (THREADS=1) or by a second thread,
+ * for a TIN of one chunk of rows and one of several.
  * Then: PRAGMA integrity_check and rtreecheck() pass, GDAL opens the file
  * with the counts and extent; an interruption at any point rolls back to
  * empty layers in a sound file; a second write and a non-GPKG dataset are
@@ -29,7 +31,7 @@ static char tmpdir[256];
 
 /* A 60 x 45 grid in UTM 33N, 10 m pixels: a plane, a bump, a flat shelf
  * (flat triangles have no aspect: NULL) and a nodata corner. */
-static tt_tin *make_tin(tt_context *ctx)
+static tt_tin *make_tin(tt_context *ctx, double max_error)
 {
   const size_t nx = 60, ny = 45;
   float *z = malloc(nx * ny * sizeof *z);
@@ -49,7 +51,7 @@ static tt_tin *make_tin(tt_context *ctx)
   CHECK_OK(ctx, tt_grid_set_geotransform(ctx, g, gt));
   tt_refine_options opt;
   tt_refine_options_init(&opt);
-  opt.max_error = 0.2;
+  opt.max_error = max_error;
   tt_tin *tin = NULL;
   CHECK_OK(ctx, tt_refine_run(ctx, g, &opt, &tin));
   tt_grid_destroy(g);
@@ -307,7 +309,7 @@ int main(void)
     return 1;
   }
   tt_context *ctx = tt_context_create();
-  tt_tin *tin = make_tin(ctx);
+  tt_tin *tin = make_tin(ctx, 0.2);
   CHECK(tin && tt_tin_triangle_count(tin) > 500);
   OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
   OSRImportFromEPSG(srs, 32633);
@@ -326,6 +328,20 @@ int main(void)
   one_case(ctx, tin, srs, o, "x_", "id", "shape", 1);
   o = CSLAddNameValue(o, "LCO", "SPATIAL_INDEX=NO");
   one_case(ctx, tin, NULL, o, "x_", "id", "shape", 0);
+  CSLDestroy(o);
+  /* The rows made on the SQLite thread (THREADS=1) and, for a TIN of many
+   * chunks of rows, by the second thread. */
+  o = CSLSetNameValue(NULL, "THREADS", "1");
+  one_case(ctx, tin, srs, o, "", "fid", "geom", 1);
+  CSLDestroy(o);
+  tt_tin *fine = make_tin(ctx, 0.0);
+  CHECK(fine && tt_tin_triangle_count(fine) > 4000);
+  one_case(ctx, fine, srs, NULL, "", "fid", "geom", 1);
+  o = CSLSetNameValue(NULL, "THREADS", "1");
+  one_case(ctx, fine, srs, o, "", "fid", "geom", 1);
+  CSLDestroy(o);
+  o = CSLSetNameValue(NULL, "JOURNAL", "MEMORY");
+  one_case(ctx, fine, srs, o, "", "fid", "geom", 1);
   CSLDestroy(o);
 
   /* Interrupted at the first, a middle and a late progress call: rolled
@@ -352,6 +368,27 @@ int main(void)
                  6);
     sqlite3_close(db);
   }
+
+  /* The fine TIN stopped in its rows while the second thread makes them
+   * (and with THREADS=1, and with the journal in memory): the same
+   * roll-back. */
+  stopper fcount = {0, 0};
+  CHECK_OK(ctx, write_gpkg(ctx, fine, path, srs, NULL, 1, 1, &fcount));
+  for (int k = 0; k < 3; k++) {
+    char **to = k == 1   ? CSLSetNameValue(NULL, "THREADS", "1")
+                : k == 2 ? CSLSetNameValue(NULL, "JOURNAL", "MEMORY")
+                         : NULL;
+    stopper st = {0, fcount.calls / 3};
+    CHECK_INT_EQ(write_gpkg(ctx, fine, path, srs, to, 1, 1, &st),
+                 TT_ERR_INTERRUPTED);
+    CSLDestroy(to);
+    sqlite3 *db = db_open(path);
+    text_is(db, "PRAGMA integrity_check", "ok");
+    CHECK_INT_EQ(scalar(db, "SELECT count(*) FROM triangles"), 0);
+    CHECK_INT_EQ(scalar(db, "SELECT count(*) FROM vertices"), 0);
+    sqlite3_close(db);
+  }
+  tt_tin_destroy(fine);
 
   /* Rows already there: refused, nothing changed. */
   CHECK_OK(ctx, write_gpkg(ctx, tin, path, srs, NULL, 1, 1, NULL));
