@@ -235,9 +235,8 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
   status = make_borders(ctx, window, wc0, wr0, t, opt->max_error, &b);
   if (status != TT_OK)
     goto done;
-  tt_refine_options o = *opt;
-  o.progress = NULL;
-  status = tt__refine_tile(ctx, g, &o, &b, &tin);
+  /* (opt->progress sees the tile's own fraction: a stop flag's poll) */
+  status = tt__refine_tile(ctx, g, opt, &b, &tin);
   if (status == TT_ERR_DATA) {
     /* no triangle in this tile: its valid samples are uncovered */
     tt_context_clear_error(ctx);
