@@ -247,6 +247,8 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
     tt_tin_destroy(T->pieces[k]);
     T->pieces[k] = NULL;
   }
+  if (T->failed < T->ntiles && T->fail_status == TT_ERR_INTERRUPTED)
+    return tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
   if (T->failed < T->ntiles) {
     tt_tile t;
     tile_of(T, T->failed, &t);
