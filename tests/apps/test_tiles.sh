@@ -76,6 +76,32 @@ bounded() {
   check "$name: no sample overlapped" [ "$(jget eval.json overlapped)" = 0 ]
 }
 
+# --- the topology checker catches what it looks for ---
+python3 - <<'PY'
+import sqlite3
+def tin(name, verts, tris):
+    db = sqlite3.connect(name)
+    db.execute("create table vertices (vertex_id, col, row)")
+    db.execute("create table triangles (v0, v1, v2)")
+    db.executemany("insert into vertices values (?,?,?)",
+                   [(i, c, r) for i, (c, r) in enumerate(verts)])
+    db.executemany("insert into triangles values (?,?,?)", tris)
+    db.commit()
+# a vertex inside the diagonal of another triangle
+tin("tj.gpkg", [(0, 0), (2, 0), (2, 2), (0, 2), (1, 1)],
+    [(0, 1, 2), (0, 4, 3), (4, 2, 3)])
+# a 2 x 2 cell square with a cell missing: a hole inside the raster
+tin("crack.gpkg", [(0, 0), (1, 0), (2, 0), (0, 1), (1, 1), (2, 1), (0, 2),
+                   (1, 2)],
+    [(0, 1, 4), (0, 4, 3), (1, 2, 5), (1, 5, 4), (3, 4, 7), (3, 7, 6)])
+PY
+python3 "$TOPO" tj.gpkg >topo.json
+check "checker: a T-junction is caught ($(cat topo.json))" \
+  [ "$(jget topo.json t_junctions)" = 1 ]
+python3 "$TOPO" crack.gpkg >topo.json
+check "checker: a hole inside the raster is a crack ($(cat topo.json))" \
+  [ "$(jget topo.json cracks)" -ge 1 ]
+
 # --- a fractal: tiled against untiled, threads, tile sizes ---
 run generate diamond_square in/ds.tif -size 513 -seed 4 -q
 run simplify -q -json -max_error 6 in/ds.tif out/u.gpkg
