@@ -725,6 +725,10 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *merger,
 tt_status tt_tin_merger_finish(tt_context *ctx, tt_tin_merger *merger,
                                tt_tin **out_tin);
 void tt_tin_merger_destroy(tt_tin_merger *merger);
+/* The vertices and triangles merged so far, and the bytes the merger holds
+ * for them (what finishing hands over, and its own tables). */
+void tt_tin_merger_size(const tt_tin_merger *merger, size_t *out_vertices,
+                        size_t *out_triangles, size_t *out_bytes);
 
 /* ---------------------------------------------------------------------------
  * Evaluation of any triangle soup (ours or another tool's) against a grid.

@@ -77,6 +77,18 @@ void tt_tin_merger_destroy(tt_tin_merger *m)
   free(m);
 }
 
+void tt_tin_merger_size(const tt_tin_merger *m, size_t *out_vertices,
+                        size_t *out_triangles, size_t *out_bytes)
+{
+  /* per vertex: col, row, height (8 as doubles), insertion error, and the
+   * star statistics finishing adds (24); per triangle: corners, max, rmse,
+   * count and squared errors; the outline table */
+  *out_vertices = m->t->nv;
+  *out_triangles = m->t->nt;
+  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 24) +
+               m->tcap * (12 + 8 + 4 + 8 + 8) + m->hcap * 12;
+}
+
 static size_t hslot(const tt_tin_merger *m, int64_t key)
 {
   uint64_t h = (uint64_t)key * 0x9E3779B97F4A7C15u;

@@ -173,10 +173,15 @@ run simplify -q -max_error 4 -tile_size 100 -threads 1 in/n.tif out/n1.gpkg
 check "nodata: threads 1 vs 2, the same layers" [ "$(dump out/n1.gpkg)" = "$(dump out/n100.gpkg)" ]
 
 # --- the memory limit chooses tiles ---
-run simplify -q -json -max_error 6 -max_memory 1500K in/ds.tif out/m.gpkg
+run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg
 check "-max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "-max_memory 1500K: tiled automatically" [ "$(jget out.txt tiling.automatic)" = True ]
-bounded "-max_memory 1500K" in/ds.tif out/m.gpkg 6
+bounded "-max_memory 1500K" in/ds.tif out/m.gpkg 30
+# the merged TIN counts against the limit too
+run simplify -q -max_error 0.5 -tile_size 64 -max_memory 2M in/ds.tif out/mm.gpkg
+check "-max_memory 2M, a dense tiled TIN: exit 1 ($rc)" [ "$rc" -eq 1 ]
+check "-max_memory 2M: says while merging ($(cat err.txt))" grep -q "while merging tile .* more than the memory limit of 2 MiB" err.txt
+check "-max_memory 2M: nothing written" [ ! -e out/mm.gpkg ]
 
 # --- refusals: usage errors, nothing written ---
 refused() {
