@@ -187,7 +187,7 @@ static const char help_simplify[] =
     "  -tile_size N      read and refine the DEM in tiles of N cells (>= 16)\n"
     "                    sharing their borders, one tile a thread, merged\n"
     "                    into one conforming TIN within -max_error; chosen\n"
-    "                    by itself when the heights do not fit -max_memory.\n"
+    "                    by itself when the DEM does not fit -max_memory.\n"
     "                    Not with -max_points, -max_triangles, -percent or\n"
     "                    -method decimate (docs/scale.md)\n"
     "\n"

@@ -220,9 +220,11 @@ planned:;
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
     goto done;
   }
-  /* Tiles (tiled.c, docs/scale.md): asked for, or because the heights
-   * alone (4 bytes a sample at least, 4.25 with the scans' bounds) would
-   * not fit the memory limit; insertion to a max error only. */
+  /* Tiles (tiled.c, docs/scale.md): asked for, or because the run (about
+   * 8 bytes a sample) would not fit -max_memory; insertion to a max error
+   * only. Without -max_memory a DEM past the system's limit is refused as
+   * before (the message names the limit): tiling a huge raster for
+   * minutes is for the user to ask. */
   size_t tile = s->tile_size;
   size_t dem_w = (size_t)GDALGetRasterBandXSize(band);
   size_t dem_h = (size_t)GDALGetRasterBandYSize(band);
@@ -233,7 +235,7 @@ planned:;
                               : (int)sysconf(_SC_NPROCESSORS_ONLN);
   if (nth < 1)
     nth = 1;
-  if (!tile && !s->decimate && no_budget && mem_limit != SIZE_MAX &&
+  if (!tile && !s->decimate && no_budget && s->max_memory &&
       dem_w > 2 && dem_h > 2 && cells > mem_limit / 8) {
     /* about 8 bytes a sample untiled: tiles of 1024 (a multiple of the
      * block size), halved until those in flight hold half the limit;
