@@ -29,6 +29,7 @@
  * in tiles of 1024 this took the peak from 344 to 130 MB.
  */
 #include "app.h"
+#include "gdal/georef.h" /* tt__georef_is_web_mercator */
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
@@ -433,7 +434,7 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     memcpy(gt, unit_gt, sizeof gt);
   }
   OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
-  if (srs && OSRIsGeographic(srs))
+  if (srs && (OSRIsGeographic(srs) || tt__georef_is_web_mercator(srs)))
     tt__app_warn(&r->msg, "%s: tiles are measured in the affine frame of "
                  "the whole raster, not in a conformal frame per sample "
                  "(docs/scale.md)", path);
