@@ -75,6 +75,8 @@ int tt__app_parse_double(const char *w, double *out);
  * NUM_TOO_LARGE beyond 2^64 - 1 (resp. SIZE_MAX). */
 int tt__app_parse_u64(const char *w, uint64_t *out);
 int tt__app_parse_size(const char *w, size_t *out);
+/* -tile_size: a whole number of cells from 16 to 65536; 0 otherwise. */
+int tt__app_parse_tile_size(const char *w, size_t *out);
 /* Bytes, or a number with K, M, G or T (powers of 1024, then B or iB). */
 int tt__app_parse_mem_size(const char *w, size_t *out);
 /* One of the words GDAL's CPLTestBool reads as a boolean. */
@@ -248,6 +250,10 @@ typedef struct app_simplify_report {
   int default_error;            /* max_error came from the 0.5% rule */
   tt_tin_summary sum;
   double t_read, t_simplify, t_write, t_total;
+  /* tiled runs (tiled.c): the tiles, their size, the threads, whether
+   * the memory limit chose tiling, the bytes the tiles in flight hold */
+  size_t tiles, tile_size, tile_bytes;
+  int tile_threads, auto_tiled;
 } app_simplify_report;
 
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p);
@@ -304,6 +310,20 @@ tt_status tt__app_study_tins_add(app_run *r, app_study_tins *w,
                                  const tt_tin *tin);
 tt_status tt__app_study_tins_commit(app_run *r, app_study_tins *w);
 void tt__app_study_tins_free(app_study_tins *w);
+/* tiled.c: the DEM of band read and refined in tiles of tile_size cells
+ * on the workers, merged into *out_tin; ro's max_error < 0 asks for the
+ * default bound (then set, and *default_error). The failure is recorded. */
+tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
+                                 const char *path, size_t tile_size,
+                                 tt_refine_options *ro, int *default_error,
+                                 tt_tin **out_tin, tt_raster_info **out_info,
+                                 size_t *out_valid, double *out_zmin,
+                                 double *out_zmax, size_t *out_tiles,
+                                 int *out_threads);
+/* What tiles of N cells of a width x height DEM on threads workers hold
+ * at most (tiled.c). */
+size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
+                          int threads);
 /* eval.c, for optimize too: opens r->s->tin's kind of dataset (a vector
  * dataset, explaining in one line why not), and picks its triangle layer
  * (-layer, else "triangles" or "*_triangles", else the first polygon

@@ -55,6 +55,7 @@ static const tt__app_opt_def opt_defs[] = {
     {"-hole", O_HOLE, 1, FOR_S},
     {"-threads", O_THREADS, 1, FOR_S | FOR_T},
     {"-max_memory", O_MAX_MEMORY, 1, FOR_S | FOR_E | FOR_R},
+    {"-tile_size", O_TILE_SIZE, 1, FOR_S},
     {"-terrain", O_TERRAIN, 1, FOR_T},
     {"-criteria", O_CRITERIA, 1, FOR_T},
     {"-methods", O_METHODS, 1, FOR_T},

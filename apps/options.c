@@ -537,6 +537,10 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
               v, TT_APP_MAX_THREADS);
       o->s.threads = (int)z;
       break;
+    case O_TILE_SIZE: /* values.c */
+      if (!tt__app_parse_tile_size(v, &o->s.tile_size))
+        USAGE("%s: -tile_size must be 16 to 65536 cells, got '%s'", cmdname, v);
+      break;
     case O_MAX_MEMORY: {
       k = tt__app_parse_mem_size(v, &z);
       if (k == NUM_BAD || (k == NUM_OK && z < 1))

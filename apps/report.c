@@ -262,6 +262,15 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
                            : tt__app_nonempty_or_null(p->info->crs_name));
   tt__json_str(&j, "frame", p->info->frame_name);
   tt__json_size(&j, "warnings", r->msg.warnings);
+  if (p->tiles) {
+    tt__json_open(&j, "tiling");
+    tt__json_size(&j, "tiles", p->tiles);
+    tt__json_size(&j, "tile_size", p->tile_size);
+    tt__json_size(&j, "threads", (size_t)p->tile_threads);
+    tt__json_bool(&j, "automatic", p->auto_tiled);
+    tt__json_size(&j, "memory_in_flight", p->tile_bytes);
+    tt__json_close(&j);
+  }
   tt__json_open(&j, "seconds");
   tt__json_num(&j, "read", p->t_read);
   tt__json_num(&j, "simplify", p->t_simplify);
@@ -322,6 +331,14 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
           r->s->t_srs ? ", written in " : "", r->s->t_srs ? r->s->t_srs : "",
           in->frame_name, zu, p->sum.seconds_mesh, p->t_write,
           p->driver ? p->driver : "?", p->t_total);
+  if (p->tiles) {
+    fprintf(r->out, "%s: %zu tiles of %zu cells on %d thread%s%s; the tiles "
+            "in flight hold at most about %.0f MiB\n", r->s->output, p->tiles,
+            p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
+            p->auto_tiled ? " (chosen because the heights do not fit the "
+                            "memory limit)" : "",
+            (double)p->tile_bytes / 1048576.0);
+  }
   if (p->dopt)
     fprintf(r->out,
             "%s: decimated from %zu vertices: %zu removed in %zu %s\n",

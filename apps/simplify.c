@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 /* -work_srs and -t_srs: a CRS GDAL understands (usage error otherwise);
  * -work_srs must also be projected. */
@@ -219,6 +220,85 @@ planned:;
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
     goto done;
   }
+  /* Tiles (tiled.c, docs/scale.md): asked for, or because the run (about
+   * 8 bytes a sample) would not fit -max_memory; insertion to a max error
+   * only. Without -max_memory a DEM past the system's limit is refused as
+   * before (the message names the limit): tiling a huge raster for
+   * minutes is for the user to ask. */
+  size_t tile = s->tile_size;
+  size_t dem_w = (size_t)GDALGetRasterBandXSize(band);
+  size_t dem_h = (size_t)GDALGetRasterBandYSize(band);
+  size_t cells = dem_w * dem_h;
+  int no_budget = !s->max_points && !s->max_triangles && !(s->percent > 0);
+  int threads_asked = tt__app_threads(r);
+  int nth = threads_asked > 0 ? threads_asked
+                              : (int)sysconf(_SC_NPROCESSORS_ONLN);
+  if (nth < 1)
+    nth = 1;
+  if (!tile && !s->decimate && no_budget && s->max_memory &&
+      dem_w > 2 && dem_h > 2 && cells > mem_limit / 8) {
+    /* about 8 bytes a sample untiled: tiles of 1024 (a multiple of the
+     * block size), halved until those in flight hold half the limit;
+     * when even tiles of 64 do not fit, the untiled run says why */
+    int bw = 0, bh = 0;
+    GDALGetBlockSize(band, &bw, &bh);
+    size_t want = 1024;
+    if (bw > 1 && bw <= 4096 && bw == bh)
+      want = ((1024 + (size_t)bw - 1) / (size_t)bw) * (size_t)bw;
+    while (want > 64 &&
+           tt__app_tile_bytes(want, dem_w, dem_h, nth) > mem_limit / 2)
+      want /= 2;
+    if (tt__app_tile_bytes(want, dem_w, dem_h, nth) <= mem_limit / 2) {
+      tile = want;
+      rep.auto_tiled = 1;
+    }
+  }
+  if (tile) {
+    if (s->decimate || !no_budget) {
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -tile_size refines each tile to -max_error "
+                        "(or the default bound) by insertion: %s cannot be "
+                        "split over tiles", s->decimate ? "-method decimate"
+                        : s->max_points ? "-max_points"
+                        : s->max_triangles ? "-max_triangles" : "-percent");
+      goto done;
+    }
+    tt_refine_options_init(&ro);
+    ro.max_error = s->max_error;
+    ro.criterion = s->criterion;
+    ro.optimize = s->optimize;
+    ro.anneal = s->anneal;
+    ro.repair = s->repair;
+    ro.threads = threads_asked;
+    rep.ropt = &ro;
+    rep.tile_size = tile;
+    rep.tile_bytes = tt__app_tile_bytes(tile, dem_w, dem_h, nth);
+    if (s->max_memory && rep.tile_bytes > s->max_memory) {
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: tiles of %zu cells on %d threads hold up to "
+                        "about %zu MiB, more than -max_memory (%zu MiB): use "
+                        "a smaller -tile_size or fewer -threads", tile, nth,
+                        rep.tile_bytes >> 20, s->max_memory >> 20);
+      goto done;
+    }
+    tt__app_phase_set(&r->prog, 0.0, 0.85);
+    double t_tiles = tt__app_now();
+    st = tt__app_simplify_tiled(r, band, s->input, tile, &ro,
+                                &rep.default_error, &tin, &info, &valid,
+                                &rep.zmin, &rep.zmax, &rep.tiles,
+                                &rep.tile_threads);
+    if (st != TT_OK)
+      goto done;
+    GDALClose(src);
+    src = NULL;
+    rep.info = info;
+    rep.driver = drvname;
+    rep.cells = cells;
+    rep.valid = valid;
+    rep.t_simplify = tt__app_now() - t_tiles;
+    tt_tin_get_summary(tin, &rep.sum);
+    goto write;
+  }
   st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
                         &info, &valid);
   if (st != TT_OK)
@@ -242,7 +322,7 @@ planned:;
   ro.optimize = s->optimize;
   ro.anneal = s->anneal;
   ro.repair = s->repair;
-  ro.threads = tt__app_threads(r);
+  ro.threads = threads_asked;
   ro.max_memory = mem_limit == SIZE_MAX ? 0 : mem_limit;
   if (s->max_error < 0 && !s->max_points && !s->max_triangles &&
       !(s->percent > 0)) {
@@ -275,7 +355,7 @@ planned:;
     dopt.threads = ro.threads;
     rep.dopt = &dopt;
   }
-  double t = tt__app_now();
+  double t_run = tt__app_now();
   st = s->decimate ? tt_decimate_run(r->ctx, grid, &dopt, &tin)
                    : tt_refine_run(r->ctx, grid, &ro, &tin);
   if (st == TT_ERR_NOMEM && ro.max_memory &&
@@ -293,14 +373,15 @@ planned:;
     tt__app_fail_tt(r, st, st == TT_ERR_INTERRUPTED ? s->output : s->input);
     goto done;
   }
-  rep.t_simplify = tt__app_now() - t;
+  rep.t_simplify = tt__app_now() - t_run;
   tt_tin_get_summary(tin, &rep.sum);
   /* The TIN keeps what it needs; the grid can go before the write. */
   tt_grid_destroy(grid);
   grid = NULL;
 
   /* Write: 85 - 100%. */
-  t = tt__app_now();
+write:;
+  double t = tt__app_now();
   tt__app_phase_set(&r->prog, 0.85, 0.99);
   if (!tt__app_continue(r, 0.85)) {
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
@@ -437,12 +518,23 @@ planned:;
        0},
       {"refused", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.refused_bound, 0},
   };
+  /* A tiled run adds its tiling (docs/scale.md). */
+  const tt_run_field tfields[] = {
+      {"tile_size", TT_FIELD_INTEGER, NULL, (int64_t)rep.tile_size, 0},
+      {"tiles", TT_FIELD_INTEGER, NULL, (int64_t)rep.tiles, 0},
+      {"tile_auto", TT_FIELD_INTEGER, NULL, rep.auto_tiled, 0},
+  };
   enum { NF = sizeof fields / sizeof fields[0],
-         ND = sizeof dfields / sizeof dfields[0] };
-  tt_run_field allf[NF + ND];
+         ND = sizeof dfields / sizeof dfields[0],
+         NT = sizeof tfields / sizeof tfields[0] };
+  tt_run_field allf[NF + ND + NT];
   memcpy(allf, fields, sizeof fields);
   memcpy(allf + NF, dfields, sizeof dfields);
   size_t nallf = NF + (s->decimate ? ND : 0);
+  if (rep.tiles) {
+    memcpy(allf + nallf, tfields, sizeof tfields);
+    nallf += NT;
+  }
   /* GPKG: the layers through OGR, then their rows and R-trees straight
    * into the closed file by tt_gpkg_write_rows() (OGR writes a feature at a
    * time and GDAL 3.6 inserts R-tree entries one by one). */

@@ -133,6 +133,9 @@ typedef struct tt_app_settings {
                                 given (GDAL_NUM_THREADS, else automatic) */
   size_t max_memory;         /* -max_memory in bytes (simplify, eval); 0:
                                 not given (the system's limit) */
+  size_t tile_size;          /* -tile_size N (simplify): tiles of N cells
+                                (docs/scale.md); 0: untiled unless the
+                                heights do not fit the memory limit */
 
   /* eval, optimize (which reads the TIN from tin and writes output) */
   const char *layer;         /* -layer; NULL: the triangles layer */

@@ -677,6 +677,60 @@ tt_status tt_decimate_run(tt_context *ctx, const tt_grid *grid,
                           const tt_decimate_options *opt, tt_tin **out_tin);
 
 /* ---------------------------------------------------------------------------
+ * Tiled runs (src/tile/): a DEM cut into tiles that share their border rows
+ * and columns, each refined alone to the same max error, the pieces joined
+ * into one conforming TIN. A tile's borders are first simplified as 1-D
+ * polylines of samples to the bound, by both neighbours alike, then kept
+ * as the tile's outline: no crack, no T-junction, every valid sample
+ * within the bound.
+ * ------------------------------------------------------------------------- */
+typedef struct tt_tile {
+  /* the tile's samples in the DEM: columns col0..col1, rows row0..row1
+   * (inclusive, at least two each way); neighbouring tiles share the
+   * column or row where they meet */
+  size_t col0, row0, col1, row1;
+  size_t dem_width, dem_height;
+} tt_tile;
+
+/* The window of the DEM a tile is run on: its samples and one column or
+ * row more beyond each side it shares with another tile. */
+void tt_tile_window(const tt_tile *tile, size_t *out_col, size_t *out_row,
+                    size_t *out_width, size_t *out_height);
+
+/* Refines one tile: window holds the samples tt_tile_window names (its
+ * geotransform that of its first sample, the DEM's ground frame, no
+ * ground points); opt must have a max error and no point, triangle or
+ * percentage budget (any criterion, repair and final optimisation). The
+ * piece is a TIN in the DEM's pixel coordinates, with no triangle when the
+ * tile has none; its valid_samples counts the tile's samples less the
+ * column and row it shares on its right and bottom sides, so the pieces'
+ * counts add up to the DEM's. The caller owns *out_piece and frees it with
+ * tt_tin_destroy(). */
+tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
+                      const tt_tile *tile, const tt_refine_options *opt,
+                      tt_tin **out_piece);
+
+/* Joins pieces into one TIN: create with the DEM's size and geotransform,
+ * add every tile's piece in a fixed order (the result depends on the
+ * order, never on which tile finished first), finish. Shared border
+ * vertices get one id (that of the first piece holding them); the errors
+ * and counts are the whole TIN's. The caller owns *out_merger and frees it
+ * with tt_tin_merger_destroy(), and owns *out_tin (tt_tin_destroy()). */
+typedef struct tt_tin_merger tt_tin_merger;
+tt_status tt_tin_merger_create(tt_context *ctx, size_t dem_width,
+                               size_t dem_height, const double gt[6],
+                               tt_tin_merger **out_merger);
+tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *merger,
+                            const tt_tin *piece, const tt_tile *tile);
+tt_status tt_tin_merger_finish(tt_context *ctx, tt_tin_merger *merger,
+                               tt_tin **out_tin);
+void tt_tin_merger_destroy(tt_tin_merger *merger);
+/* The vertices and triangles merged so far, and the bytes the merger holds
+ * for them (what finishing hands over, and its own tables). */
+void tt_tin_merger_size(const tt_tin_merger *merger, size_t *out_vertices,
+                        size_t *out_triangles, size_t *out_bytes);
+
+/* ---------------------------------------------------------------------------
  * Evaluation of any triangle soup (ours or another tool's) against a grid.
  * ------------------------------------------------------------------------- */
 typedef struct tt_eval_result {

@@ -68,6 +68,8 @@ typedef struct read_options {
   size_t max_memory;     /* bytes */
   int max_memory_default; /* not given: the system's limit */
   const char *max_memory_source; /* which limit that is (tt_memory_limit) */
+  int has_window;        /* WINDOW=col,row,width,height: a tile's window */
+  size_t win[4];
 } read_options;
 
 static char *dup_str(const char *s)
@@ -162,6 +164,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->srcnodata_neg = 0;
   opt->srcnodata_mag = 0;
   opt->max_memory = 0;
+  opt->has_window = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
     char *key = NULL;
@@ -213,10 +216,22 @@ static tt_status parse_options(tt_context *ctx, char **options,
         opt->max_memory = v >= (double)SIZE_MAX ? SIZE_MAX : (size_t)v;
         has_max_memory = 1;
       }
+    } else if (strcasecmp(key, "WINDOW") == 0) {
+      unsigned long long w[4];
+      char tail;
+      if (sscanf(value, "%llu,%llu,%llu,%llu%c", &w[0], &w[1], &w[2], &w[3],
+                 &tail) != 4 || w[2] < 2 || w[3] < 2)
+        s = tt__error(ctx, TT_ERR_ARG, "WINDOW must be col,row,width,height "
+                      "(width and height 2 or more), got \"%s\"", value);
+      else {
+        for (int k = 0; k < 4; k++)
+          opt->win[k] = (size_t)w[k];
+        opt->has_window = 1;
+      }
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
-                    "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS)",
-                    key);
+                    "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS, "
+                    "WINDOW)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -648,7 +663,19 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                   "2 x 2 are needed to make a triangle", path, xsize, ysize);
     goto done;
   }
-  const size_t nx = (size_t)xsize, ny = (size_t)ysize;
+  /* A window (a tile): its samples only; the ground frame is still the
+   * whole raster's, so that every tile measures alike. */
+  const size_t wx = opt.has_window ? opt.win[0] : 0;
+  const size_t wy = opt.has_window ? opt.win[1] : 0;
+  if (opt.has_window && (opt.win[0] + opt.win[2] > (size_t)xsize ||
+                         opt.win[1] + opt.win[3] > (size_t)ysize)) {
+    s = tt__error(ctx, TT_ERR_ARG, "%s: window of %zu x %zu at column %zu, "
+                  "row %zu passes the raster's %d x %d", path, opt.win[2],
+                  opt.win[3], opt.win[0], opt.win[1], xsize, ysize);
+    goto done;
+  }
+  const size_t nx = opt.has_window ? opt.win[2] : (size_t)xsize;
+  const size_t ny = opt.has_window ? opt.win[3] : (size_t)ysize;
   if (nx > SIZE_MAX / sizeof(float) / ny) {
     s = tt__error(ctx, TT_ERR_LIMIT, "%s: %zu x %zu heights do not fit in "
                   "this machine's address space", path, nx, ny);
@@ -739,7 +766,11 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
     s = with_path(ctx, s, path);
     goto done;
   }
-  s = tt_grid_set_geotransform(ctx, grid, gt);
+  double wgt[6];
+  memcpy(wgt, gt, sizeof wgt);
+  wgt[0] += (double)wx * gt[1] + (double)wy * gt[2];
+  wgt[3] += (double)wx * gt[4] + (double)wy * gt[5];
+  s = tt_grid_set_geotransform(ctx, grid, wgt);
   if (s != TT_OK) {
     s = with_path(ctx, s, path);
     goto done;
@@ -748,8 +779,9 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   double frame_scale_error = NAN;
   if (srs || opt.work_srs) {
     double frame[4];
-    s = tt__georef_ground_frame(ctx, srs, opt.work_srs, gt, nx, ny, frame,
-                                frame_name, sizeof frame_name);
+    s = tt__georef_ground_frame(ctx, srs, opt.work_srs, gt, (size_t)xsize,
+                                (size_t)ysize, frame, frame_name,
+                                sizeof frame_name);
     if (s == TT_ERR_DATA) {
       /* A CRS that says geographic over coordinates that cannot be (a
        * mislabelled projected grid) or a grid centred on a pole: measure
@@ -771,7 +803,10 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                                                            : SIZE_MAX;
       int conformal = srs && (OSRIsGeographic(srs) ||
                               tt__georef_is_web_mercator(srs));
-      if (s == TT_OK && conformal && with_points > opt.max_memory) {
+      if (s == TT_OK && conformal && opt.has_window) {
+        /* tiles keep the whole raster's affine frame (the caller says
+         * so once) */
+      } else if (s == TT_OK && conformal && with_points > opt.max_memory) {
         char need_s[32], max_s[32];
         tt__warn(ctx, "%s: the heights and ground points of %zu x %zu "
                  "samples would need %s, more than %s (%s): keeping the "
@@ -851,7 +886,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   const int identity = scale == 1.0 && offset == 0.0 && conv.z_factor == 1.0;
 
   /* Hold GDAL's block cache to a few blocks unless the user chose a size. */
-  if (!CPLGetConfigOption("GDAL_CACHEMAX", NULL)) {
+  if (!opt.has_window && !CPLGetConfigOption("GDAL_CACHEMAX", NULL)) {
     GIntBig block_bytes = (GIntBig)bw * bh *
                           (GIntBig)(GDALGetDataTypeSizeBytes(dtype) + 1);
     GIntBig want = TT_READ_CACHE_BYTES;
@@ -890,12 +925,14 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
         dst = grid->z + r0 * nx + c0;
       }
       CPLErrorReset();
-      CPLErr err = GDALRasterIOEx(band, GF_Read, (int)c0, (int)r0,
+      CPLErr err = GDALRasterIOEx(band, GF_Read, (int)(c0 + wx),
+                                  (int)(r0 + wy),
                                   (int)ncols, (int)nrows, dst, (int)ncols,
                                   (int)nrows, type, (GSpacing)es,
                                   (GSpacing)(nx * es), NULL);
       if (err == CE_None && mask_band)
-        err = GDALRasterIOEx(mask_band, GF_Read, (int)c0, (int)r0,
+        err = GDALRasterIOEx(mask_band, GF_Read, (int)(c0 + wx),
+                             (int)(r0 + wy),
                              (int)ncols, (int)nrows, mask + c0, (int)ncols,
                              (int)nrows, GDT_Byte, 1, (GSpacing)nx, NULL);
       if (err != CE_None) {
@@ -921,7 +958,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
       goto done;
     }
   }
-  if (valid == 0) {
+  if (valid == 0 && !opt.has_window) {
     s = tt__error(ctx, TT_ERR_DATA, "%s: all nodata: band %d has no valid "
                   "sample", path, GDALGetBandNumber(band));
     goto done;

@@ -26,6 +26,14 @@
 #include "base/internal.h"
 
 #define TT__EDGE_CONSTRAINED 1u
+/* Tile runs (src/tile/): a boundary edge on a side shared with another
+ * tile. Its samples are within the bound by the border's simplification,
+ * so refinement never takes one as a candidate (no vertex the neighbour
+ * does not have); BORDER_SHARED when the neighbour's TIN has the same edge,
+ * whose samples then belong to one of the two by the top-left rule
+ * (raster_scan.h), as if the edge were an inner one. */
+#define TT__EDGE_BORDER 2u
+#define TT__EDGE_BORDER_SHARED 4u
 
 /* A vertex: one 16-byte record, so a triangle's corners cost three cache
  * lines, not twelve. Its height is read through tt__mesh_z(): the record's

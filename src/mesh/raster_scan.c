@@ -49,10 +49,12 @@ void tt__scan_tri_from_mesh(const tt__mesh *m, int32_t t, tt__scan_tri *st)
   /* Interior on the positive side of every normalised edge function; the
    * half-edge with direction (dx, dy) owns its samples iff dy > 0 or
    * (dy == 0 and dx > 0): of an edge's two half-edges exactly one passes.
-   * Direction is taken in pixel space, the same for both triangles. */
+   * Direction is taken in pixel space, the same for both triangles. A
+   * tile's boundary edge that the neighbouring tile's TIN shares follows
+   * the same rule (its twin is in the other tile). */
   for (int k = 0; k < 3; k++) {
     int32_t e = 3 * t + k;
-    if (m->twin[e] < 0) {
+    if (m->twin[e] < 0 && !(m->eflag[e] & TT__EDGE_BORDER_SHARED)) {
       st->own[k] = true;
       continue;
     }

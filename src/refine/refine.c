@@ -28,6 +28,14 @@
  * pass over the samples; with a final pass, a reported step applies it to
  * a copy of the mesh. Without a recorder none of that runs.
  *
+ * Tiles (tt__refine_tile, src/tile/): the border vertices of the tile's
+ * shared sides are inserted into the starting triangulation's boundary
+ * edges, the boundary edges on those sides are flagged TT__EDGE_BORDER,
+ * and the candidate scans skip their samples (the border's 1-D
+ * simplification bounds them), so no vertex is ever added on a shared side
+ * and the neighbouring tile meets the same edges. Boundary edges are never
+ * flipped, so neither repairs nor optimisers move a border edge.
+ *
  * Memory per triangle slot: mesh 27 bytes, candidate 8 + error 8, heap 4
  * (+ 16 per triangle above max_error; + 24 for the sums when recording);
  * per sample, while inserting: the scans' tile bounds, 0.25 bytes.
@@ -44,6 +52,7 @@
 #include "optimize/swap.h"
 #include "tin/curve.h"
 #include "tin/tin.h"
+#include "tile/tile.h"
 
 #include <float.h>
 #include <stdio.h>
@@ -80,6 +89,7 @@ typedef struct refine {
   size_t max_points, max_tris;
   double max_error;    /* < 0: none */
   size_t forced;       /* vertices the nodata outline required */
+  const tt__tile_borders *borders; /* tile runs, else NULL */
   const char *phase;   /* for messages: "inserting", ... */
   /* progress */
   double e0, frac;
@@ -253,6 +263,10 @@ static bool add_jobs(refine *r, int32_t t, size_t *njobs, int64_t *samples)
 {
   tt__scan_tri st;
   tt__scan_tri_from_mesh(&r->m, t, &st);
+  if (r->borders)
+    for (int k = 0; k < 3; k++)
+      if (r->m.eflag[3 * t + k] & TT__EDGE_BORDER)
+        st.own[k] = false; /* bounded by the border's simplification */
   int64_t xlo, xhi, ylo, yhi;
   tt__scan_tri_bbox(&st, &xlo, &xhi, &ylo, &yhi);
   int64_t area2 = (st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) -
@@ -480,6 +494,75 @@ static bool domain_vertex(void *arg, int32_t col, int32_t row,
   return add_vertex(arg, col, row, NAN, out_v);
 }
 
+/* The side of the tile grid that both ends of a boundary edge lie on
+ * (tile.h's numbering), or -1. */
+static int side_of(const tt_grid *g, const tt__mesh_vertex *a,
+                   const tt__mesh_vertex *b)
+{
+  if (a->c == 0 && b->c == 0)
+    return 0;
+  if (a->r == 0 && b->r == 0)
+    return 1;
+  if ((size_t)a->c == g->nx - 1 && (size_t)b->c == g->nx - 1)
+    return 2;
+  if ((size_t)a->r == g->ny - 1 && (size_t)b->r == g->ny - 1)
+    return 3;
+  return -1;
+}
+
+/* Tile runs: the border vertices split the boundary edges they lie on
+ * (those outside this tile's TIN are the neighbour's alone), then every
+ * boundary edge on a shared side is flagged. */
+static tt_status start_borders(refine *r)
+{
+  const tt__tile_borders *b = r->borders;
+  tt__mesh *m = &r->m;
+  int32_t last = -1;
+  for (size_t i = 0; i < b->n; i++) {
+    int32_t on;
+    int32_t t = tt__mesh_locate(m, last, b->col[i], b->row[i], &on);
+    if (t < 0)
+      continue;
+    last = t;
+    if (on <= -2)
+      continue; /* a vertex already: a corner of the start or the outline */
+    if (on < 0 || m->twin[on] >= 0)
+      return tt__error(r->ctx, TT_ERR_INTERNAL, "border vertex (%d, %d) "
+                       "is not on the tile's boundary", (int)b->col[i],
+                       (int)b->row[i]);
+    int32_t v, opp[4];
+    if (!add_vertex(r, b->col[i], b->row[i], NAN, &v) ||
+        !tt__mesh_split_edge(m, on, v, opp) ||
+        tt__swap_repair(m, r->crit, &r->env, opp, 4, &r->stack) < 0)
+      return oom(r);
+    last = m->v[v].edge >= 0 ? m->v[v].edge / 3 : -1;
+    r->forced++;
+  }
+  for (size_t t = 0; t < m->nslots; t++) {
+    if (!tt__mesh_live(m, (int32_t)t))
+      continue;
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * (int32_t)t + k;
+      if (m->twin[e] >= 0)
+        continue;
+      const tt__mesh_vertex *va = &m->v[m->hv[e]];
+      const tt__mesh_vertex *vb = &m->v[m->hv[tt__next(e)]];
+      int s = side_of(r->g, va, vb);
+      if (s < 0 || !(b->shared & (1u << s)))
+        continue;
+      int32_t p = (s == 0 || s == 2) ? va->r : va->c;
+      int32_t q = (s == 0 || s == 2) ? vb->r : vb->c;
+      int32_t lo = p < q ? p : q, len = p < q ? q - p : p - q;
+      /* a longer edge spans a run between breaks: covered on both sides
+       * (border.c); a unit one is when the neighbour's cell is */
+      m->eflag[e] |= TT__EDGE_BORDER;
+      if (len >= 2 || b->cover[s][lo])
+        m->eflag[e] |= TT__EDGE_BORDER_SHARED;
+    }
+  }
+  return TT_OK;
+}
+
 static tt_status start(refine *r, size_t valid)
 {
   const tt_grid *g = r->g;
@@ -498,6 +581,8 @@ static tt_status start(refine *r, size_t valid)
       return s;
     r->forced = r->m.nv - before;
   }
+  if (r->borders && (s = start_borders(r)) != TT_OK)
+    return s;
   /* every slot written so far is logged: scan them all */
   if (!drain(r))
     return oom(r);
@@ -691,8 +776,9 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
   return TT_OK;
 }
 
-tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
-                        const tt_refine_options *opt, tt_tin **out_tin)
+static tt_status run(tt_context *ctx, const tt_grid *grid,
+                     const tt_refine_options *opt,
+                     const tt__tile_borders *borders, tt_tin **out_tin)
 {
   double t_start = tt__now();
   if (!grid || !opt || !out_tin)
@@ -715,6 +801,7 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   r.ctx = ctx;
   r.g = grid;
   r.opt = opt;
+  r.borders = borders;
   r.crit = tt__criterion_get(opt->criterion);
   r.repair = tt_repair_resolve(opt->repair, opt->criterion);
   tt__metric metric;
@@ -905,7 +992,10 @@ tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
   if (status != TT_OK)
     goto done;
   double t_meshed = tt__now();
-  status = tt__tin_build(ctx, &r.m, grid, r.ins_err, r.pool, out_tin);
+  status = borders ? tt__tin_build_homes(ctx, &r.m, grid, r.ins_err, r.pool,
+                                         out_tin)
+                   : tt__tin_build(ctx, &r.m, grid, r.ins_err, r.pool,
+                                   out_tin);
   r.ins_err = NULL; /* taken over by the tin, or freed on failure */
   if (status != TT_OK)
     goto done;
@@ -935,4 +1025,19 @@ done:
   tt__mesh_free(&r.m);
   tt__curve_free(&r.curve);
   return status;
+}
+
+tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
+                        const tt_refine_options *opt, tt_tin **out_tin)
+{
+  return run(ctx, grid, opt, NULL, out_tin);
+}
+
+tt_status tt__refine_tile(tt_context *ctx, const tt_grid *grid,
+                          const tt_refine_options *opt,
+                          const tt__tile_borders *borders, tt_tin **out_tin)
+{
+  if (!borders)
+    return tt__error(ctx, TT_ERR_ARG, "borders must not be NULL");
+  return run(ctx, grid, opt, borders, out_tin);
 }

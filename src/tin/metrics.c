@@ -137,8 +137,9 @@ static size_t top_row(const tt__mesh *m, int32_t t)
   return (size_t)(r < r2 ? r : r2);
 }
 
-tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
-                        double *ins_err, tt__pool *pool, tt_tin **out_tin)
+static tt_status build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
+                       double *ins_err, tt__pool *pool, bool homes,
+                       tt_tin **out_tin)
 {
   tt_status status;
   tt_tin *tin = NULL;
@@ -179,6 +180,10 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     return status;
   }
   tin->v_ins_err = ins_err;
+  if (homes && !(tin->v_home = malloc((nv ? nv : 1) * sizeof *tin->v_home))) {
+    status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
+    goto done;
+  }
   slot_to_tri = malloc((m->nslots ? m->nslots : 1) * sizeof *slot_to_tri);
   t_sq = malloc((m->nlive ? m->nlive : 1) * sizeof *t_sq);
   if (!slot_to_tri || !t_sq) {
@@ -298,6 +303,8 @@ tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
       continue;
     int32_t t = slot_to_tri[e / 3];
     tin->t_n[t]++;
+    if (tin->v_home)
+      tin->v_home[vmap[v]] = t;
     count++;
     if (max_index < 0) {
       max_index = (int64_t)m->v[v].r * (int64_t)g->nx + m->v[v].c;
@@ -352,4 +359,17 @@ done:
   free(vmap);
   tt_tin_destroy(tin);
   return status;
+}
+
+tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
+                        double *ins_err, tt__pool *pool, tt_tin **out_tin)
+{
+  return build(ctx, m, g, ins_err, pool, false, out_tin);
+}
+
+tt_status tt__tin_build_homes(tt_context *ctx, const tt__mesh *m,
+                              const tt_grid *g, double *ins_err,
+                              tt__pool *pool, tt_tin **out_tin)
+{
+  return build(ctx, m, g, ins_err, pool, true, out_tin);
 }

@@ -24,6 +24,7 @@ void tt_tin_destroy(tt_tin *tin)
   free(tin->v_star_rmse);
   free(tin->v_star_n);
   free(tin->v_importance);
+  free(tin->v_home);
   free(tin->tv);
   free(tin->t_max);
   free(tin->t_rmse);

@@ -23,6 +23,9 @@ struct tt_tin {
   double *v_star_max, *v_star_rmse;
   uint64_t *v_star_n;
   double *v_importance;  /* decimation (NULL after refinement: NaN) */
+  int32_t *v_home;       /* tile runs (tt__tin_build_homes): the triangle
+                            whose t_n counts the vertex's own sample; NULL
+                            otherwise */
   /* triangles */
   int32_t *tv;           /* 3 per triangle */
   double *t_max;
@@ -54,5 +57,10 @@ static inline double tt__tin_z(const tt_tin *tin, size_t v)
 TT_HIDDEN tt_status tt__tin_build(tt_context *ctx, const tt__mesh *m,
                                   const tt_grid *g, double *ins_err,
                                   tt__pool *pool, tt_tin **out_tin);
+
+/* tt__tin_build that also fills v_home (for merging tiles, src/tile/). */
+TT_HIDDEN tt_status tt__tin_build_homes(tt_context *ctx, const tt__mesh *m,
+                                        const tt_grid *g, double *ins_err,
+                                        tt__pool *pool, tt_tin **out_tin);
 
 #endif /* TT_TIN_H */

@@ -1,0 +1,53 @@
+/*
+ * tile.h -- what the tiling stage's files share (internal): the border
+ * vertices of a tile, made by border.c and forced into refinement by
+ * refine.c (tt__refine_tile), and the flags that mark tile borders in the
+ * mesh.
+ *
+ * A tile's sides are numbered 0 left (column 0 of the tile), 1 top (row
+ * 0), 2 right (last column), 3 bottom (last row). A side is shared when a
+ * neighbouring tile lies beyond it (not at the DEM's edge).
+ */
+#ifndef TT_TILE_H
+#define TT_TILE_H
+
+#include "base/internal.h"
+
+/* What refinement needs to know of a tile's borders, in the tile grid's
+ * pixel coordinates. */
+typedef struct tt__tile_borders {
+  unsigned shared;      /* bit s: side s is shared */
+  /* the border vertices (valid samples on shared sides that both tiles
+   * keep), in a fixed order: side by side, along each side */
+  int32_t *col, *row;
+  size_t n, cap;
+  /* per shared side, per unit segment k (samples k and k+1 along it): 1
+   * when the neighbour's grid cell on that segment has three valid corners
+   * or more, so the neighbour's TIN covers the segment too */
+  uint8_t *cover[4];
+} tt__tile_borders;
+
+TT_HIDDEN void tt__tile_borders_free(tt__tile_borders *b);
+
+/* Simplifies one border line of n samples z (NaN: nodata) to max_error:
+ * sets keep[i] for the samples that become vertices. brk[i] marks the
+ * samples that must end a polyline (the line's ends and every sample next
+ * to nodata on the line or on the lines either side of it); each run
+ * between two consecutive breaks is then simplified top-down (the worst
+ * sample under the chord first, the first of equal ones), until every
+ * sample of the run is within max_error of its chord, less a margin of a
+ * few ulps of the heights (border.c). False when out of memory. */
+TT_HIDDEN bool tt__border_simplify(const double *z, const uint8_t *brk,
+                                   size_t n, double max_error,
+                                   uint8_t *keep);
+
+/* Greedy insertion of a tile grid with its border vertices forced and its
+ * shared sides kept (refine.c): the options' stop conditions must be a
+ * max error only. The TIN records, per vertex, the triangle its own sample
+ * is counted in (tt_tin.v_home), for the merge. */
+TT_HIDDEN tt_status tt__refine_tile(tt_context *ctx, const tt_grid *grid,
+                                    const tt_refine_options *opt,
+                                    const tt__tile_borders *borders,
+                                    tt_tin **out_tin);
+
+#endif /* TT_TILE_H */
