@@ -181,6 +181,10 @@ run generate fault big.tif -size 700 -seed 3 -q
 check "file size limit: exit 1 ($rc: $(cat err.txt))" [ "$rc" -eq 1 ]
 check "file size limit: names the output" grep -q "full.ply" err.txt
 check "file size limit: nothing left" bash -c '[ ! -e full.ply ] && [ -z "$(ls -A | grep "^\.tt")" ]'
+# Job control on: a background job of a non-interactive shell starts with
+# SIGINT ignored (and keeps it ignored, as it should), so without it the
+# signal would never reach terratin.
+set -m
 for ext in 2dm xml nc; do
   of=()
   [ "$ext" = nc ] && of=(-of UGRID)
@@ -198,6 +202,7 @@ for ext in 2dm xml nc; do
   fi
   check "SIGINT .$ext: no temporary file" no_temp
 done
+set +m
 
 # --- QGIS ------------------------------------------------------------------
 if /usr/bin/python3 -c 'import qgis' >/dev/null 2>&1; then
