@@ -636,12 +636,16 @@ plain_rows(const tt_grid *g, const tt__scan_tri *st, const plane *p,
   rows_init(st, (int64_t)g->nx, ylo, &r);
   if (yhi < r.ymax)
     r.ymax = yhi;
-  scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
+  bool pf = tt__scan_prefetches(g);
+  if (pf)
+    scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
   for (int64_t y = r.ymin; y <= r.ymax; y++) {
     int64_t xl, xr;
     if (!row_span_step(&r, &xl, &xr))
       continue;
-    prefetch_row(TT_ZARR(g) + (size_t)y * g->nx, g->nx, y, r.ymax, xl, xr);
+    if (pf)
+      prefetch_row(TT_ZARR(g) + (size_t)y * g->nx, g->nx, y, r.ymax, xl,
+                   xr);
     double m = segment_max(g, st, p, kn, y, xl, xr, kernel);
     if (m > b->err)
       best_set(b, m, y, xl, xr, -1);
@@ -744,12 +748,14 @@ static void stats_run(const tt_grid *g, const tt__scan_tri *st,
   kern_init(&kn, p.gx);
   row_acc acc = {0, 0, 0, 0};
   int64_t max_y = -1, max_xl = 0, max_xr = -1;
+  bool pf = tt__scan_prefetches(g);
   for (int64_t y = r.ymin; y <= r.ymax; y++) {
     int64_t xl, xr;
     if (!row_span_step(&r, &xl, &xr))
       continue;
     const TT_Z *zr = TT_ZARR(g) + (size_t)y * g->nx;
-    prefetch_row(zr, g->nx, y, r.ymax, xl, xr);
+    if (pf)
+      prefetch_row(zr, g->nx, y, r.ymax, xl, xr);
     double rowbase = p.z0 + p.gy * (double)(y - p.y0);
     double before = acc.max;
     size_t nbefore = acc.count;

@@ -83,6 +83,8 @@ typedef struct refine {
   size_t inscap;
   tt__edge_stack stack;
   tt__pool *pool;      /* NULL: single-threaded */
+  bool prefetch;       /* the grid is larger than the caches: rows are
+                          asked for ahead (tt__scan_prefetches) */
   tt__scan_tiles tiles; /* error bounds per tile (empty: none) */
   struct scan_job_t *jobs; /* scans of this round */
   size_t jobcap;
@@ -334,9 +336,10 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
     } else if (!add_jobs(r, t, &njobs, &samples))
       return false;
   }
-  if (samples < PARALLEL_MIN_SAMPLES) {
-    /* small triangles, cold in cache: ask for all their rows first, so
-     * the misses overlap instead of queueing one row at a time */
+  if (samples < PARALLEL_MIN_SAMPLES && r->prefetch) {
+    /* small triangles, cold in cache (on a grid larger than the caches):
+     * ask for all their rows first, so the misses overlap instead of
+     * queueing one row at a time */
     for (size_t i = 0; i < njobs; i++)
       if (!tt__scan_tiled(&r->jobs[i].st))
         tt__scan_prefetch(r->g, &r->jobs[i].st, INT64_MIN, INT64_MAX);
@@ -645,7 +648,7 @@ static void prefetch_next(const refine *r, int32_t *ahead)
         __builtin_prefetch(&m->hv[f - f % 3]);
     }
     int64_t s = r->cand[t];
-    if (s >= 0) {
+    if (s >= 0 && r->prefetch) {
       /* the rows around the sample it will insert */
       int64_t nx = (int64_t)r->g->nx, ny = (int64_t)r->g->ny;
       int64_t col = s % nx, row = s / nx;
@@ -830,6 +833,7 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
    * triangles are scanned row by row, with the same results */
   if (!opt->step) /* recording scans every sample: no use for them */
     (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
+  r.prefetch = tt__scan_prefetches(grid);
   r.max_error = opt->max_error;
   r.rec = opt->step != NULL;
   r.heap_floor = r.rec ? -1.0 : opt->max_error;
