@@ -64,33 +64,70 @@ static void mark(uint8_t *dirs, const tt_grid *g, int64_t x, int64_t y,
       (uint8_t)(1u << dir_of(-dx, -dy));
 }
 
-/* The outline as unit-step directions per sample. */
-static void outline(const tt_grid *g, uint8_t *dirs)
+/* Validity of row y into v[0 .. nx - 1]: all 0 past the last row. */
+static void valid_row(const tt_grid *g, int64_t y, uint8_t *v)
+{
+  size_t nx = g->nx;
+  if ((size_t)y >= g->ny) {
+    memset(v, 0, nx);
+    return;
+  }
+  for (size_t x = 0; x < nx; x++)
+    v[x] = !isnan(tt__grid_z(g, (size_t)y * nx + x));
+}
+
+/* cell_valid() of a row of cells from the validity of its two rows of
+ * samples (va above, vb below): 0 in the last column, and all 0 when the
+ * row is not a row of cells (in false). */
+static void cell_row(const uint8_t *va, const uint8_t *vb, size_t nx,
+                     bool in, uint8_t *c)
+{
+  for (size_t x = 0; x + 1 < nx; x++)
+    c[x] = in ? (uint8_t)(va[x] + va[x + 1] + vb[x] + vb[x + 1]) : 0;
+  c[nx - 1] = 0;
+}
+
+/* The outline as unit-step directions per sample. One pass down the
+ * rows with the validity of two sample rows and the corner counts of two
+ * cell rows at hand (scratch: 4 nx bytes), where asking ok_at() and
+ * cell_valid() per sample read each height about nine times. */
+static void outline(const tt_grid *g, uint8_t *dirs, uint8_t *scratch)
 {
   int64_t nx = (int64_t)g->nx, ny = (int64_t)g->ny;
-  for (int64_t y = 0; y < ny; y++)
+  uint8_t *va = scratch, *vb = scratch + nx;   /* rows y, y + 1 */
+  uint8_t *cprev = scratch + 2 * nx, *ccur = scratch + 3 * nx; /* cells
+                                                   of rows y - 1, y */
+  memset(cprev, 0, (size_t)nx);
+  valid_row(g, 0, va);
+  for (int64_t y = 0; y < ny; y++) {
+    valid_row(g, y + 1, vb);
+    cell_row(va, vb, (size_t)nx, y + 1 < ny, ccur);
     for (int64_t x = 0; x < nx; x++) {
-      if (!ok_at(g, x, y))
+      if (!va[x])
         continue;
       /* axis edge to the right: cells above (x, y-1) and below (x, y) */
-      if (ok_at(g, x + 1, y) &&
-          (cell_valid(g, x, y - 1) >= 3) != (cell_valid(g, x, y) >= 3))
+      if (x + 1 < nx && va[x + 1] && (cprev[x] >= 3) != (ccur[x] >= 3))
         mark(dirs, g, x, y, 1, 0);
       /* axis edge downwards: cells left (x-1, y) and right (x, y) */
-      if (ok_at(g, x, y + 1) &&
-          (cell_valid(g, x - 1, y) >= 3) != (cell_valid(g, x, y) >= 3))
+      if (vb[x] && ((x > 0 ? ccur[x - 1] : 0) >= 3) != (ccur[x] >= 3))
         mark(dirs, g, x, y, 0, 1);
     }
-  /* the long side of every three-valid cell */
-  for (int64_t y = 0; y + 1 < ny; y++)
+    /* the long side of every three-valid cell */
     for (int64_t x = 0; x + 1 < nx; x++) {
-      if (cell_valid(g, x, y) != 3)
+      if (ccur[x] != 3)
         continue;
-      if (!ok_at(g, x, y) || !ok_at(g, x + 1, y + 1))
+      if (!va[x] || !vb[x + 1])
         mark(dirs, g, x + 1, y, -1, 1); /* (x+1,y) - (x,y+1) */
       else
         mark(dirs, g, x, y, 1, 1);      /* (x,y) - (x+1,y+1) */
     }
+    uint8_t *t = va;
+    va = vb;
+    vb = t;
+    t = cprev;
+    cprev = ccur;
+    ccur = t;
+  }
 }
 
 /* A sample in the middle of a straight run: two opposite directions. */
@@ -325,15 +362,15 @@ tt_status tt__domain_build(tt_context *ctx, tt__mesh *m, const tt_grid *g,
 {
   tt_status status = TT_OK;
   size_t n = g->nx * g->ny;
-  uint8_t *dirs = calloc(n, 1);
+  uint8_t *dirs = calloc(n + 4 * g->nx, 1); /* + outline()'s scratch */
   vmap vm = {NULL, NULL, 0};
   queue q = {NULL, 0, 0, 0};
   if (!dirs) {
     status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the nodata "
-                       "outline (%zu bytes)", n);
+                       "outline (%zu bytes)", n + 4 * g->nx);
     goto done;
   }
-  outline(g, dirs);
+  outline(g, dirs, dirs + n);
 
   /* 1. the outline's corners become vertices (walk-located insertion,
    *    Delaunay-repaired, in row order so walks stay short) */

@@ -168,8 +168,15 @@ static void rows_init(const tt__scan_tri *st, int64_t nx, int64_t from,
       int32_t a = (int32_t)(-s * (st->y[k1] - st->y[k]));
       r->ney[k] = s * (st->x[k1] - st->x[k]);
       r->nb[k] = r->ney[k] * (r->ymin - st->y[k]) + a * (bx0 - st->x[k]);
-      r->noff[k][0] = _mm_set_epi32(3 * a, 2 * a, a, 0);
-      r->noff[k][1] = _mm_set_epi32(7 * a, 6 * a, 5 * a, 4 * a);
+      /* lanes {0, a, 2a, 3a} as a in lanes 1, 3 plus 2a in lanes 2, 3,
+       * and 4a more for lanes 4..7: a few vector operations where eight
+       * products put into lanes one by one cost twice as many */
+      __m128i va = _mm_set1_epi32(a);
+      __m128i lo = _mm_add_epi32(
+          _mm_and_si128(va, _mm_set_epi32(-1, 0, -1, 0)),
+          _mm_and_si128(_mm_add_epi32(va, va), _mm_set_epi32(-1, -1, 0, 0)));
+      r->noff[k][0] = lo;
+      r->noff[k][1] = _mm_add_epi32(lo, _mm_slli_epi32(va, 2));
       r->nthr[k] = _mm_set1_epi32(st->own[k] ? -1 : 0);
     }
     int32_t w = (int32_t)(bx1 - bx0);

@@ -636,12 +636,18 @@ plain_rows(const tt_grid *g, const tt__scan_tri *st, const plane *p,
   rows_init(st, (int64_t)g->nx, ylo, &r);
   if (yhi < r.ymax)
     r.ymax = yhi;
-  scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
+  /* the last row prefetch_row asks rows ahead for: none (-1, rows are
+   * >= 0) on a grid in cache, so the loop tests nothing more per row */
+  int64_t pf_ymax = -1;
+  if (tt__scan_prefetches(g)) {
+    pf_ymax = r.ymax;
+    scan_prefetch(g, st, r.ymin, r.ymin + PREFETCH_AHEAD - 1);
+  }
   for (int64_t y = r.ymin; y <= r.ymax; y++) {
     int64_t xl, xr;
     if (!row_span_step(&r, &xl, &xr))
       continue;
-    prefetch_row(TT_ZARR(g) + (size_t)y * g->nx, g->nx, y, r.ymax, xl, xr);
+    prefetch_row(TT_ZARR(g) + (size_t)y * g->nx, g->nx, y, pf_ymax, xl, xr);
     double m = segment_max(g, st, p, kn, y, xl, xr, kernel);
     if (m > b->err)
       best_set(b, m, y, xl, xr, -1);
@@ -744,12 +750,13 @@ static void stats_run(const tt_grid *g, const tt__scan_tri *st,
   kern_init(&kn, p.gx);
   row_acc acc = {0, 0, 0, 0};
   int64_t max_y = -1, max_xl = 0, max_xr = -1;
+  int64_t pf_ymax = tt__scan_prefetches(g) ? r.ymax : -1; /* as above */
   for (int64_t y = r.ymin; y <= r.ymax; y++) {
     int64_t xl, xr;
     if (!row_span_step(&r, &xl, &xr))
       continue;
     const TT_Z *zr = TT_ZARR(g) + (size_t)y * g->nx;
-    prefetch_row(zr, g->nx, y, r.ymax, xl, xr);
+    prefetch_row(zr, g->nx, y, pf_ymax, xl, xr);
     double rowbase = p.z0 + p.gy * (double)(y - p.y0);
     double before = acc.max;
     size_t nbefore = acc.count;

@@ -83,6 +83,8 @@ typedef struct refine {
   size_t inscap;
   tt__edge_stack stack;
   tt__pool *pool;      /* NULL: single-threaded */
+  bool prefetch;       /* the grid is larger than the caches: rows are
+                          asked for ahead (tt__scan_prefetches) */
   tt__scan_tiles tiles; /* error bounds per tile (empty: none) */
   struct scan_job_t *jobs; /* scans of this round */
   size_t jobcap;
@@ -310,6 +312,19 @@ static int cmp_i32(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
+/* A live slot's scan result into its candidate and the heap. */
+static bool set_candidate(refine *r, int32_t t, double err, int64_t index)
+{
+  r->cand[t] = index;
+  r->cerr[t] = err;
+  /* (max_error < 0, none: every candidate enters) */
+  if (index < 0 || err <= r->heap_floor) {
+    tt__heap_remove(&r->heap, t);
+    return true;
+  }
+  return tt__heap_set(&r->heap, t, err);
+}
+
 /* Rescans the given triangle slots, each once: dead slots leave the heap,
  * live ones are scanned (in parallel when there is a pool) and then, in
  * slot order, enter the heap or leave it. */
@@ -321,6 +336,30 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
     sort_slots(slots, n);
   else
     qsort(slots, n, sizeof(int32_t), cmp_i32);
+  if (!r->pool && !r->rec && !r->prefetch) {
+    /* one thread on a grid in cache: each triangle scanned where it is
+     * met, without the jobs (their hand-over, the copies, the second
+     * pass); the heap's order is total (ties by slot), so the order of
+     * its updates changes nothing */
+    for (size_t i = 0; i < n; i++) {
+      int32_t t = slots[i];
+      if (i > 0 && t == slots[i - 1])
+        continue;
+      if (!tt__mesh_live(&r->m, t)) {
+        tt__heap_remove(&r->heap, t);
+        continue;
+      }
+      tt__scan_tri st;
+      tt__scan_tri_from_mesh(&r->m, t, &st);
+      double err;
+      int64_t index;
+      tt__scan_candidate_rows(r->g, &r->tiles, &st, INT64_MIN, INT64_MAX,
+                              &err, &index);
+      if (!set_candidate(r, t, err, index))
+        return false;
+    }
+    return true;
+  }
   size_t njobs = 0;
   int64_t samples = 0;
   for (size_t i = 0; i < n; i++) {
@@ -334,9 +373,10 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
     } else if (!add_jobs(r, t, &njobs, &samples))
       return false;
   }
-  if (samples < PARALLEL_MIN_SAMPLES) {
-    /* small triangles, cold in cache: ask for all their rows first, so
-     * the misses overlap instead of queueing one row at a time */
+  if (samples < PARALLEL_MIN_SAMPLES && r->prefetch) {
+    /* small triangles, cold in cache (on a grid larger than the caches):
+     * ask for all their rows first, so the misses overlap instead of
+     * queueing one row at a time */
     for (size_t i = 0; i < njobs; i++)
       if (!tt__scan_tiled(&r->jobs[i].st))
         tt__scan_prefetch(r->g, &r->jobs[i].st, INT64_MIN, INT64_MAX);
@@ -355,8 +395,6 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
         err = r->jobs[i].err;
         index = r->jobs[i].index;
       }
-    r->cand[t] = index;
-    r->cerr[t] = err;
     if (r->rec) {
       /* the bands' sums, in row order */
       tt__scan_stats ss = r->jobs[first].ss;
@@ -367,10 +405,7 @@ static bool rescan(refine *r, int32_t *slots, size_t n)
       }
       tt__curve_set(&r->curve, t, &ss);
     }
-    /* (max_error < 0, none: every candidate enters) */
-    if (index < 0 || err <= r->heap_floor)
-      tt__heap_remove(&r->heap, t);
-    else if (!tt__heap_set(&r->heap, t, err))
+    if (!set_candidate(r, t, err, index))
       return false;
   }
   return true;
@@ -645,7 +680,7 @@ static void prefetch_next(const refine *r, int32_t *ahead)
         __builtin_prefetch(&m->hv[f - f % 3]);
     }
     int64_t s = r->cand[t];
-    if (s >= 0) {
+    if (s >= 0 && r->prefetch) {
       /* the rows around the sample it will insert */
       int64_t nx = (int64_t)r->g->nx, ny = (int64_t)r->g->ny;
       int64_t col = s % nx, row = s / nx;
@@ -830,6 +865,7 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
    * triangles are scanned row by row, with the same results */
   if (!opt->step) /* recording scans every sample: no use for them */
     (void)tt__scan_tiles_build(grid, r.pool, &r.tiles);
+  r.prefetch = tt__scan_prefetches(grid);
   r.max_error = opt->max_error;
   r.rec = opt->step != NULL;
   r.heap_floor = r.rec ? -1.0 : opt->max_error;
