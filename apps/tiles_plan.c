@@ -38,6 +38,20 @@
 
 #define PLAN_HEAD "{\n  \"terratin_tiles_plan\": 1,"
 
+#define PLAN_HELP                                                           \
+  "A tiled run (simplify -tile_size) as independent jobs, for a cluster:\n" \
+  "  plan   checks simplify's options (-tile_size and -max_error needed),\n"\
+  "         writes PLAN.json (the DEM's path, size and time, the tiles and\n"\
+  "         their windows, the options) and makes the folder PLAN.json.tiles\n"\
+  "  run    refines tile TILE_ID (0 .. tiles-1) alone, on one thread, and\n" \
+  "         writes its piece PLAN.json.tiles/TILE_ID.ttp\n"                 \
+  "  merge  joins every piece into OUT as simplify writes it: the same\n"   \
+  "         triangles and vertices as simplify -tile_size with the plan's\n"\
+  "         options; a missing or stale piece, or a changed DEM, is refused\n"\
+  "Each job can run on any machine that sees the same paths; the borders\n" \
+  "of neighbouring tiles are computed alike by both. tools/tt_dask.py runs\n"\
+  "the jobs on Dask distributed; docs/scale.md shows Slurm too.\n"
+
 static uint64_t fnv1a(const char *p, size_t n)
 {
   uint64_t h = UINT64_C(14695981039346656037);
@@ -416,7 +430,7 @@ void tt_app_tiles(char **argv, tt_progress_fn fn, void *arg,
   else if (sub && strcmp(sub, "merge") == 0)
     tt__tiles_merge(argv + 1, fn, arg, res);
   else if (sub && (strcmp(sub, "-h") == 0 || strcmp(sub, "--help") == 0)) {
-    printf("%s\n", PLAN_USAGE);
+    printf("%s\n\n%s", PLAN_USAGE, PLAN_HELP);
     tt__app_result_ok(res);
   } else
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
