@@ -116,5 +116,20 @@ run tiles merge n.json nm.gpkg -q
 run simplify -q -max_error 5 -tile_size 100 nd.tif ns.gpkg
 check "nodata: merge = simplify -tile_size" [ -s nm.gpkg ] && [ "$(dump nm.gpkg)" = "$(dump ns.gpkg)" ]
 
+# an interrupted tile leaves no piece and no temporary file
+"$T" generate diamond_square big.tif -size 2049 -seed 2 -q || exit 1
+run tiles plan big.tif b.json -max_error 0 -tile_size 2048
+"$T" tiles run b.json 0 >/dev/null 2>err.txt &
+pid=$!
+sleep 1
+kill -TERM $pid
+wait $pid
+rc=$?
+if [ $rc -eq 0 ]; then
+  echo "note: the tile finished before the interruption; not checked"
+else
+  check "interrupted run: nothing in the pieces' folder" [ -z "$(ls -A b.json.tiles)" ]
+fi
+
 echo "$passed passed, $failed failed"
 [ $failed -eq 0 ]
