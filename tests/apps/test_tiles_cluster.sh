@@ -108,7 +108,11 @@ run tiles
 check "tiles alone: usage" [ $rc -eq 2 ]
 
 # nodata across the tile borders
-gdal_calc.py -A ds.tif --outfile=nd.tif --calc="where((A>200)*(A<260),-9999,A)" --NoDataValue=-9999 --type=Float32 --quiet >/dev/null 2>&1 || fail "gdal_calc"
+gdal_calc.py -A ds.tif --outfile=nd.tif --calc="where((A>20)*(A<40),-9999,A)" --NoDataValue=-9999 --type=Float32 --quiet >/dev/null 2>&1 || fail "gdal_calc"
+vp=$(gdalinfo -stats nd.tif 2>/dev/null | sed -n 's/.*STATISTICS_VALID_PERCENT=//p')
+rm -f nd.tif.aux.xml
+echo "nodata DEM: $vp % valid"
+check "nodata: some samples are nodata" python3 -c 'import sys; sys.exit(0 if 20 < float(sys.argv[1]) < 99 else 1)' "$vp"
 run tiles plan nd.tif n.json -max_error 5 -tile_size 100
 : >err.txt
 check "nodata: every tile" all_tiles n.json "$(sed -n 's/^  "tiles": \([0-9]*\),/\1/p' n.json)"
