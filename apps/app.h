@@ -320,6 +320,18 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
                                  size_t *out_valid, double *out_zmin,
                                  double *out_zmax, size_t *out_tiles,
                                  int *out_threads);
+/* `terratin tiles run` and `tiles merge` (tiles_*.c) run simplify's tiled
+ * path with this set: save, the one tile given is computed and handed to
+ * it (nothing else written); load, every tile's piece is read by it
+ * instead of computed (then merged and written as simplify does). */
+typedef struct tt_app_tiles_hook {
+  size_t tile;
+  tt_status (*save)(void *arg, app_run *r, size_t k, const tt_tin *piece);
+  tt_status (*load)(void *arg, tt_context *ctx, size_t k, tt_tin **piece,
+                    char *msg, size_t msgsize);
+  void *arg;
+} tt_app_tiles_hook;
+extern tt_app_tiles_hook tt__app_tiles_hook;
 /* What tiles of N cells of a width x height DEM on threads workers hold
  * at most (tiled.c). */
 size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,

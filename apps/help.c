@@ -19,6 +19,7 @@ static const char help_top[] =
     "  optimize   re-triangulate a TIN's vertices for a criterion\n"
     "  study      compare criteria, methods and optimisers over terrains\n"
     "  rasterize  a TIN's surface on a DEM's grid, as a raster\n"
+    "  tiles      plan, run and merge a tiled run as separate jobs (clusters)\n"
     "\n"
     "Options of every command:\n"
     "  --help              this help, or the help of COMMAND\n"

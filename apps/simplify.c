@@ -287,7 +287,7 @@ planned:;
                                 &rep.default_error, &tin, &info, &valid,
                                 &rep.zmin, &rep.zmax, &rep.tiles,
                                 &rep.tile_threads);
-    if (st != TT_OK)
+    if (st != TT_OK || !tin) /* no TIN: one tile of `tiles run`, saved */
       goto done;
     GDALClose(src);
     src = NULL;

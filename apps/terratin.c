@@ -133,7 +133,9 @@ int main(int argc, char **argv)
   int have_dog = pipe(wake_pipe) == 0 &&
                  pthread_create(&dog, NULL, watchdog, NULL) == 0;
   install_handlers();
-  if (tt_app_options_new(argv + 1, &opts, &res) == TT_OK) {
+  if (argv[1] && strcmp(argv[1], "tiles") == 0) {
+    tt_app_tiles(argv + 2, tt_app_term_progress_fn, &bar, &res);
+  } else if (tt_app_options_new(argv + 1, &opts, &res) == TT_OK) {
     const tt_app_settings *s = tt_app_options_settings(opts);
     const char *out = s->error_raster ? s->error_raster : s->output;
     if (out && strlen(out) < sizeof stop_msg - 64)

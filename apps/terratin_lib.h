@@ -198,6 +198,11 @@ int tt_app_options_wants_progress_bar(const tt_app_options *options);
  * and one-line message in out_result. */
 tt_status tt_app_run(const tt_app_options *options, tt_app_result *out_result);
 
+/* `terratin tiles plan|run|merge ...` (apps/tiles_plan.c, docs/scale.md):
+ * argv holds the words after "tiles"; fn is polled for an interruption. */
+void tt_app_tiles(char **argv, tt_progress_fn fn, void *arg,
+                  tt_app_result *out_result);
+
 /* The help text of a command (TT_APP_NONE: the top level). */
 const char *tt_app_help(tt_app_command topic);
 

@@ -119,13 +119,28 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k)
                                                 w, h));
   tt_grid *win = NULL;
   tt_raster_info *info = NULL;
-  pthread_mutex_lock(&T->gdal);
-  tt_status st = tt_gdal_read_grid(ctx, T->band, ro, NULL, NULL, &win,
-                                   &info);
-  pthread_mutex_unlock(&T->gdal);
+  tt_status st = TT_OK;
+  const tt_app_tiles_hook *hook = &tt__app_tiles_hook;
+  /* merging pieces from files reads the DEM for tile 0's raster info only */
+  if (!(hook->load && k > 0)) {
+    pthread_mutex_lock(&T->gdal);
+    st = tt_gdal_read_grid(ctx, T->band, ro, NULL, NULL, &win, &info);
+    pthread_mutex_unlock(&T->gdal);
+  }
   CSLDestroy(ro);
   tt_tin *piece = NULL;
-  if (st == TT_OK && T->minmax_only) {
+  if (st == TT_OK && hook->load && !T->minmax_only) {
+    char msg[TT_APP_MESSAGE_MAX];
+    msg[0] = '\0';
+    st = hook->load(hook->arg, ctx, k, &piece, msg, sizeof msg);
+    if (st != TT_OK) {
+      tt_grid_destroy(win);
+      tt_raster_info_destroy(info);
+      tt_tin_destroy(piece);
+      fail(T, k, st, msg);
+      return;
+    }
+  } else if (st == TT_OK && T->minmax_only) {
     double lo = INFINITY, hi = -INFINITY;
     size_t n = 0;
     for (size_t y = 0; y < h; y++)
@@ -299,6 +314,8 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
   return TT_OK;
 }
 
+tt_app_tiles_hook tt__app_tiles_hook;
+
 size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
                           int threads)
 {
@@ -438,6 +455,24 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     tt__app_warn(&r->msg, "%s: tiles are measured in the affine frame of "
                  "the whole raster, not in a conformal frame per sample "
                  "(docs/scale.md)", path);
+  if (tt__app_tiles_hook.save) {
+    /* `terratin tiles run`: this one tile, handed to the hook */
+    size_t k = tt__app_tiles_hook.tile;
+    if (k >= T.ntiles) {
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, path, "tile %zu "
+                        "does not exist: the plan has %zu tiles", k, T.ntiles);
+      goto done;
+    }
+    T.failed = T.ntiles;
+    run_tile(&T, r->ctx, k);
+    if (T.failed < T.ntiles) {
+      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, T.fail_status, path,
+                        "tile %zu: %s", k, T.fail_msg);
+      goto done;
+    }
+    st = tt__app_tiles_hook.save(tt__app_tiles_hook.arg, r, k, T.pieces[k]);
+    goto done;
+  }
   st = tt_tin_merger_create(r->ctx, T.W, T.H, gt, &merger);
   if (st != TT_OK) {
     tt__app_fail_tt(r, st, path);
@@ -484,6 +519,8 @@ done:
     *out_tin = NULL;
   }
   tt_tin_merger_destroy(merger);
+  if (tt__app_tiles_hook.save && T.pieces && tt__app_tiles_hook.tile < T.ntiles)
+    tt_tin_destroy(T.pieces[tt__app_tiles_hook.tile]);
   tt_raster_info_destroy(T.info);
   CSLDestroy(T.ropts);
   free(T.pieces);

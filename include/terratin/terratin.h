@@ -730,6 +730,17 @@ void tt_tin_merger_destroy(tt_tin_merger *merger);
 void tt_tin_merger_size(const tt_tin_merger *merger, size_t *out_vertices,
                         size_t *out_triangles, size_t *out_bytes);
 
+/* A piece as bytes and back (src/tile/piece.c), for cluster runs that make
+ * each tile in its own process: every array as it is in memory (one byte
+ * order), tag (the caller's: the plan and the tile) and a checksum. A
+ * decoded piece merges exactly as the encoded one. The caller frees *out
+ * with free() and *out_piece with tt_tin_destroy(). Decoding refuses bytes
+ * that are damaged or carry another tag (TT_ERR_DATA). */
+tt_status tt_tin_piece_encode(tt_context *ctx, const tt_tin *piece,
+                              uint64_t tag, void **out, size_t *out_len);
+tt_status tt_tin_piece_decode(tt_context *ctx, const void *bytes, size_t len,
+                              uint64_t tag, tt_tin **out_piece);
+
 /* ---------------------------------------------------------------------------
  * Evaluation of any triangle soup (ours or another tool's) against a grid.
  * ------------------------------------------------------------------------- */
