@@ -178,6 +178,15 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
                            tt_progress_fn progress, void *progress_arg,
                            tt_grid **out_grid, tt_raster_info **out_info,
                            size_t *out_valid);
+/* optimize's and rasterize's inputs: the DEM (s->input) read into a grid
+ * with the progress phase set, then the TIN (s->tin) opened with its
+ * triangles layer; both inputs protected from outp. On failure (recorded)
+ * the caller still owns and frees whatever was set. */
+tt_status tt__app_read_dem_and_tin(app_run *r, tt_output *outp,
+                                   tt_grid **out_grid,
+                                   tt_raster_info **out_info,
+                                   size_t *out_valid, GDALDatasetH *out_tds,
+                                   OGRLayerH *out_layer);
 void tt__app_height_range(const tt_grid *grid, double *out_min,
                           double *out_max);
 const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);

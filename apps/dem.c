@@ -315,3 +315,38 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
   *out_min = lo;
   *out_max = hi;
 }
+
+/* What optimize and rasterize read before their work: the DEM into a grid,
+ * then the TIN dataset and its triangles layer, each out of the output's
+ * reach (every file either input reads from: an archive, a GPKG, VRT
+ * sources). The DEM takes the progress phase the caller set. */
+tt_status tt__app_read_dem_and_tin(app_run *r, tt_output *outp,
+                                   tt_grid **out_grid,
+                                   tt_raster_info **out_info,
+                                   size_t *out_valid, GDALDatasetH *out_tds,
+                                   OGRLayerH *out_layer)
+{
+  const tt_app_settings *s = r->s;
+  GDALRasterBandH band = NULL;
+  GDALDatasetH src = tt__app_open_raster(r, s->input, s->band, &band);
+  if (!src)
+    return r->res->status;
+  tt_status st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
+  if (st != TT_OK) {
+    GDALClose(src);
+    return tt__app_fail_tt(r, st, s->output);
+  }
+  st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog,
+                        out_grid, out_info, out_valid);
+  GDALClose(src);
+  if (st != TT_OK)
+    return st;
+  *out_tds = tt__app_open_vector(r, s->tin);
+  if (!*out_tds)
+    return r->res->status;
+  st = tt_output_protect_dataset(r->ctx, outp, *out_tds, s->tin);
+  if (st != TT_OK)
+    return tt__app_fail_tt(r, st, s->output);
+  *out_layer = tt__app_tin_layer(r, *out_tds);
+  return *out_layer ? TT_OK : r->res->status;
+}

@@ -59,8 +59,7 @@ tt_status tt__app_optimize(app_run *r)
   const tt_app_settings *s = r->s;
   tt_status st = TT_OK;
   tt_output *outp = NULL;
-  GDALDatasetH src = NULL, tds = NULL, dst = NULL;
-  GDALRasterBandH band = NULL;
+  GDALDatasetH tds = NULL, dst = NULL;
   tt_grid *grid = NULL;
   tt_raster_info *info = NULL;
   tt_tin *tin = NULL;
@@ -92,39 +91,10 @@ tt_status tt__app_optimize(app_run *r)
 
   /* Read the DEM and the triangles. */
   tt__app_phase_set(&r->prog, 0.0, 0.10);
-  src = tt__app_open_raster(r, s->input, s->band, &band);
-  if (!src) {
-    st = r->res->status;
-    goto done;
-  }
-  /* Every file either input is read from (an archive, a GPKG: name, VRT
-   * sources) is out of the output's reach, as in simplify. */
-  st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
-  if (st != TT_OK) {
-    tt__app_fail_tt(r, st, s->output);
-    goto done;
-  }
-  st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
-                        &info, &valid);
+  OGRLayerH layer = NULL;
+  st = tt__app_read_dem_and_tin(r, outp, &grid, &info, &valid, &tds, &layer);
   if (st != TT_OK)
     goto done;
-  GDALClose(src);
-  src = NULL;
-  tds = tt__app_open_vector(r, s->tin);
-  if (!tds) {
-    st = r->res->status;
-    goto done;
-  }
-  st = tt_output_protect_dataset(r->ctx, outp, tds, s->tin);
-  if (st != TT_OK) {
-    tt__app_fail_tt(r, st, s->output);
-    goto done;
-  }
-  OGRLayerH layer = tt__app_tin_layer(r, tds);
-  if (!layer) {
-    st = r->res->status;
-    goto done;
-  }
   char lname[256];
   snprintf(lname, sizeof lname, "%s", OGR_L_GetName(layer));
   r->msg.last[0] = '\0';
@@ -309,8 +279,6 @@ done:
     GDALClose(dst);
   if (tds)
     GDALClose(tds);
-  if (src)
-    GDALClose(src);
   tt_output_destroy(outp);
   if (srs)
     OSRDestroySpatialReference(srs);

@@ -183,8 +183,7 @@ tt_status tt__app_rasterize(app_run *r)
   const tt_app_settings *s = r->s;
   tt_status st = TT_OK;
   tt_output *outp = NULL;
-  GDALDatasetH src = NULL, tds = NULL;
-  GDALRasterBandH band = NULL;
+  GDALDatasetH tds = NULL;
   tt_grid *grid = NULL;
   tt_raster_info *info = NULL;
   double *xyz = NULL, *z = NULL;
@@ -212,37 +211,10 @@ tt_status tt__app_rasterize(app_run *r)
   }
 
   tt__app_phase_set(&r->prog, 0.0, 0.4);
-  src = tt__app_open_raster(r, s->input, s->band, &band);
-  if (!src) {
-    st = r->res->status;
-    goto done;
-  }
-  st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
-  if (st != TT_OK) {
-    tt__app_fail_tt(r, st, s->output);
-    goto done;
-  }
-  st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
-                        &info, &valid);
+  OGRLayerH layer = NULL;
+  st = tt__app_read_dem_and_tin(r, outp, &grid, &info, &valid, &tds, &layer);
   if (st != TT_OK)
     goto done;
-  GDALClose(src);
-  src = NULL;
-  tds = tt__app_open_vector(r, s->tin);
-  if (!tds) {
-    st = r->res->status;
-    goto done;
-  }
-  st = tt_output_protect_dataset(r->ctx, outp, tds, s->tin);
-  if (st != TT_OK) {
-    tt__app_fail_tt(r, st, s->output);
-    goto done;
-  }
-  OGRLayerH layer = tt__app_tin_layer(r, tds);
-  if (!layer) {
-    st = r->res->status;
-    goto done;
-  }
   char lname[256];
   snprintf(lname, sizeof lname, "%s", OGR_L_GetName(layer));
   if (tt__app_layer_in_other_crs(layer, info))
@@ -348,8 +320,6 @@ tt_status tt__app_rasterize(app_run *r)
 done:
   if (tds)
     GDALClose(tds);
-  if (src)
-    GDALClose(src);
   tt_output_destroy(outp);
   free(z);
   free(xyz);
