@@ -18,6 +18,7 @@
 # hold, must be refused with one line naming the sample. Prints "N passed,
 # M failed"; exits 1 on any failure, 77 (skip) when a tool is missing.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then
@@ -35,15 +36,6 @@ W=$(mktemp -d "${TMPDIR:-/tmp}/tt_bands.XXXXXX") || exit 1
 trap 'rm -rf "$W"' EXIT
 cd "$W" || exit 1
 
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-check() {
-  local what=$1
-  shift
-  if "$@"; then pass; else fail "$what"; fi
-}
 
 cat >oracle.py <<'PY'
 """make TYPE NAME: NAME.raw and NAME.vrt (a raw VRT band), 41 x 33 samples.

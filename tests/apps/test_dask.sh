@@ -7,6 +7,7 @@
 # with nothing written. Skips (77) when /usr/bin/python3 has no
 # `distributed` (Debian python3-distributed, an optional heavy client).
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then
@@ -29,15 +30,6 @@ cd "$W" || exit 1
 export TMPDIR="$W" # the workers' spill folders too
 export DASK_TEMPORARY_DIRECTORY="$W"
 
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-check() {
-  local what=$1
-  shift
-  if "$@"; then pass; else fail "$what"; fi
-}
 dump() { ogrinfo -ro -al -q "$1" triangles vertices 2>/dev/null | md5sum | cut -d' ' -f1; }
 
 "$T" generate diamond_square ds.tif -size 513 -seed 11 -q || exit 1

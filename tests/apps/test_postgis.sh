@@ -20,6 +20,7 @@
 # installed (apt-get install postgresql-15 postgresql-15-postgis-3).
 # Prints "N passed, M failed"; exits 1 on any failure.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then
@@ -87,15 +88,6 @@ fi
 cd "$W/work" || exit 1
 PG="PG:host=$S dbname=postgres user=tt"
 
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-check() {
-  local what=$1
-  shift
-  if "$@"; then pass; else fail "$what"; fi
-}
 not() { ! "$@"; }
 rc=0
 run() {

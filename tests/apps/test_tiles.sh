@@ -14,6 +14,7 @@
 # tiled run leaves nothing behind. Prints "N passed, M failed"; exits 1 on
 # any failure, 77 when a tool is missing.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then
@@ -33,15 +34,6 @@ trap 'rm -rf "$W"' EXIT
 cd "$W" || exit 1
 mkdir in out
 
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-check() {
-  local what=$1
-  shift
-  if "$@"; then pass; else fail "$what"; fi
-}
 rc=0
 run() {
   "$T" "$@" >out.txt 2>err.txt
