@@ -12,7 +12,8 @@
 # GeoPackage's R-tree, whose float boxes are widened by a quarter cell).
 # Prints wall seconds and peak memory (GNU time's maximum resident set) of
 # every step, the vertices and triangles, and each window's max error,
-# RMSE, uncovered and overlapped samples. Needs ~12 GiB free in WORK
+# RMSE, uncovered and overlapped samples, then tests/apps/tin_topology.py
+# on the whole TIN (conforming). Needs ~12 GiB free in WORK
 # (the DEM 3.4 GiB, the GeoPackage 7.5 GiB for SIZE 32769).
 set -eu
 WORK=${1:-/work/huge}
@@ -102,5 +103,11 @@ if [ "$NT" -ge 2 ]; then
   window "seams_${m}_$m" $((m * TILE)) $((m * TILE)) $w $w
 fi
 rm -f win.tif win.gpkg
+# the whole TIN's topology (python, sqlite3: about 8 GiB and 7 minutes for
+# 32769^2; TT_HUGE_TOPOLOGY=0 skips it)
+if [ "${TT_HUGE_TOPOLOGY:-1}" != 0 ]; then
+  timed topology python3 "$HERE/tests/apps/tin_topology.py" tin.gpkg
+  said topology
+fi
 echo "bound: $E"
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
