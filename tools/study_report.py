@@ -124,6 +124,17 @@ def ranks(values):
     return {c: 1 + sum(values[o] < values[c] for o in order) for c in values}
 
 
+def beside(ours, pub):
+    """A published table's cells: ours (the best of the row in bold), then
+    the study's and our difference to it, a cell per criterion of C7."""
+    best = min(ours.values())
+    cells = []
+    for c in C7:
+        b = "**" if ours[c] == best else ""
+        cells.append("%s%s%s (%s, %s)" % (b, fmt(ours[c]), b, fmt(pub[c]),
+                                          pct(ours[c] / pub[c] - 1)))
+    return cells
+
 def spearman(a, b):
     keys = list(a)
     ra, rb = ranks(a), ranks(b)
@@ -252,13 +263,7 @@ def report(study_out, out_dir):
         ours = {c: t1[pts][c]["mean_abs_error"] for c in C7}
         pub = dict(zip(C7, PUB_INSERT[pts]))
         t1_ours[pts] = ours
-        best = min(ours.values())
-        cells = []
-        for c in C7:
-            b = "**" if ours[c] == best else ""
-            cells.append("%s%s%s (%s, %s)" % (b, fmt(ours[c]), b,
-                                              fmt(pub[c]),
-                                              pct(ours[c] / pub[c] - 1)))
+        cells = beside(ours, pub)
         w("| %d | %d | %s | %.2f |" % (PUB_INSERT_PCT[pts], pts,
                                        " | ".join(cells),
                                        spearman(ours, pub)))
@@ -295,13 +300,7 @@ def report(study_out, out_dir):
         ours = {c: t2[keep][c]["mean_abs_error"] for c in C7}
         pub = dict(zip(C7, PUB_DECIMATE[dele]))
         t2_ours[dele] = ours
-        best = min(ours.values())
-        cells = []
-        for c in C7:
-            b = "**" if ours[c] == best else ""
-            cells.append("%s%s%s (%s, %s)" % (b, fmt(ours[c]), b,
-                                              fmt(pub[c]),
-                                              pct(ours[c] / pub[c] - 1)))
+        cells = beside(ours, pub)
         w("| %d | %d | %s | %.2f |" % (dele, dele * 1000, " | ".join(cells),
                                        spearman(ours, pub)))
     w("")
