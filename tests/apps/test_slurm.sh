@@ -55,6 +55,13 @@ fi
 ip link set lo up && ip addr add 127.0.0.2/8 dev lo ||
   { echo "FAIL: ip link set lo up / ip addr add 127.0.0.2/8 dev lo" >&2; exit 1; }
 NETNS=$(readlink /proc/$$/ns/net)
+# the cleanup kills every process of this namespace: make sure it is not
+# the machine's
+if [ -z "$NETNS" ] || [ "$NETNS" = "$(readlink /proc/1/ns/net)" ] ||
+   [ "$NETNS" = "$(readlink /proc/$PPID/ns/net 2>/dev/null)" ]; then
+  echo "FAIL: not in a network namespace of its own (${NETNS:-unknown})" >&2
+  exit 1
+fi
 
 W=$(mktemp -d "${TMPDIR:-/tmp}/tt_slurm.XXXXXX") || exit 1
 chmod 700 "$W"
