@@ -175,7 +175,7 @@ wait_job() {
   return 1
 }
 states() { scontrol show job "$1" 2>/dev/null | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p' | sort | uniq -c | tr -s ' ' | tr '\n' ';'; }
-check "merge job submitted (${MERGE:-none}), array ${ARRAY:-none}" [ -n "$MERGE" ] && [ -n "$ARRAY" ]
+check "merge job submitted (${MERGE:-none}), array ${ARRAY:-none}" eval '[ -n "$MERGE" ] && [ -n "$ARRAY" ]'
 check "merge job finished within 120 s" wait_job "${MERGE:-0}"
 echo "array job $ARRAY: $(states "$ARRAY")  merge job $MERGE: $(states "$MERGE")"
 check "16 array tasks completed" [ "$(states "$ARRAY")" = " 16 COMPLETED;" ]
