@@ -4,8 +4,13 @@
 # of a 513^2 fractal; the merged layers equal `simplify -tile_size` with the
 # same options (md5 of ogrinfo), the tiles ran in 2 processes other than
 # the driver, the plan and pieces are gone afterwards; a bad DEM exits 1
-# with nothing written. Skips (77) when /usr/bin/python3 has no
-# `distributed` (Debian python3-distributed, an optional heavy client).
+# with nothing written. Then docs/scale.md's real-cluster form: `dask
+# scheduler` and two `dask worker` commands (one worker process each) on
+# 127.0.0.1, every listening socket checked to be on 127.0.0.1, and
+# `tt_dask.py --scheduler`: the same layers, the tiles run in both workers,
+# a failing tile exits 1 with nothing written. Skips (77) when
+# /usr/bin/python3 has no `distributed` (Debian python3-distributed, an
+# optional heavy client).
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
