@@ -12,7 +12,7 @@ as the driver (a shared file system on a real cluster) and terratin.
              DEM OUT.gpkg -max_error E -tile_size N [simplify options]
 
 Without --scheduler a LocalCluster of N worker processes (one thread each)
-is started on 127.0.0.1 with no dashboard. Exit codes: 0 done, 1 a tile or
+is started with every socket (its HTTP servers too) on 127.0.0.1. Exit codes: 0 done, 1 a tile or
 the merge failed (nothing written), 2 usage, 3 distributed is missing.
 """
 import argparse
@@ -63,8 +63,10 @@ def main(argv):
     try:
         import distributed
     except ImportError:
-        print("tt_dask.py: the Python package distributed is missing "
-              "(Debian: apt-get install python3-distributed)",
+        print("tt_dask.py: %s has no Python package distributed "
+              "(Debian: apt-get install python3-distributed, for "
+              "/usr/bin/python3: run /usr/bin/python3 tt_dask.py ... when "
+              "another python3 comes first on PATH)" % sys.executable,
               file=sys.stderr)
         return 3
     terratin = os.path.abspath(args.terratin) if os.sep in args.terratin \
@@ -91,9 +93,15 @@ def main(argv):
         if args.scheduler:
             client = distributed.Client(args.scheduler)
         else:
+            # Every listening socket on 127.0.0.1: the scheduler's and the
+            # workers' HTTP servers are started even without a dashboard
+            # (dashboard_address=None still binds :8787 on every interface
+            # in distributed 2022.12), so they get 127.0.0.1 and a free port.
             cluster = distributed.LocalCluster(
                 n_workers=args.workers, threads_per_worker=1,
-                processes=True, host="127.0.0.1", dashboard_address=None)
+                processes=True, host="127.0.0.1",
+                dashboard_address="127.0.0.1:0",
+                worker_dashboard_address="127.0.0.1:0")
             client = distributed.Client(cluster)
         nworkers = len(client.scheduler_info()["workers"])
         t1 = time.monotonic()

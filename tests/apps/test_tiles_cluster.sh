@@ -57,45 +57,45 @@ check "run: nothing else in the folder" [ "$(ls -A p.json.tiles | wc -l)" -eq 16
 run tiles merge p.json m.gpkg -q
 check "merge: exit 0" [ $rc -eq 0 ]
 run simplify -q -max_error 6 -tile_size 128 -criterion delaunay -threads 2 ds.tif s.gpkg
-check "merge = simplify -tile_size (layers)" [ -s m.gpkg ] && [ "$(dump m.gpkg)" = "$(dump s.gpkg)" ]
+check "merge = simplify -tile_size (layers)" eval '[ -s m.gpkg ] && [ "$(dump m.gpkg)" = "$(dump s.gpkg)" ]'
 nv=$(ogrinfo -ro -so m.gpkg vertices 2>/dev/null | sed -n 's/Feature Count: //p')
 echo "fractal 513, tiles of 128: merged vertices $nv"
 
 # refusals
 run tiles run p.json 16
-check "run: tile out of range refused" [ $rc -eq 2 ] && one_line "no tile 16"
+check "run: tile out of range refused" eval '[ $rc -eq 2 ] && one_line "no tile 16"'
 run tiles run p.json 3
-check "run: existing piece refused" [ $rc -eq 1 ] && one_line "exists"
+check "run: existing piece refused" eval '[ $rc -eq 1 ] && one_line "exists"'
 run tiles merge p.json m.gpkg
-check "merge: existing output refused" [ $rc -eq 1 ] && one_line "exists"
+check "merge: existing output refused" eval '[ $rc -eq 1 ] && one_line "exists"'
 run tiles plan ds.tif p.json -max_error 6 -tile_size 128
-check "plan: existing plan refused" [ $rc -eq 1 ] && one_line "exists"
+check "plan: existing plan refused" eval '[ $rc -eq 1 ] && one_line "exists"'
 run tiles plan ds.tif q.json -tile_size 128
-check "plan: no -max_error refused" [ $rc -eq 2 ] && one_line "max_error" && [ ! -e q.json ]
+check "plan: no -max_error refused" eval '[ $rc -eq 2 ] && one_line "max_error" && [ ! -e q.json ]'
 run tiles plan ds.tif q.json -max_error 6 -tile_size 128 -max_points 100
-check "plan: a budget refused" [ $rc -eq 2 ] && [ ! -e q.json ]
+check "plan: a budget refused" eval '[ $rc -eq 2 ] && [ ! -e q.json ]'
 run tiles plan nothere.tif q.json -max_error 6 -tile_size 128
-check "plan: a missing DEM refused" [ $rc -ne 0 ] && one_line "nothere.tif" && [ ! -e q.json ]
+check "plan: a missing DEM refused" eval '[ $rc -ne 0 ] && one_line "nothere.tif" && [ ! -e q.json ]'
 mv p.json.tiles/5.ttp five.ttp
 run tiles merge p.json m2.gpkg
-check "merge: missing piece refused" [ $rc -eq 1 ] && one_line "1 of 16 tile pieces missing" && [ ! -e m2.gpkg ]
+check "merge: missing piece refused" eval '[ $rc -eq 1 ] && one_line "1 of 16 tile pieces missing" && [ ! -e m2.gpkg ]'
 cp p.json.tiles/6.ttp p.json.tiles/5.ttp
 run tiles merge p.json m2.gpkg
-check "merge: stale piece refused" [ $rc -eq 1 ] && one_line "stale" && [ ! -e m2.gpkg ]
+check "merge: stale piece refused" eval '[ $rc -eq 1 ] && one_line "stale" && [ ! -e m2.gpkg ]'
 head -c 1000 five.ttp >p.json.tiles/5.ttp
 run tiles merge p.json m2.gpkg
-check "merge: damaged piece refused" [ $rc -eq 1 ] && one_line "checksum\|not a terratin\|short" && [ ! -e m2.gpkg ]
+check "merge: damaged piece refused" eval '[ $rc -eq 1 ] && one_line "checksum\|not a terratin\|short" && [ ! -e m2.gpkg ]'
 mv five.ttp p.json.tiles/5.ttp
 check "merge: no stray file" [ "$(ls -A | grep -c 'm2\|tmp')" -eq 0 ]
 run tiles run p.json 3 -overwrite
 check "run -overwrite: exit 0" [ $rc -eq 0 ]
 run tiles merge p.json m.gpkg -overwrite -q
-check "merge -overwrite: the same layers" [ $rc -eq 0 ] && [ "$(dump m.gpkg)" = "$(dump s.gpkg)" ]
+check "merge -overwrite: the same layers" eval '[ $rc -eq 0 ] && [ "$(dump m.gpkg)" = "$(dump s.gpkg)" ]'
 touch -d '2001-01-01' ds.tif
 run tiles run p.json 3 -overwrite
-check "run: changed DEM refused" [ $rc -eq 1 ] && one_line "changed since"
+check "run: changed DEM refused" eval '[ $rc -eq 1 ] && one_line "changed since"'
 run tiles merge p.json m3.gpkg
-check "merge: changed DEM refused" [ $rc -eq 1 ] && one_line "changed since" && [ ! -e m3.gpkg ]
+check "merge: changed DEM refused" eval '[ $rc -eq 1 ] && one_line "changed since" && [ ! -e m3.gpkg ]'
 run tiles
 check "tiles alone: usage" [ $rc -eq 2 ]
 
@@ -110,7 +110,7 @@ run tiles plan nd.tif n.json -max_error 5 -tile_size 100
 check "nodata: every tile" all_tiles n.json "$(sed -n 's/^  "tiles": \([0-9]*\),/\1/p' n.json)"
 run tiles merge n.json nm.gpkg -q
 run simplify -q -max_error 5 -tile_size 100 nd.tif ns.gpkg
-check "nodata: merge = simplify -tile_size" [ -s nm.gpkg ] && [ "$(dump nm.gpkg)" = "$(dump ns.gpkg)" ]
+check "nodata: merge = simplify -tile_size" eval '[ -s nm.gpkg ] && [ "$(dump nm.gpkg)" = "$(dump ns.gpkg)" ]'
 
 # an interrupted tile leaves no piece and no temporary file
 "$T" generate diamond_square big.tif -size 2049 -seed 2 -q || exit 1
