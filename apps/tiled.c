@@ -18,6 +18,11 @@
  * at their next check (refinement polls the stop flag every 256
  * insertions).
  *
+ * A geographic or Web Mercator DEM is measured on the ground as untiled:
+ * every window comes with the whole raster's ground points of its samples
+ * (tt_gdal_read_grid), the pieces with their vertices' (src/tile/), and
+ * the merger takes the geodesic area function from tile 0's window.
+ *
  * Without -max_error the bound is 0.5 % of the height range, as untiled:
  * one more pass over the tiles finds the range first.
  *
@@ -65,6 +70,7 @@ typedef struct tiled {
   tt_status fail_status;
   char fail_msg[TT_APP_MESSAGE_MAX];
   tt_raster_info *info;     /* from tile 0 */
+  tt_tin_merger *merger;    /* tile 0's window gives it the area function */
   size_t max_memory;        /* -max_memory, 0: not given */
   size_t inflight_bytes;    /* what the tiles in flight may hold */
   char merge_msg[TT_APP_MESSAGE_MAX]; /* the main thread's failure */
@@ -128,6 +134,9 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k)
     pthread_mutex_unlock(&T->gdal);
   }
   CSLDestroy(ro);
+  if (st == TT_OK && k == 0 && T->merger)
+    tt_tin_merger_set_ground(T->merger, win); /* before done[0]: merged
+                                                 after it */
   tt_tin *piece = NULL;
   if (st == TT_OK && hook->load && !T->minmax_only) {
     char msg[TT_APP_MESSAGE_MAX];
@@ -316,17 +325,26 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
 
 tt_app_tiles_hook tt__app_tiles_hook;
 
+int tt__app_ground_points(GDALRasterBandH band)
+{
+  GDALDatasetH ds = GDALGetBandDataset(band);
+  OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+  return srs && (OSRIsGeographic(srs) || tt__georef_is_web_mercator(srs));
+}
+
 size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
-                          int threads)
+                          int threads, int ground)
 {
   /* per tile in flight: the window and the tile's copy as doubles at
    * worst (16 bytes a sample), the scans' bounds, and refinement's state
    * and the piece for a vertex every 4 samples at most (~60 bytes a
-   * vertex): about 32 bytes a sample; up to 2 x threads tiles */
+   * vertex): about 32 bytes a sample; with ground points (a geographic
+   * or Web Mercator DEM) 16 bytes a sample more in the window and in the
+   * tile's copy: 64; up to 2 x threads tiles */
   size_t w = (N < width ? N : width) + 3, h = (N < height ? N : height) + 3;
   size_t tiles = ((width - 2) / N + 1) * ((height - 2) / N + 1);
   size_t inflight = 2 * (size_t)(threads > 0 ? threads : 1);
-  return (inflight < tiles ? inflight : tiles) * 32 * w * h;
+  return (inflight < tiles ? inflight : tiles) * (ground ? 64 : 32) * w * h;
 }
 
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
@@ -377,7 +395,8 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
   if (s->work_srs)
     T.ropts = CSLSetNameValue(T.ropts, "WORK_SRS", s->work_srs);
   T.max_memory = s->max_memory;
-  T.inflight_bytes = tt__app_tile_bytes(T.N, T.W, T.H, T.nthreads);
+  T.inflight_bytes = tt__app_tile_bytes(T.N, T.W, T.H, T.nthreads,
+                                        tt__app_ground_points(band));
   T.ro = *ro;
   T.ro.threads = 1;
   T.ro.max_memory = 0; /* bounded by the tiles in flight (simplify.c) */
@@ -450,11 +469,6 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     const double unit_gt[6] = {0, 1, 0, 0, 0, 1};
     memcpy(gt, unit_gt, sizeof gt);
   }
-  OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
-  if (srs && (OSRIsGeographic(srs) || tt__georef_is_web_mercator(srs)))
-    tt__app_warn(&r->msg, "%s: tiles are measured in the affine frame of "
-                 "the whole raster, not in a conformal frame per sample "
-                 "(docs/scale.md)", path);
   if (tt__app_tiles_hook.save) {
     /* `terratin tiles run`: this one tile, handed to the hook */
     size_t k = tt__app_tiles_hook.tile;
@@ -478,6 +492,7 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     tt__app_fail_tt(r, st, path);
     goto done;
   }
+  T.merger = merger;
   st = run_all(&T, merger);
   if (st != TT_OK)
     goto done;
