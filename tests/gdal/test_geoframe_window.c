@@ -5,10 +5,10 @@
  * grid's, and the scale factor and convergence at a sample with its
  * neighbours in the window are the whole grid's bit for bit. Also: the
  * range of k the reader reports (over the raster's outline and centre) is
- * the range over every sample, and a window given a ground origin outside
- * its raster is refused. Three DEMs: 10 x 6 degrees at 70-76 N (oblique
- * stereographic, scaled), 1 x 0.6 degree at 45 N (UTM) and a Web Mercator
- * grid at 58-61 N. */
+ * the range over every sample. Three DEMs: 10 x 6 degrees at 70-76 N
+ * (oblique stereographic, scaled), 1 x 0.6 degree at 45 N (UTM) and a Web
+ * Mercator grid at 58-61 N. And issue19_nodata_corners: a TIN's ground
+ * points belong to its own vertices when the mesh dropped some. */
 #include "terratin/terratin_gdal.h"
 #include "terratin_lib.h"
 #include "tt_test.h"
@@ -153,6 +153,85 @@ static void check_dem(const char *name, size_t nx, size_t ny,
   GDALClose(ds);
 }
 
+/* Interior angles (degrees) of the triangle a, b, c: the smallest. */
+static double min_angle(const double *a, const double *b, const double *c)
+{
+  const double *p[3] = {a, b, c};
+  double m = 180;
+  for (int i = 0; i < 3; i++) {
+    const double *o = p[i], *u = p[(i + 1) % 3], *v = p[(i + 2) % 3];
+    double ux = u[0] - o[0], uy = u[1] - o[1];
+    double vx = v[0] - o[0], vy = v[1] - o[1];
+    double ang = atan2(fabs(ux * vy - uy * vx), ux * vx + uy * vy);
+    m = fmin(m, ang * 180 / 3.14159265358979323846);
+  }
+  return m;
+}
+
+/* issue19_nodata_corners: a geographic DEM whose corners and blobs are
+ * nodata (vertices outside the valid domain or in no triangle are dropped
+ * from the TIN): every triangle's angles are those of its
+ * corners' ground points. The TIN's ground points were indexed by the
+ * mesh's vertex ids, not the TIN's, and so belonged to other vertices
+ * (Luxembourg's slopes up to 75 times off). */
+static void test_nodata_corners(void)
+{
+  const size_t nx = 60, ny = 50;
+  const double gt[6] = {6, 1.0 / 120, 0, 50, 0, -1.0 / 120};
+  GDALDatasetH ds = make_ds(nx, ny, gt, 4326);
+  CHECK(ds != NULL);
+  if (!ds)
+    return;
+  GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+  GDALSetRasterNoDataValue(band, -9999);
+  /* nodata: the corners, blobs where the heights are low, and single
+   * valid samples inside them (in no triangle) */
+  float *z = malloc(nx * ny * sizeof *z);
+  CHECK(z && GDALRasterIO(band, GF_Read, 0, 0, (int)nx, (int)ny, z, (int)nx,
+                          (int)ny, GDT_Float32, 0, 0) == CE_None);
+  for (size_t r = 0; z && r < ny; r++)
+    for (size_t c = 0; c < nx; c++) {
+      int corner = (c < 5 || c + 5 >= nx) && (r < 5 || r + 5 >= ny);
+      if (corner || (z[r * nx + c] < -40 && (c + r) % 7 != 0))
+        z[r * nx + c] = -9999;
+    }
+  CHECK(z && GDALRasterIO(band, GF_Write, 0, 0, (int)nx, (int)ny, z,
+                          (int)nx, (int)ny, GDT_Float32, 0, 0) == CE_None);
+  free(z);
+  tt_grid *g = NULL;
+  tt_raster_info *info = NULL;
+  CHECK_OK(ctx, tt_gdal_read_grid(ctx, band, NULL, NULL, NULL, &g, &info));
+  tt_tin *tin = NULL;
+  tt_refine_options ro;
+  tt_refine_options_init(&ro);
+  ro.max_error = 1;
+  if (g)
+    CHECK_OK(ctx, tt_refine_run(ctx, g, &ro, &tin));
+  const double *xy = g ? tt_grid_ground_xy(g) : NULL;
+  CHECK(xy != NULL);
+  double worst = 0;
+  size_t n = tin ? tt_tin_triangle_count(tin) : 0;
+  for (size_t t = 0; xy && t < n; t++) {
+    tt_triangle_info ti;
+    CHECK_INT_EQ(tt_tin_triangle(tin, t, &ti), TT_OK);
+    const double *p[3];
+    for (int j = 0; j < 3; j++) {
+      tt_vertex_info vi;
+      tt_tin_vertex(tin, (size_t)ti.v[j], &vi);
+      p[j] = xy + 2 * ((size_t)vi.row * nx + (size_t)vi.col);
+    }
+    worst = fmax(worst, fabs(ti.min_angle_deg - min_angle(p[0], p[1], p[2])));
+  }
+  printf("nodata corners: %zu triangles, smallest angles within %.3g degree "
+         "of their ground points'\n", n, worst);
+  CHECK(n > 100);
+  CHECK_DBL_LE(worst, 1e-6);
+  tt_tin_destroy(tin);
+  tt_grid_destroy(g);
+  tt_raster_info_destroy(info);
+  GDALClose(ds);
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -165,6 +244,7 @@ int main(void)
   const double webmerc[6] = {1000000, 2500, 0, 8600000, 0, -5000};
   check_dem("Web Mercator at 58-61 N", 120, 120, webmerc, 3857,
             "per vertex");
+  test_nodata_corners();
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
