@@ -32,6 +32,13 @@
  * constant that balances their largest and smallest scale over the DEM (a
  * constant factor keeps a projection conformal); the frame's name says so.
  *
+ * Everything is a function of the whole raster, never of the part read: a
+ * window (a tile, tiled runs of issue 19) gets the frame of the raster's
+ * extent, the range of k over the raster's outline and centre
+ * (raster_scale_range), and its samples projected from their column and
+ * row in the raster, so that a window's ground points, k and convergence
+ * are the whole grid's bit for bit.
+ *
  * Scale factor and convergence come from the projected grid itself
  * (tt_grid_ground_scale_at, engine, with ellipsoid_metric below; for the
  * TIN's vertices only, nothing stored per sample): the
@@ -44,11 +51,15 @@
  * truncation error is of the order of (pixel / earth radius)^2.
  *
  * Invariants: on success every sample has finite x, y and k > 0, and the
- * grid's ground frame is J at the centre sample (so its orientation, and
- * the pixel-space orientation the mesh keeps, are the projection's).
+ * grid's ground frame is J at the raster's centre sample (so its
+ * orientation, and the pixel-space orientation the mesh keeps, are the
+ * projection's).
  *
  * Workload: one batched PROJ transformation per row (nx points), 16 bytes
- * of ground points per sample kept on the grid, O(1) per sample after.
+ * of ground points per sample kept on the grid, O(1) per sample after;
+ * for the range of k, at most 1,033 samples of the outline and centre,
+ * each with its 3 x 3 neighbours projected (under 10,000 points, whatever
+ * the size of the raster or the window).
  */
 #include "gdal/georef.h"
 #include "base/internal.h"
