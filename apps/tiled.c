@@ -7,8 +7,9 @@
  * (-threads, GDAL_NUM_THREADS, else the core count) take the tiles in
  * order; each reads its window (the tile and one line beyond each shared
  * side: tt_tile_window) with tt_gdal_read_grid's WINDOW option -- GDAL
- * datasets are not for concurrent use, so reads take turns under a mutex
- * -- and refines it with tt_tile_run, one thread per tile. The main thread
+ * datasets are not for concurrent use, so each worker opens the DEM for
+ * itself (reads take turns under a mutex on the shared dataset when it
+ * cannot) -- and refines it with tt_tile_run, one thread per tile. The main thread
  * merges the pieces strictly in tile order, so the TIN is the same for any
  * thread count, and a worker does not start a tile more than 2 x threads
  * ahead of the merge, so at most that many windows and pieces are held:
@@ -113,8 +114,11 @@ static void fail(tiled *T, size_t k, tt_status st, const char *msg)
   pthread_mutex_unlock(&T->lock);
 }
 
-/* One tile: read, then refine (or measure the range). */
-static void run_tile(tiled *T, tt_context *ctx, size_t k)
+/* One tile: read (from own, a worker's own dataset's band, or the shared
+ * band under the mutex when own is NULL), then refine (or measure the
+ * range). */
+static void run_tile(tiled *T, tt_context *ctx, size_t k,
+                     GDALRasterBandH own)
 {
   tt_tile t;
   tile_of(T, k, &t);
@@ -128,7 +132,9 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k)
   tt_status st = TT_OK;
   const tt_app_tiles_hook *hook = &tt__app_tiles_hook;
   /* merging pieces from files reads the DEM for tile 0's raster info only */
-  if (!(hook->load && k > 0)) {
+  if (!(hook->load && k > 0) && own) {
+    st = tt_gdal_read_grid(ctx, own, ro, NULL, NULL, &win, &info);
+  } else if (!(hook->load && k > 0)) {
     pthread_mutex_lock(&T->gdal);
     st = tt_gdal_read_grid(ctx, T->band, ro, NULL, NULL, &win, &info);
     pthread_mutex_unlock(&T->gdal);
@@ -191,6 +197,19 @@ static void *worker(void *arg)
   tiled *T = arg;
   tt_context *ctx = tt_context_create();
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  /* With more than one worker, each opens the DEM again for itself: a
+   * GDAL dataset is for one thread at a time, and with a dataset each the
+   * reads go in parallel -- with them the projection of a geographic
+   * window's samples, which runs inside the read and is most of a tile's
+   * time. The shared band under the mutex when the file cannot be opened
+   * again (/vsistdin/). */
+  GDALDatasetH own = T->nthreads > 1 ? GDALOpenEx(T->path, GDAL_OF_RASTER |
+                                                  GDAL_OF_READONLY, NULL,
+                                                  NULL, NULL)
+                                     : NULL;
+  GDALRasterBandH band = own ? GDALGetRasterBand(own,
+                                                 GDALGetBandNumber(T->band))
+                             : NULL;
   for (;;) {
     pthread_mutex_lock(&T->lock);
     while (!atomic_load(&T->stop) && T->next < T->ntiles &&
@@ -207,8 +226,10 @@ static void *worker(void *arg)
       fail(T, k, TT_ERR_NOMEM, "out of memory");
       break;
     }
-    run_tile(T, ctx, k);
+    run_tile(T, ctx, k, band);
   }
+  if (own)
+    GDALClose(own);
   CPLPopErrorHandler();
   tt_context_destroy(ctx);
   return NULL;
@@ -478,7 +499,7 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
       goto done;
     }
     T.failed = T.ntiles;
-    run_tile(&T, r->ctx, k);
+    run_tile(&T, r->ctx, k, NULL);
     if (T.failed < T.ntiles) {
       st = tt__app_fail(r, TT_APP_EXIT_FAILURE, T.fail_status, path,
                         "tile %zu: %s", k, T.fail_msg);
