@@ -9,10 +9,11 @@
  * side: tt_tile_window) with tt_gdal_read_grid's WINDOW option -- GDAL
  * datasets are not for concurrent use, so each worker opens the DEM for
  * itself (reads take turns under a mutex on the shared dataset when it
- * cannot) -- and refines it with tt_tile_run, one thread per tile. The main thread
- * merges the pieces strictly in tile order, so the TIN is the same for any
- * thread count, and a worker does not start a tile more than 2 x threads
- * ahead of the merge, so at most that many windows and pieces are held:
+ * cannot) -- and refines it with tt_tile_run, one thread per tile. The
+ * main thread merges the pieces strictly in tile order, so the TIN is the
+ * same for any thread count, and a worker does not start a tile more than
+ * 2 x threads ahead of the merge, so at most that many windows and pieces
+ * are held:
  * memory is bounded by the tile size and the threads, not by the DEM
  * (the merged TIN's own records grow with its vertices, as in any run).
  * The first failure in tile order, or an interruption, stops the workers

@@ -700,8 +700,10 @@ void tt_tile_window(const tt_tile *tile, size_t *out_col, size_t *out_row,
 /* Refines one tile: window holds the samples tt_tile_window names (its
  * geotransform that of its first sample, the DEM's ground frame, and for
  * a geographic or Web Mercator DEM the whole DEM's ground points of its
- * samples, as tt_gdal_read_grid's WINDOW reads them); opt must have a max error and no point, triangle or
- * percentage budget (any criterion, repair and final optimisation). The
+ * samples, as tt_gdal_read_grid's WINDOW reads them); opt must have a
+ * max error and no point, triangle or percentage budget (any criterion,
+ * repair and final optimisation). The piece's vertices keep their ground
+ * points, scale factors and convergences (from the window). The
  * piece is a TIN in the DEM's pixel coordinates, with no triangle when the
  * tile has none; its valid_samples counts the tile's samples less the
  * column and row it shares on its right and bottom sides, so the pieces'
