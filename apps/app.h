@@ -342,9 +342,12 @@ typedef struct tt_app_tiles_hook {
 } tt_app_tiles_hook;
 extern tt_app_tiles_hook tt__app_tiles_hook;
 /* What tiles of N cells of a width x height DEM on threads workers hold
- * at most (tiled.c). */
+ * at most (tiled.c); ground: the DEM is measured on ground points
+ * (tt__app_ground_points). */
 size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
-                          int threads);
+                          int threads, int ground);
+/* Whether band's DEM gets ground points (geographic or Web Mercator). */
+int tt__app_ground_points(GDALRasterBandH band);
 /* eval.c, for optimize too: opens r->s->tin's kind of dataset (a vector
  * dataset, explaining in one line why not), and picks its triangle layer
  * (-layer, else "triangles" or "*_triangles", else the first polygon

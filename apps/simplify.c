@@ -235,6 +235,7 @@ planned:;
                               : (int)sysconf(_SC_NPROCESSORS_ONLN);
   if (nth < 1)
     nth = 1;
+  int ground = tt__app_ground_points(band);
   if (!tile && !s->decimate && no_budget && s->max_memory &&
       dem_w > 2 && dem_h > 2 && cells > mem_limit / 8) {
     /* about 8 bytes a sample untiled: tiles of 1024 (a multiple of the
@@ -246,9 +247,9 @@ planned:;
     if (bw > 1 && bw <= 4096 && bw == bh)
       want = ((1024 + (size_t)bw - 1) / (size_t)bw) * (size_t)bw;
     while (want > 64 &&
-           tt__app_tile_bytes(want, dem_w, dem_h, nth) > mem_limit / 2)
+           tt__app_tile_bytes(want, dem_w, dem_h, nth, ground) > mem_limit / 2)
       want /= 2;
-    if (tt__app_tile_bytes(want, dem_w, dem_h, nth) <= mem_limit / 2) {
+    if (tt__app_tile_bytes(want, dem_w, dem_h, nth, ground) <= mem_limit / 2) {
       tile = want;
       rep.auto_tiled = 1;
     }
@@ -272,7 +273,7 @@ planned:;
     ro.threads = threads_asked;
     rep.ropt = &ro;
     rep.tile_size = tile;
-    rep.tile_bytes = tt__app_tile_bytes(tile, dem_w, dem_h, nth);
+    rep.tile_bytes = tt__app_tile_bytes(tile, dem_w, dem_h, nth, ground);
     if (s->max_memory && rep.tile_bytes > s->max_memory) {
       st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
                         "simplify: tiles of %zu cells on %d threads hold up to "

@@ -7,16 +7,23 @@
  * (-threads, GDAL_NUM_THREADS, else the core count) take the tiles in
  * order; each reads its window (the tile and one line beyond each shared
  * side: tt_tile_window) with tt_gdal_read_grid's WINDOW option -- GDAL
- * datasets are not for concurrent use, so reads take turns under a mutex
- * -- and refines it with tt_tile_run, one thread per tile. The main thread
- * merges the pieces strictly in tile order, so the TIN is the same for any
- * thread count, and a worker does not start a tile more than 2 x threads
- * ahead of the merge, so at most that many windows and pieces are held:
+ * datasets are not for concurrent use, so each worker opens the DEM for
+ * itself (reads take turns under a mutex on the shared dataset when it
+ * cannot) -- and refines it with tt_tile_run, one thread per tile. The
+ * main thread merges the pieces strictly in tile order, so the TIN is the
+ * same for any thread count, and a worker does not start a tile more than
+ * 2 x threads ahead of the merge, so at most that many windows and pieces
+ * are held:
  * memory is bounded by the tile size and the threads, not by the DEM
  * (the merged TIN's own records grow with its vertices, as in any run).
  * The first failure in tile order, or an interruption, stops the workers
  * at their next check (refinement polls the stop flag every 256
  * insertions).
+ *
+ * A geographic or Web Mercator DEM is measured on the ground as untiled:
+ * every window comes with the whole raster's ground points of its samples
+ * (tt_gdal_read_grid), the pieces with their vertices' (src/tile/), and
+ * the merger takes the geodesic area function from tile 0's window.
  *
  * Without -max_error the bound is 0.5 % of the height range, as untiled:
  * one more pass over the tiles finds the range first.
@@ -65,6 +72,7 @@ typedef struct tiled {
   tt_status fail_status;
   char fail_msg[TT_APP_MESSAGE_MAX];
   tt_raster_info *info;     /* from tile 0 */
+  tt_tin_merger *merger;    /* tile 0's window gives it the area function */
   size_t max_memory;        /* -max_memory, 0: not given */
   size_t inflight_bytes;    /* what the tiles in flight may hold */
   char merge_msg[TT_APP_MESSAGE_MAX]; /* the main thread's failure */
@@ -107,8 +115,11 @@ static void fail(tiled *T, size_t k, tt_status st, const char *msg)
   pthread_mutex_unlock(&T->lock);
 }
 
-/* One tile: read, then refine (or measure the range). */
-static void run_tile(tiled *T, tt_context *ctx, size_t k)
+/* One tile: read (from own, a worker's own dataset's band, or the shared
+ * band under the mutex when own is NULL), then refine (or measure the
+ * range). */
+static void run_tile(tiled *T, tt_context *ctx, size_t k,
+                     GDALRasterBandH own)
 {
   tt_tile t;
   tile_of(T, k, &t);
@@ -122,12 +133,17 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k)
   tt_status st = TT_OK;
   const tt_app_tiles_hook *hook = &tt__app_tiles_hook;
   /* merging pieces from files reads the DEM for tile 0's raster info only */
-  if (!(hook->load && k > 0)) {
+  if (!(hook->load && k > 0) && own) {
+    st = tt_gdal_read_grid(ctx, own, ro, NULL, NULL, &win, &info);
+  } else if (!(hook->load && k > 0)) {
     pthread_mutex_lock(&T->gdal);
     st = tt_gdal_read_grid(ctx, T->band, ro, NULL, NULL, &win, &info);
     pthread_mutex_unlock(&T->gdal);
   }
   CSLDestroy(ro);
+  if (st == TT_OK && k == 0 && T->merger)
+    tt_tin_merger_set_ground(T->merger, win); /* before done[0]: merged
+                                                 after it */
   tt_tin *piece = NULL;
   if (st == TT_OK && hook->load && !T->minmax_only) {
     char msg[TT_APP_MESSAGE_MAX];
@@ -182,6 +198,19 @@ static void *worker(void *arg)
   tiled *T = arg;
   tt_context *ctx = tt_context_create();
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  /* With more than one worker, each opens the DEM again for itself: a
+   * GDAL dataset is for one thread at a time, and with a dataset each the
+   * reads go in parallel -- with them the projection of a geographic
+   * window's samples, which runs inside the read and is most of a tile's
+   * time. The shared band under the mutex when the file cannot be opened
+   * again (/vsistdin/). */
+  GDALDatasetH own = T->nthreads > 1 ? GDALOpenEx(T->path, GDAL_OF_RASTER |
+                                                  GDAL_OF_READONLY, NULL,
+                                                  NULL, NULL)
+                                     : NULL;
+  GDALRasterBandH band = own ? GDALGetRasterBand(own,
+                                                 GDALGetBandNumber(T->band))
+                             : NULL;
   for (;;) {
     pthread_mutex_lock(&T->lock);
     while (!atomic_load(&T->stop) && T->next < T->ntiles &&
@@ -198,8 +227,10 @@ static void *worker(void *arg)
       fail(T, k, TT_ERR_NOMEM, "out of memory");
       break;
     }
-    run_tile(T, ctx, k);
+    run_tile(T, ctx, k, band);
   }
+  if (own)
+    GDALClose(own);
   CPLPopErrorHandler();
   tt_context_destroy(ctx);
   return NULL;
@@ -316,17 +347,26 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
 
 tt_app_tiles_hook tt__app_tiles_hook;
 
+int tt__app_ground_points(GDALRasterBandH band)
+{
+  GDALDatasetH ds = GDALGetBandDataset(band);
+  OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+  return srs && (OSRIsGeographic(srs) || tt__georef_is_web_mercator(srs));
+}
+
 size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
-                          int threads)
+                          int threads, int ground)
 {
   /* per tile in flight: the window and the tile's copy as doubles at
    * worst (16 bytes a sample), the scans' bounds, and refinement's state
    * and the piece for a vertex every 4 samples at most (~60 bytes a
-   * vertex): about 32 bytes a sample; up to 2 x threads tiles */
+   * vertex): about 32 bytes a sample; with ground points (a geographic
+   * or Web Mercator DEM) 16 bytes a sample more in the window and in the
+   * tile's copy: 64; up to 2 x threads tiles */
   size_t w = (N < width ? N : width) + 3, h = (N < height ? N : height) + 3;
   size_t tiles = ((width - 2) / N + 1) * ((height - 2) / N + 1);
   size_t inflight = 2 * (size_t)(threads > 0 ? threads : 1);
-  return (inflight < tiles ? inflight : tiles) * 32 * w * h;
+  return (inflight < tiles ? inflight : tiles) * (ground ? 64 : 32) * w * h;
 }
 
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
@@ -377,7 +417,8 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
   if (s->work_srs)
     T.ropts = CSLSetNameValue(T.ropts, "WORK_SRS", s->work_srs);
   T.max_memory = s->max_memory;
-  T.inflight_bytes = tt__app_tile_bytes(T.N, T.W, T.H, T.nthreads);
+  T.inflight_bytes = tt__app_tile_bytes(T.N, T.W, T.H, T.nthreads,
+                                        tt__app_ground_points(band));
   T.ro = *ro;
   T.ro.threads = 1;
   T.ro.max_memory = 0; /* bounded by the tiles in flight (simplify.c) */
@@ -450,11 +491,6 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     const double unit_gt[6] = {0, 1, 0, 0, 0, 1};
     memcpy(gt, unit_gt, sizeof gt);
   }
-  OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
-  if (srs && (OSRIsGeographic(srs) || tt__georef_is_web_mercator(srs)))
-    tt__app_warn(&r->msg, "%s: tiles are measured in the affine frame of "
-                 "the whole raster, not in a conformal frame per sample "
-                 "(docs/scale.md)", path);
   if (tt__app_tiles_hook.save) {
     /* `terratin tiles run`: this one tile, handed to the hook */
     size_t k = tt__app_tiles_hook.tile;
@@ -464,7 +500,7 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
       goto done;
     }
     T.failed = T.ntiles;
-    run_tile(&T, r->ctx, k);
+    run_tile(&T, r->ctx, k, NULL);
     if (T.failed < T.ntiles) {
       st = tt__app_fail(r, TT_APP_EXIT_FAILURE, T.fail_status, path,
                         "tile %zu: %s", k, T.fail_msg);
@@ -478,6 +514,7 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     tt__app_fail_tt(r, st, path);
     goto done;
   }
+  T.merger = merger;
   st = run_all(&T, merger);
   if (st != TT_OK)
     goto done;

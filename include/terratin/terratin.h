@@ -698,9 +698,12 @@ void tt_tile_window(const tt_tile *tile, size_t *out_col, size_t *out_row,
                     size_t *out_width, size_t *out_height);
 
 /* Refines one tile: window holds the samples tt_tile_window names (its
- * geotransform that of its first sample, the DEM's ground frame, no
- * ground points); opt must have a max error and no point, triangle or
- * percentage budget (any criterion, repair and final optimisation). The
+ * geotransform that of its first sample, the DEM's ground frame, and for
+ * a geographic or Web Mercator DEM the whole DEM's ground points of its
+ * samples, as tt_gdal_read_grid's WINDOW reads them); opt must have a
+ * max error and no point, triangle or percentage budget (any criterion,
+ * repair and final optimisation). The piece's vertices keep their ground
+ * points, scale factors and convergences (from the window). The
  * piece is a TIN in the DEM's pixel coordinates, with no triangle when the
  * tile has none; its valid_samples counts the tile's samples less the
  * column and row it shares on its right and bottom sides, so the pieces'
@@ -724,6 +727,11 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *merger,
                             const tt_tin *piece, const tt_tile *tile);
 tt_status tt_tin_merger_finish(tt_context *ctx, tt_tin_merger *merger,
                                tt_tin **out_tin);
+/* The merged TIN measures areas with the area function of window (any
+ * window of the DEM as tt_gdal_read_grid reads it: geodesic areas for a
+ * geographic or Web Mercator DEM). Pieces from tt_tile_run bring it
+ * themselves; pieces decoded from bytes (tt_tin_piece_decode) do not. */
+void tt_tin_merger_set_ground(tt_tin_merger *merger, const tt_grid *window);
 void tt_tin_merger_destroy(tt_tin_merger *merger);
 /* The vertices and triangles merged so far, and the bytes the merger holds
  * for them (what finishing hands over, and its own tables). */

@@ -88,9 +88,9 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * conversion), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
  * the working frame), WINDOW=col,row,width,height (read those samples
  * only, for a tile: the grid's geotransform is that of its first sample,
- * its ground frame the whole raster's, a geographic raster keeps the
- * affine frame without ground points, a window of nodata only is no
- * error, GDAL's cache is left alone).
+ * its ground frame the whole raster's, a geographic or Web Mercator
+ * raster's ground points those of the whole raster's samples, bit for bit,
+ * a window of nodata only is no error, GDAL's cache is left alone).
  * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
  * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
 tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,

@@ -273,6 +273,27 @@ void tt__grid_ground_jacobian(const tt_grid *g, size_t c, size_t r,
   out_j[3] = d1(colx + 1, r, ny, 2 * nx);
 }
 
+void tt__grid_set_ground_origin(tt_grid *g, size_t col0, size_t row0,
+                                const double raster_gt[6])
+{
+  g->has_morigin = true;
+  g->mc0 = col0;
+  g->mr0 = row0;
+  memcpy(g->mgt, raster_gt, sizeof g->mgt);
+}
+
+void tt__grid_ground_map_xy(const tt_grid *g, size_t c, size_t r,
+                            double *out_x, double *out_y)
+{
+  const double *gt = g->has_morigin ? g->mgt : g->gt;
+  if (g->has_morigin) {
+    c += g->mc0;
+    r += g->mr0;
+  }
+  *out_x = gt[0] + (c + 0.5) * gt[1] + (r + 0.5) * gt[2];
+  *out_y = gt[3] + (c + 0.5) * gt[4] + (r + 0.5) * gt[5];
+}
+
 tt_status tt_grid_ground_scale_at(const tt_grid *grid, size_t col,
                                   size_t row, double *out_k,
                                   double *out_convergence)
@@ -284,10 +305,11 @@ tt_status tt_grid_ground_scale_at(const tt_grid *grid, size_t col,
   tt__grid_ground_jacobian(grid, col, row, j);
   double jcx = j[0], jrx = j[1], jcy = j[2], jry = j[3];
   double en[2] = {1, 1};
-  if (grid->metric_fn)
-    grid->metric_fn(grid->metric_par,
-                    gt[0] + (col + 0.5) * gt[1] + (row + 0.5) * gt[2],
-                    gt[3] + (col + 0.5) * gt[4] + (row + 0.5) * gt[5], en);
+  if (grid->metric_fn) {
+    double mx, my;
+    tt__grid_ground_map_xy(grid, col, row, &mx, &my);
+    grid->metric_fn(grid->metric_par, mx, my, en);
+  }
   double ge = en[0], gn = en[1];
   double gdet = gt[1] * gt[5] - gt[2] * gt[4];
   double detj = jcx * jry - jrx * jcy, detg = ge * gn * gdet;

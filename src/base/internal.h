@@ -49,6 +49,14 @@ struct tt_grid {
   double *gxy;
   tt_ground_metric_fn metric_fn;  /* tt_grid_set_ground_metric_fn, or NULL */
   double metric_par[4];
+  /* Where the ground metric is evaluated (tt__grid_set_ground_origin): a
+   * window of a raster gives its samples' map coordinates from the
+   * raster's geotransform mgt and the raster's column mc0 + c and row
+   * mr0 + r, so a tile computes exactly what the whole raster does; when
+   * has_morigin is false, from gt and (c, r). */
+  bool has_morigin;
+  size_t mc0, mr0;
+  double mgt[6];
   tt_area_fn area_fn;  /* tt_grid_set_area_fn, or NULL */
   double area_par[4];
 };
@@ -70,6 +78,18 @@ TT_HIDDEN bool tt__grid_widen(tt_grid *g);
  * points, c < nx, r < ny). */
 TT_HIDDEN void tt__grid_ground_jacobian(const tt_grid *g, size_t c, size_t r,
                                         double out_j[4]);
+
+/* Makes g a window of a raster for the ground metric: its sample (c, r)
+ * is the raster's (col0 + c, row0 + r), whose map coordinates come from
+ * raster_gt (tt_grid_ground_scale_at then gives the whole raster's values
+ * bit for bit, where the finite differences see the same neighbours). */
+TT_HIDDEN void tt__grid_set_ground_origin(tt_grid *g, size_t col0,
+                                          size_t row0,
+                                          const double raster_gt[6]);
+/* The map coordinates at which g's ground metric is evaluated for sample
+ * (c, r) (the centre of the pixel, in the raster of the ground origin). */
+TT_HIDDEN void tt__grid_ground_map_xy(const tt_grid *g, size_t c, size_t r,
+                                      double *out_x, double *out_y);
 
 /* Sets the context's status and message and returns the status, so a
  * failure reads `return tt__error(ctx, TT_ERR_ARG, "...", ...);`. A NULL

@@ -44,17 +44,27 @@ TT_HIDDEN OGRSpatialReferenceH tt__georef_utm_of(OGRSpatialReferenceH srs,
 TT_HIDDEN int tt__georef_is_web_mercator(OGRSpatialReferenceH srs);
 
 /* Ground points for a grid in a geographic or Web Mercator CRS
- * (georef_conformal.c):
- * projects every sample into a conformal working projection suited to the
- * extent (or work_srs), fills the grid's ground points (tt_grid_alloc_
- * ground_points) and sets its ground frame to the projection's Jacobian at
- * the centre. out_name describes the frame; out_scale_error gets the
- * largest |k - 1| over the samples. TT_ERR_ARG for an unusable work_srs;
- * other failures leave the grid as it was and return the status. */
+ * (georef_conformal.c): the grid is the window at (col0, row0) of a raster
+ * of raster_nx x raster_ny samples with geotransform raster_gt (the whole
+ * raster: 0, 0 and the grid's own size). Chooses a conformal working
+ * projection for the raster's extent (or work_srs), projects every sample
+ * of the grid from the raster's column and row, fills the grid's ground
+ * points (tt_grid_alloc_ground_points), its ground metric and origin and
+ * its area function, and sets its ground frame to the projection's
+ * Jacobian at the raster's centre. The frame, its constant scale and
+ * everything measured depend on the raster only: a window's ground points
+ * are the whole raster's, bit for bit. out_name describes the frame;
+ * out_scale_error gets the largest |k - 1| over the raster's outline and
+ * centre. TT_ERR_ARG for an unusable work_srs; other failures leave the
+ * grid as it was and return the status. */
 TT_HIDDEN tt_status tt__georef_ground_points(tt_context *ctx,
                                              OGRSpatialReferenceH srs,
                                              const char *work_srs,
-                                             tt_grid *grid, char *out_name,
+                                             const double raster_gt[6],
+                                             size_t raster_nx,
+                                             size_t raster_ny, size_t col0,
+                                             size_t row0, tt_grid *grid,
+                                             char *out_name,
                                              size_t name_size,
                                              double *out_scale_error);
 

@@ -32,6 +32,13 @@
  * constant that balances their largest and smallest scale over the DEM (a
  * constant factor keeps a projection conformal); the frame's name says so.
  *
+ * Everything is a function of the whole raster, never of the part read: a
+ * window (a tile, tiled runs of issue 19) gets the frame of the raster's
+ * extent, the range of k over the raster's outline and centre
+ * (raster_scale_range), and its samples projected from their column and
+ * row in the raster, so that a window's ground points, k and convergence
+ * are the whole grid's bit for bit.
+ *
  * Scale factor and convergence come from the projected grid itself
  * (tt_grid_ground_scale_at, engine, with ellipsoid_metric below; for the
  * TIN's vertices only, nothing stored per sample): the
@@ -44,11 +51,15 @@
  * truncation error is of the order of (pixel / earth radius)^2.
  *
  * Invariants: on success every sample has finite x, y and k > 0, and the
- * grid's ground frame is J at the centre sample (so its orientation, and
- * the pixel-space orientation the mesh keeps, are the projection's).
+ * grid's ground frame is J at the raster's centre sample (so its
+ * orientation, and the pixel-space orientation the mesh keeps, are the
+ * projection's).
  *
  * Workload: one batched PROJ transformation per row (nx points), 16 bytes
- * of ground points per sample kept on the grid, O(1) per sample after.
+ * of ground points per sample kept on the grid, O(1) per sample after;
+ * for the range of k, at most 1,033 samples of the outline and centre,
+ * each with its 3 x 3 neighbours projected (under 10,000 points, whatever
+ * the size of the raster or the window).
  */
 #include "gdal/georef.h"
 #include "base/internal.h"
@@ -324,8 +335,133 @@ static tt_status check_web_mercator(tt_context *ctx,
   return TT_OK;
 }
 
+/* The scale factor k, convergence and Jacobian J of raster sample (c, r)
+ * exactly as tt_grid_ground_scale_at gives them on the whole raster's
+ * ground points: a grid of the sample's neighbours (three a side, the
+ * raster's edge where it has one, so the finite differences are the same)
+ * projected from the raster's own columns and rows. */
+static tt_status raster_scale_at(tt_context *ctx,
+                                 OGRCoordinateTransformationH ct,
+                                 const double gt[6], size_t nx, size_t ny,
+                                 size_t c, size_t r,
+                                 const double metric_par[4], double *out_k,
+                                 double *out_conv, double out_j[4])
+{
+  size_t c0 = c > 0 ? c - 1 : 0, c1 = c + 1 < nx ? c + 1 : nx - 1;
+  size_t r0 = r > 0 ? r - 1 : 0, r1 = r + 1 < ny ? r + 1 : ny - 1;
+  if (c == 0)
+    c1 = nx > 2 ? 2 : nx - 1;
+  if (c == nx - 1)
+    c0 = nx > 2 ? nx - 3 : 0;
+  if (r == 0)
+    r1 = ny > 2 ? 2 : ny - 1;
+  if (r == ny - 1)
+    r0 = ny > 2 ? ny - 3 : 0;
+  size_t w = c1 - c0 + 1, h = r1 - r0 + 1;
+  double x[9], y[9];
+  int ok[9];
+  for (size_t j = 0; j < h; j++)
+    for (size_t i = 0; i < w; i++) {
+      double px = (double)(c0 + i) + 0.5, py = (double)(r0 + j) + 0.5;
+      x[j * w + i] = gt[0] + px * gt[1] + py * gt[2];
+      y[j * w + i] = gt[3] + px * gt[4] + py * gt[5];
+    }
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  int all = OCTTransformEx(ct, (int)(w * h), x, y, NULL, ok);
+  CPLPopErrorHandler();
+  tt_grid *g = NULL;
+  tt_status s = tt_grid_create(ctx, w, h, &g);
+  if (s == TT_OK)
+    s = tt_grid_set_geotransform(ctx, g, gt);
+  if (s == TT_OK)
+    s = tt_grid_alloc_ground_points(ctx, g);
+  if (s != TT_OK)
+    goto done;
+  double *xy = tt_grid_ground_xy(g);
+  for (size_t i = 0; i < w * h; i++) {
+    if (!all || !ok[i] || !isfinite(x[i]) || !isfinite(y[i])) {
+      s = tt__error(ctx, TT_ERR_DATA, "PROJ cannot project sample (col %zu, "
+                    "row %zu)", c0 + i % w, r0 + i / w);
+      goto done;
+    }
+    xy[2 * i] = x[i];
+    xy[2 * i + 1] = y[i];
+  }
+  tt_grid_set_ground_metric_fn(g, ellipsoid_metric, metric_par);
+  tt__grid_set_ground_origin(g, c0, r0, gt);
+  if (tt_grid_ground_scale_at(g, c - c0, r - r0, out_k, out_conv) != TT_OK) {
+    s = tt__error(ctx, TT_ERR_DATA, "no scale factor at sample (col %zu, "
+                  "row %zu) (a pole?)", c, r);
+    goto done;
+  }
+  tt__grid_ground_jacobian(g, c - c0, r - r0, out_j);
+done:
+  tt_grid_destroy(g);
+  return s;
+}
+
+/* Samples a side of the raster's outline is measured at for the range of
+ * k: its two ends and up to this many steps between. */
+#define TT_OUTLINE_STEPS 256
+
+/* The range of k over the raster (before any constant scale), and J at its
+ * centre sample (nx / 2, ny / 2): k at the samples of the outline (every
+ * sample of a side up to TT_OUTLINE_STEPS + 1 of them, evenly spaced
+ * otherwise) and at the two to four samples around the centre. For the
+ * frames chosen here k is a function of the distance from the centre
+ * (stereographic), of the latitude (polar stereographic, Mercator,
+ * Lambert's conic) or of the distance from the central meridian (UTM),
+ * each of which takes its extremes over a longitude/latitude rectangle on
+ * its outline or at its centre; the sampling of a long side misses at most
+ * the second-order bump of k between two measured samples. It depends on
+ * the raster only, never on a window: every tile and an untiled run get
+ * the same range, scale and frame. */
+static tt_status raster_scale_range(tt_context *ctx,
+                                    OGRCoordinateTransformationH ct,
+                                    const double gt[6], size_t nx,
+                                    size_t ny, const double metric_par[4],
+                                    double *out_kmin, double *out_kmax,
+                                    double out_centre_j[4])
+{
+  double kmin = HUGE_VAL, kmax = -HUGE_VAL, k, conv, j[4];
+  tt_status s = raster_scale_at(ctx, ct, gt, nx, ny, nx / 2, ny / 2,
+                                metric_par, &k, &conv, out_centre_j);
+  if (s != TT_OK)
+    return s;
+  for (int side = 0; side < 4; side++) {
+    size_t n = side < 2 ? nx : ny; /* 0, 1: top, bottom rows; 2, 3: columns */
+    size_t steps = n - 1 < TT_OUTLINE_STEPS ? n - 1 : TT_OUTLINE_STEPS;
+    for (size_t i = 0; i <= steps; i++) {
+      size_t at = (size_t)((double)i * (double)(n - 1) / (double)steps + 0.5);
+      size_t c = side < 2 ? at : side == 2 ? 0 : nx - 1;
+      size_t r = side < 2 ? (side == 0 ? 0 : ny - 1) : at;
+      s = raster_scale_at(ctx, ct, gt, nx, ny, c, r, metric_par, &k, &conv,
+                          j);
+      if (s != TT_OK)
+        return s;
+      kmin = fmin(kmin, k);
+      kmax = fmax(kmax, k);
+    }
+  }
+  for (int q = 0; q < 4; q++) {
+    size_t c = (q & 1) ? nx / 2 : (nx - 1) / 2;
+    size_t r = (q & 2) ? ny / 2 : (ny - 1) / 2;
+    s = raster_scale_at(ctx, ct, gt, nx, ny, c, r, metric_par, &k, &conv, j);
+    if (s != TT_OK)
+      return s;
+    kmin = fmin(kmin, k);
+    kmax = fmax(kmax, k);
+  }
+  *out_kmin = kmin;
+  *out_kmax = kmax;
+  return TT_OK;
+}
+
 tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
-                                   const char *work_srs, tt_grid *grid,
+                                   const char *work_srs,
+                                   const double raster_gt[6],
+                                   size_t raster_nx, size_t raster_ny,
+                                   size_t col0, size_t row0, tt_grid *grid,
                                    char *out_name, size_t name_size,
                                    double *out_scale_error)
 {
@@ -337,7 +473,8 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   char work_name[384] = "";
   frame_kind kind = FRAME_USER;
   const size_t nx = grid->nx, ny = grid->ny;
-  const double *gt = grid->gt;
+  const size_t rnx = raster_nx, rny = raster_ny;
+  const double *gt = raster_gt;
 
   OGRErr err = OGRERR_NONE;
   source sk = {0, 0, 0, 0};
@@ -350,19 +487,20 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
                                                                    per unit */
   sk.u = u;
   if (err != OGRERR_NONE || !(a > 0) || !isfinite(invf) || invf < 0 ||
-      !(u > 0) || nx < 2 || ny < 2)
+      !(u > 0) || rnx < 2 || rny < 2 || col0 + nx > rnx || row0 + ny > rny)
     return tt__error(ctx, TT_ERR_DATA, "no ellipsoid or angular unit for "
                      "ground points");
   double f = invf > 0 ? 1.0 / invf : 0.0, e2 = f * (2.0 - f);
   double deg = u * 180.0 / TT_PI;
 
-  /* Extent of the sample centres (a geotransform is affine, longitude
-   * and latitude monotonic in x and y: the corners). */
+  /* Extent of the whole raster's sample centres (a geotransform is
+   * affine, longitude and latitude monotonic in x and y: the corners): a
+   * window gets the frame of the raster it is cut from. */
   double lon_min = HUGE_VAL, lon_max = -HUGE_VAL, lat_min = HUGE_VAL,
          lat_max = -HUGE_VAL;
   for (int k = 0; k < 4; k++) {
-    double px = (k & 1) ? (double)nx - 0.5 : 0.5;
-    double py = (k & 2) ? (double)ny - 0.5 : 0.5;
+    double px = (k & 1) ? (double)rnx - 0.5 : 0.5;
+    double py = (k & 2) ? (double)rny - 0.5 : 0.5;
     double lon = (gt[0] + px * gt[1] + py * gt[2]) * deg;
     double lat = (gt[3] + px * gt[4] + py * gt[5]) * deg;
     if (sk.webmerc) {
@@ -408,7 +546,7 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
   if (src)
     OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
   if (sk.webmerc) {
-    s = check_web_mercator(ctx, src, &sk, gt, nx, ny);
+    s = check_web_mercator(ctx, src, &sk, gt, rnx, rny);
     if (s != TT_OK)
       goto done;
   }
@@ -422,6 +560,18 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
                   work_name);
     goto done;
   }
+
+  /* The range of k and the frame at the centre, of the whole raster. */
+  const double metric_par[4] = {a, e2, sk.webmerc ? -sk.R : u, 0};
+  double kmin, kmax, centre_frame[4];
+  s = raster_scale_range(ctx, ct, gt, rnx, rny, metric_par, &kmin, &kmax,
+                         centre_frame);
+  if (s != TT_OK)
+    goto done;
+  double scale = 1.0;
+  if (kind == FRAME_POLAR || kind == FRAME_MERCATOR || kind == FRAME_STEREO)
+    scale = 2.0 / (kmin + kmax);
+
   lx = malloc(nx * sizeof *lx);
   ly = malloc(nx * sizeof *ly);
   ok = malloc(nx * sizeof *ok);
@@ -434,9 +584,12 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     goto done;
   double *xy = tt_grid_ground_xy(grid);
 
+  /* Every sample from the raster's own column and row (not the window's
+   * geotransform), so that two tiles sharing a sample compute the same
+   * bits for it, and an untiled run too. */
   for (size_t r = 0; r < ny; r++) {
     for (size_t c = 0; c < nx; c++) {
-      double px = (double)c + 0.5, py = (double)r + 0.5;
+      double px = (double)(col0 + c) + 0.5, py = (double)(row0 + r) + 0.5;
       lx[c] = gt[0] + px * gt[1] + py * gt[2];
       ly[c] = gt[3] + px * gt[4] + py * gt[5];
     }
@@ -446,42 +599,19 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     for (size_t c = 0; c < nx; c++) {
       if (!all || !ok[c] || !isfinite(lx[c]) || !isfinite(ly[c])) {
         s = tt__error(ctx, TT_ERR_DATA, "PROJ cannot project sample (col "
-                      "%zu, row %zu) into %s", c, r, work_name);
+                      "%zu, row %zu) into %s", col0 + c, row0 + r,
+                      work_name);
         goto done;
       }
-      xy[2 * (r * nx + c)] = lx[c];
-      xy[2 * (r * nx + c) + 1] = ly[c];
+      xy[2 * (r * nx + c)] = lx[c] * scale;
+      xy[2 * (r * nx + c) + 1] = ly[c] * scale;
     }
   }
-
-  /* Scale factor and convergence per sample (tt_grid_ground_scale_at,
-   * against the ellipsoid's metric): their range here; the TIN derives
-   * them again for its vertices. */
-  const double metric_par[4] = {a, e2, sk.webmerc ? -sk.R : u, 0};
+  /* k and the convergence at the TIN's vertices (tt_grid_ground_scale_at,
+   * against the ellipsoid's metric, at the raster's map coordinates) */
   tt_grid_set_ground_metric_fn(grid, ellipsoid_metric, metric_par);
-  double kmin = HUGE_VAL, kmax = -HUGE_VAL;
-  for (size_t r = 0; r < ny; r++) {
-    for (size_t c = 0; c < nx; c++) {
-      double k = 0, conv = 0;
-      if (tt_grid_ground_scale_at(grid, c, r, &k, &conv) != TT_OK) {
-        s = tt__error(ctx, TT_ERR_DATA, "no scale factor at sample (col "
-                      "%zu, row %zu) (a pole?)", c, r);
-        goto done;
-      }
-      kmin = fmin(kmin, k);
-      kmax = fmax(kmax, k);
-    }
-  }
-  double centre_frame[4];
-  tt__grid_ground_jacobian(grid, nx / 2, ny / 2, centre_frame);
-  double scale = 1.0;
-  if (kind == FRAME_POLAR || kind == FRAME_MERCATOR || kind == FRAME_STEREO)
-    scale = 2.0 / (kmin + kmax);
+  tt__grid_set_ground_origin(grid, col0, row0, raster_gt);
   if (scale != 1.0) {
-    for (size_t i = 0; i < nx * ny; i++) {
-      xy[2 * i] *= scale;
-      xy[2 * i + 1] *= scale;
-    }
     for (int k = 0; k < 4; k++)
       centre_frame[k] *= scale;
     kmin *= scale;

@@ -663,7 +663,8 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                   "2 x 2 are needed to make a triangle", path, xsize, ysize);
     goto done;
   }
-  /* A window (a tile): its samples only; the ground frame is still the
+  /* A window (a tile): its samples only; the ground frame (and, for a
+   * geographic or Web Mercator raster, the ground points) are still the
    * whole raster's, so that every tile measures alike. */
   const size_t wx = opt.has_window ? opt.win[0] : 0;
   const size_t wy = opt.has_window ? opt.win[1] : 0;
@@ -803,10 +804,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                                                            : SIZE_MAX;
       int conformal = srs && (OSRIsGeographic(srs) ||
                               tt__georef_is_web_mercator(srs));
-      if (s == TT_OK && conformal && opt.has_window) {
-        /* tiles keep the whole raster's affine frame (the caller says
-         * so once) */
-      } else if (s == TT_OK && conformal && with_points > opt.max_memory) {
+      if (s == TT_OK && conformal && with_points > opt.max_memory) {
         char need_s[32], max_s[32];
         tt__warn(ctx, "%s: the heights and ground points of %zu x %zu "
                  "samples would need %s, more than %s (%s): keeping the "
@@ -818,8 +816,12 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
                  tt__format_bytes(max_s, sizeof max_s, opt.max_memory), frame_name);
       } else if (s == TT_OK && conformal) {
         char conformal_name[512];
-        s = tt__georef_ground_points(ctx, srs, opt.work_srs, grid,
-                                     conformal_name, sizeof conformal_name,
+        /* a window (a tile) gets the whole raster's frame and the
+         * ground points of its samples as the whole raster has them */
+        s = tt__georef_ground_points(ctx, srs, opt.work_srs, gt,
+                                     (size_t)xsize, (size_t)ysize, wx, wy,
+                                     grid, conformal_name,
+                                     sizeof conformal_name,
                                      &frame_scale_error);
         if (s == TT_OK) {
           snprintf(frame_name, sizeof frame_name, "%s", conformal_name);

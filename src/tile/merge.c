@@ -17,9 +17,16 @@
  * vertices shared by triangles, so two triangles meeting at a single
  * vertex count as one piece here (across an edge in an untiled run).
  *
- * Memory: the TIN's arrays as a refined TIN holds them, plus 8 bytes per
- * triangle (its squared errors) and 16 per vertex on a tile outline (the
- * table) until the end; no sample.
+ * A geographic or Web Mercator DEM's pieces carry their vertices' ground
+ * points, scale factors and convergences (tile.c), which are copied with
+ * the vertex (a shared vertex's are the same in both pieces: computed
+ * from the DEM's column and row, and from the window beyond the border),
+ * and the merged TIN measures areas with the pieces' area function.
+ *
+ * Memory: the TIN's arrays as a refined TIN holds them (with ground
+ * points, 24 bytes a vertex more), plus 8 bytes per triangle (its squared
+ * errors) and 16 per vertex on a tile outline (the table) until the end;
+ * no sample.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"
@@ -32,6 +39,12 @@ struct tt_tin_merger {
   size_t W, H;
   double gt[6], frame[4];
   bool have_frame, f64;
+  /* a geographic or Web Mercator DEM: the vertices' ground points, scale
+   * factors and convergences (every piece has them or none), and the
+   * area function (from a piece, or tt_tin_merger_set_ground) */
+  bool ground;
+  tt_area_fn area_fn;
+  double area_par[4];
   tt_tin *t;             /* the arrays, grown as pieces come */
   size_t vcap, tcap;
   double *t_sq;          /* per triangle: sum of squared errors */
@@ -85,9 +98,13 @@ void tt_tin_merger_size(const tt_tin_merger *m, size_t *out_vertices,
    * count and squared errors; the outline table */
   *out_vertices = m->t->nv;
   *out_triangles = m->t->nt;
-  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 24) +
+  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 24 +
+                         (m->ground ? 16 + 4 + 4 : 0)) +
                m->tcap * (12 + 8 + 4 + 8 + 8) + m->hcap * 12;
 }
+
+static void set_area_fn(tt_tin_merger *m, tt_area_fn fn,
+                        const double params[4]);
 
 static size_t hslot(const tt_tin_merger *m, int64_t key)
 {
@@ -146,6 +163,9 @@ static bool reserve(tt_tin_merger *m, size_t nv, size_t nt)
     } else {
       GROW(vz, c)
     }
+    if (m->ground) {
+      GROW(vgxy, 2 * c) GROW(vgk, c) GROW(vgconv, c)
+    }
     m->vcap = c;
   }
   if (nt > m->tcap) {
@@ -197,7 +217,15 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *m,
   if (!m->have_frame) {
     memcpy(m->frame, piece->frame, sizeof m->frame);
     m->have_frame = true;
+    m->ground = piece->vgxy != NULL;
   }
+  if ((piece->vgxy != NULL) != m->ground)
+    return tt__error(ctx, TT_ERR_ARG, "the piece of the tile at column %zu, "
+                     "row %zu is %s ground points, the pieces before it %s",
+                     tile->col0, tile->row0, piece->vgxy ? "measured on"
+                     : "without", m->ground ? "on them" : "without them");
+  if (piece->area_fn && !m->area_fn)
+    set_area_fn(m, piece->area_fn, piece->area_par);
   if (piece->vzd && !m->f64 && !widen(m))
     goto oom;
   map = malloc(piece->nv * sizeof *map);
@@ -233,6 +261,12 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *m,
     else
       t->vz[id] = piece->vz[v];
     t->v_ins_err[id] = piece->v_ins_err ? piece->v_ins_err[v] : NAN;
+    if (m->ground) {
+      t->vgxy[2 * id] = piece->vgxy[2 * v];
+      t->vgxy[2 * id + 1] = piece->vgxy[2 * v + 1];
+      t->vgk[id] = piece->vgk[v];
+      t->vgconv[id] = piece->vgconv[v];
+    }
     if (outline) {
       m->hkey[slot] = key;
       m->hval[slot] = (int32_t)id;
@@ -272,6 +306,21 @@ done:
   free(map);
   free(drop);
   return status;
+}
+
+/* The merged TIN's area function (geodesic areas of a geographic DEM). */
+static void set_area_fn(tt_tin_merger *m, tt_area_fn fn,
+                        const double params[4])
+{
+  m->area_fn = fn;
+  for (int k = 0; k < 4; k++)
+    m->area_par[k] = fn ? params[k] : 0;
+}
+
+void tt_tin_merger_set_ground(tt_tin_merger *m, const tt_grid *window)
+{
+  if (window->area_fn)
+    set_area_fn(m, window->area_fn, window->area_par);
 }
 
 static int32_t uf_find(int32_t *p, int32_t x)
@@ -327,6 +376,8 @@ tt_status tt_tin_merger_finish(tt_context *ctx, tt_tin_merger *m,
   free(p);
   memcpy(t->gt, m->gt, sizeof t->gt);
   memcpy(t->frame, m->frame, sizeof t->frame);
+  t->area_fn = m->area_fn;
+  memcpy(t->area_par, m->area_par, sizeof t->area_par);
   tt_tin_summary *s = &t->summary;
   s->vertices = t->nv;
   s->triangles = t->nt;

@@ -8,7 +8,11 @@
  * machines of one byte order, as a cluster's are), the caller's tag (the
  * plan's hash and the tile's id: a piece of another plan is refused), the
  * counts, a bit per array present, the summary, the georeference, the
- * arrays, and an FNV-1a 64 checksum of everything before it.
+ * arrays, and an FNV-1a 64 checksum of everything before it. A piece of a
+ * geographic or Web Mercator DEM has its vertices' ground points, scale
+ * factors and convergences among the arrays; its area function is code,
+ * not data: the merge takes it from a window of the DEM
+ * (tt_tin_merger_set_ground).
  */
 #include "tile/tile.h"
 #include "tin/tin.h"
@@ -38,7 +42,7 @@ static size_t fields_of(tt_tin *t, field *f)
   F(vc, 1, 0) F(vr, 1, 0) F(vz, 1, 0) F(vzd, 1, 0) F(v_ins_err, 1, 0)
   F(v_star_max, 1, 0) F(v_star_rmse, 1, 0) F(v_star_n, 1, 0)
   F(v_importance, 1, 0) F(v_home, 1, 0) F(tv, 3, 1) F(t_max, 1, 1)
-  F(t_rmse, 1, 1) F(t_n, 1, 1)
+  F(t_rmse, 1, 1) F(t_n, 1, 1) F(vgxy, 2, 0) F(vgk, 1, 0) F(vgconv, 1, 0)
 #undef F
   return n;
 }
@@ -66,11 +70,9 @@ tt_status tt_tin_piece_encode(tt_context *ctx, const tt_tin *piece,
 {
   *out = NULL;
   *out_len = 0;
-  if (!piece || piece->vgxy || piece->vgk || piece->vgconv ||
-      piece->area_fn)
-    return tt__error(ctx, TT_ERR_ARG, "a piece of a tile has no "
-                         "ground points or area function");
-  field f[16];
+  if (!piece)
+    return tt__error(ctx, TT_ERR_ARG, "piece must not be NULL");
+  field f[20];
   tt_tin *t = (tt_tin *)piece; /* read only */
   size_t nf = fields_of(t, f), len = sizeof(head) + 8;
   head h;
@@ -137,7 +139,7 @@ tt_status tt_tin_piece_decode(tt_context *ctx, const void *bytes, size_t len,
   memcpy(t->gt, h.gt, sizeof h.gt);
   memcpy(t->frame, h.frame, sizeof h.frame);
   memcpy(t->area_par, h.area_par, sizeof h.area_par);
-  field f[16];
+  field f[20];
   size_t nf = fields_of(t, f), at = sizeof h;
   for (size_t i = 0; i < nf; i++) {
     if (!(h.mask & (1u << i)))

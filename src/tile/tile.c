@@ -22,8 +22,15 @@
  * a window, the tile's extent and the options give the same piece on any
  * machine.
  *
+ * A geographic or Web Mercator DEM is measured on ground points, as
+ * untiled: the window holds the whole raster's (tt_gdal_read_grid), the
+ * tile's grid a copy of the tile's part, and the piece keeps its
+ * vertices' ground points, scale factors and convergences (the latter
+ * from the window, so that they are the untiled run's at the borders too).
+ *
  * Memory: the window's heights, a copy of the tile's (4 or 8 bytes a
- * sample), and refinement's state for the tile.
+ * sample), with ground points 16 bytes a sample more in each, and
+ * refinement's state for the tile.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"
@@ -148,6 +155,49 @@ done:
   return status;
 }
 
+/* The tile's part of the window's ground points (a geographic or Web
+ * Mercator DEM: the whole raster's, tt_gdal_read_grid), with its ground
+ * metric, origin and area function: the tile is measured on the ground
+ * as an untiled run measures it. 16 bytes a sample of the tile. */
+static tt_status copy_ground(tt_context *ctx, const tt_grid *w, size_t dx,
+                             size_t dy, tt_grid *g)
+{
+  if (!w->gxy)
+    return TT_OK;
+  tt_status status = tt_grid_alloc_ground_points(ctx, g);
+  if (status != TT_OK)
+    return status;
+  for (size_t y = 0; y < g->ny; y++)
+    memcpy(g->gxy + 2 * y * g->nx, w->gxy + 2 * ((y + dy) * w->nx + dx),
+           2 * g->nx * sizeof *g->gxy);
+  tt_grid_set_ground_metric_fn(g, w->metric_fn, w->metric_par);
+  tt_grid_set_area_fn(g, w->area_fn, w->area_par);
+  if (w->has_morigin)
+    tt__grid_set_ground_origin(g, w->mc0 + dx, w->mr0 + dy, w->mgt);
+  return TT_OK;
+}
+
+/* The scale factor and convergence of the piece's vertices (DEM pixel
+ * coordinates) from the window rather than the tile: the window holds one
+ * line beyond every shared side, so a vertex on a tile's border gets the
+ * central differences of an untiled run (and the same values in both
+ * tiles that have it), not one-sided ones. */
+static void window_scales(const tt_grid *w, size_t wc0, size_t wr0,
+                          tt_tin *tin)
+{
+  for (size_t v = 0; v < tin->nv; v++) {
+    double k = 1, conv = 0;
+    if (tt_grid_ground_scale_at(w, (size_t)tin->vc[v] - wc0,
+                                (size_t)tin->vr[v] - wr0, &k,
+                                &conv) != TT_OK) {
+      k = 1;
+      conv = 0;
+    }
+    tin->vgk[v] = (float)k;
+    tin->vgconv[v] = (float)conv;
+  }
+}
+
 /* An empty piece: the tile has no triangle (all nodata, or its valid
  * samples in no cell with three valid corners). */
 static tt_status empty_piece(tt_context *ctx, size_t owned, tt_tin **out)
@@ -190,9 +240,6 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
                      "%zu x %zu samples (the tile and one line beyond each "
                      "shared side), got %zu x %zu", t->col0, t->row0, wnx,
                      wny, window->nx, window->ny);
-  if (window->gxy)
-    return tt__error(ctx, TT_ERR_ARG, "tiles are measured in the affine "
-                     "ground frame: the window must have no ground points");
 
   tt_status status;
   tt_grid *g = NULL;
@@ -223,7 +270,8 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
   gt[0] += (double)dx * gt[1] + (double)dy * gt[2];
   gt[3] += (double)dx * gt[4] + (double)dy * gt[5];
   if ((status = tt_grid_set_geotransform(ctx, g, gt)) != TT_OK ||
-      (status = tt_grid_set_ground_frame(ctx, g, window->frame)) != TT_OK)
+      (status = tt_grid_set_ground_frame(ctx, g, window->frame)) != TT_OK ||
+      (status = copy_ground(ctx, window, dx, dy, g)) != TT_OK)
     goto done;
   size_t valid = 0;
   for (size_t i = 0; i < nx * ny; i++)
@@ -250,6 +298,8 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
     tin->vc[v] += (int32_t)t->col0;
     tin->vr[v] += (int32_t)t->row0;
   }
+  if (tin->vgxy)
+    window_scales(window, wc0, wr0, tin);
   memcpy(tin->gt, window->gt, sizeof tin->gt);
   tin->gt[0] -= (double)wc0 * tin->gt[1] + (double)wr0 * tin->gt[2];
   tin->gt[3] -= (double)wc0 * tin->gt[4] + (double)wr0 * tin->gt[5];

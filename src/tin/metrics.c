@@ -205,10 +205,15 @@ static tt_status build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
       status = tt__error(ctx, TT_ERR_NOMEM, "out of memory for the TIN");
       goto done;
     }
+    /* indexed as the TIN's vertices (vmap): a vertex in no triangle
+     * (removed by decimation, outside the valid domain) is skipped */
     for (size_t v = 0; v < m->nv; v++) {
+      if (vmap[v] < 0)
+        continue;
       size_t i = (size_t)m->v[v].r * g->nx + (size_t)m->v[v].c;
-      tin->vgxy[2 * v] = g->gxy[2 * i];
-      tin->vgxy[2 * v + 1] = g->gxy[2 * i + 1];
+      size_t o = (size_t)vmap[v];
+      tin->vgxy[2 * o] = g->gxy[2 * i];
+      tin->vgxy[2 * o + 1] = g->gxy[2 * i + 1];
       /* the scale and convergence of the vertex's sample, derived here
        * for vertices only (the grid keeps 16 bytes a sample) */
       double k = 1, conv = 0;
@@ -217,8 +222,8 @@ static tt_status build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
         k = 1;
         conv = 0;
       }
-      tin->vgk[v] = (float)k;
-      tin->vgconv[v] = (float)conv;
+      tin->vgk[o] = (float)k;
+      tin->vgconv[o] = (float)conv;
     }
   }
   for (size_t v = 0; v < m->nv; v++) {

@@ -1,0 +1,148 @@
+#!/usr/bin/env bash
+# test_tiles_geo.sh -- issue 19: tiled runs of geographic and Web Mercator
+# DEMs measured on the ground, as untiled runs are ($TT_TERRATIN). A
+# 257^2 fractal given three georeferencings: EPSG:4326 over 1 x 0.5 degree
+# at 69.5-70 N (a UTM frame), EPSG:4326 over 10 x 6 degrees at 70-76 N (an
+# oblique stereographic frame with its constant scale) and EPSG:3857 at
+# 58-61 N (map scale about 2). For each, `simplify -tile_size 64` on 2
+# threads against an untiled run at the same bound: the frame reported is
+# the untiled one and no affine-frame warning is given; the tiled TIN is
+# conforming (tin_topology.py) and within the bound by `terratin eval`;
+# its vertex count is within 5 % of the untiled one; every triangle that
+# both TINs have (the same three samples) has the same area_2d, area_3d,
+# slope, aspect and angles, to 1e-12 relative (the same ground points,
+# scale factors, convergences and geodesic areas; only the rotation of the
+# corners, and so the rounding, may differ; in the affine frame of the
+# whole raster that tiles had before, slopes differed by up to 1.2 % in
+# the UTM case and 17 % in the stereographic one); 1 thread gives
+# the same layers; and
+# `tiles plan/run/merge` gives the same layers as `simplify -tile_size`
+# (the pieces carry the ground points, the merge the geodesic areas).
+# Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
+# missing.
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
+
+T=${TT_TERRATIN:-}
+if [ -z "$T" ] || [ ! -x "$T" ]; then
+  echo "SKIP: TT_TERRATIN is not set or not executable"
+  exit 77
+fi
+for tool in gdal_translate ogrinfo python3 md5sum; do
+  if ! command -v "$tool" >/dev/null 2>&1; then
+    echo "SKIP: $tool is missing"
+    exit 77
+  fi
+done
+TOPO="$(cd "$(dirname "$0")" && pwd)/tin_topology.py"
+
+W=$(mktemp -d "${TMPDIR:-/tmp}/tt_tiles_geo.XXXXXX") || exit 1
+trap 'rm -rf "$W"' EXIT
+cd "$W" || exit 1
+
+rc=0
+run() {
+  "$T" "$@" >out.txt 2>err.txt
+  rc=$?
+}
+jget() { # jget FILE KEY[.KEY...]
+  python3 -c 'import json,sys
+d=json.load(open(sys.argv[1]))
+for k in sys.argv[2].split("."): d=d[k]
+print(d)' "$1" "$2"
+}
+dump() { ogrinfo -ro -al -q "$1" triangles vertices 2>/dev/null | md5sum | cut -d' ' -f1; }
+within() { python3 -c 'import sys; a,b,p=map(float,sys.argv[1:]); sys.exit(0 if abs(a/b-1)*100<=p else 1)' "$1" "$2" "$3"; }
+
+# same_triangles A.gpkg B.gpkg: the attributes of the triangles both TINs
+# have (the same three samples) are equal; prints how many there are
+cat >same.py <<'PY'
+import sqlite3, sys
+COLS = "area_2d, area_3d, slope, aspect, min_angle, max_angle"
+def tris(path):
+    db = sqlite3.connect(path)
+    v = {i: (c, r) for i, c, r in
+         db.execute("select vertex_id, col, row from vertices")}
+    return {tuple(sorted(v[i] for i in row[:3])): row[3:] for row in
+            db.execute("select v0, v1, v2, %s from triangles" % COLS)}
+a, b = tris(sys.argv[1]), tris(sys.argv[2])
+common = [k for k in a if k in b]
+# the corners may come in another rotation: rounding differs by an ulp
+worst, at = 0.0, None
+for k in common:
+    for i, (x, y) in enumerate(zip(a[k], b[k])):
+        d = abs(x - y)
+        if i == 3:  # aspect: 0 and 360 are one azimuth
+            d = min(d, 360 - d)
+        d /= max(1.0, abs(x), abs(y))
+        if d > worst:
+            worst, at = d, k
+print("%d of %d triangles in common, largest relative difference %.3g%s" % (
+    len(common), len(a), worst,
+    (" at %s: %s vs %s" % (at, a[at], b[at])) if at else ""))
+sys.exit(0 if len(common) * 2 > len(a) and worst <= 1e-12 else 1)
+PY
+
+run generate diamond_square ds.tif -size 257 -seed 7 -q
+check "generate: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+E=4
+# name, SRS, extent (ulx uly lrx lry), the frame the untiled run chooses
+cases=(
+  "utm|EPSG:4326|10 70 11 69.5|UTM zone 32N"
+  "stereo|EPSG:4326|10 76 20 70|oblique stereographic"
+  "webmerc|EPSG:3857|1000000 8600000 1300000 8000000|UTM zone 32N"
+)
+for c in "${cases[@]}"; do
+  IFS='|' read -r name srs ullr frame <<<"$c"
+  # shellcheck disable=SC2086
+  gdal_translate -q -a_srs "$srs" -a_ullr $ullr ds.tif $name.tif
+  run simplify -q -json -max_error $E $name.tif u_$name.gpkg
+  check "$name untiled: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  cp out.txt u.json
+  run simplify -json -max_error $E -tile_size 64 -threads 2 $name.tif t_$name.gpkg
+  check "$name tiled: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  cp out.txt t.json
+  check "$name tiled: no affine-frame warning ($(cat err.txt))" \
+    bash -c "! grep -qi 'affine' err.txt"
+  fu=$(jget u.json frame); ft=$(jget t.json frame)
+  check "$name: frame '$ft' is the untiled '$fu'" [ "$ft" = "$fu" ]
+  check "$name: frame is $frame" bash -c "echo '$fu' | grep -q '$frame'"
+  check "$name: per vertex" bash -c "echo '$ft' | grep -q 'per vertex'"
+  nu=$(jget u.json vertices); nt=$(jget t.json vertices)
+  echo "note: $name: tiled $nt vertices, untiled $nu; frame $ft"
+  check "$name: tiled vertices $nt within 5 % of untiled $nu" within "$nt" "$nu" 5
+  if python3 "$TOPO" t_$name.gpkg >topo.json 2>topo.err; then pass; else
+    fail "$name: not conforming: $(cat topo.json topo.err)"; fi
+  check "$name: Euler characteristic 1 ($(cat topo.json))" \
+    [ "$(jget topo.json euler)" = 1 ]
+  "$T" eval -json -max_error $E $name.tif t_$name.gpkg >eval.json 2>eval.err
+  erc=$?
+  check "$name: eval within $E ($(cat eval.err))" [ $erc -eq 0 ]
+  check "$name: none uncovered" [ "$(jget eval.json uncovered)" = 0 ]
+  check "$name: none overlapped" [ "$(jget eval.json overlapped)" = 0 ]
+  python3 same.py t_$name.gpkg u_$name.gpkg >same.txt 2>&1
+  src=$?
+  check "$name: common triangles' attributes equal ($(cat same.txt))" [ $src -eq 0 ]
+  echo "note: $name: $(cat same.txt)"
+  run simplify -q -max_error $E -tile_size 64 -threads 1 $name.tif t1_$name.gpkg
+  check "$name: 1 and 2 threads give the same layers" \
+    [ "$(dump t1_$name.gpkg)" = "$(dump t_$name.gpkg)" ]
+done
+
+# tiles plan/run/merge of the stereographic DEM: the pieces keep the
+# ground points, the merge takes the geodesic areas from a window
+run tiles plan stereo.tif p.json -max_error $E -tile_size 64
+check "plan: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+n=$(jget p.json tiles)
+ok=0
+for k in $(seq 0 $((n - 1))); do
+  "$T" tiles run p.json "$k" >/dev/null 2>>err.txt || ok=1
+done
+check "tiles run: $n tiles exit 0 ($(cat err.txt))" [ "$ok" -eq 0 ]
+run tiles merge p.json m.gpkg -q
+check "merge: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "merge: the layers of simplify -tile_size" \
+  [ "$(dump m.gpkg)" = "$(dump t_stereo.gpkg)" ]
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
