@@ -54,7 +54,8 @@ for spec in "N36W085.hgt:$valid" "n36.dt0:" "dem.vrt:$valid" \
   case $f in /vsizip/*) [ -f dem.zip ] || { echo "SKIP: no zip command"; continue; } ;; esac
   out=$(echo "$f" | tr '/.' '__').gpkg
   "$T" simplify -q -json -max_error 10 "$f" "$out" >s.json 2>err.txt
-  check "$f: simplify exit 0 ($(head -c 200 err.txt))" [ $? -eq 0 ]
+  rc=$? # before the check: its $(...) would reset $?
+  check "$f: simplify exit 0 ($(head -c 200 err.txt))" [ $rc -eq 0 ]
   [ -s s.json ] || continue
   [ -n "$want" ] && check "$f: $want valid samples" [ "$(get s.json valid_samples)" = "$want" ]
   "$T" eval -json -max_error 10 "$f" "$out" >e.json 2>err.txt
