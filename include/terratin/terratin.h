@@ -710,6 +710,18 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
                       const tt_tile *tile, const tt_refine_options *opt,
                       tt_tin **out_piece);
 
+/* The same by vertex decimation (tt_decimate_run): the tile's start
+ * (every option of opt, but a max error as the only stop condition) keeps
+ * its border vertices and no other sample of its shared sides, and no
+ * removal, repair or final pass touches them, so the pieces meet as
+ * refined ones do. With start greedy:N a tile inserts ceil(N x its cells /
+ * the DEM's cells) vertices after its corners, outline and border
+ * vertices. */
+tt_status tt_tile_decimate(tt_context *ctx, const tt_grid *window,
+                           const tt_tile *tile,
+                           const tt_decimate_options *opt,
+                           tt_tin **out_piece);
+
 /* Joins pieces into one TIN: create with the DEM's size and geotransform,
  * add every tile's piece in a fixed order (the result depends on the
  * order, never on which tile finished first), finish. Shared border
