@@ -321,10 +321,14 @@ tt_status tt__app_study_tins_commit(app_run *r, app_study_tins *w);
 void tt__app_study_tins_free(app_study_tins *w);
 /* tiled.c: the DEM of band read and refined in tiles of tile_size cells
  * on the workers, merged into *out_tin; ro's max_error < 0 asks for the
- * default bound (then set, and *default_error). The failure is recorded. */
+ * default bound (then set, and *default_error). With dopt (else NULL) the
+ * tiles are decimated with its options, its max_error that of ro. The
+ * failure is recorded. */
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
                                  const char *path, size_t tile_size,
-                                 tt_refine_options *ro, int *default_error,
+                                 tt_refine_options *ro,
+                                 tt_decimate_options *dopt,
+                                 int *default_error,
                                  tt_tin **out_tin, tt_raster_info **out_info,
                                  size_t *out_valid, double *out_zmin,
                                  double *out_zmax, size_t *out_tiles,

@@ -47,6 +47,31 @@ static int check_srs(app_run *r, const char *option, const char *value,
   return ok;
 }
 
+/* The decimation options of the command: ro's stops, criterion and
+ * passes, and the -start, -importance, -selection, -onepass, -hole. */
+static void decimate_options(const tt_app_settings *s,
+                             const tt_refine_options *ro,
+                             tt_decimate_options *dopt)
+{
+  tt_decimate_options_init(dopt);
+  dopt->max_error = ro->max_error;
+  dopt->max_points = ro->max_points;
+  dopt->max_triangles = ro->max_triangles;
+  dopt->percent = ro->percent;
+  dopt->criterion = ro->criterion;
+  dopt->optimize = ro->optimize;
+  dopt->anneal = ro->anneal;
+  dopt->repair = ro->repair;
+  dopt->start = s->start;
+  dopt->start_points = s->start_points;
+  dopt->importance = s->importance;
+  dopt->selection = s->selection;
+  dopt->onepass = s->onepass;
+  dopt->hole = s->hole;
+  dopt->progress = ro->progress;
+  dopt->progress_arg = ro->progress_arg;
+  dopt->threads = ro->threads;
+}
 
 tt_status tt__app_simplify(app_run *r)
 {
@@ -62,8 +87,10 @@ tt_status tt__app_simplify(app_run *r)
   char **wopts = NULL, **dsco = NULL;
   app_simplify_report rep;
   tt_refine_options ro;
+  tt_decimate_options dopt;
   size_t valid = 0;
   memset(&rep, 0, sizeof rep);
+  tt_decimate_options_init(&dopt);
 
   if (tt__app_same_file(s->input, s->output))
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
@@ -254,12 +281,20 @@ planned:;
     }
   }
   if (tile) {
-    if (s->decimate || !no_budget) {
+    if (s->decimate && !no_budget) {
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -tile_size with -method decimate "
+                        "simplifies each tile to -max_error (or the default "
+                        "bound): %s is for -method insert only in tiles "
+                        "(docs/scale.md)", s->max_points ? "-max_points"
+                        : s->max_triangles ? "-max_triangles" : "-percent");
+      goto done;
+    }
+    if (!no_budget) {
       st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
                         "simplify: -tile_size refines each tile to -max_error "
-                        "(or the default bound) by insertion: %s cannot be "
-                        "split over tiles", s->decimate ? "-method decimate"
-                        : s->max_points ? "-max_points"
+                        "(or the default bound): %s cannot be split over "
+                        "tiles", s->max_points ? "-max_points"
                         : s->max_triangles ? "-max_triangles" : "-percent");
       goto done;
     }
@@ -283,7 +318,12 @@ planned:;
     }
     tt__app_phase_set(&r->prog, 0.0, 0.85);
     double t_tiles = tt__app_now();
+    if (s->decimate) {
+      decimate_options(s, &ro, &dopt);
+      rep.dopt = &dopt;
+    }
     st = tt__app_simplify_tiled(r, band, s->input, tile, &ro,
+                                s->decimate ? &dopt : NULL,
                                 &rep.default_error, &tin, &info, &valid,
                                 &rep.zmin, &rep.zmax, &rep.tiles,
                                 &rep.tile_threads);
@@ -333,26 +373,8 @@ planned:;
   ro.progress = tt__app_phase_fn;
   ro.progress_arg = &r->prog;
   rep.ropt = &ro;
-  tt_decimate_options dopt;
-  tt_decimate_options_init(&dopt);
   if (s->decimate) {
-    dopt.max_error = ro.max_error;
-    dopt.max_points = ro.max_points;
-    dopt.max_triangles = ro.max_triangles;
-    dopt.percent = ro.percent;
-    dopt.criterion = ro.criterion;
-    dopt.optimize = ro.optimize;
-    dopt.anneal = ro.anneal;
-    dopt.repair = ro.repair;
-    dopt.start = s->start;
-    dopt.start_points = s->start_points;
-    dopt.importance = s->importance;
-    dopt.selection = s->selection;
-    dopt.onepass = s->onepass;
-    dopt.hole = s->hole;
-    dopt.progress = ro.progress;
-    dopt.progress_arg = ro.progress_arg;
-    dopt.threads = ro.threads;
+    decimate_options(s, &ro, &dopt);
     rep.dopt = &dopt;
   }
   double t_run = tt__app_now();

@@ -18,6 +18,9 @@
  * at their next check (refinement polls the stop flag every 256
  * insertions).
  *
+ * With -method decimate each tile is decimated instead (tt_tile_decimate),
+ * with the same borders.
+ *
  * Without -max_error the bound is 0.5 % of the height range, as untiled:
  * one more pass over the tiles finds the range first.
  *
@@ -50,6 +53,8 @@ typedef struct tiled {
   const char *path;
   char **ropts;             /* the read options but WINDOW */
   tt_refine_options ro;     /* per tile: one thread, stop flag polled */
+  tt_decimate_options dec;  /* the same for decimation, when decimate */
+  bool decimate;
   size_t W, H, N, ntx, nty, ntiles;
   int nthreads;
   bool minmax_only;         /* the pre-pass for the default bound */
@@ -156,7 +161,8 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k)
     T->zmax[k] = hi;
     T->valid[k] = n;
   } else if (st == TT_OK) {
-    st = tt_tile_run(ctx, win, &t, &T->ro, &piece);
+    st = T->decimate ? tt_tile_decimate(ctx, win, &t, &T->dec, &piece)
+                     : tt_tile_run(ctx, win, &t, &T->ro, &piece);
   }
   tt_grid_destroy(win);
   if (st != TT_OK) {
@@ -331,7 +337,9 @@ size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
 
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
                                  const char *path, size_t tile_size,
-                                 tt_refine_options *ro, int *default_error,
+                                 tt_refine_options *ro,
+                                 tt_decimate_options *dopt,
+                                 int *default_error,
                                  tt_tin **out_tin, tt_raster_info **out_info,
                                  size_t *out_valid, double *out_zmin,
                                  double *out_zmax, size_t *out_tiles,
@@ -383,6 +391,14 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
   T.ro.max_memory = 0; /* bounded by the tiles in flight (simplify.c) */
   T.ro.progress = stop_check;
   T.ro.progress_arg = &T;
+  if (dopt) {
+    T.decimate = true;
+    T.dec = *dopt;
+    T.dec.max_error = ro->max_error;
+    T.dec.threads = 1;
+    T.dec.progress = stop_check;
+    T.dec.progress_arg = &T;
+  }
   T.pieces = calloc(T.ntiles, sizeof *T.pieces);
   T.done = calloc(T.ntiles, sizeof *T.done);
   T.zmin = calloc(T.ntiles, sizeof *T.zmin);
@@ -440,6 +456,9 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     }
     ro->max_error = 0.005 * (zmax - zmin);
     T.ro.max_error = ro->max_error;
+    T.dec.max_error = ro->max_error;
+    if (dopt)
+      dopt->max_error = ro->max_error;
     *default_error = 1;
     T.minmax_only = false;
   }

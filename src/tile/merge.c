@@ -41,6 +41,10 @@ struct tt_tin_merger {
   size_t hcap, hn;
   /* sums, in piece order */
   size_t covered, valid, forced;
+  /* decimated pieces: their counts summed (rounds: the most of any), and
+   * whether any piece has importances (else the TIN has none) */
+  size_t start_vertices, removed, rounds, refused;
+  bool importance;
   double sum_abs, sum_sq, max_err;
   int64_t max_index;
   double seconds_mesh, seconds_stats;
@@ -80,12 +84,12 @@ void tt_tin_merger_destroy(tt_tin_merger *m)
 void tt_tin_merger_size(const tt_tin_merger *m, size_t *out_vertices,
                         size_t *out_triangles, size_t *out_bytes)
 {
-  /* per vertex: col, row, height (8 as doubles), insertion error, and the
-   * star statistics finishing adds (24); per triangle: corners, max, rmse,
+  /* per vertex: col, row, height (8 as doubles), insertion error,
+   * importance, and the star statistics finishing adds (24); per triangle: corners, max, rmse,
    * count and squared errors; the outline table */
   *out_vertices = m->t->nv;
   *out_triangles = m->t->nt;
-  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 24) +
+  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 8 + 24) +
                m->tcap * (12 + 8 + 4 + 8 + 8) + m->hcap * 12;
 }
 
@@ -140,7 +144,7 @@ static bool reserve(tt_tin_merger *m, size_t nv, size_t nt)
   if (!(p = realloc(t->field, (n) * sizeof *t->field)))                    \
     return false;                                                          \
   t->field = p;
-    GROW(vc, c) GROW(vr, c) GROW(v_ins_err, c)
+    GROW(vc, c) GROW(vr, c) GROW(v_ins_err, c) GROW(v_importance, c)
     if (m->f64) {
       GROW(vzd, c)
     } else {
@@ -189,6 +193,12 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *m,
   const tt_error_stats *e = &piece->summary.errors;
   m->valid += piece->summary.valid_samples;
   m->forced += piece->summary.forced_vertices;
+  m->start_vertices += piece->summary.start_vertices;
+  m->removed += piece->summary.removed_vertices;
+  m->refused += piece->summary.refused_bound;
+  if (piece->summary.rounds > m->rounds)
+    m->rounds = piece->summary.rounds;
+  m->importance |= piece->v_importance != NULL;
   m->seconds_mesh += piece->summary.seconds_mesh;
   m->seconds_stats += piece->summary.seconds_statistics;
   m->t->summary.criterion = piece->summary.criterion;
@@ -233,6 +243,7 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *m,
     else
       t->vz[id] = piece->vz[v];
     t->v_ins_err[id] = piece->v_ins_err ? piece->v_ins_err[v] : NAN;
+    t->v_importance[id] = piece->v_importance ? piece->v_importance[v] : NAN;
     if (outline) {
       m->hkey[slot] = key;
       m->hval[slot] = (int32_t)id;
@@ -336,6 +347,14 @@ tt_status tt_tin_merger_finish(tt_context *ctx, tt_tin_merger *m,
   s->stop_reason = TT_STOP_MAX_ERROR;
   s->components = pieces;
   s->forced_vertices = m->forced;
+  s->start_vertices = m->start_vertices;
+  s->removed_vertices = m->removed;
+  s->rounds = m->rounds;
+  s->refused_bound = m->refused;
+  if (!m->importance) {
+    free(t->v_importance);
+    t->v_importance = NULL;
+  }
   s->seconds_mesh = m->seconds_mesh;
   s->seconds_statistics = m->seconds_stats;
   tt_error_stats *e = &s->errors;
