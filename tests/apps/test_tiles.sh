@@ -9,8 +9,10 @@
 # `terratin eval` (every valid sample within the bound, covered once); the
 # layers are the same for 1 and 2 threads; the vertex count is within 5 %
 # of an untiled run's; the default bound is the untiled one; -max_memory
-# too small for the heights tiles by itself; bad -tile_size values,
-# budgets and decimation are refused with nothing written; an interrupted
+# too small for the heights tiles by itself; decimation in tiles keeps
+# the border polylines' vertices (those of insertion's tiles), with every
+# decimation option, the same for 1 and 2 threads; bad -tile_size values
+# and decimation with budgets are refused with nothing written; an interrupted
 # tiled run leaves nothing behind. Prints "N passed, M failed"; exits 1 on
 # any failure, 77 when a tool is missing.
 set -u
@@ -164,6 +166,47 @@ check "nodata: the same uncovered samples as untiled" \
 run simplify -q -max_error 4 -tile_size 100 -threads 1 in/n.tif out/n1.gpkg
 check "nodata: threads 1 vs 2, the same layers" [ "$(dump out/n1.gpkg)" = "$(dump out/n100.gpkg)" ]
 
+# --- decimation in tiles: the border vertices kept, every option ---
+run simplify -q -json -method decimate -max_error 6 in/ds.tif out/du.gpkg
+cp out.txt du.json
+run simplify -q -json -method decimate -max_error 6 -tile_size 128 -threads 2 in/ds.tif out/dt.gpkg
+check "decimate, tiles of 128: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+cp out.txt dt.json
+nu=$(jget du.json vertices)
+nv=$(jget dt.json vertices)
+echo "note: fractal 513, decimation at 6: tiles of 128: $nv vertices, untiled $nu"
+check "decimate, tiles of 128: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
+check "decimate, tiles of 128: method reported" [ "$(jget dt.json method)" = decimate ]
+conforming "decimate, tiles of 128" out/dt.gpkg
+bounded "decimate, tiles of 128" in/ds.tif out/dt.gpkg 6
+check "decimate: uncovered 0" [ "$(jget eval.json uncovered)" = 0 ]
+run simplify -q -method decimate -max_error 6 -tile_size 128 -threads 1 in/ds.tif out/dt1.gpkg
+check "decimate: threads 1 vs 2, the same layers" [ "$(dump out/dt1.gpkg)" = "$(dump out/dt.gpkg)" ]
+# the border vertices are those of insertion's tiles (the border polylines)
+python3 - out/dt.gpkg out/t128.gpkg 128 513 >bv.txt <<'PY'
+import sqlite3, sys
+def border(p, n, w):
+    db = sqlite3.connect(p)
+    return {(c, r) for c, r in db.execute("select col, row from vertices")
+            if (c % n == 0 and 0 < c < w - 1) or (r % n == 0 and 0 < r < w - 1)}
+a, b = border(sys.argv[1], int(sys.argv[3]), int(sys.argv[4])), border(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
+print(len(a), len(b), len(a ^ b))
+PY
+read -r nba nbb nbx <bv.txt
+check "decimate: $nba border vertices, insertion's $nbb, $nbx differ" [ "$nbx" = 0 ] && [ "$nba" -gt 0 ]
+for opts in "-start greedy -importance drop" "-selection sequential -hole minangle" \
+            "-onepass -importance volume" "-start greedy:20000 -importance hdh"; do
+  run simplify -q -json -method decimate -max_error 4 -tile_size 100 -threads 2 $opts in/n.tif out/dn.gpkg -overwrite
+  check "decimate $opts, nodata: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  conforming "decimate $opts, nodata" out/dn.gpkg in/n.asc ""
+  case $opts in
+    *greedy:*) ;; # starts above the bound: no removal lowers its error
+    *) bounded "decimate $opts, nodata" in/n.tif out/dn.gpkg 4 ;;
+  esac
+  run simplify -q -method decimate -max_error 4 -tile_size 100 -threads 1 $opts in/n.tif out/dn1.gpkg -overwrite
+  check "decimate $opts: threads 1 vs 2, the same layers" [ "$(dump out/dn1.gpkg)" = "$(dump out/dn.gpkg)" ]
+done
+
 # --- the memory limit chooses tiles ---
 run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg
 check "-max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
@@ -193,7 +236,7 @@ refused "-tile_size 1e3" simplify -tile_size 1e3 in/ds.tif out/x.gpkg
 refused "-tile_size 99999" simplify -tile_size 99999 in/ds.tif out/x.gpkg
 refused "-tile_size with -percent" simplify -tile_size 256 -percent 5 in/ds.tif out/x.gpkg
 refused "-tile_size with -max_points" simplify -tile_size 256 -max_points 500 in/ds.tif out/x.gpkg
-refused "-tile_size with decimation" simplify -tile_size 256 -method decimate -max_error 3 in/ds.tif out/x.gpkg
+refused "-tile_size, decimation with -max_points" simplify -tile_size 256 -method decimate -max_points 500 in/ds.tif out/x.gpkg
 refused "tiles over -max_memory" simplify -tile_size 512 -max_memory 1M -max_error 6 in/ds.tif out/x.gpkg
 
 # --- an interrupted tiled run leaves nothing (SIGTERM: a background job
@@ -235,6 +278,18 @@ for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschg
   check "$b: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
   conforming "$b, tiles of 128" out/${b}_t.gpkg in/$b.asc ""
   bounded "$b, tiles of 128" "$S/$p" out/${b}_t.gpkg $e
+  # decimation
+  run simplify -q -json -method decimate -max_error $e "$S/$p" out/${b}_du.gpkg
+  cp out.txt ${b}_du.json
+  run simplify -q -json -method decimate -max_error $e -tile_size 128 "$S/$p" out/${b}_dt.gpkg
+  check "$b: tiled decimation exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  cp out.txt ${b}_dt.json
+  nu=$(jget ${b}_du.json vertices)
+  nv=$(jget ${b}_dt.json vertices)
+  echo "note: $b, decimation at $e: tiles of 128: $nv vertices, untiled $nu"
+  check "$b, decimation: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
+  conforming "$b, decimation in tiles of 128" out/${b}_dt.gpkg in/$b.asc ""
+  bounded "$b, decimation in tiles of 128" "$S/$p" out/${b}_dt.gpkg $e
 done
 
 echo "$passed passed, $failed failed"
