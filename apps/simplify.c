@@ -262,7 +262,7 @@ planned:;
                               : (int)sysconf(_SC_NPROCESSORS_ONLN);
   if (nth < 1)
     nth = 1;
-  if (!tile && !s->decimate && no_budget && s->max_memory &&
+  if (!tile && !s->decimate && s->max_memory &&
       dem_w > 2 && dem_h > 2 && cells > mem_limit / 8) {
     /* about 8 bytes a sample untiled: tiles of 1024 (a multiple of the
      * block size), halved until those in flight hold half the limit;
@@ -290,16 +290,12 @@ planned:;
                         : s->max_triangles ? "-max_triangles" : "-percent");
       goto done;
     }
-    if (!no_budget) {
-      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                        "simplify: -tile_size refines each tile to -max_error "
-                        "(or the default bound): %s cannot be split over "
-                        "tiles", s->max_points ? "-max_points"
-                        : s->max_triangles ? "-max_triangles" : "-percent");
-      goto done;
-    }
     tt_refine_options_init(&ro);
     ro.max_error = s->max_error;
+    /* a budget becomes the bound whose tiles meet it (tiled_budget.c) */
+    ro.max_points = s->max_points;
+    ro.max_triangles = s->max_triangles;
+    ro.percent = s->percent;
     ro.criterion = s->criterion;
     ro.optimize = s->optimize;
     ro.anneal = s->anneal;
@@ -326,7 +322,7 @@ planned:;
                                 s->decimate ? &dopt : NULL,
                                 &rep.default_error, &tin, &info, &valid,
                                 &rep.zmin, &rep.zmax, &rep.tiles,
-                                &rep.tile_threads);
+                                &rep.tile_threads, &rep.budget_passes);
     if (st != TT_OK || !tin) /* no TIN: one tile of `tiles run`, saved */
       goto done;
     GDALClose(src);

@@ -899,6 +899,10 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
   int32_t ahead = -1; /* the likely next insertion's triangle (prefetch) */
   for (size_t iter = 1;; iter++) {
     prefetch_next(&r, &ahead);
+    if (borders && borders->curve)
+      borders->curve(borders->curve_arg, r.m.nv,
+                     tt__heap_size(&r.heap) ? tt__heap_top(&r.heap).key
+                                            : 0.0);
     if (tt__heap_size(&r.heap) == 0) {
       /* every sample is exact: an error limit, if any, is met */
       reason = r.max_error >= 0 ? TT_STOP_MAX_ERROR : TT_STOP_EXHAUSTED;

@@ -168,10 +168,17 @@ static tt_status empty_piece(tt_context *ctx, size_t owned, tt_tin **out)
 
 /* One tile by refinement (ropt) or decimation (dopt): the other is
  * NULL. */
+/* tt_tile_curve's part: the callback and the insertions allowed. */
+typedef struct curve_req {
+  tt_tile_curve_fn fn;
+  void *arg;
+  size_t max_insertions;
+} curve_req;
+
 static tt_status run_tile(tt_context *ctx, const tt_grid *window,
                           const tt_tile *tile, const tt_refine_options *ropt,
                           const tt_decimate_options *dopt,
-                          tt_tin **out_piece)
+                          const curve_req *curve, tt_tin **out_piece)
 {
   if (!window || !tile || !(ropt || dopt) || !out_piece)
     return tt__error(ctx, TT_ERR_ARG, "window, tile, options and out_piece "
@@ -184,12 +191,12 @@ static tt_status run_tile(tt_context *ctx, const tt_grid *window,
                      "do not lie in a %zu x %zu DEM with two samples or more "
                      "each way", t->col0, t->col1, t->row0, t->row1,
                      t->dem_width, t->dem_height);
-  double max_error = ropt ? ropt->max_error : dopt->max_error;
-  if ((ropt && (ropt->max_points || ropt->max_triangles ||
-                ropt->percent > 0)) ||
-      (dopt && (dopt->max_points || dopt->max_triangles ||
-                dopt->percent > 0)) ||
-      !(max_error >= 0))
+  double max_error = curve ? 0.0 : ropt ? ropt->max_error : dopt->max_error;
+  bool budget = (ropt && (ropt->max_points || ropt->max_triangles ||
+                          ropt->percent > 0)) ||
+                (dopt && (dopt->max_points || dopt->max_triangles ||
+                          dopt->percent > 0));
+  if (!curve && (budget || !(max_error >= 0)))
     return tt__error(ctx, TT_ERR_ARG, "a tile is simplified to a max error "
                      "only: point, triangle and percentage budgets are for "
                      "the whole DEM (the command turns them into a bound, "
@@ -240,13 +247,33 @@ static tt_status run_tile(tt_context *ctx, const tt_grid *window,
   for (size_t i = 0; i < nx * ny; i++)
     valid += !isnan(tt__grid_z(g, i));
   if (valid < 3) {
-    status = empty_piece(ctx, owned, out_piece);
+    if (!curve)
+      status = empty_piece(ctx, owned, out_piece);
     goto done;
   }
-  status = make_borders(ctx, window, wc0, wr0, t, max_error, &b);
+  /* a curve's borders keep only the corners and the breaks */
+  status = make_borders(ctx, window, wc0, wr0, t,
+                        curve ? INFINITY : max_error, &b);
   if (status != TT_OK)
     goto done;
   /* (opt->progress sees the tile's own fraction: a stop flag's poll) */
+  if (curve) {
+    tt_refine_options o = *ropt;
+    o.max_error = -1;
+    o.max_points = curve->max_insertions; /* after the start: tile.h */
+    o.max_triangles = 0;
+    o.percent = 0;
+    o.optimize = TT_OPTIMIZE_NONE;
+    o.step = NULL;
+    b.curve = curve->fn;
+    b.curve_arg = curve->arg;
+    status = tt__refine_tile(ctx, g, &o, &b, &tin);
+    if (status == TT_ERR_DATA) {
+      tt_context_clear_error(ctx);
+      status = TT_OK;
+    }
+    goto done; /* no piece */
+  }
   if (ropt) {
     status = tt__refine_tile(ctx, g, ropt, &b, &tin);
   } else {
@@ -302,7 +329,7 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
 {
   if (!opt)
     return tt__error(ctx, TT_ERR_ARG, "options must not be NULL");
-  return run_tile(ctx, window, tile, opt, NULL, out_piece);
+  return run_tile(ctx, window, tile, opt, NULL, NULL, out_piece);
 }
 
 tt_status tt_tile_decimate(tt_context *ctx, const tt_grid *window,
@@ -312,5 +339,18 @@ tt_status tt_tile_decimate(tt_context *ctx, const tt_grid *window,
 {
   if (!opt)
     return tt__error(ctx, TT_ERR_ARG, "options must not be NULL");
-  return run_tile(ctx, window, tile, NULL, opt, out_piece);
+  return run_tile(ctx, window, tile, NULL, opt, NULL, out_piece);
+}
+
+tt_status tt_tile_curve(tt_context *ctx, const tt_grid *window,
+                        const tt_tile *tile, const tt_refine_options *opt,
+                        size_t max_insertions, tt_tile_curve_fn fn,
+                        void *arg)
+{
+  if (!opt || !fn || max_insertions < 1)
+    return tt__error(ctx, TT_ERR_ARG, "options and fn must not be NULL, "
+                     "max_insertions at least 1");
+  curve_req c = {fn, arg, max_insertions};
+  tt_tin *none = NULL;
+  return run_tile(ctx, window, tile, opt, NULL, &c, &none);
 }

@@ -28,6 +28,11 @@ typedef struct tt__tile_borders {
   /* per shared side, per sample along it: 1 when it is a border vertex
    * (decimation removes the side's other samples, decimate.c) */
   uint8_t *kept[4];
+  /* tt_tile_curve: called by refinement before each insertion and when
+   * it stops, with the vertices and the largest error of the tile's
+   * candidates (its shared sides' samples left out); NULL otherwise */
+  tt_tile_curve_fn curve;
+  void *curve_arg;
 } tt__tile_borders;
 
 TT_HIDDEN void tt__tile_borders_free(tt__tile_borders *b);
