@@ -9,7 +9,9 @@
 # `terratin eval` (every valid sample within the bound, covered once); the
 # layers are the same for 1 and 2 threads; the vertex count is within 5 %
 # of an untiled run's; the default bound is the untiled one; -max_memory
-# too small for the heights tiles by itself; decimation in tiles keeps
+# too small for the heights tiles by itself; -max_points, -max_triangles
+# and -percent in tiles give at most the budget and within 3 % of it, the
+# same for 1 and 2 threads; decimation in tiles keeps
 # the border polylines' vertices (those of insertion's tiles), with every
 # decimation option, the same for 1 and 2 threads; bad -tile_size values
 # and decimation with budgets are refused with nothing written; an interrupted
@@ -207,11 +209,54 @@ for opts in "-start greedy -importance drop" "-selection sequential -hole minang
   check "decimate $opts: threads 1 vs 2, the same layers" [ "$(dump out/dn1.gpkg)" = "$(dump out/dn.gpkg)" ]
 done
 
+# --- budgets of the whole DEM in tiles: never over, a few per cent below ---
+# budget DEM TILE FLAG N MAXCOUNT_KEY: exit 0, count <= max, within 3 %
+budget() {
+  local dem=$1 n=$2 flag=$3 val=$4 key=$5
+  run simplify -q -json -$flag $val -tile_size $n -threads 2 $dem out/b.gpkg -overwrite
+  check "-$flag $val, tiles of $n: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  cp out.txt b.json
+  local got max e
+  got=$(jget b.json $key)
+  if [ "$flag" = percent ]; then
+    max=$(python3 -c 'import sys,math; print(max(1,math.floor(float(sys.argv[1])/100*int(sys.argv[2]))))' "$val" "$(jget b.json valid_samples)")
+  else
+    max=$val
+  fi
+  e=$(jget b.json limits.max_error)
+  echo "note: $dem -$flag $val in tiles of $n: $got $key of $max at the bound $e, $(jget b.json tiling.budget_passes) runs"
+  check "-$flag $val: $got $key <= $max" [ "$got" -le "$max" ]
+  check "-$flag $val: $got $key within 3 % below $max" within "$got" "$max" 3
+  conforming "-$flag $val, tiles of $n" out/b.gpkg "${6:-}" "${7-1}"
+  bounded "-$flag $val, tiles of $n" $dem out/b.gpkg "$e"
+  run simplify -q -$flag $val -tile_size $n -threads 1 $dem out/b1.gpkg -overwrite
+  check "-$flag $val: threads 1 vs 2, the same layers" [ "$(dump out/b1.gpkg)" = "$(dump out/b.gpkg)" ]
+}
+budget in/ds.tif 128 max_points 20000 vertices
+budget in/ds.tif 128 percent 1 vertices
+budget in/ds.tif 100 max_triangles 30000 triangles
+budget in/ds.tif 128 max_points 500 vertices
+budget in/n.tif 100 percent 2 vertices in/n.asc ""
+# with -max_error too, the first stop wins: the bound is the larger
+run simplify -q -json -max_points 20000 -max_error 9 -tile_size 128 in/ds.tif out/b.gpkg -overwrite
+check "-max_points with -max_error 9: bound 9 ($(jget out.txt limits.max_error))" [ "$(jget out.txt limits.max_error)" = 9 ]
+check "-max_points with -max_error 9: under the budget" [ "$(jget out.txt vertices)" -le 20000 ]
+# a budget below the tiles' corners is refused, nothing written
+rm -f out/x.gpkg
+run simplify -max_points 10 -tile_size 128 in/ds.tif out/x.gpkg
+check "-max_points 10 in 16 tiles: exit 2 ($(cat err.txt))" [ "$rc" -eq 2 ]
+check "-max_points 10: says the budget is below ($(cat err.txt))" grep -q "budget of 10 vertices is below" err.txt
+check "-max_points 10: nothing written" [ ! -e out/x.gpkg ]
+
 # --- the memory limit chooses tiles ---
 run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg
 check "-max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "-max_memory 1500K: tiled automatically" [ "$(jget out.txt tiling.automatic)" = True ]
 bounded "-max_memory 1500K" in/ds.tif out/m.gpkg 30
+run simplify -q -json -max_points 5000 -max_memory 1500K in/ds.tif out/mp.gpkg
+check "-max_points 5000 -max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "-max_points 5000 -max_memory 1500K: tiled automatically" [ "$(jget out.txt tiling.automatic)" = True ]
+check "-max_points 5000 -max_memory 1500K: $(jget out.txt vertices) <= 5000" [ "$(jget out.txt vertices)" -le 5000 ]
 # the merged TIN counts against the limit too
 run simplify -q -max_error 0.5 -tile_size 64 -max_memory 2M in/ds.tif out/mm.gpkg
 check "-max_memory 2M, a dense tiled TIN: exit 1 ($rc)" [ "$rc" -eq 1 ]
@@ -234,8 +279,6 @@ refused "-tile_size -5" simplify -tile_size -5 in/ds.tif out/x.gpkg
 refused "-tile_size abc" simplify -tile_size abc in/ds.tif out/x.gpkg
 refused "-tile_size 1e3" simplify -tile_size 1e3 in/ds.tif out/x.gpkg
 refused "-tile_size 99999" simplify -tile_size 99999 in/ds.tif out/x.gpkg
-refused "-tile_size with -percent" simplify -tile_size 256 -percent 5 in/ds.tif out/x.gpkg
-refused "-tile_size with -max_points" simplify -tile_size 256 -max_points 500 in/ds.tif out/x.gpkg
 refused "-tile_size, decimation with -max_points" simplify -tile_size 256 -method decimate -max_points 500 in/ds.tif out/x.gpkg
 refused "tiles over -max_memory" simplify -tile_size 512 -max_memory 1M -max_error 6 in/ds.tif out/x.gpkg
 

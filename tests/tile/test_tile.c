@@ -9,6 +9,9 @@
  *  - its vertex count is within a few per cent of an untiled run's;
  *  - grids with nodata across, along and at the corners of tile borders;
  *  - every criterion and final optimisation keeps the borders;
+ *  - decimation in tiles keeps the border polylines' vertices, with every
+ *    decimation option; no optimiser swaps a border edge;
+ *  - a tile's error-against-count curve (budgets) matches untiled runs;
  *  - bad tiles and budgets are refused. */
 #include "terratin/terratin.h"
 #include "tt_test.h"
@@ -514,6 +517,71 @@ static void test_optimizers(void)
   tt_grid_destroy(g);
 }
 
+/* tt_tile_curve: on a tile that is the whole DEM (no shared side) a run
+ * to a bound E stops at the curve's first point at or below E, so the
+ * curve's count at E is an untiled run's, for any E. */
+typedef struct curve_rec {
+  size_t n, pts[20000];
+  double err[20000];
+} curve_rec;
+
+static void record(void *arg, size_t vertices, double max_error)
+{
+  curve_rec *c = arg;
+  if (c->n < 20000) {
+    c->pts[c->n] = vertices;
+    c->err[c->n] = max_error;
+    c->n++;
+  }
+}
+
+static void test_curve(void)
+{
+  tt_grid *g = fractal(129, 21);
+  tt_tile t = {0, 0, 128, 128, 129, 129};
+  tt_grid *win = window_of(g, &t);
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.threads = 1;
+  curve_rec *c = calloc(1, sizeof *c);
+  CHECK(tt_tile_curve(ctx, win, &t, &o, 129 * 129, record, c) == TT_OK);
+  CHECK(c->n > 100);
+  CHECK_INT_EQ(c->pts[0], 4); /* the corners */
+  CHECK(c->pts[c->n - 1] <= 129 * 129);
+  static const double bounds[] = {20, 8, 3, 1.5};
+  for (size_t k = 0; k < 4; k++) {
+    size_t at = 0;
+    while (at < c->n && c->err[at] > bounds[k])
+      at++;
+    CHECK(at < c->n);
+    o.max_error = bounds[k];
+    tt_tin *tin = NULL;
+    CHECK(tt_refine_run(ctx, g, &o, &tin) == TT_OK);
+    printf("curve: at %g, %zu vertices; a run to it %zu\n", bounds[k],
+           c->pts[at], tt_tin_vertex_count(tin));
+    CHECK_INT_EQ(c->pts[at], tt_tin_vertex_count(tin));
+    tt_tin_destroy(tin);
+  }
+  /* a tile with shared sides: its vertices never drop, its errors are
+   * the candidates' (the sides left out), and it ends at the cap */
+  tt_tile in = {40, 40, 80, 80, 129, 129};
+  tt_grid *w2 = window_of(g, &in);
+  c->n = 0;
+  CHECK(tt_tile_curve(ctx, w2, &in, &o, 200, record, c) == TT_OK);
+  CHECK(c->n > 10);
+  for (size_t i = 1; i < c->n; i++)
+    CHECK(c->pts[i] == c->pts[i - 1] + 1 || i + 1 == c->n);
+  CHECK(c->pts[c->n - 1] <= c->pts[0] + 200);
+  o.max_error = 1;
+  tt_tin *none = NULL;
+  CHECK(tt_tile_curve(ctx, w2, &in, &o, 0, record, c) == TT_ERR_ARG);
+  CHECK(none == NULL);
+  free(c);
+  tt_grid_destroy(w2);
+  tt_grid_destroy(win);
+  tt_grid_destroy(g);
+}
+
 static void test_refusals(void)
 {
   tt_grid *g = fractal(65, 1);
@@ -546,6 +614,7 @@ int main(void)
   test_nodata();
   test_decimate();
   test_optimizers();
+  test_curve();
   test_refusals();
   tt_context_destroy(ctx);
   return tt_test_failures ? 1 : 0;
