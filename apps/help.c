@@ -193,7 +193,7 @@ static const char help_simplify[] =
     "                    vertices; -max_points, -max_triangles, -percent\n"
     "                    become the one bound that meets them, found by a\n"
     "                    first pass over the tiles (never more than the\n"
-    "                    budget; -method insert only) (docs/scale.md)\n"
+    "                    budget) (docs/scale.md)\n"
     "\n"
     "Undeclared fill values (-9999, -32767, -32000, ... in runs, far from\n"
     "the other heights) are warned about with the -srcnodata to use.\n"

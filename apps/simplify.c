@@ -248,15 +248,14 @@ planned:;
     goto done;
   }
   /* Tiles (tiled.c, docs/scale.md): asked for, or because the run (about
-   * 8 bytes a sample) would not fit -max_memory; insertion to a max error
-   * only. Without -max_memory a DEM past the system's limit is refused as
+   * 8 bytes a sample) would not fit -max_memory (insertion only:
+   * decimation refuses -max_memory); a budget becomes a bound. Without -max_memory a DEM past the system's limit is refused as
    * before (the message names the limit): tiling a huge raster for
    * minutes is for the user to ask. */
   size_t tile = s->tile_size;
   size_t dem_w = (size_t)GDALGetRasterBandXSize(band);
   size_t dem_h = (size_t)GDALGetRasterBandYSize(band);
   size_t cells = dem_w * dem_h;
-  int no_budget = !s->max_points && !s->max_triangles && !(s->percent > 0);
   int threads_asked = tt__app_threads(r);
   int nth = threads_asked > 0 ? threads_asked
                               : (int)sysconf(_SC_NPROCESSORS_ONLN);
@@ -281,15 +280,6 @@ planned:;
     }
   }
   if (tile) {
-    if (s->decimate && !no_budget) {
-      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                        "simplify: -tile_size with -method decimate "
-                        "simplifies each tile to -max_error (or the default "
-                        "bound): %s is for -method insert only in tiles "
-                        "(docs/scale.md)", s->max_points ? "-max_points"
-                        : s->max_triangles ? "-max_triangles" : "-percent");
-      goto done;
-    }
     tt_refine_options_init(&ro);
     ro.max_error = s->max_error;
     /* a budget becomes the bound whose tiles meet it (tiled_budget.c) */

@@ -451,6 +451,7 @@ static tt_status budget_run(tiled *T, tt_refine_options *ro,
     if (ro->max_error >= 0 && e < ro->max_error)
       e = ro->max_error;
     T->ro.max_error = e;
+    T->dec.max_error = e;
     st = merge_all(T, gt, out_tin);
     if (st != TT_OK)
       return st;
@@ -558,6 +559,8 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     T.decimate = true;
     T.dec = *dopt;
     T.dec.max_error = ro->max_error;
+    T.dec.max_points = T.dec.max_triangles = 0; /* a budget: a bound */
+    T.dec.percent = 0;
     T.dec.threads = 1;
     T.dec.progress = stop_check;
     T.dec.progress_arg = &T;

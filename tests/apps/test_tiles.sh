@@ -13,8 +13,8 @@
 # and -percent in tiles give at most the budget and within 3 % of it, the
 # same for 1 and 2 threads; decimation in tiles keeps
 # the border polylines' vertices (those of insertion's tiles), with every
-# decimation option, the same for 1 and 2 threads; bad -tile_size values
-# and decimation with budgets are refused with nothing written; an interrupted
+# decimation option, the same for 1 and 2 threads, and meets a budget too;
+# bad -tile_size values are refused with nothing written; an interrupted
 # tiled run leaves nothing behind. Prints "N passed, M failed"; exits 1 on
 # any failure, 77 when a tool is missing.
 set -u
@@ -237,6 +237,17 @@ budget in/ds.tif 128 percent 1 vertices
 budget in/ds.tif 100 max_triangles 30000 triangles
 budget in/ds.tif 128 max_points 500 vertices
 budget in/n.tif 100 percent 2 vertices in/n.asc ""
+# decimation to a budget: the same bound search, decimated runs
+run simplify -q -json -method decimate -max_points 5000 -tile_size 128 -threads 2 in/ds.tif out/bd.gpkg
+check "decimate -max_points 5000: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+cp out.txt bd.json
+echo "note: in/ds.tif decimate -max_points 5000 in tiles of 128: $(jget bd.json vertices) vertices at the bound $(jget bd.json limits.max_error), $(jget bd.json tiling.budget_passes) runs"
+check "decimate -max_points 5000: $(jget bd.json vertices) <= 5000" [ "$(jget bd.json vertices)" -le 5000 ]
+check "decimate -max_points 5000: within 5 % below" within "$(jget bd.json vertices)" 5000 5
+conforming "decimate -max_points 5000" out/bd.gpkg
+bounded "decimate -max_points 5000" in/ds.tif out/bd.gpkg "$(jget bd.json limits.max_error)"
+run simplify -q -method decimate -max_points 5000 -tile_size 128 -threads 1 in/ds.tif out/bd1.gpkg
+check "decimate -max_points 5000: threads 1 vs 2, the same layers" [ "$(dump out/bd1.gpkg)" = "$(dump out/bd.gpkg)" ]
 # with -max_error too, the first stop wins: the bound is the larger
 run simplify -q -json -max_points 20000 -max_error 9 -tile_size 128 in/ds.tif out/b.gpkg -overwrite
 check "-max_points with -max_error 9: bound 9 ($(jget out.txt limits.max_error))" [ "$(jget out.txt limits.max_error)" = 9 ]
@@ -279,7 +290,6 @@ refused "-tile_size -5" simplify -tile_size -5 in/ds.tif out/x.gpkg
 refused "-tile_size abc" simplify -tile_size abc in/ds.tif out/x.gpkg
 refused "-tile_size 1e3" simplify -tile_size 1e3 in/ds.tif out/x.gpkg
 refused "-tile_size 99999" simplify -tile_size 99999 in/ds.tif out/x.gpkg
-refused "-tile_size, decimation with -max_points" simplify -tile_size 256 -method decimate -max_points 500 in/ds.tif out/x.gpkg
 refused "tiles over -max_memory" simplify -tile_size 512 -max_memory 1M -max_error 6 in/ds.tif out/x.gpkg
 
 # --- an interrupted tiled run leaves nothing (SIGTERM: a background job
