@@ -9,68 +9,15 @@
 # `terratin eval` (every valid sample within the bound, covered once); the
 # layers are the same for 1 and 2 threads; the vertex count is within 5 %
 # of an untiled run's; the default bound is the untiled one; -max_memory
-# too small for the heights tiles by itself; -max_points, -max_triangles
-# and -percent in tiles give at most the budget and within 3 % of it, the
-# same for 1 and 2 threads; decimation in tiles keeps
-# the border polylines' vertices (those of insertion's tiles), with every
-# decimation option, the same for 1 and 2 threads, and meets a budget too;
-# bad -tile_size values are refused with nothing written; an interrupted
+# too small for the heights tiles by itself (with a budget too); bad
+# -tile_size values are refused with nothing written (decimation and
+# budgets in tiles: test_tiles_methods.sh); an interrupted
 # tiled run leaves nothing behind. Prints "N passed, M failed"; exits 1 on
 # any failure, 77 when a tool is missing.
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
-T=${TT_TERRATIN:-}
-if [ -z "$T" ] || [ ! -x "$T" ]; then
-  echo "SKIP: TT_TERRATIN is not set or not executable"
-  exit 77
-fi
-for tool in gdal_translate gdal_rasterize ogrinfo python3 md5sum; do
-  if ! command -v "$tool" >/dev/null 2>&1; then
-    echo "SKIP: $tool is missing"
-    exit 77
-  fi
-done
-TOPO="$(cd "$(dirname "$0")" && pwd)/tin_topology.py"
-
-W=$(mktemp -d "${TMPDIR:-/tmp}/tt_tiles.XXXXXX") || exit 1
-trap 'rm -rf "$W"' EXIT
-cd "$W" || exit 1
-mkdir in out
-
-rc=0
-run() {
-  "$T" "$@" >out.txt 2>err.txt
-  rc=$?
-}
-jget() { # jget FILE KEY[.KEY...]
-  python3 -c 'import json,sys
-d=json.load(open(sys.argv[1]))
-for k in sys.argv[2].split("."): d=d[k]
-print(d)' "$1" "$2"
-}
-dump() { ogrinfo -ro -al -q "$1" triangles vertices 2>/dev/null | md5sum | cut -d' ' -f1; }
-# within A B PCT: |A/B - 1| <= PCT %
-within() { python3 -c 'import sys; a,b,p=map(float,sys.argv[1:]); sys.exit(0 if abs(a/b-1)*100<=p else 1)' "$1" "$2" "$3"; }
-
-# conforming NAME GPKG [ASC] [EULER]: topology, and eval within E
-conforming() {
-  local name=$1 gpkg=$2 asc=${3:-} euler=${4:-1}
-  if python3 "$TOPO" "$gpkg" $asc >topo.json 2>topo.err; then pass; else
-    fail "$name: not conforming: $(cat topo.json topo.err)"; fi
-  if [ -n "$euler" ]; then
-    check "$name: Euler characteristic $euler ($(cat topo.json))" \
-      [ "$(jget topo.json euler)" = "$euler" ]
-  fi
-}
-# bounded NAME DEM GPKG E: eval says every valid sample is within E, each
-# covered once
-bounded() {
-  local name=$1 dem=$2 gpkg=$3 e=$4
-  "$T" eval -json -max_error "$e" "$dem" "$gpkg" >eval.json 2>eval.err
-  check "$name: eval within $e ($(cat eval.err))" [ $? -eq 0 ]
-  check "$name: no sample overlapped" [ "$(jget eval.json overlapped)" = 0 ]
-}
+. "$(dirname "${BASH_SOURCE[0]}")/tt_tiles_lib.sh" || exit 1
 
 # --- the topology checker catches what it looks for ---
 python3 - <<'PY'
@@ -168,97 +115,6 @@ check "nodata: the same uncovered samples as untiled" \
 run simplify -q -max_error 4 -tile_size 100 -threads 1 in/n.tif out/n1.gpkg
 check "nodata: threads 1 vs 2, the same layers" [ "$(dump out/n1.gpkg)" = "$(dump out/n100.gpkg)" ]
 
-# --- decimation in tiles: the border vertices kept, every option ---
-run simplify -q -json -method decimate -max_error 6 in/ds.tif out/du.gpkg
-cp out.txt du.json
-run simplify -q -json -method decimate -max_error 6 -tile_size 128 -threads 2 in/ds.tif out/dt.gpkg
-check "decimate, tiles of 128: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-cp out.txt dt.json
-nu=$(jget du.json vertices)
-nv=$(jget dt.json vertices)
-echo "note: fractal 513, decimation at 6: tiles of 128: $nv vertices, untiled $nu"
-check "decimate, tiles of 128: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
-check "decimate, tiles of 128: method reported" [ "$(jget dt.json method)" = decimate ]
-conforming "decimate, tiles of 128" out/dt.gpkg
-bounded "decimate, tiles of 128" in/ds.tif out/dt.gpkg 6
-check "decimate: uncovered 0" [ "$(jget eval.json uncovered)" = 0 ]
-run simplify -q -method decimate -max_error 6 -tile_size 128 -threads 1 in/ds.tif out/dt1.gpkg
-check "decimate: threads 1 vs 2, the same layers" [ "$(dump out/dt1.gpkg)" = "$(dump out/dt.gpkg)" ]
-# the border vertices are those of insertion's tiles (the border polylines)
-python3 - out/dt.gpkg out/t128.gpkg 128 513 >bv.txt <<'PY'
-import sqlite3, sys
-def border(p, n, w):
-    db = sqlite3.connect(p)
-    return {(c, r) for c, r in db.execute("select col, row from vertices")
-            if (c % n == 0 and 0 < c < w - 1) or (r % n == 0 and 0 < r < w - 1)}
-a, b = border(sys.argv[1], int(sys.argv[3]), int(sys.argv[4])), border(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
-print(len(a), len(b), len(a ^ b))
-PY
-read -r nba nbb nbx <bv.txt
-check "decimate: $nba border vertices, insertion's $nbb, $nbx differ" [ "$nbx" = 0 ] && [ "$nba" -gt 0 ]
-for opts in "-start greedy -importance drop" "-selection sequential -hole minangle" \
-            "-onepass -importance volume" "-start greedy:20000 -importance hdh"; do
-  run simplify -q -json -method decimate -max_error 4 -tile_size 100 -threads 2 $opts in/n.tif out/dn.gpkg -overwrite
-  check "decimate $opts, nodata: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-  conforming "decimate $opts, nodata" out/dn.gpkg in/n.asc ""
-  case $opts in
-    *greedy:*) ;; # starts above the bound: no removal lowers its error
-    *) bounded "decimate $opts, nodata" in/n.tif out/dn.gpkg 4 ;;
-  esac
-  run simplify -q -method decimate -max_error 4 -tile_size 100 -threads 1 $opts in/n.tif out/dn1.gpkg -overwrite
-  check "decimate $opts: threads 1 vs 2, the same layers" [ "$(dump out/dn1.gpkg)" = "$(dump out/dn.gpkg)" ]
-done
-
-# --- budgets of the whole DEM in tiles: never over, a few per cent below ---
-# budget DEM TILE FLAG N MAXCOUNT_KEY: exit 0, count <= max, within 3 %
-budget() {
-  local dem=$1 n=$2 flag=$3 val=$4 key=$5
-  run simplify -q -json -$flag $val -tile_size $n -threads 2 $dem out/b.gpkg -overwrite
-  check "-$flag $val, tiles of $n: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-  cp out.txt b.json
-  local got max e
-  got=$(jget b.json $key)
-  if [ "$flag" = percent ]; then
-    max=$(python3 -c 'import sys,math; print(max(1,math.floor(float(sys.argv[1])/100*int(sys.argv[2]))))' "$val" "$(jget b.json valid_samples)")
-  else
-    max=$val
-  fi
-  e=$(jget b.json limits.max_error)
-  echo "note: $dem -$flag $val in tiles of $n: $got $key of $max at the bound $e, $(jget b.json tiling.budget_passes) runs"
-  check "-$flag $val: $got $key <= $max" [ "$got" -le "$max" ]
-  check "-$flag $val: $got $key within 3 % below $max" within "$got" "$max" 3
-  conforming "-$flag $val, tiles of $n" out/b.gpkg "${6:-}" "${7-1}"
-  bounded "-$flag $val, tiles of $n" $dem out/b.gpkg "$e"
-  run simplify -q -$flag $val -tile_size $n -threads 1 $dem out/b1.gpkg -overwrite
-  check "-$flag $val: threads 1 vs 2, the same layers" [ "$(dump out/b1.gpkg)" = "$(dump out/b.gpkg)" ]
-}
-budget in/ds.tif 128 max_points 20000 vertices
-budget in/ds.tif 128 percent 1 vertices
-budget in/ds.tif 100 max_triangles 30000 triangles
-budget in/ds.tif 128 max_points 500 vertices
-budget in/n.tif 100 percent 2 vertices in/n.asc ""
-# decimation to a budget: the same bound search, decimated runs
-run simplify -q -json -method decimate -max_points 5000 -tile_size 128 -threads 2 in/ds.tif out/bd.gpkg
-check "decimate -max_points 5000: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-cp out.txt bd.json
-echo "note: in/ds.tif decimate -max_points 5000 in tiles of 128: $(jget bd.json vertices) vertices at the bound $(jget bd.json limits.max_error), $(jget bd.json tiling.budget_passes) runs"
-check "decimate -max_points 5000: $(jget bd.json vertices) <= 5000" [ "$(jget bd.json vertices)" -le 5000 ]
-check "decimate -max_points 5000: within 5 % below" within "$(jget bd.json vertices)" 5000 5
-conforming "decimate -max_points 5000" out/bd.gpkg
-bounded "decimate -max_points 5000" in/ds.tif out/bd.gpkg "$(jget bd.json limits.max_error)"
-run simplify -q -method decimate -max_points 5000 -tile_size 128 -threads 1 in/ds.tif out/bd1.gpkg
-check "decimate -max_points 5000: threads 1 vs 2, the same layers" [ "$(dump out/bd1.gpkg)" = "$(dump out/bd.gpkg)" ]
-# with -max_error too, the first stop wins: the bound is the larger
-run simplify -q -json -max_points 20000 -max_error 9 -tile_size 128 in/ds.tif out/b.gpkg -overwrite
-check "-max_points with -max_error 9: bound 9 ($(jget out.txt limits.max_error))" [ "$(jget out.txt limits.max_error)" = 9 ]
-check "-max_points with -max_error 9: under the budget" [ "$(jget out.txt vertices)" -le 20000 ]
-# a budget below the tiles' corners is refused, nothing written
-rm -f out/x.gpkg
-run simplify -max_points 10 -tile_size 128 in/ds.tif out/x.gpkg
-check "-max_points 10 in 16 tiles: exit 2 ($(cat err.txt))" [ "$rc" -eq 2 ]
-check "-max_points 10: says the budget is below ($(cat err.txt))" grep -q "budget of 10 vertices is below" err.txt
-check "-max_points 10: nothing written" [ ! -e out/x.gpkg ]
-
 # --- the memory limit chooses tiles ---
 run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg
 check "-max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
@@ -331,18 +187,6 @@ for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschg
   check "$b: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
   conforming "$b, tiles of 128" out/${b}_t.gpkg in/$b.asc ""
   bounded "$b, tiles of 128" "$S/$p" out/${b}_t.gpkg $e
-  # decimation
-  run simplify -q -json -method decimate -max_error $e "$S/$p" out/${b}_du.gpkg
-  cp out.txt ${b}_du.json
-  run simplify -q -json -method decimate -max_error $e -tile_size 128 "$S/$p" out/${b}_dt.gpkg
-  check "$b: tiled decimation exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-  cp out.txt ${b}_dt.json
-  nu=$(jget ${b}_du.json vertices)
-  nv=$(jget ${b}_dt.json vertices)
-  echo "note: $b, decimation at $e: tiles of 128: $nv vertices, untiled $nu"
-  check "$b, decimation: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
-  conforming "$b, decimation in tiles of 128" out/${b}_dt.gpkg in/$b.asc ""
-  bounded "$b, decimation in tiles of 128" "$S/$p" out/${b}_dt.gpkg $e
 done
 
 echo "$passed passed, $failed failed"
