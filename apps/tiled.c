@@ -19,7 +19,11 @@
  * insertions).
  *
  * With -method decimate each tile is decimated instead (tt_tile_decimate),
- * with the same borders.
+ * with the same borders. A budget of the whole DEM (-max_points,
+ * -max_triangles, -percent) is turned into one bound (budget_run): a
+ * pass records every tile's error-against-count curve (tt_tile_curve,
+ * tiled_budget.c), then the tiles are run at the bound the curves give,
+ * again while the TIN passes the budget (docs/scale.md).
  *
  * Without -max_error the bound is 0.5 % of the height range, as untiled:
  * one more pass over the tiles finds the range first.
