@@ -294,6 +294,8 @@ planned:;
     rep.ropt = &ro;
     rep.tile_size = tile;
     rep.tile_bytes = tt__app_tile_bytes(tile, dem_w, dem_h, nth);
+    if (s->decimate) /* a start of every sample: about 80 bytes, not 32 */
+      rep.tile_bytes = rep.tile_bytes / 32 * 80;
     if (s->max_memory && rep.tile_bytes > s->max_memory) {
       st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
                         "simplify: tiles of %zu cells on %d threads hold up to "
