@@ -263,6 +263,7 @@ typedef struct app_simplify_report {
    * the memory limit chose tiling, the bytes the tiles in flight hold */
   size_t tiles, tile_size, tile_bytes;
   int tile_threads, auto_tiled;
+  int budget_passes;  /* tiled runs to a budget: the runs at a bound */
 } app_simplify_report;
 
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p);
@@ -321,14 +322,46 @@ tt_status tt__app_study_tins_commit(app_run *r, app_study_tins *w);
 void tt__app_study_tins_free(app_study_tins *w);
 /* tiled.c: the DEM of band read and refined in tiles of tile_size cells
  * on the workers, merged into *out_tin; ro's max_error < 0 asks for the
- * default bound (then set, and *default_error). The failure is recorded. */
+ * default bound (then set, and *default_error); ro's max_points,
+ * max_triangles or percent, a budget of the whole DEM, is turned into a
+ * bound (tiled_budget.c; ro->max_error is set to it, *out_passes says how
+ * many runs at a bound it took). With dopt (else NULL) the
+ * tiles are decimated with its options, its max_error that of ro. The
+ * failure is recorded. */
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
                                  const char *path, size_t tile_size,
-                                 tt_refine_options *ro, int *default_error,
+                                 tt_refine_options *ro,
+                                 tt_decimate_options *dopt,
+                                 int *default_error,
                                  tt_tin **out_tin, tt_raster_info **out_info,
                                  size_t *out_valid, double *out_zmin,
                                  double *out_zmax, size_t *out_tiles,
-                                 int *out_threads);
+                                 int *out_threads, int *out_passes);
+/* tiled_budget.c: a tile's error-against-count curve, thinned (the points
+ * where the error reaches a new low, one every 2 % of vertices, and the
+ * last), and the bound that makes the tiles' counts meet a budget. */
+typedef struct app_curve {
+  uint32_t *pts;
+  double *err;
+  size_t n, cap;
+  double low;                /* the lowest error seen */
+  size_t pending_pts;        /* a low skipped by the spacing */
+  double pending_err;
+  bool has_pending;
+  bool failed;               /* out of memory while recording */
+} app_curve;
+/* Adds one call of tt_tile_curve's callback; ends the curve. False when
+ * out of memory. */
+bool tt__app_curve_add(app_curve *c, size_t vertices, double err);
+bool tt__app_curve_end(app_curve *c);
+void tt__app_curve_free(app_curve *c);
+/* The smallest error of any of the n curves (or 0 when above < 0)
+ * strictly between above and below at which the tiles' counts summed are
+ * at most target (else the largest of them; NaN when there is none), and
+ * that sum. False when out of memory. */
+bool tt__app_curves_bound(const app_curve *c, size_t n, size_t target,
+                          double above, double below, double *out_bound,
+                          size_t *out_estimate);
 /* `terratin tiles run` and `tiles merge` (tiles_*.c) run simplify's tiled
  * path with this set: save, the one tile given is computed and handed to
  * it (nothing else written); load, every tile's piece is read by it

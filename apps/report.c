@@ -269,6 +269,7 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
     tt__json_size(&j, "threads", (size_t)p->tile_threads);
     tt__json_bool(&j, "automatic", p->auto_tiled);
     tt__json_size(&j, "memory_in_flight", p->tile_bytes);
+    tt__json_size(&j, "budget_passes", (size_t)p->budget_passes);
     tt__json_close(&j);
   }
   tt__json_open(&j, "seconds");
@@ -338,6 +339,11 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
             p->auto_tiled ? " (chosen because the heights do not fit the "
                             "memory limit)" : "",
             (double)p->tile_bytes / 1048576.0);
+    if (p->budget_passes)
+      fprintf(r->out, "%s: the budget is met at the bound %g, found from "
+              "the tiles' curves (one pass) and %d run%s at a bound\n",
+              r->s->output, p->ropt ? p->ropt->max_error : 0.0,
+              p->budget_passes, p->budget_passes == 1 ? "" : "s");
   }
   if (p->dopt)
     fprintf(r->out,

@@ -47,6 +47,31 @@ static int check_srs(app_run *r, const char *option, const char *value,
   return ok;
 }
 
+/* The decimation options of the command: ro's stops, criterion and
+ * passes, and the -start, -importance, -selection, -onepass, -hole. */
+static void decimate_options(const tt_app_settings *s,
+                             const tt_refine_options *ro,
+                             tt_decimate_options *dopt)
+{
+  tt_decimate_options_init(dopt);
+  dopt->max_error = ro->max_error;
+  dopt->max_points = ro->max_points;
+  dopt->max_triangles = ro->max_triangles;
+  dopt->percent = ro->percent;
+  dopt->criterion = ro->criterion;
+  dopt->optimize = ro->optimize;
+  dopt->anneal = ro->anneal;
+  dopt->repair = ro->repair;
+  dopt->start = s->start;
+  dopt->start_points = s->start_points;
+  dopt->importance = s->importance;
+  dopt->selection = s->selection;
+  dopt->onepass = s->onepass;
+  dopt->hole = s->hole;
+  dopt->progress = ro->progress;
+  dopt->progress_arg = ro->progress_arg;
+  dopt->threads = ro->threads;
+}
 
 tt_status tt__app_simplify(app_run *r)
 {
@@ -62,8 +87,10 @@ tt_status tt__app_simplify(app_run *r)
   char **wopts = NULL, **dsco = NULL;
   app_simplify_report rep;
   tt_refine_options ro;
+  tt_decimate_options dopt;
   size_t valid = 0;
   memset(&rep, 0, sizeof rep);
+  tt_decimate_options_init(&dopt);
 
   if (tt__app_same_file(s->input, s->output))
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
@@ -221,22 +248,21 @@ planned:;
     goto done;
   }
   /* Tiles (tiled.c, docs/scale.md): asked for, or because the run (about
-   * 8 bytes a sample) would not fit -max_memory; insertion to a max error
-   * only. Without -max_memory a DEM past the system's limit is refused as
+   * 8 bytes a sample) would not fit -max_memory (insertion only:
+   * decimation refuses -max_memory); a budget becomes a bound. Without -max_memory a DEM past the system's limit is refused as
    * before (the message names the limit): tiling a huge raster for
    * minutes is for the user to ask. */
   size_t tile = s->tile_size;
   size_t dem_w = (size_t)GDALGetRasterBandXSize(band);
   size_t dem_h = (size_t)GDALGetRasterBandYSize(band);
   size_t cells = dem_w * dem_h;
-  int no_budget = !s->max_points && !s->max_triangles && !(s->percent > 0);
   int threads_asked = tt__app_threads(r);
   int nth = threads_asked > 0 ? threads_asked
                               : (int)sysconf(_SC_NPROCESSORS_ONLN);
   if (nth < 1)
     nth = 1;
   int ground = tt__app_ground_points(band);
-  if (!tile && !s->decimate && no_budget && s->max_memory &&
+  if (!tile && !s->decimate && s->max_memory &&
       dem_w > 2 && dem_h > 2 && cells > mem_limit / 8) {
     /* about 8 bytes a sample untiled: tiles of 1024 (a multiple of the
      * block size), halved until those in flight hold half the limit;
@@ -255,17 +281,12 @@ planned:;
     }
   }
   if (tile) {
-    if (s->decimate || !no_budget) {
-      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                        "simplify: -tile_size refines each tile to -max_error "
-                        "(or the default bound) by insertion: %s cannot be "
-                        "split over tiles", s->decimate ? "-method decimate"
-                        : s->max_points ? "-max_points"
-                        : s->max_triangles ? "-max_triangles" : "-percent");
-      goto done;
-    }
     tt_refine_options_init(&ro);
     ro.max_error = s->max_error;
+    /* a budget becomes the bound whose tiles meet it (tiled_budget.c) */
+    ro.max_points = s->max_points;
+    ro.max_triangles = s->max_triangles;
+    ro.percent = s->percent;
     ro.criterion = s->criterion;
     ro.optimize = s->optimize;
     ro.anneal = s->anneal;
@@ -274,6 +295,8 @@ planned:;
     rep.ropt = &ro;
     rep.tile_size = tile;
     rep.tile_bytes = tt__app_tile_bytes(tile, dem_w, dem_h, nth, ground);
+    if (s->decimate) /* a start of every sample: 48 bytes a sample more */
+      rep.tile_bytes = rep.tile_bytes / (ground ? 64 : 32) * (ground ? 112 : 80);
     if (s->max_memory && rep.tile_bytes > s->max_memory) {
       st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
                         "simplify: tiles of %zu cells on %d threads hold up to "
@@ -284,10 +307,15 @@ planned:;
     }
     tt__app_phase_set(&r->prog, 0.0, 0.85);
     double t_tiles = tt__app_now();
+    if (s->decimate) {
+      decimate_options(s, &ro, &dopt);
+      rep.dopt = &dopt;
+    }
     st = tt__app_simplify_tiled(r, band, s->input, tile, &ro,
+                                s->decimate ? &dopt : NULL,
                                 &rep.default_error, &tin, &info, &valid,
                                 &rep.zmin, &rep.zmax, &rep.tiles,
-                                &rep.tile_threads);
+                                &rep.tile_threads, &rep.budget_passes);
     if (st != TT_OK || !tin) /* no TIN: one tile of `tiles run`, saved */
       goto done;
     GDALClose(src);
@@ -334,26 +362,8 @@ planned:;
   ro.progress = tt__app_phase_fn;
   ro.progress_arg = &r->prog;
   rep.ropt = &ro;
-  tt_decimate_options dopt;
-  tt_decimate_options_init(&dopt);
   if (s->decimate) {
-    dopt.max_error = ro.max_error;
-    dopt.max_points = ro.max_points;
-    dopt.max_triangles = ro.max_triangles;
-    dopt.percent = ro.percent;
-    dopt.criterion = ro.criterion;
-    dopt.optimize = ro.optimize;
-    dopt.anneal = ro.anneal;
-    dopt.repair = ro.repair;
-    dopt.start = s->start;
-    dopt.start_points = s->start_points;
-    dopt.importance = s->importance;
-    dopt.selection = s->selection;
-    dopt.onepass = s->onepass;
-    dopt.hole = s->hole;
-    dopt.progress = ro.progress;
-    dopt.progress_arg = ro.progress_arg;
-    dopt.threads = ro.threads;
+    decimate_options(s, &ro, &dopt);
     rep.dopt = &dopt;
   }
   double t_run = tt__app_now();

@@ -25,6 +25,13 @@
  * (tt_gdal_read_grid), the pieces with their vertices' (src/tile/), and
  * the merger takes the geodesic area function from tile 0's window.
  *
+ * With -method decimate each tile is decimated instead (tt_tile_decimate),
+ * with the same borders. A budget of the whole DEM (-max_points,
+ * -max_triangles, -percent) is turned into one bound (budget_run): a
+ * pass records every tile's error-against-count curve (tt_tile_curve,
+ * tiled_budget.c), then the tiles are run at the bound the curves give,
+ * again while the TIN passes the budget (docs/scale.md).
+ *
  * Without -max_error the bound is 0.5 % of the height range, as untiled:
  * one more pass over the tiles finds the range first.
  *
@@ -57,9 +64,15 @@ typedef struct tiled {
   const char *path;
   char **ropts;             /* the read options but WINDOW */
   tt_refine_options ro;     /* per tile: one thread, stop flag polled */
+  tt_decimate_options dec;  /* the same for decimation, when decimate */
+  bool decimate;
   size_t W, H, N, ntx, nty, ntiles;
   int nthreads;
   bool minmax_only;         /* the pre-pass for the default bound */
+  bool curve_pass;          /* the pre-pass of a budget (tiled_budget.c) */
+  app_curve *curves;        /* per tile (curve pass) */
+  size_t curve_cap;         /* insertions a curve may record, per cell */
+  double curve_per_cell;
   pthread_mutex_t lock, gdal;
   pthread_cond_t cond;
   size_t next, merged;      /* the next tile to take, the tiles merged */
@@ -113,6 +126,27 @@ static void fail(tiled *T, size_t k, tt_status st, const char *msg)
   atomic_store(&T->stop, 1);
   pthread_cond_broadcast(&T->cond);
   pthread_mutex_unlock(&T->lock);
+}
+
+static void curve_point(void *arg, size_t vertices, double max_error)
+{
+  app_curve *c = arg;
+  if (!c->failed && !tt__app_curve_add(c, vertices, max_error))
+    c->failed = true;
+}
+
+/* The valid samples a tile counts (its window less the margins and its
+ * shared right column and bottom row, as tt_tile_run's pieces). */
+static size_t owned_valid(const tt_grid *win, const tt_tile *t)
+{
+  size_t c0, r0, w, h, n = 0;
+  tt_tile_window(t, &c0, &r0, &w, &h);
+  size_t x1 = t->col1 - (t->col1 + 1 < t->dem_width);
+  size_t y1 = t->row1 - (t->row1 + 1 < t->dem_height);
+  for (size_t y = t->row0; y <= y1; y++)
+    for (size_t x = t->col0; x <= x1; x++)
+      n += !isnan(tt_grid_sample(win, x - c0, y - r0));
+  return n;
 }
 
 /* One tile: read (from own, a worker's own dataset's band, or the shared
@@ -171,8 +205,23 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k,
     T->zmin[k] = lo;
     T->zmax[k] = hi;
     T->valid[k] = n;
+  } else if (st == TT_OK && T->curve_pass) {
+    /* a budget's first pass: the tile's curve, its valid samples */
+    size_t cells = (t.col1 - t.col0 + 1) * (t.row1 - t.row0 + 1);
+    size_t cap = (size_t)ceil(T->curve_per_cell * (double)cells) + 64;
+    T->valid[k] = owned_valid(win, &t);
+    st = tt_tile_curve(ctx, win, &t, &T->ro, cap, curve_point,
+                       &T->curves[k]);
+    if (st == TT_OK && (T->curves[k].failed ||
+                        !tt__app_curve_end(&T->curves[k]))) {
+      tt_grid_destroy(win);
+      tt_raster_info_destroy(info);
+      fail(T, k, TT_ERR_NOMEM, "out of memory for its curve");
+      return;
+    }
   } else if (st == TT_OK) {
-    st = tt_tile_run(ctx, win, &t, &T->ro, &piece);
+    st = T->decimate ? tt_tile_decimate(ctx, win, &t, &T->dec, &piece)
+                     : tt_tile_run(ctx, win, &t, &T->ro, &piece);
   }
   tt_grid_destroy(win);
   if (st != TT_OK) {
@@ -345,6 +394,133 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
   return TT_OK;
 }
 
+/* Every tile refined (or decimated) and merged into *out_tin. */
+static tt_status merge_all(tiled *T, const double gt[6], tt_tin **out_tin)
+{
+  tt_tin_merger *merger = NULL;
+  tt_status st = tt_tin_merger_create(T->r->ctx, T->W, T->H, gt, &merger);
+  if (st != TT_OK)
+    return tt__app_fail_tt(T->r, st, T->path);
+  for (size_t k = 0; k < T->ntiles; k++)
+    T->done[k] = false;
+  T->merger = merger; /* for tile 0's window to give the area function */
+  st = run_all(T, merger);
+  if (st == TT_OK) {
+    st = tt_tin_merger_finish(T->r->ctx, merger, out_tin);
+    if (st != TT_OK)
+      tt__app_fail_tt(T->r, st, T->path);
+  }
+  T->merger = NULL;
+  tt_tin_merger_destroy(merger);
+  return st;
+}
+
+/* A budget of the whole DEM (-max_points, -max_triangles, -percent;
+ * tiled_budget.c): the curve pass, then the tiles at the bound whose
+ * curves meet the budget, and again at a larger one while the TIN has
+ * more vertices or triangles than the budget allows. ro->max_error, when
+ * set, is a floor of the bound (its stop may come first, as untiled). */
+#define BUDGET_PASSES 6
+static tt_status budget_run(tiled *T, tt_refine_options *ro,
+                            const double gt[6], tt_tin **out_tin,
+                            int *out_passes)
+{
+  app_run *r = T->r;
+  tt_status st = TT_OK;
+  size_t cells = T->W * T->H;
+  /* the curves are recorded to 4 times a tile's share of the budget by
+   * its cells (the percentage taken of every cell) */
+  double want = ro->max_points ? (double)ro->max_points : INFINITY;
+  if (ro->percent > 0)
+    want = fmin(want, ro->percent / 100.0 * (double)cells);
+  if (ro->max_triangles)
+    want = fmin(want, (double)ro->max_triangles / 2.0);
+  T->curve_per_cell = 4.0 * want / (double)cells;
+  T->curves = calloc(T->ntiles, sizeof *T->curves);
+  if (!T->curves)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
+                        "out of memory for %zu curves", T->ntiles);
+  T->curve_pass = true;
+  app_phase keep = r->prog;
+  tt__app_phase_set(&r->prog, keep.lo, keep.lo + 0.3 * (keep.hi - keep.lo));
+  st = run_all(T, NULL);
+  T->curve_pass = false;
+  r->prog = keep;
+  tt__app_phase_set(&r->prog, keep.lo + 0.3 * (keep.hi - keep.lo), keep.hi);
+  if (st != TT_OK)
+    return st;
+  size_t valid = 0;
+  for (size_t k = 0; k < T->ntiles; k++)
+    valid += T->valid[k];
+  size_t max_v = ro->max_points ? ro->max_points : SIZE_MAX;
+  if (ro->percent > 0) {
+    size_t p = (size_t)floor(ro->percent / 100.0 * (double)valid);
+    max_v = p < max_v ? (p ? p : 1) : max_v;
+  }
+  size_t max_t = ro->max_triangles ? ro->max_triangles : SIZE_MAX;
+  size_t target = max_v < max_t / 2 ? max_v : max_t / 2;
+  /* The bounds run: a first from the curves; while the TIN passes the
+   * budget, a larger one aimed lower by the excess; once it fits but
+   * keeps less than 98 % of the budget, one smaller bound aimed higher by
+   * the shortfall, and if that passes the budget, the fitting bound again
+   * (the same TIN: runs are deterministic). */
+  double above = -1, below = INFINITY, e = 0, good = NAN;
+  bool calibrated = false;
+  size_t nv = 0, nt = 0;
+  for (int pass = 1;; pass++) {
+    size_t estimate;
+    double next;
+    if (!tt__app_curves_bound(T->curves, T->ntiles, target, above, below,
+                              &next, &estimate))
+      return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
+                          "out of memory for the curves");
+    if (isnan(next) && !isnan(good))
+      next = good; /* nothing between: back to the fitting bound */
+    if (isnan(next) || pass > BUDGET_PASSES)
+      return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_LIMIT, T->path,
+                          "the budget of %zu %s is below what %zu tiles make "
+                          "at the bound %g (%zu vertices, %zu triangles: "
+                          "their corners and borders); ask for more, or use "
+                          "a larger -tile_size", nv > max_v ? max_v : max_t,
+                          nv > max_v ? "vertices" : "triangles", T->ntiles,
+                          e, nv, nt);
+    e = next;
+    if (ro->max_error >= 0 && e < ro->max_error)
+      e = ro->max_error;
+    T->ro.max_error = e;
+    T->dec.max_error = e;
+    st = merge_all(T, gt, out_tin);
+    if (st != TT_OK)
+      return st;
+    nv = tt_tin_vertex_count(*out_tin);
+    nt = tt_tin_triangle_count(*out_tin);
+    *out_passes = pass;
+    bool fits = nv <= max_v && nt <= max_t;
+    double f = fmin(max_v < SIZE_MAX ? (double)max_v / (double)nv : INFINITY,
+                    max_t < SIZE_MAX ? (double)max_t / (double)nt : INFINITY);
+    if (fits && (calibrated || f <= 1 / 0.98 || e == good ||
+                 (ro->max_error >= 0 && e == ro->max_error)))
+      break;
+    tt_tin_destroy(*out_tin);
+    *out_tin = NULL;
+    size_t aim = (size_t)floor((double)target * f * (fits ? 0.995 : 1.0));
+    if (fits) {
+      /* short of the budget: once, a smaller bound */
+      calibrated = true;
+      good = e;
+      below = e;
+      above = -1;
+      target = aim > target ? aim : target + 1;
+    } else {
+      /* over: a larger bound (below the fitting one, if any) */
+      above = e;
+      target = aim < target ? aim : target - 1;
+    }
+  }
+  ro->max_error = e;
+  return TT_OK;
+}
+
 tt_app_tiles_hook tt__app_tiles_hook;
 
 int tt__app_ground_points(GDALRasterBandH band)
@@ -371,18 +547,20 @@ size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
 
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
                                  const char *path, size_t tile_size,
-                                 tt_refine_options *ro, int *default_error,
+                                 tt_refine_options *ro,
+                                 tt_decimate_options *dopt,
+                                 int *default_error,
                                  tt_tin **out_tin, tt_raster_info **out_info,
                                  size_t *out_valid, double *out_zmin,
                                  double *out_zmax, size_t *out_tiles,
-                                 int *out_threads)
+                                 int *out_threads, int *out_passes)
 {
   const tt_app_settings *s = r->s;
   tiled T;
   memset(&T, 0, sizeof T);
   tt_status st = TT_OK;
-  tt_tin_merger *merger = NULL;
   *out_tin = NULL;
+  *out_passes = 0;
   *out_info = NULL;
   T.r = r;
   T.band = band;
@@ -424,6 +602,16 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
   T.ro.max_memory = 0; /* bounded by the tiles in flight (simplify.c) */
   T.ro.progress = stop_check;
   T.ro.progress_arg = &T;
+  if (dopt) {
+    T.decimate = true;
+    T.dec = *dopt;
+    T.dec.max_error = ro->max_error;
+    T.dec.max_points = T.dec.max_triangles = 0; /* a budget: a bound */
+    T.dec.percent = 0;
+    T.dec.threads = 1;
+    T.dec.progress = stop_check;
+    T.dec.progress_arg = &T;
+  }
   T.pieces = calloc(T.ntiles, sizeof *T.pieces);
   T.done = calloc(T.ntiles, sizeof *T.done);
   T.zmin = calloc(T.ntiles, sizeof *T.zmin);
@@ -458,7 +646,10 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
 
   /* The range of heights: the default bound needs it, the report too. */
   double zmin = INFINITY, zmax = -INFINITY;
-  if (ro->max_error < 0) {
+  bool budget = ro->max_points || ro->max_triangles || ro->percent > 0;
+  T.ro.max_points = T.ro.max_triangles = 0;
+  T.ro.percent = 0;
+  if (ro->max_error < 0 && !budget) {
     T.minmax_only = true;
     app_phase keep = r->prog;
     tt__app_phase_set(&r->prog, keep.lo, keep.lo + 0.1 * (keep.hi - keep.lo));
@@ -481,6 +672,9 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     }
     ro->max_error = 0.005 * (zmax - zmin);
     T.ro.max_error = ro->max_error;
+    T.dec.max_error = ro->max_error;
+    if (dopt)
+      dopt->max_error = ro->max_error;
     *default_error = 1;
     T.minmax_only = false;
   }
@@ -509,20 +703,10 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     st = tt__app_tiles_hook.save(tt__app_tiles_hook.arg, r, k, T.pieces[k]);
     goto done;
   }
-  st = tt_tin_merger_create(r->ctx, T.W, T.H, gt, &merger);
-  if (st != TT_OK) {
-    tt__app_fail_tt(r, st, path);
-    goto done;
-  }
-  T.merger = merger;
-  st = run_all(&T, merger);
+  st = budget ? budget_run(&T, ro, gt, out_tin, out_passes)
+              : merge_all(&T, gt, out_tin);
   if (st != TT_OK)
     goto done;
-  st = tt_tin_merger_finish(r->ctx, merger, out_tin);
-  if (st != TT_OK) {
-    tt__app_fail_tt(r, st, path);
-    goto done;
-  }
   tt_tin_summary sum;
   tt_tin_get_summary(*out_tin, &sum);
   if (T.info) {
@@ -555,7 +739,10 @@ done:
     tt_tin_destroy(*out_tin);
     *out_tin = NULL;
   }
-  tt_tin_merger_destroy(merger);
+  if (T.curves)
+    for (size_t k = 0; k < T.ntiles; k++)
+      tt__app_curve_free(&T.curves[k]);
+  free(T.curves);
   if (tt__app_tiles_hook.save && T.pieces && tt__app_tiles_hook.tile < T.ntiles)
     tt_tin_destroy(T.pieces[tt__app_tiles_hook.tile]);
   tt_raster_info_destroy(T.info);

@@ -43,7 +43,8 @@
   "  plan   checks simplify's options (-tile_size and -max_error needed),\n"\
   "         writes PLAN.json (the DEM's path, size and time, the tiles and\n"\
   "         their windows, the options) and makes the folder PLAN.json.tiles\n"\
-  "  run    refines tile TILE_ID (0 .. tiles-1) alone, on one thread, and\n" \
+  "  run    simplifies tile TILE_ID (0 .. tiles-1) alone (-method insert\n"\
+  "         or decimate), on one thread, and\n"                            \
   "         writes its piece PLAN.json.tiles/TILE_ID.ttp\n"                 \
   "  merge  joins every piece into OUT as simplify writes it: the same\n"   \
   "         triangles and vertices as simplify -tile_size with the plan's\n"\
@@ -155,13 +156,16 @@ static void plan_cmd(char **argv, tt_app_result *res)
   if (tt_app_options_new(sv, &o, res) != TT_OK)
     goto done;
   const tt_app_settings *s = tt_app_options_settings(o);
+  /* A budget becomes a bound only after a pass over every tile
+   * (tiled_budget.c): not a plan's job, whose tiles are independent. */
   if (!s->tile_size || s->max_error < 0 || s->max_points ||
-      s->max_triangles || s->percent > 0 || s->decimate) {
+      s->max_triangles || s->percent > 0) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                        "tiles plan: -tile_size N and -max_error E are needed "
-                       "(tiles are refined by insertion to a bound; no "
-                       "-max_points, -max_triangles, -percent or "
-                       "-method decimate)");
+                       "(each tile is simplified to a bound alone; no "
+                       "-max_points, -max_triangles or -percent: their bound "
+                       "needs a pass over every tile first, which simplify "
+                       "-tile_size makes)");
     goto done;
   }
   for (size_t i = 0; words && words[i]; i++)

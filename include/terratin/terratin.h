@@ -713,6 +713,35 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
                       const tt_tile *tile, const tt_refine_options *opt,
                       tt_tin **out_piece);
 
+/* The same by vertex decimation (tt_decimate_run): the tile's start
+ * (every option of opt, but a max error as the only stop condition) keeps
+ * its border vertices and no other sample of its shared sides, and no
+ * removal, repair or final pass touches them, so the pieces meet as
+ * refined ones do. With start greedy:N a tile inserts ceil(N x its cells /
+ * the DEM's cells) vertices after its corners, outline and border
+ * vertices. */
+tt_status tt_tile_decimate(tt_context *ctx, const tt_grid *window,
+                           const tt_tile *tile,
+                           const tt_decimate_options *opt,
+                           tt_tin **out_piece);
+
+/* The error-against-count curve of one tile, for budgets of the whole
+ * DEM (the command's -max_points, -max_triangles and -percent in tiles,
+ * docs/scale.md): the tile refined as tt_tile_run does with opt (its
+ * criterion, repair and threads; its stops ignored), but with its shared
+ * sides simplified to no bound (only the tile's corners and the samples
+ * next to nodata on them are border vertices), until max_insertions
+ * vertices were inserted or every candidate is exact. fn is called before
+ * each insertion and once at the end with the tile's vertices and the
+ * largest error of its samples off the shared sides: a run to a bound E
+ * stops at the first call whose error is <= E. No piece is kept. */
+typedef void (*tt_tile_curve_fn)(void *arg, size_t vertices,
+                                 double max_error);
+tt_status tt_tile_curve(tt_context *ctx, const tt_grid *window,
+                        const tt_tile *tile, const tt_refine_options *opt,
+                        size_t max_insertions, tt_tile_curve_fn fn,
+                        void *arg);
+
 /* Joins pieces into one TIN: create with the DEM's size and geotransform,
  * add every tile's piece in a fixed order (the result depends on the
  * order, never on which tile finished first), finish. Shared border

@@ -29,6 +29,11 @@
  * under the criterion's swap value; local and lookahead, the local swap
  * of optimize.c seeded with them.
  *
+ * Tiles (tt__decimate_tile, src/tile/): the border vertices of the
+ * tile's shared sides are pinned and the side's other samples removed
+ * first (trim_borders), so the piece meets its neighbour's border edges
+ * exactly; boundary edges are never flipped.
+ *
  * Determinism: everything after the start runs in one thread in a fixed
  * order (ties on vertex indices), so the TIN does not depend on threads.
  * Memory: the mesh, 9 bytes per vertex, 4 per vertex of candidates, the
@@ -742,6 +747,39 @@ static tt_status run_sequential(run *r)
   return TT_OK;
 }
 
+/* Tile runs: the samples of the start on shared sides that are not
+ * border vertices go first, in index order, without a check (each lies
+ * strictly inside a straight run of the side whose cells are all valid,
+ * so the boundary rule lets it go, and what is left of the side are the
+ * border's chords, which hold its samples within the bound: border.c);
+ * the border vertices are pinned. The starting count is taken after. */
+static tt_status trim_borders(run *r)
+{
+  tt__dec *d = &r->d;
+  tt__mesh *m = &d->m;
+  for (size_t v = 0; v < m->nv; v++) {
+    bool kept;
+    if (m->v[v].edge < 0 ||
+        !tt__tile_on_border(d->borders, d->g->nx, d->g->ny, m->v[v].c,
+                            m->v[v].r, &kept))
+      continue;
+    if (kept) {
+      d->vflag[v] |= TT__DV_PINNED;
+      continue;
+    }
+    double imp;
+    int ok = tt__dec_evaluate(d, (int32_t)v, TT__DEC_FILL, &imp, NULL);
+    if (ok < 0 || (ok > 0 && !remove_filled(r, (int32_t)v, false)))
+      return oom(r);
+    if (ok == 0)
+      return tt__error(d->ctx, TT_ERR_INTERNAL, "sample (%d, %d) of a tile "
+                       "border is no border vertex and cannot be removed",
+                       (int)m->v[v].c, (int)m->v[v].r);
+  }
+  r->removed = 0;
+  return TT_OK;
+}
+
 /* Vertices that may never go: those with several fans (the outline
  * pinches there) and the ends of constrained inner edges. */
 static void pin(tt__dec *d)
@@ -819,12 +857,16 @@ static tt_status build_tin(run *r, tt_tin **out_tin)
     status = oom(r);
     goto done;
   }
+  if (d->borders) /* the piece's scans follow the neighbour's edges */
+    tt__tile_flag_edges(&c, d->g->nx, d->g->ny, d->borders);
   for (size_t v = 0; v < m->nv; v++)
     if (map[v] >= 0) {
       ins[map[v]] = NAN; /* no insertion error: NULL in the outputs */
       imp[map[v]] = d->vimp[v];
     }
-  status = tt__tin_build(d->ctx, &c, d->g, ins, r->pool, out_tin);
+  status = d->borders
+               ? tt__tin_build_homes(d->ctx, &c, d->g, ins, r->pool, out_tin)
+               : tt__tin_build(d->ctx, &c, d->g, ins, r->pool, out_tin);
   ins = NULL; /* taken over */
   if (status != TT_OK)
     goto done;
@@ -844,10 +886,35 @@ tt_status tt_decimate_run(tt_context *ctx, const tt_grid *grid,
   return tt__decimate_run_checked(ctx, grid, opt, NULL, NULL, out_tin);
 }
 
+static tt_status decimate(tt_context *ctx, const tt_grid *grid,
+                          const tt_decimate_options *opt,
+                          const tt__tile_borders *borders,
+                          tt__dec_check_fn check, void *check_arg,
+                          tt_tin **out_tin);
+
 tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
                                    const tt_decimate_options *opt,
                                    tt__dec_check_fn check, void *check_arg,
                                    tt_tin **out_tin)
+{
+  return decimate(ctx, grid, opt, NULL, check, check_arg, out_tin);
+}
+
+tt_status tt__decimate_tile(tt_context *ctx, const tt_grid *grid,
+                            const tt_decimate_options *opt,
+                            const tt__tile_borders *borders,
+                            tt_tin **out_tin)
+{
+  if (!borders)
+    return tt__error(ctx, TT_ERR_ARG, "borders must not be NULL");
+  return decimate(ctx, grid, opt, borders, NULL, NULL, out_tin);
+}
+
+static tt_status decimate(tt_context *ctx, const tt_grid *grid,
+                          const tt_decimate_options *opt,
+                          const tt__tile_borders *borders,
+                          tt__dec_check_fn check, void *check_arg,
+                          tt_tin **out_tin)
 {
   double t_start = tt__now();
   if (!grid || !opt || !out_tin)
@@ -873,6 +940,7 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
   d->ctx = ctx;
   d->g = grid;
   d->opt = opt;
+  d->borders = borders;
   d->crit = tt__criterion_get(opt->criterion);
   d->max_error = opt->max_error;
   d->importance = opt->importance != TT_IMPORTANCE_AUTO ? opt->importance
@@ -924,8 +992,17 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
     d->vimp[v] = NAN;
     d->nvert += d->m.v[v].edge >= 0;
   }
+  if (borders && (status = trim_borders(&r)) != TT_OK)
+    goto done;
   pin(d);
   size_t start_vertices = d->nvert;
+  size_t pinned_border = 0;
+  for (size_t v = 0; borders && v < d->m.nv; v++) {
+    bool kept;
+    pinned_border += d->m.v[v].edge >= 0 &&
+                     tt__tile_on_border(borders, grid->nx, grid->ny,
+                                        d->m.v[v].c, d->m.v[v].r, &kept);
+  }
   r.valid = valid;
   r.t_start = t_start;
   status = report_step(&r, false);
@@ -982,6 +1059,7 @@ tt_status tt__decimate_run_checked(tt_context *ctx, const tt_grid *grid,
   s->removed_vertices = r.removed;
   s->rounds = r.rounds;
   s->refused_bound = r.refused;
+  s->forced_vertices = pinned_border;
   if (opt->progress && !opt->progress(1.0, "done", opt->progress_arg)) {
     tt_tin_destroy(*out_tin);
     *out_tin = NULL;

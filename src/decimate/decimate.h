@@ -16,6 +16,7 @@
 #include "mesh/mesh.h"
 #include "mesh/raster_scan.h"
 #include "optimize/swap.h"
+#include "tile/tile.h"
 
 /* per-vertex flags */
 #define TT__DV_PINNED 1u  /* may never go: several fans, or an inner
@@ -41,6 +42,7 @@ typedef struct tt__dec {
   uint8_t *vflag;             /* per vertex */
   double *vimp;               /* per vertex: importance (NaN: may not go) */
   size_t nvert;               /* vertices alive */
+  const tt__tile_borders *borders; /* tile runs (tile.h), else NULL */
 } tt__dec;
 
 /* What tt__dec_evaluate computes. */

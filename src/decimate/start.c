@@ -13,6 +13,10 @@
  *   greedy    a greedy Delaunay insertion (tt_refine_run) down to zero
  *             error: every sample is then exact;
  *   greedy:N  the same stopped at N vertices (the study's start).
+ * A tile (tt__decimate_tile) starts the same ways; its greedy starts are
+ * tt__refine_tile's, with the tile's border vertices forced and no other
+ * vertex on its shared sides; `all` keeps every sample, and decimate.c
+ * removes the shared sides' samples that are not border vertices first.
  * The greedy TINs are taken over vertex for vertex (index = insertion
  * rank) and triangle for triangle.
  *
@@ -145,7 +149,11 @@ static tt_status start_greedy(tt__dec *d, size_t points)
   ro.threads = o->threads;
   ro.optimize = TT_OPTIMIZE_NONE;
   tt_tin *tin = NULL;
-  tt_status status = tt_refine_run(d->ctx, d->g, &ro, &tin);
+  /* a tile starts from its border vertices, as refinement does, and N
+   * counts the insertions after them (tile.h) */
+  tt_status status = d->borders
+                         ? tt__refine_tile(d->ctx, d->g, &ro, d->borders, &tin)
+                         : tt_refine_run(d->ctx, d->g, &ro, &tin);
   if (status != TT_OK)
     return status;
   tt__mesh *m = &d->m;

@@ -529,22 +529,6 @@ static bool domain_vertex(void *arg, int32_t col, int32_t row,
   return add_vertex(arg, col, row, NAN, out_v);
 }
 
-/* The side of the tile grid that both ends of a boundary edge lie on
- * (tile.h's numbering), or -1. */
-static int side_of(const tt_grid *g, const tt__mesh_vertex *a,
-                   const tt__mesh_vertex *b)
-{
-  if (a->c == 0 && b->c == 0)
-    return 0;
-  if (a->r == 0 && b->r == 0)
-    return 1;
-  if ((size_t)a->c == g->nx - 1 && (size_t)b->c == g->nx - 1)
-    return 2;
-  if ((size_t)a->r == g->ny - 1 && (size_t)b->r == g->ny - 1)
-    return 3;
-  return -1;
-}
-
 /* Tile runs: the border vertices split the boundary edges they lie on
  * (those outside this tile's TIN are the neighbour's alone), then every
  * boundary edge on a shared side is flagged. */
@@ -573,28 +557,7 @@ static tt_status start_borders(refine *r)
     last = m->v[v].edge >= 0 ? m->v[v].edge / 3 : -1;
     r->forced++;
   }
-  for (size_t t = 0; t < m->nslots; t++) {
-    if (!tt__mesh_live(m, (int32_t)t))
-      continue;
-    for (int k = 0; k < 3; k++) {
-      int32_t e = 3 * (int32_t)t + k;
-      if (m->twin[e] >= 0)
-        continue;
-      const tt__mesh_vertex *va = &m->v[m->hv[e]];
-      const tt__mesh_vertex *vb = &m->v[m->hv[tt__next(e)]];
-      int s = side_of(r->g, va, vb);
-      if (s < 0 || !(b->shared & (1u << s)))
-        continue;
-      int32_t p = (s == 0 || s == 2) ? va->r : va->c;
-      int32_t q = (s == 0 || s == 2) ? vb->r : vb->c;
-      int32_t lo = p < q ? p : q, len = p < q ? q - p : p - q;
-      /* a longer edge spans a run between breaks: covered on both sides
-       * (border.c); a unit one is when the neighbour's cell is */
-      m->eflag[e] |= TT__EDGE_BORDER;
-      if (len >= 2 || b->cover[s][lo])
-        m->eflag[e] |= TT__EDGE_BORDER_SHARED;
-    }
-  }
+  tt__tile_flag_edges(m, r->g->nx, r->g->ny, b);
   return TT_OK;
 }
 
@@ -889,6 +852,9 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
     status = mem_check(&r, r.m.vcap, r.m.tcap);
   if (status != TT_OK)
     goto done;
+  /* a tile's max_points counts the insertions after its start (tile.h) */
+  if (borders && r.max_points)
+    r.max_points += r.m.nv;
   /* Every limit is exact: a budget below what the start needs (the four
    * corners, or the hull and the nodata outline's forced vertices, which
    * the run cannot drop) is refused before any insertion, with the count
@@ -933,6 +899,10 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
   int32_t ahead = -1; /* the likely next insertion's triangle (prefetch) */
   for (size_t iter = 1;; iter++) {
     prefetch_next(&r, &ahead);
+    if (borders && borders->curve)
+      borders->curve(borders->curve_arg, r.m.nv,
+                     tt__heap_size(&r.heap) ? tt__heap_top(&r.heap).key
+                                            : 0.0);
     if (tt__heap_size(&r.heap) == 0) {
       /* every sample is exact: an error limit, if any, is met */
       reason = r.max_error >= 0 ? TT_STOP_MAX_ERROR : TT_STOP_EXHAUSTED;

@@ -25,6 +25,7 @@
  * pairs of indices, at most n.
  */
 #include "tile/tile.h"
+#include "mesh/mesh.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -35,12 +36,73 @@ void tt__tile_borders_free(tt__tile_borders *b)
     return;
   free(b->col);
   free(b->row);
-  for (int s = 0; s < 4; s++)
+  for (int s = 0; s < 4; s++) {
     free(b->cover[s]);
+    free(b->kept[s]);
+    b->cover[s] = NULL;
+    b->kept[s] = NULL;
+  }
   b->col = b->row = NULL;
   b->n = b->cap = 0;
-  for (int s = 0; s < 4; s++)
-    b->cover[s] = NULL;
+}
+
+/* The side of the tile grid that both ends of an edge lie on (tile.h's
+ * numbering), or -1. */
+static int side_of(size_t nx, size_t ny, const tt__mesh_vertex *a,
+                   const tt__mesh_vertex *b)
+{
+  if (a->c == 0 && b->c == 0)
+    return 0;
+  if (a->r == 0 && b->r == 0)
+    return 1;
+  if ((size_t)a->c == nx - 1 && (size_t)b->c == nx - 1)
+    return 2;
+  if ((size_t)a->r == ny - 1 && (size_t)b->r == ny - 1)
+    return 3;
+  return -1;
+}
+
+void tt__tile_flag_edges(tt__mesh *m, size_t nx, size_t ny,
+                         const tt__tile_borders *b)
+{
+  for (size_t t = 0; t < m->nslots; t++) {
+    if (!tt__mesh_live(m, (int32_t)t))
+      continue;
+    for (int k = 0; k < 3; k++) {
+      int32_t e = 3 * (int32_t)t + k;
+      if (m->twin[e] >= 0)
+        continue;
+      const tt__mesh_vertex *va = &m->v[m->hv[e]];
+      const tt__mesh_vertex *vb = &m->v[m->hv[tt__next(e)]];
+      int s = side_of(nx, ny, va, vb);
+      if (s < 0 || !(b->shared & (1u << s)))
+        continue;
+      int32_t p = (s == 0 || s == 2) ? va->r : va->c;
+      int32_t q = (s == 0 || s == 2) ? vb->r : vb->c;
+      int32_t lo = p < q ? p : q, len = p < q ? q - p : p - q;
+      /* a longer edge spans a run between breaks: covered on both sides
+       * (border.c); a unit one is when the neighbour's cell is */
+      m->eflag[e] |= TT__EDGE_BORDER;
+      if (len >= 2 || b->cover[s][lo])
+        m->eflag[e] |= TT__EDGE_BORDER_SHARED;
+    }
+  }
+}
+
+int tt__tile_on_border(const tt__tile_borders *b, size_t nx, size_t ny,
+                       int32_t col, int32_t row, bool *out_kept)
+{
+  int on = 0;
+  bool kept = true;
+  const int s[4] = {col == 0, row == 0, (size_t)col == nx - 1,
+                    (size_t)row == ny - 1};
+  for (int k = 0; k < 4; k++)
+    if (s[k] && (b->shared & (1u << k))) {
+      on = 1;
+      kept = kept && b->kept[k] && b->kept[k][k == 0 || k == 2 ? row : col];
+    }
+  *out_kept = kept;
+  return on;
 }
 
 /* Simplifies the all-valid run [a, b] (both already kept). */

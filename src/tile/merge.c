@@ -54,6 +54,10 @@ struct tt_tin_merger {
   size_t hcap, hn;
   /* sums, in piece order */
   size_t covered, valid, forced;
+  /* decimated pieces: their counts summed (rounds: the most of any), and
+   * whether any piece has importances (else the TIN has none) */
+  size_t start_vertices, removed, rounds, refused;
+  bool importance;
   double sum_abs, sum_sq, max_err;
   int64_t max_index;
   double seconds_mesh, seconds_stats;
@@ -93,12 +97,12 @@ void tt_tin_merger_destroy(tt_tin_merger *m)
 void tt_tin_merger_size(const tt_tin_merger *m, size_t *out_vertices,
                         size_t *out_triangles, size_t *out_bytes)
 {
-  /* per vertex: col, row, height (8 as doubles), insertion error, and the
-   * star statistics finishing adds (24); per triangle: corners, max, rmse,
+  /* per vertex: col, row, height (8 as doubles), insertion error,
+   * importance, and the star statistics finishing adds (24); per triangle: corners, max, rmse,
    * count and squared errors; the outline table */
   *out_vertices = m->t->nv;
   *out_triangles = m->t->nt;
-  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 24 +
+  *out_bytes = m->vcap * (4 + 4 + (m->f64 ? 8 : 4) + 8 + 8 + 24 +
                          (m->ground ? 16 + 4 + 4 : 0)) +
                m->tcap * (12 + 8 + 4 + 8 + 8) + m->hcap * 12;
 }
@@ -157,7 +161,7 @@ static bool reserve(tt_tin_merger *m, size_t nv, size_t nt)
   if (!(p = realloc(t->field, (n) * sizeof *t->field)))                    \
     return false;                                                          \
   t->field = p;
-    GROW(vc, c) GROW(vr, c) GROW(v_ins_err, c)
+    GROW(vc, c) GROW(vr, c) GROW(v_ins_err, c) GROW(v_importance, c)
     if (m->f64) {
       GROW(vzd, c)
     } else {
@@ -209,6 +213,12 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *m,
   const tt_error_stats *e = &piece->summary.errors;
   m->valid += piece->summary.valid_samples;
   m->forced += piece->summary.forced_vertices;
+  m->start_vertices += piece->summary.start_vertices;
+  m->removed += piece->summary.removed_vertices;
+  m->refused += piece->summary.refused_bound;
+  if (piece->summary.rounds > m->rounds)
+    m->rounds = piece->summary.rounds;
+  m->importance |= piece->v_importance != NULL;
   m->seconds_mesh += piece->summary.seconds_mesh;
   m->seconds_stats += piece->summary.seconds_statistics;
   m->t->summary.criterion = piece->summary.criterion;
@@ -267,6 +277,7 @@ tt_status tt_tin_merger_add(tt_context *ctx, tt_tin_merger *m,
       t->vgk[id] = piece->vgk[v];
       t->vgconv[id] = piece->vgconv[v];
     }
+    t->v_importance[id] = piece->v_importance ? piece->v_importance[v] : NAN;
     if (outline) {
       m->hkey[slot] = key;
       m->hval[slot] = (int32_t)id;
@@ -387,6 +398,14 @@ tt_status tt_tin_merger_finish(tt_context *ctx, tt_tin_merger *m,
   s->stop_reason = TT_STOP_MAX_ERROR;
   s->components = pieces;
   s->forced_vertices = m->forced;
+  s->start_vertices = m->start_vertices;
+  s->removed_vertices = m->removed;
+  s->rounds = m->rounds;
+  s->refused_bound = m->refused;
+  if (!m->importance) {
+    free(t->v_importance);
+    t->v_importance = NULL;
+  }
   s->seconds_mesh = m->seconds_mesh;
   s->seconds_statistics = m->seconds_stats;
   tt_error_stats *e = &s->errors;

@@ -11,7 +11,8 @@
  * border vertices (border.c) without talking to each other. The tile's own
  * samples are then refined with those vertices forced into its outline and
  * its shared sides kept free of any other vertex (refine.c,
- * tt__refine_tile); a border edge both neighbours have gives its samples to
+ * tt__refine_tile), or decimated with those vertices kept and the sides'
+ * other samples removed (decimate.c, tt__decimate_tile); a border edge both neighbours have gives its samples to
  * one of them by the top-left rule, so every valid sample is counted once
  * over the tiles, and valid_samples counts a tile's samples less its
  * shared right column and bottom row.
@@ -126,8 +127,10 @@ static tt_status make_borders(tt_context *ctx, const tt_grid *w, size_t wc0,
     if (!tt__border_simplify(line[0], brk, n, max_error, keep))
       goto oom;
     b->cover[s] = calloc(n, 1);
-    if (!b->cover[s])
+    b->kept[s] = malloc(n);
+    if (!b->cover[s] || !b->kept[s])
       goto oom;
+    memcpy(b->kept[s], keep, n);
     for (size_t i = 0; i + 1 < n; i++) {
       int valid = !isnan(line[0][i]) + !isnan(line[0][i + 1]) +
                   !isnan(line[2][i]) + !isnan(line[2][i + 1]);
@@ -213,11 +216,21 @@ static tt_status empty_piece(tt_context *ctx, size_t owned, tt_tin **out)
   return TT_OK;
 }
 
-tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
-                      const tt_tile *tile, const tt_refine_options *opt,
-                      tt_tin **out_piece)
+/* One tile by refinement (ropt) or decimation (dopt): the other is
+ * NULL. */
+/* tt_tile_curve's part: the callback and the insertions allowed. */
+typedef struct curve_req {
+  tt_tile_curve_fn fn;
+  void *arg;
+  size_t max_insertions;
+} curve_req;
+
+static tt_status run_tile(tt_context *ctx, const tt_grid *window,
+                          const tt_tile *tile, const tt_refine_options *ropt,
+                          const tt_decimate_options *dopt,
+                          const curve_req *curve, tt_tin **out_piece)
 {
-  if (!window || !tile || !opt || !out_piece)
+  if (!window || !tile || !(ropt || dopt) || !out_piece)
     return tt__error(ctx, TT_ERR_ARG, "window, tile, options and out_piece "
                      "must not be NULL");
   *out_piece = NULL;
@@ -228,11 +241,16 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
                      "do not lie in a %zu x %zu DEM with two samples or more "
                      "each way", t->col0, t->col1, t->row0, t->row1,
                      t->dem_width, t->dem_height);
-  if (opt->max_points || opt->max_triangles || opt->percent > 0 ||
-      !(opt->max_error >= 0))
-    return tt__error(ctx, TT_ERR_ARG, "a tile is refined to a max error "
+  double max_error = curve ? 0.0 : ropt ? ropt->max_error : dopt->max_error;
+  bool budget = (ropt && (ropt->max_points || ropt->max_triangles ||
+                          ropt->percent > 0)) ||
+                (dopt && (dopt->max_points || dopt->max_triangles ||
+                          dopt->percent > 0));
+  if (!curve && (budget || !(max_error >= 0)))
+    return tt__error(ctx, TT_ERR_ARG, "a tile is simplified to a max error "
                      "only: point, triangle and percentage budgets are for "
-                     "the whole DEM");
+                     "the whole DEM (the command turns them into a bound, "
+                     "docs/scale.md)");
   size_t wc0, wr0, wnx, wny;
   tt_tile_window(t, &wc0, &wr0, &wnx, &wny);
   if (window->nx != wnx || window->ny != wny)
@@ -277,14 +295,48 @@ tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
   for (size_t i = 0; i < nx * ny; i++)
     valid += !isnan(tt__grid_z(g, i));
   if (valid < 3) {
-    status = empty_piece(ctx, owned, out_piece);
+    if (!curve)
+      status = empty_piece(ctx, owned, out_piece);
     goto done;
   }
-  status = make_borders(ctx, window, wc0, wr0, t, opt->max_error, &b);
+  /* a curve's borders keep only the corners and the breaks */
+  status = make_borders(ctx, window, wc0, wr0, t,
+                        curve ? INFINITY : max_error, &b);
   if (status != TT_OK)
     goto done;
   /* (opt->progress sees the tile's own fraction: a stop flag's poll) */
-  status = tt__refine_tile(ctx, g, opt, &b, &tin);
+  if (curve) {
+    tt_refine_options o = *ropt;
+    o.max_error = -1;
+    o.max_points = curve->max_insertions; /* after the start: tile.h */
+    o.max_triangles = 0;
+    o.percent = 0;
+    o.optimize = TT_OPTIMIZE_NONE;
+    o.step = NULL;
+    b.curve = curve->fn;
+    b.curve_arg = curve->arg;
+    status = tt__refine_tile(ctx, g, &o, &b, &tin);
+    if (status == TT_ERR_DATA) {
+      tt_context_clear_error(ctx);
+      status = TT_OK;
+    }
+    goto done; /* no piece */
+  }
+  if (ropt) {
+    status = tt__refine_tile(ctx, g, ropt, &b, &tin);
+  } else {
+    /* greedy:N: the tile's share of N by its cells, rounded up (at least
+     * 1), inserted after its start */
+    tt_decimate_options o = *dopt;
+    if (o.start == TT_DSTART_GREEDY_N) {
+      double share = (double)o.start_points * (double)(nx * ny) /
+                     ((double)t->dem_width * (double)t->dem_height);
+      o.start_points = (size_t)ceil(share);
+      if (o.start_points < 1)
+        o.start_points = 1;
+    }
+    status = tt__decimate_tile(ctx, g, &o, &b, &tin);
+  }
   if (status == TT_ERR_DATA) {
     /* no triangle in this tile: its valid samples are uncovered */
     tt_context_clear_error(ctx);
@@ -319,4 +371,36 @@ done:
   tt_tin_destroy(tin);
   tt_grid_destroy(g);
   return status;
+}
+
+tt_status tt_tile_run(tt_context *ctx, const tt_grid *window,
+                      const tt_tile *tile, const tt_refine_options *opt,
+                      tt_tin **out_piece)
+{
+  if (!opt)
+    return tt__error(ctx, TT_ERR_ARG, "options must not be NULL");
+  return run_tile(ctx, window, tile, opt, NULL, NULL, out_piece);
+}
+
+tt_status tt_tile_decimate(tt_context *ctx, const tt_grid *window,
+                           const tt_tile *tile,
+                           const tt_decimate_options *opt,
+                           tt_tin **out_piece)
+{
+  if (!opt)
+    return tt__error(ctx, TT_ERR_ARG, "options must not be NULL");
+  return run_tile(ctx, window, tile, NULL, opt, NULL, out_piece);
+}
+
+tt_status tt_tile_curve(tt_context *ctx, const tt_grid *window,
+                        const tt_tile *tile, const tt_refine_options *opt,
+                        size_t max_insertions, tt_tile_curve_fn fn,
+                        void *arg)
+{
+  if (!opt || !fn || max_insertions < 1)
+    return tt__error(ctx, TT_ERR_ARG, "options and fn must not be NULL, "
+                     "max_insertions at least 1");
+  curve_req c = {fn, arg, max_insertions};
+  tt_tin *none = NULL;
+  return run_tile(ctx, window, tile, opt, NULL, &c, &none);
 }

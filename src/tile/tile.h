@@ -25,9 +25,32 @@ typedef struct tt__tile_borders {
    * when the neighbour's grid cell on that segment has three valid corners
    * or more, so the neighbour's TIN covers the segment too */
   uint8_t *cover[4];
+  /* per shared side, per sample along it: 1 when it is a border vertex
+   * (decimation removes the side's other samples, decimate.c) */
+  uint8_t *kept[4];
+  /* tt_tile_curve: called by refinement before each insertion and when
+   * it stops, with the vertices and the largest error of the tile's
+   * candidates (its shared sides' samples left out); NULL otherwise */
+  tt_tile_curve_fn curve;
+  void *curve_arg;
 } tt__tile_borders;
 
 TT_HIDDEN void tt__tile_borders_free(tt__tile_borders *b);
+
+/* Flags every boundary edge of m on a shared side of the nx x ny tile grid
+ * TT__EDGE_BORDER, and TT__EDGE_BORDER_SHARED when the neighbour's TIN has
+ * it too (mesh.h): refinement after inserting the border vertices, and
+ * decimation's start and result (decimate.c). */
+struct tt__mesh;
+TT_HIDDEN void tt__tile_flag_edges(struct tt__mesh *m, size_t nx, size_t ny,
+                                   const tt__tile_borders *b);
+
+/* Whether sample (col, row) of the nx x ny tile grid lies on a shared
+ * side: 1 and *out_kept (whether it is a border vertex) when it does, else
+ * 0. */
+TT_HIDDEN int tt__tile_on_border(const tt__tile_borders *b, size_t nx,
+                                 size_t ny, int32_t col, int32_t row,
+                                 bool *out_kept);
 
 /* Simplifies one border line of n samples z (NaN: nodata) to max_error:
  * sets keep[i] for the samples that become vertices. brk[i] marks the
@@ -43,11 +66,24 @@ TT_HIDDEN bool tt__border_simplify(const double *z, const uint8_t *brk,
 
 /* Greedy insertion of a tile grid with its border vertices forced and its
  * shared sides kept (refine.c): the options' stop conditions must be a
- * max error only. The TIN records, per vertex, the triangle its own sample
+ * max error, or a max_points counting only the vertices inserted after
+ * the start (its corners, nodata outline and border vertices: decimation's
+ * greedy:N start in tiles). The TIN records, per vertex, the triangle its own sample
  * is counted in (tt_tin.v_home), for the merge. */
 TT_HIDDEN tt_status tt__refine_tile(tt_context *ctx, const tt_grid *grid,
                                     const tt_refine_options *opt,
                                     const tt__tile_borders *borders,
                                     tt_tin **out_tin);
+
+/* Vertex decimation of a tile grid (decimate.c): the start's samples on
+ * shared sides that are not border vertices are removed first, the border
+ * vertices are never removed, and border edges are flagged as refinement
+ * does; opt's stop conditions must be a max error only. With start
+ * greedy:N, N counts the vertices inserted after the tile's start. v_home
+ * is filled as by tt__refine_tile. */
+TT_HIDDEN tt_status tt__decimate_tile(tt_context *ctx, const tt_grid *grid,
+                                      const tt_decimate_options *opt,
+                                      const tt__tile_borders *borders,
+                                      tt_tin **out_tin);
 
 #endif /* TT_TILE_H */

@@ -9,65 +9,15 @@
 # `terratin eval` (every valid sample within the bound, covered once); the
 # layers are the same for 1 and 2 threads; the vertex count is within 5 %
 # of an untiled run's; the default bound is the untiled one; -max_memory
-# too small for the heights tiles by itself; bad -tile_size values,
-# budgets and decimation are refused with nothing written; an interrupted
+# too small for the heights tiles by itself (with a budget too); bad
+# -tile_size values are refused with nothing written (decimation and
+# budgets in tiles: test_tiles_methods.sh); an interrupted
 # tiled run leaves nothing behind. Prints "N passed, M failed"; exits 1 on
 # any failure, 77 when a tool is missing.
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
-T=${TT_TERRATIN:-}
-if [ -z "$T" ] || [ ! -x "$T" ]; then
-  echo "SKIP: TT_TERRATIN is not set or not executable"
-  exit 77
-fi
-for tool in gdal_translate gdal_rasterize ogrinfo python3 md5sum; do
-  if ! command -v "$tool" >/dev/null 2>&1; then
-    echo "SKIP: $tool is missing"
-    exit 77
-  fi
-done
-TOPO="$(cd "$(dirname "$0")" && pwd)/tin_topology.py"
-
-W=$(mktemp -d "${TMPDIR:-/tmp}/tt_tiles.XXXXXX") || exit 1
-trap 'rm -rf "$W"' EXIT
-cd "$W" || exit 1
-mkdir in out
-
-rc=0
-run() {
-  "$T" "$@" >out.txt 2>err.txt
-  rc=$?
-}
-jget() { # jget FILE KEY[.KEY...]
-  python3 -c 'import json,sys
-d=json.load(open(sys.argv[1]))
-for k in sys.argv[2].split("."): d=d[k]
-print(d)' "$1" "$2"
-}
-dump() { ogrinfo -ro -al -q "$1" triangles vertices 2>/dev/null | md5sum | cut -d' ' -f1; }
-# within A B PCT: |A/B - 1| <= PCT %
-within() { python3 -c 'import sys; a,b,p=map(float,sys.argv[1:]); sys.exit(0 if abs(a/b-1)*100<=p else 1)' "$1" "$2" "$3"; }
-
-# conforming NAME GPKG [ASC] [EULER]: topology, and eval within E
-conforming() {
-  local name=$1 gpkg=$2 asc=${3:-} euler=${4-1} # "": not checked
-  if python3 "$TOPO" "$gpkg" $asc >topo.json 2>topo.err; then pass; else
-    fail "$name: not conforming: $(cat topo.json topo.err)"; fi
-  if [ -n "$euler" ]; then
-    check "$name: Euler characteristic $euler ($(cat topo.json))" \
-      [ "$(jget topo.json euler)" = "$euler" ]
-  fi
-}
-# bounded NAME DEM GPKG E: eval says every valid sample is within E, each
-# covered once
-bounded() {
-  local name=$1 dem=$2 gpkg=$3 e=$4
-  "$T" eval -json -max_error "$e" "$dem" "$gpkg" >eval.json 2>eval.err
-  local rc=$? # before the check: its $(...) would reset $?
-  check "$name: eval within $e ($(cat eval.err))" [ $rc -eq 0 ]
-  check "$name: no sample overlapped" [ "$(jget eval.json overlapped)" = 0 ]
-}
+. "$(dirname "${BASH_SOURCE[0]}")/tt_tiles_lib.sh" || exit 1
 
 # --- the topology checker catches what it looks for ---
 python3 - <<'PY'
@@ -184,6 +134,10 @@ run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg
 check "-max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "-max_memory 1500K: tiled automatically" [ "$(jget out.txt tiling.automatic)" = True ]
 bounded "-max_memory 1500K" in/ds.tif out/m.gpkg 30
+run simplify -q -json -max_points 5000 -max_memory 1500K in/ds.tif out/mp.gpkg
+check "-max_points 5000 -max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "-max_points 5000 -max_memory 1500K: tiled automatically" [ "$(jget out.txt tiling.automatic)" = True ]
+check "-max_points 5000 -max_memory 1500K: $(jget out.txt vertices) <= 5000" [ "$(jget out.txt vertices)" -le 5000 ]
 # the merged TIN counts against the limit too
 run simplify -q -max_error 0.5 -tile_size 64 -max_memory 2M in/ds.tif out/mm.gpkg
 check "-max_memory 2M, a dense tiled TIN: exit 1 ($rc)" [ "$rc" -eq 1 ]
@@ -206,9 +160,6 @@ refused "-tile_size -5" simplify -tile_size -5 in/ds.tif out/x.gpkg
 refused "-tile_size abc" simplify -tile_size abc in/ds.tif out/x.gpkg
 refused "-tile_size 1e3" simplify -tile_size 1e3 in/ds.tif out/x.gpkg
 refused "-tile_size 99999" simplify -tile_size 99999 in/ds.tif out/x.gpkg
-refused "-tile_size with -percent" simplify -tile_size 256 -percent 5 in/ds.tif out/x.gpkg
-refused "-tile_size with -max_points" simplify -tile_size 256 -max_points 500 in/ds.tif out/x.gpkg
-refused "-tile_size with decimation" simplify -tile_size 256 -method decimate -max_error 3 in/ds.tif out/x.gpkg
 refused "tiles over -max_memory" simplify -tile_size 512 -max_memory 1M -max_error 6 in/ds.tif out/x.gpkg
 
 # --- an interrupted tiled run leaves nothing (SIGTERM: a background job

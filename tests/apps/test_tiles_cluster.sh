@@ -3,7 +3,8 @@
 # command ($TT_TERRATIN): `tiles plan`, `tiles run` of every tile (in
 # reverse order), `tiles merge` give the same triangles and vertices layers
 # as `simplify -tile_size` with the same options (md5 of ogrinfo), on a
-# fractal and on a DEM with nodata across tile borders; a missing piece, a
+# fractal (refined, and decimated: the plan carries -method decimate) and
+# on a DEM with nodata across tile borders; a missing piece, a
 # stale piece (another tile's), a changed DEM, a tile id out of range, an
 # existing plan, piece or output without -overwrite, a plan without
 # -max_error and a damaged piece are refused with one line, a non-zero exit
@@ -60,6 +61,16 @@ run simplify -q -max_error 6 -tile_size 128 -criterion delaunay -threads 2 ds.ti
 check "merge = simplify -tile_size (layers)" eval '[ -s m.gpkg ] && [ "$(dump m.gpkg)" = "$(dump s.gpkg)" ]'
 nv=$(ogrinfo -ro -so m.gpkg vertices 2>/dev/null | sed -n 's/Feature Count: //p')
 echo "fractal 513, tiles of 128: merged vertices $nv"
+
+# decimation: the plan carries -method decimate and its options
+run tiles plan ds.tif d.json -max_error 6 -tile_size 128 -method decimate -importance drop
+check "plan, decimate: exit 0" [ $rc -eq 0 ]
+: >err.txt
+check "run, decimate: every tile" all_tiles d.json 16
+run tiles merge d.json dm.gpkg -q
+check "merge, decimate: exit 0" [ $rc -eq 0 ]
+run simplify -q -max_error 6 -tile_size 128 -method decimate -importance drop -threads 2 ds.tif ds.gpkg
+check "merge = simplify -tile_size -method decimate (layers)" [ -s dm.gpkg ] && [ "$(dump dm.gpkg)" = "$(dump ds.gpkg)" ]
 
 # refusals
 run tiles run p.json 16

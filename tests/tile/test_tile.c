@@ -9,6 +9,9 @@
  *  - its vertex count is within a few per cent of an untiled run's;
  *  - grids with nodata across, along and at the corners of tile borders;
  *  - every criterion and final optimisation keeps the borders;
+ *  - decimation in tiles keeps the border polylines' vertices, with every
+ *    decimation option; no optimiser swaps a border edge;
+ *  - a tile's error-against-count curve (budgets) matches untiled runs;
  *  - bad tiles and budgets are refused. */
 #include "terratin/terratin.h"
 #include "tt_test.h"
@@ -48,8 +51,9 @@ static tt_grid *window_of(const tt_grid *g, const tt_tile *t)
 }
 
 /* Tiles of n cells; run in reverse order when reverse, merged in order. */
-static tt_tin *run_tiled(const tt_grid *g, size_t n,
-                         const tt_refine_options *opt, bool reverse)
+static tt_tin *run_tiled_by(const tt_grid *g, size_t n,
+                            const tt_refine_options *opt,
+                            const tt_decimate_options *dopt, bool reverse)
 {
   size_t W = tt_grid_width(g), H = tt_grid_height(g);
   size_t ntx = (W - 2) / n + 1, nty = (H - 2) / n + 1, nt = ntx * nty;
@@ -68,7 +72,9 @@ static tt_tin *run_tiled(const tt_grid *g, size_t n,
   for (size_t k = 0; k < nt; k++) {
     size_t i = reverse ? nt - 1 - k : k;
     tt_grid *win = window_of(g, &tiles[i]);
-    tt_status st = tt_tile_run(ctx, win, &tiles[i], opt, &pieces[i]);
+    tt_status st = dopt ? tt_tile_decimate(ctx, win, &tiles[i], dopt,
+                                           &pieces[i])
+                        : tt_tile_run(ctx, win, &tiles[i], opt, &pieces[i]);
     if (st != TT_OK)
       fprintf(stderr, "tile %zu: %s\n", i, tt_context_errmsg(ctx));
     CHECK(st == TT_OK);
@@ -89,6 +95,102 @@ static tt_tin *run_tiled(const tt_grid *g, size_t n,
   free(pieces);
   free(tiles);
   return tin;
+}
+
+static tt_tin *run_tiled(const tt_grid *g, size_t n,
+                         const tt_refine_options *opt, bool reverse)
+{
+  return run_tiled_by(g, n, opt, NULL, reverse);
+}
+
+static tt_tin *run_tiled_dec(const tt_grid *g, size_t n,
+                             const tt_decimate_options *opt, bool reverse)
+{
+  return run_tiled_by(g, n, NULL, opt, reverse);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* The tile borders of a TIN in tiles of n: every pair of consecutive
+ * vertices along a shared border line (both valid samples whose segment
+ * lies in the TIN) is joined by an edge of the TIN (no border edge was
+ * swapped or split); and when ref is given, the vertices on the border
+ * lines are exactly ref's (the border polylines). Returns the number of
+ * vertices on border lines. */
+static size_t check_borders(const char *what, const tt_grid *g, size_t n,
+                            const tt_tin *tin, const tt_tin *ref)
+{
+  size_t W = tt_grid_width(g), H = tt_grid_height(g);
+  size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
+  int32_t *id = malloc(W * H * sizeof *id);
+  for (size_t i = 0; i < W * H; i++)
+    id[i] = -1;
+  for (size_t v = 0; v < nv; v++) {
+    tt_vertex_info vi;
+    tt_tin_vertex(tin, v, &vi);
+    id[(size_t)vi.row * W + (size_t)vi.col] = (int32_t)v;
+  }
+  uint8_t *ref_id = calloc(W * H, 1);
+  for (size_t v = 0; ref && v < tt_tin_vertex_count(ref); v++) {
+    tt_vertex_info vi;
+    tt_tin_vertex(ref, v, &vi);
+    ref_id[(size_t)vi.row * W + (size_t)vi.col] = 1;
+  }
+  uint64_t *edges = malloc(3 * nt * sizeof *edges);
+  for (size_t t = 0; t < nt; t++) {
+    tt_triangle_info ti;
+    tt_tin_triangle(tin, t, &ti);
+    for (int k = 0; k < 3; k++) {
+      uint64_t a = (uint64_t)ti.v[k], b = (uint64_t)ti.v[(k + 1) % 3];
+      edges[3 * t + k] = a < b ? a << 32 | b : b << 32 | a;
+    }
+  }
+  qsort(edges, 3 * nt, sizeof *edges, cmp_u64);
+  size_t on_lines = 0, missing = 0, differ = 0;
+  /* vertical lines x = n i, horizontal lines y = n j, inside the DEM */
+  for (int dir = 0; dir < 2; dir++) {
+    size_t lines = dir == 0 ? W : H, len = dir == 0 ? H : W;
+    for (size_t at = n; at + 1 < lines; at += n) {
+      int32_t prev = -1;
+      size_t prev_i = 0;
+      for (size_t i = 0; i < len; i++) {
+        size_t c = dir == 0 ? at : i, r = dir == 0 ? i : at;
+        int32_t v = id[r * W + c];
+        if (ref)
+          differ += (v >= 0) != (ref_id[r * W + c] != 0);
+        if (v < 0)
+          continue;
+        on_lines++;
+        /* the segment from the previous vertex: all valid samples */
+        bool valid_run = prev >= 0;
+        for (size_t k = prev_i; valid_run && k <= i; k++)
+          valid_run = !isnan(tt_grid_sample(g, dir == 0 ? at : k,
+                                            dir == 0 ? k : at));
+        if (valid_run && i - prev_i >= 2) {
+          uint64_t a = (uint64_t)prev, b = (uint64_t)v;
+          uint64_t key = a < b ? a << 32 | b : b << 32 | a;
+          if (!bsearch(&key, edges, 3 * nt, sizeof *edges, cmp_u64))
+            missing++;
+        }
+        prev = v;
+        prev_i = i;
+      }
+    }
+  }
+  if (missing || differ)
+    fprintf(stderr, "%s: %zu border segments without their edge, %zu "
+            "border samples differing from the polylines\n", what, missing,
+            differ);
+  CHECK_INT_EQ(missing, 0);
+  CHECK_INT_EQ(differ, 0);
+  free(id);
+  free(ref_id);
+  free(edges);
+  return on_lines;
 }
 
 /* Everything the oracles say about a tiled TIN; returns its vertices. */
@@ -270,6 +372,216 @@ static void test_nodata(void)
   tt_grid_destroy(g);
 }
 
+/* Decimation in tiles: every start, importance, selection and hole rule;
+ * the bound on every sample, conformity, the border vertices exactly the
+ * border polylines (those of insertion's tiles at the same bound), the
+ * tile order irrelevant. */
+static void dec_case(const char *what, const tt_grid *g, size_t n,
+                     const tt_decimate_options *o, const tt_tin *ref,
+                     bool all_valid, bool reverse)
+{
+  tt_tin *tin = run_tiled_dec(g, n, o, false);
+  /* greedy:N starts above the bound (no removal adds to its error) */
+  double bound = o->start == TT_DSTART_GREEDY_N ? INFINITY : o->max_error;
+  size_t nv = check_tin(what, g, tin, bound, all_valid);
+  size_t nb = check_borders(what, g, n, tin, ref);
+  printf("%s: %zu vertices, %zu on tile borders\n", what, nv, nb);
+  if (reverse) {
+    tt_tin *rev = run_tiled_dec(g, n, o, true);
+    CHECK(same_tin(tin, rev));
+    tt_tin_destroy(rev);
+  }
+  tt_tin_destroy(tin);
+}
+
+static void test_decimate(void)
+{
+  tt_grid *g = fractal(65, 5);
+  tt_refine_options ro;
+  tt_refine_options_init(&ro);
+  ro.max_error = 2.0;
+  ro.threads = 1;
+  tt_tin *ref = run_tiled(g, 20, &ro, false);
+  tt_decimate_options o;
+  tt_decimate_options_init(&o);
+  o.max_error = ro.max_error;
+  o.threads = 1;
+  tt_tin *untiled = NULL;
+  CHECK(tt_decimate_run(ctx, g, &o, &untiled) == TT_OK);
+  tt_tin *tiled = run_tiled_dec(g, 20, &o, false);
+  printf("decimation, fractal 65 at 2: tiles of 20 %zu vertices, untiled "
+         "%zu, insertion in tiles %zu\n", tt_tin_vertex_count(tiled),
+         tt_tin_vertex_count(untiled), tt_tin_vertex_count(ref));
+  /* within a few per cent of the untiled decimation */
+  double more = (double)tt_tin_vertex_count(tiled) /
+                (double)tt_tin_vertex_count(untiled) - 1;
+  CHECK(more < 0.10 && more > -0.10);
+  tt_tin_destroy(tiled);
+  tt_tin_destroy(untiled);
+  dec_case("decimate, start all", g, 20, &o, ref, true, true);
+  static const tt_importance imps[] = {
+      TT_IMPORTANCE_DEGREE, TT_IMPORTANCE_HDH, TT_IMPORTANCE_ABH,
+      TT_IMPORTANCE_VOLUME, TT_IMPORTANCE_DROP};
+  for (size_t k = 0; k < sizeof imps / sizeof imps[0]; k++) {
+    tt_decimate_options oi = o;
+    oi.importance = imps[k];
+    char what[80];
+    snprintf(what, sizeof what, "decimate, importance %s",
+             tt_importance_name(imps[k]));
+    dec_case(what, g, 20, &oi, ref, true, false);
+  }
+  tt_decimate_options os = o;
+  os.selection = TT_SELECTION_SEQUENTIAL;
+  dec_case("decimate, sequential", g, 20, &os, ref, true, false);
+  tt_decimate_options op = o;
+  op.onepass = 1;
+  dec_case("decimate, onepass", g, 20, &op, ref, true, false);
+  tt_decimate_options oh = o;
+  oh.hole = TT_HOLE_DP;
+  dec_case("decimate, hole dp", g, 20, &oh, ref, true, false);
+  tt_decimate_options om = o;
+  om.hole = TT_HOLE_MINANGLE;
+  om.criterion = TT_CRITERION_MINMAX_ANGLE;
+  om.optimize = TT_OPTIMIZE_LOOKAHEAD;
+  dec_case("decimate, minmax_angle, lookahead", g, 20, &om, ref, true,
+           false);
+  tt_decimate_options og = o;
+  og.start = TT_DSTART_GREEDY;
+  dec_case("decimate, start greedy", g, 20, &og, ref, true, false);
+  og.start = TT_DSTART_GREEDY_N;
+  og.start_points = 1200; /* a tile of 20 inserts 1200 x 21^2 / 65^2 */
+  dec_case("decimate, start greedy:1200", g, 20, &og, ref, true, false);
+  tt_tin_destroy(ref);
+  tt_grid_destroy(g);
+
+  /* nodata across, along and at the corners of borders */
+  g = fractal(65, 9);
+  float *z = tt_grid_heights(g);
+  uint64_t rng = 3;
+  for (size_t r = 0; r < 65; r++)
+    for (size_t c = 0; c < 65; c++) {
+      double dx = (double)c - 16, dy = (double)r - 27;
+      bool hole = dx * dx + dy * dy < 7 * 7;
+      hole |= c == 32 && r > 5 && r < 15;
+      hole |= c >= 31 && c <= 33 && r >= 31 && r <= 34;
+      hole |= c > 50 && r > 50;
+      hole |= tt_test_uniform(&rng) < 0.003;
+      if (hole)
+        z[r * 65 + c] = NAN;
+    }
+  ref = run_tiled(g, 16, &ro, false);
+  dec_case("decimate, nodata", g, 16, &o, ref, false, true);
+  og.start = TT_DSTART_GREEDY;
+  dec_case("decimate, nodata, start greedy", g, 16, &og, ref, false, false);
+  tt_tin_destroy(ref);
+  tt_grid_destroy(g);
+}
+
+/* The optimisers per tile never swap a border edge: the border vertices
+ * stay the polylines' and each border segment stays an edge
+ * (check_borders), with the bound and conformity (check_tin). */
+static void test_optimizers(void)
+{
+  tt_grid *g = fractal(65, 13);
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.max_error = 2.0;
+  o.threads = 1;
+  o.optimize = TT_OPTIMIZE_NONE;
+  tt_tin *ref = run_tiled(g, 20, &o, false);
+  static const struct {
+    tt_criterion c;
+    tt_optimize opt;
+  } cases[] = {
+      {TT_CRITERION_DELAUNAY, TT_OPTIMIZE_LOCAL},
+      {TT_CRITERION_L2, TT_OPTIMIZE_LOCAL},
+      {TT_CRITERION_ABN, TT_OPTIMIZE_LOOKAHEAD},
+      {TT_CRITERION_MIN_AREA, TT_OPTIMIZE_ANNEAL},
+      {TT_CRITERION_MINMAX_ANGLE, TT_OPTIMIZE_EDGE_INSERTION}};
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    tt_refine_options oo = o;
+    oo.criterion = cases[k].c;
+    oo.optimize = cases[k].opt;
+    tt_tin *tin = run_tiled(g, 20, &oo, false);
+    char what[80];
+    snprintf(what, sizeof what, "optimize %s, %s",
+             tt_optimize_name(cases[k].opt), tt_criterion_name(cases[k].c));
+    check_tin(what, g, tin, o.max_error, true);
+    check_borders(what, g, 20, tin, ref);
+    tt_tin *rev = run_tiled(g, 20, &oo, true);
+    CHECK(same_tin(tin, rev));
+    tt_tin_destroy(rev);
+    tt_tin_destroy(tin);
+  }
+  tt_tin_destroy(ref);
+  tt_grid_destroy(g);
+}
+
+/* tt_tile_curve: on a tile that is the whole DEM (no shared side) a run
+ * to a bound E stops at the curve's first point at or below E, so the
+ * curve's count at E is an untiled run's, for any E. */
+typedef struct curve_rec {
+  size_t n, pts[20000];
+  double err[20000];
+} curve_rec;
+
+static void record(void *arg, size_t vertices, double max_error)
+{
+  curve_rec *c = arg;
+  if (c->n < 20000) {
+    c->pts[c->n] = vertices;
+    c->err[c->n] = max_error;
+    c->n++;
+  }
+}
+
+static void test_curve(void)
+{
+  tt_grid *g = fractal(129, 21);
+  tt_tile t = {0, 0, 128, 128, 129, 129};
+  tt_grid *win = window_of(g, &t);
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.threads = 1;
+  curve_rec *c = calloc(1, sizeof *c);
+  CHECK(tt_tile_curve(ctx, win, &t, &o, 129 * 129, record, c) == TT_OK);
+  CHECK(c->n > 100);
+  CHECK_INT_EQ(c->pts[0], 4); /* the corners */
+  CHECK(c->pts[c->n - 1] <= 129 * 129);
+  static const double bounds[] = {20, 8, 3, 1.5};
+  for (size_t k = 0; k < 4; k++) {
+    size_t at = 0;
+    while (at < c->n && c->err[at] > bounds[k])
+      at++;
+    CHECK(at < c->n);
+    o.max_error = bounds[k];
+    tt_tin *tin = NULL;
+    CHECK(tt_refine_run(ctx, g, &o, &tin) == TT_OK);
+    printf("curve: at %g, %zu vertices; a run to it %zu\n", bounds[k],
+           c->pts[at], tt_tin_vertex_count(tin));
+    CHECK_INT_EQ(c->pts[at], tt_tin_vertex_count(tin));
+    tt_tin_destroy(tin);
+  }
+  /* a tile with shared sides: its vertices never drop, its errors are
+   * the candidates' (the sides left out), and it ends at the cap */
+  tt_tile in = {40, 40, 80, 80, 129, 129};
+  tt_grid *w2 = window_of(g, &in);
+  c->n = 0;
+  CHECK(tt_tile_curve(ctx, w2, &in, &o, 200, record, c) == TT_OK);
+  CHECK(c->n > 10);
+  for (size_t i = 1; i < c->n; i++)
+    CHECK(c->pts[i] == c->pts[i - 1] + 1 || i + 1 == c->n);
+  CHECK(c->pts[c->n - 1] <= c->pts[0] + 200);
+  o.max_error = 1;
+  tt_tin *none = NULL;
+  CHECK(tt_tile_curve(ctx, w2, &in, &o, 0, record, c) == TT_ERR_ARG);
+  CHECK(none == NULL);
+  free(c);
+  tt_grid_destroy(w2);
+  tt_grid_destroy(win);
+  tt_grid_destroy(g);
+}
+
 static void test_refusals(void)
 {
   tt_grid *g = fractal(65, 1);
@@ -300,6 +612,9 @@ int main(void)
   test_fractal();
   test_criteria();
   test_nodata();
+  test_decimate();
+  test_optimizers();
+  test_curve();
   test_refusals();
   tt_context_destroy(ctx);
   return tt_test_failures ? 1 : 0;

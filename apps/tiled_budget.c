@@ -1,0 +1,149 @@
+/*
+ * tiled_budget.c -- -max_points, -max_triangles and -percent in tiles
+ * (docs/scale.md): a budget of the whole DEM turned into the one bound E
+ * every tile is refined to.
+ *
+ * A first pass records each tile's error-against-count curve
+ * (tt_tile_curve: the tile refined without its border vertices, the
+ * largest error of its candidates before each insertion). A run to a
+ * bound E stops at the first point of the curve whose error is <= E, so
+ * only the points where the error reaches a new low matter; of those a
+ * curve keeps one every 2 % of vertices more (and the last), about 600
+ * points of 12 bytes at most for a tile of a million vertices. A skipped
+ * low is followed by a kept one with more vertices and a lower error, so
+ * the count a thinned curve gives at E is never below the unthinned one's.
+ * The bound is the smallest error of any curve at which the counts summed
+ * over the tiles meet the target (tiled.c then runs the tiles at it and
+ * corrects the target by what the real count says).
+ */
+#include "app.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+static bool push(app_curve *c, size_t vertices, double err)
+{
+  if (c->n == c->cap) {
+    size_t cap = c->cap ? 2 * c->cap : 16;
+    uint32_t *p = realloc(c->pts, cap * sizeof *p);
+    if (!p)
+      return false;
+    c->pts = p;
+    double *e = realloc(c->err, cap * sizeof *e);
+    if (!e)
+      return false;
+    c->err = e;
+    c->cap = cap;
+  }
+  c->pts[c->n] = (uint32_t)vertices;
+  c->err[c->n] = err;
+  c->n++;
+  c->has_pending = false;
+  return true;
+}
+
+bool tt__app_curve_add(app_curve *c, size_t vertices, double err)
+{
+  if (c->n == 0 && !c->has_pending)
+    c->low = INFINITY;
+  if (!(err < c->low))
+    return true;
+  c->low = err;
+  size_t last = c->n ? c->pts[c->n - 1] : 0;
+  if (c->n && vertices < last + (last / 50 > 1 ? last / 50 : 1)) {
+    c->pending_pts = vertices;
+    c->pending_err = err;
+    c->has_pending = true;
+    return true;
+  }
+  return push(c, vertices, err);
+}
+
+bool tt__app_curve_end(app_curve *c)
+{
+  return !c->has_pending || push(c, c->pending_pts, c->pending_err);
+}
+
+void tt__app_curve_free(app_curve *c)
+{
+  free(c->pts);
+  free(c->err);
+  c->pts = NULL;
+  c->err = NULL;
+  c->n = c->cap = 0;
+}
+
+/* The vertices a tile has when refined to e: its first point at or below
+ * e; past its end (a curve cut at its insertions), its last. */
+static size_t count_at(const app_curve *c, double e)
+{
+  if (c->n == 0)
+    return 0;
+  size_t lo = 0, hi = c->n; /* errors decrease along the curve */
+  while (lo < hi) {
+    size_t mid = (lo + hi) / 2;
+    if (c->err[mid] <= e)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return c->pts[lo < c->n ? lo : c->n - 1];
+}
+
+static size_t sum_at(const app_curve *c, size_t n, double e)
+{
+  size_t s = 0;
+  for (size_t k = 0; k < n; k++)
+    s += count_at(&c[k], e);
+  return s;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+bool tt__app_curves_bound(const app_curve *c, size_t n, size_t target,
+                          double above, double below, double *out_bound,
+                          size_t *out_estimate)
+{
+  size_t m = 1;
+  for (size_t k = 0; k < n; k++)
+    m += c[k].n;
+  double *e = malloc(m * sizeof *e);
+  if (!e)
+    return false;
+  size_t ne = 0;
+  if (above < 0)
+    e[ne++] = 0;
+  for (size_t k = 0; k < n; k++)
+    for (size_t i = 0; i < c[k].n; i++)
+      if (c[k].err[i] > above && c[k].err[i] < below)
+        e[ne++] = c[k].err[i];
+  if (ne == 0) {
+    free(e);
+    *out_bound = NAN; /* no bound in between */
+    *out_estimate = 0;
+    return true;
+  }
+  qsort(e, ne, sizeof *e, cmp_double);
+  /* the counts fall as the bound grows: the first bound that meets the
+   * target, by bisection over the curves' errors */
+  size_t lo = 0, hi = ne - 1;
+  if (sum_at(c, n, e[hi]) > target) {
+    lo = hi; /* none meets it: the largest, the fewest vertices */
+  } else {
+    while (lo < hi) {
+      size_t mid = (lo + hi) / 2;
+      if (sum_at(c, n, e[mid]) <= target)
+        hi = mid;
+      else
+        lo = mid + 1;
+    }
+  }
+  *out_bound = e[lo];
+  *out_estimate = sum_at(c, n, e[lo]);
+  free(e);
+  return true;
+}

@@ -1,0 +1,170 @@
+#!/usr/bin/env bash
+# test_tiles_methods.sh -- issue 19, every method and budget in tiles
+# through the terratin command ($TT_TERRATIN):
+#  - `-method decimate -tile_size`: conforming (tin_topology.py), every
+#    valid sample within the bound (terratin eval), within 5 % of untiled
+#    decimation, the same layers for 1 and 2 threads, the vertices on the
+#    tile border lines exactly those of insertion's tiles (the border
+#    polylines), and the decimation options (-start, -importance,
+#    -selection, -onepass, -hole) on a DEM with nodata across borders;
+#  - -max_points, -max_triangles and -percent in tiles (insertion and
+#    decimation): never more than the budget, within 3 % below it (5 %
+#    for decimation), conforming, within the bound the run reports, the
+#    same for 1 and 2 threads; with -max_error the larger bound wins; a
+#    budget below the tiles' corners is refused with nothing written;
+#  - Mt Hood and Vinschgau decimated in tiles, when TT_SHARED_TESTDATA has
+#    them.
+# Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
+# missing.
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
+. "$(dirname "${BASH_SOURCE[0]}")/tt_tiles_lib.sh" || exit 1
+
+run generate diamond_square in/ds.tif -size 257 -seed 4 -q
+# nodata across, along and at the corners of tiles of 64
+# (two columns: GDAL's CSV driver does not open a file of one column)
+cat >in/holes.csv <<'CSV'
+id,WKT
+1,"POLYGON ((40 -70,90 -70,90 -120,40 -120,40 -70))"
+2,"POLYGON ((127.5 -10,128.5 -10,128.5 -60,127.5 -60,127.5 -10))"
+3,"POLYGON ((124 -124,132 -124,132 -132,124 -132,124 -124))"
+4,"POLYGON ((200 -200,257 -200,257 -257,200 -257,200 -200))"
+CSV
+run generate diamond_square in/n0.tif -size 257 -seed 9 -q
+gdal_translate -q -a_ullr 0 0 257 -257 -a_nodata -9999 in/n0.tif in/n.tif
+gdal_rasterize -q -burn -9999 -l holes in/holes.csv in/n.tif 2>err.txt
+rc=$? # before the check: its $(...) would reset $?
+check "nodata DEM made ($(cat err.txt))" [ $rc -eq 0 ]
+gdal_translate -q -of AAIGrid in/n.tif in/n.asc
+# the holes are there, and the untiled TIN's Euler characteristic is the
+# one the tiled TINs must have (1 less the holes inside the domain)
+run simplify -q -json -max_error 2 in/n.tif out/n_untiled.gpkg
+check "nodata, untiled: holes in the DEM" \
+  [ "$(jget out.txt valid_samples)" -lt $((257 * 257 - 3000)) ]
+python3 "$TOPO" out/n_untiled.gpkg in/n.asc >topo.json 2>topo.err
+n_euler=$(jget topo.json euler)
+check "nodata, untiled: the holes make the Euler characteristic < 1" \
+  [ "$n_euler" -lt 1 ]
+
+# --- decimation in tiles: the border vertices kept, every option ---
+run simplify -q -json -max_error 3 -tile_size 64 -threads 2 in/ds.tif out/t64.gpkg
+check "insertion, tiles of 64: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+run simplify -q -json -method decimate -max_error 3 in/ds.tif out/du.gpkg
+cp out.txt du.json
+run simplify -q -json -method decimate -max_error 3 -tile_size 64 -threads 2 in/ds.tif out/dt.gpkg
+check "decimate, tiles of 64: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+cp out.txt dt.json
+nu=$(jget du.json vertices)
+nv=$(jget dt.json vertices)
+echo "note: fractal 257, decimation at 3: tiles of 64: $nv vertices, untiled $nu"
+check "decimate, tiles of 64: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
+check "decimate, tiles of 64: method reported" [ "$(jget dt.json method)" = decimate ]
+conforming "decimate, tiles of 64" out/dt.gpkg
+bounded "decimate, tiles of 64" in/ds.tif out/dt.gpkg 3
+check "decimate: uncovered 0" [ "$(jget eval.json uncovered)" = 0 ]
+run simplify -q -method decimate -max_error 3 -tile_size 64 -threads 1 in/ds.tif out/dt1.gpkg
+check "decimate: threads 1 vs 2, the same layers" [ "$(dump out/dt1.gpkg)" = "$(dump out/dt.gpkg)" ]
+# the border vertices are those of insertion's tiles (the border polylines)
+python3 - out/dt.gpkg out/t64.gpkg 64 257 >bv.txt <<'PY'
+import sqlite3, sys
+def border(p, n, w):
+    db = sqlite3.connect(p)
+    return {(c, r) for c, r in db.execute("select col, row from vertices")
+            if (c % n == 0 and 0 < c < w - 1) or (r % n == 0 and 0 < r < w - 1)}
+n, w = int(sys.argv[3]), int(sys.argv[4])
+a, b = border(sys.argv[1], n, w), border(sys.argv[2], n, w)
+print(len(a), len(b), len(a ^ b))
+PY
+read -r nba nbb nbx <bv.txt
+check "decimate: $nba border vertices, insertion's $nbb, $nbx differ" eval '[ "$nbx" = 0 ] && [ "$nba" -gt 0 ]'
+for opts in "-start greedy -importance drop" "-selection sequential -hole minangle" \
+            "-onepass -importance volume" "-start greedy:5000 -importance hdh"; do
+  run simplify -q -json -method decimate -max_error 2 -tile_size 64 -threads 2 $opts in/n.tif out/dn.gpkg -overwrite
+  check "decimate $opts, nodata: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  conforming "decimate $opts, nodata" out/dn.gpkg in/n.asc "$n_euler"
+  case $opts in
+    *greedy:*) ;; # starts above the bound: no removal lowers its error
+    *) bounded "decimate $opts, nodata" in/n.tif out/dn.gpkg 2 ;;
+  esac
+  run simplify -q -method decimate -max_error 2 -tile_size 64 -threads 1 $opts in/n.tif out/dn1.gpkg -overwrite
+  check "decimate $opts: threads 1 vs 2, the same layers" [ "$(dump out/dn1.gpkg)" = "$(dump out/dn.gpkg)" ]
+done
+
+# --- budgets of the whole DEM in tiles: never over, a few per cent below ---
+# budget DEM TILE FLAG N KEY [ASC EULER]: exit 0, count <= max, within 3 %
+budget() {
+  local dem=$1 n=$2 flag=$3 val=$4 key=$5
+  run simplify -q -json -$flag $val -tile_size $n -threads 2 $dem out/b.gpkg -overwrite
+  check "-$flag $val, tiles of $n: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  cp out.txt b.json
+  local got max e
+  got=$(jget b.json $key)
+  if [ "$flag" = percent ]; then
+    max=$(python3 -c 'import sys,math; print(max(1,math.floor(float(sys.argv[1])/100*int(sys.argv[2]))))' "$val" "$(jget b.json valid_samples)")
+  else
+    max=$val
+  fi
+  e=$(jget b.json limits.max_error)
+  echo "note: $dem -$flag $val in tiles of $n: $got $key of $max at the bound $e, $(jget b.json tiling.budget_passes) runs"
+  check "-$flag $val: $got $key <= $max" [ "$got" -le "$max" ]
+  check "-$flag $val: $got $key within 3 % below $max" within "$got" "$max" 3
+  conforming "-$flag $val, tiles of $n" out/b.gpkg "${6:-}" "${7-1}"
+  bounded "-$flag $val, tiles of $n" $dem out/b.gpkg "$e"
+  run simplify -q -$flag $val -tile_size $n -threads 1 $dem out/b1.gpkg -overwrite
+  check "-$flag $val: threads 1 vs 2, the same layers" [ "$(dump out/b1.gpkg)" = "$(dump out/b.gpkg)" ]
+}
+budget in/ds.tif 64 max_points 8000 vertices
+budget in/ds.tif 64 percent 1 vertices
+budget in/ds.tif 50 max_triangles 10000 triangles
+budget in/ds.tif 64 max_points 300 vertices
+budget in/n.tif 64 percent 2 vertices in/n.asc "$n_euler"
+# decimation to a budget: the same bound search, decimated runs
+run simplify -q -json -method decimate -max_points 2000 -tile_size 64 -threads 2 in/ds.tif out/bd.gpkg
+check "decimate -max_points 2000: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+cp out.txt bd.json
+echo "note: fractal 257, decimate -max_points 2000 in tiles of 64: $(jget bd.json vertices) vertices at the bound $(jget bd.json limits.max_error), $(jget bd.json tiling.budget_passes) runs"
+check "decimate -max_points 2000: $(jget bd.json vertices) <= 2000" [ "$(jget bd.json vertices)" -le 2000 ]
+check "decimate -max_points 2000: within 5 % below" within "$(jget bd.json vertices)" 2000 5
+conforming "decimate -max_points 2000" out/bd.gpkg
+bounded "decimate -max_points 2000" in/ds.tif out/bd.gpkg "$(jget bd.json limits.max_error)"
+run simplify -q -method decimate -max_points 2000 -tile_size 64 -threads 1 in/ds.tif out/bd1.gpkg
+check "decimate -max_points 2000: threads 1 vs 2, the same layers" [ "$(dump out/bd1.gpkg)" = "$(dump out/bd.gpkg)" ]
+# with -max_error too, the first stop wins: the bound is the larger
+run simplify -q -json -max_points 8000 -max_error 9 -tile_size 64 in/ds.tif out/b.gpkg -overwrite
+check "-max_points with -max_error 9: bound 9 ($(jget out.txt limits.max_error))" [ "$(jget out.txt limits.max_error)" = 9 ]
+check "-max_points with -max_error 9: under the budget" [ "$(jget out.txt vertices)" -le 8000 ]
+# a budget below the tiles' corners is refused, nothing written
+rm -f out/x.gpkg
+run simplify -max_points 10 -tile_size 64 in/ds.tif out/x.gpkg
+check "-max_points 10 in 16 tiles: exit 2 ($(cat err.txt))" [ "$rc" -eq 2 ]
+check "-max_points 10: one line" [ "$(wc -l <err.txt)" -eq 1 ]
+check "-max_points 10: says the budget is below ($(cat err.txt))" grep -q "budget of 10 vertices is below" err.txt
+check "-max_points 10: nothing written" [ ! -e out/x.gpkg ]
+
+# --- real DEMs decimated in tiles, when the shared test data are there ---
+S=${TT_SHARED_TESTDATA:-}
+for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschgau.tif:20; do
+  p=${rel%%:*}
+  e=${rel##*:}
+  if [ -z "$S" ] || [ ! -f "$S/$p" ]; then
+    echo "note: $p not in TT_SHARED_TESTDATA; skipped"
+    continue
+  fi
+  b=$(basename "$p" .tif)
+  gdal_translate -q -of AAIGrid "$S/$p" in/$b.asc
+  # decimation
+  run simplify -q -json -method decimate -max_error $e "$S/$p" out/${b}_du.gpkg
+  cp out.txt ${b}_du.json
+  run simplify -q -json -method decimate -max_error $e -tile_size 128 "$S/$p" out/${b}_dt.gpkg
+  check "$b: tiled decimation exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  cp out.txt ${b}_dt.json
+  nu=$(jget ${b}_du.json vertices)
+  nv=$(jget ${b}_dt.json vertices)
+  echo "note: $b, decimation at $e: tiles of 128: $nv vertices, untiled $nu"
+  check "$b, decimation: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
+  conforming "$b, decimation in tiles of 128" out/${b}_dt.gpkg in/$b.asc 1
+  bounded "$b, decimation in tiles of 128" "$S/$p" out/${b}_dt.gpkg $e
+done
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
