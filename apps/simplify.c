@@ -541,8 +541,11 @@ write:;
   int direct_rows = tt__app_str_ieq(drvname, "GPKG");
   if (direct_rows) {
     wopts = CSLSetNameValue(wopts, "ROWS", "DEFERRED");
-    /* a temporary file: removed on failure, renamed only when complete */
+    /* a temporary file: removed on failure, renamed only when complete,
+     * so the journal can stay in memory and the big tables can be written
+     * as database pages with SQLite closed (io_gpkg_rows.c) */
     wopts = CSLSetNameValue(wopts, "JOURNAL", "MEMORY");
+    wopts = CSLSetNameValue(wopts, "PAGES", "YES");
     if (ro.threads > 0) /* -threads 1: no thread making the rows either */
       wopts = CSLSetNameValue(wopts, "THREADS",
                               CPLSPrintf("%d", ro.threads));

@@ -166,11 +166,12 @@ static tt_status parse_options(write_state *w, char **options)
         s = tt__error(w->ctx, TT_ERR_ARG, "RTREE=%s: expected NOW or "
                       "DEFERRED", value);
     } else if (strcasecmp(key, "THREADS") != 0 &&
-               strcasecmp(key, "JOURNAL") != 0) {
-      /* THREADS and JOURNAL are tt_gpkg_write_rows()'s */
+               strcasecmp(key, "JOURNAL") != 0 &&
+               strcasecmp(key, "PAGES") != 0) {
+      /* THREADS, JOURNAL and PAGES are tt_gpkg_write_rows()'s */
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
                     "(known: JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, "
-                    "ROWS, RTREE, STYLE, T_SRS, THREADS)", key);
+                    "PAGES, ROWS, RTREE, STYLE, T_SRS, THREADS)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
