@@ -430,14 +430,13 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
 {
   layer_table *t = p->layer[0];
   tt_triangle_info tr;
-  tt_vertex_info v[3];
-  double px[3], py[3];
-  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, v, px, py);
+  double px[3], py[3], pz[3];
+  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, px, py, pz);
   if (s != TT_OK)
     return s;
-  double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
+  double lo[3] = {px[0], py[0], pz[0]}, hi[3] = {px[0], py[0], pz[0]};
   for (int k = 1; k < 3; k++) {
-    double c[3] = {px[k], py[k], v[k].z};
+    double c[3] = {px[k], py[k], pz[k]};
     for (int d = 0; d < 3; d++) {
       if (c[d] < lo[d]) lo[d] = c[d];
       if (c[d] > hi[d]) hi[d] = c[d];
@@ -455,7 +454,7 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
   for (int k = 0; k < 4; k++) {
     q = put_f64(q, px[k % 3]);
     q = put_f64(q, py[k % 3]);
-    q = put_f64(q, v[k % 3].z);
+    q = put_f64(q, pz[k % 3]);
   }
   *blob_len = (int)(q - blob);
   extend(t, lo[0], lo[1]);
@@ -642,11 +641,13 @@ static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
 
 /* The writing thread, its rows all written, packs the R-trees the maker
  * has not begun (the vertices' first: the maker begins with the
- * triangles'), so that the two share the sorts. */
-static void pipe_pack_too(rows_pipe *p, size_t node_cap)
+ * triangles'), so that the two share the sorts. Returns the trees it
+ * packed (bit k: layer k). */
+static unsigned pipe_pack_too(rows_pipe *p, size_t node_cap)
 {
+  unsigned mine = 0;
   if (!p->threaded || !node_cap)
-    return;
+    return 0;
   for (int k = 1; k >= 0; k--) {
     pthread_mutex_lock(&p->lock);
     int claimed = p->claimed[k], failed = p->failed;
@@ -661,7 +662,9 @@ static void pipe_pack_too(rows_pipe *p, size_t node_cap)
       free(t->boxes);
       t->boxes = NULL;
     }
+    mine |= 1u << k;
   }
+  return mine;
 }
 
 /* Joins the maker: after its packing when the rows went in (ok), else
@@ -1294,24 +1297,33 @@ static tt_status pages_write(pages_job *j)
   for (int k = 0; k < 2 && s == TT_OK; k++)
     if (j->todo[k])
       s = append_layer(w, j->pipe, k, &j->lay[k], t[k], format);
+  unsigned mine = 0;
   if (s == TT_OK && j->rtree)
-    pipe_pack_too(j->pipe, j->pipe->node_cap);
-  pipe_join(j->pipe, s == TT_OK); /* the boxes and extents are complete */
-  w->pipe = NULL;
+    mine = pipe_pack_too(j->pipe, j->pipe->node_cap);
+  /* The tables, and the R-trees this thread packed, while the maker packs
+   * the others; then those. */
   for (int k = 0; k < 2; k++)
     if (t[k] && s == TT_OK) {
       s = tt__sqlite_table_finish(t[k]);
       t[k] = NULL;
       j->layer[k]->last_fid = (sqlite3_int64)j->count[k];
     }
-  for (int k = 0; k < 2 && s == TT_OK; k++) {
-    if (!j->rtree || !j->todo[k])
-      continue;
-    w->lo = k ? 0.97 : 0.9;
-    w->hi = k ? 0.99 : 0.97;
-    s = tt__rtree_write_pages(w->ctx, j->layer[k]->name, j->layer[k]->boxes,
-                              j->count[k], j->pipe->packed[k], &j->sh[k], f,
-                              rtree_progress, w);
+  int written = 0; /* trees written: progress 0.9 to 0.95 to 0.99 */
+  for (int pass = 0; pass < 2; pass++) {
+    if (pass == 1) {
+      pipe_join(j->pipe, s == TT_OK); /* the boxes, extents, trees done */
+      w->pipe = NULL;
+    }
+    for (int k = 1; k >= 0 && s == TT_OK; k--) {
+      if (!j->rtree || !j->todo[k] || ((mine >> k) & 1) != (pass == 0))
+        continue;
+      w->lo = written ? 0.95 : 0.9;
+      w->hi = written++ ? 0.99 : 0.95;
+      s = tt__rtree_write_pages(w->ctx, j->layer[k]->name,
+                                j->layer[k]->boxes, j->count[k],
+                                j->pipe->packed[k], &j->sh[k], f,
+                                rtree_progress, w);
+    }
   }
   if (s == TT_OK)
     s = tt__sqlite_file_commit(f);

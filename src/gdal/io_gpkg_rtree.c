@@ -1412,27 +1412,19 @@ tt_status tt__gpkg_rtree_drop(tt_context *ctx, sqlite3 *db,
   return s;
 }
 
-/* Appends the row (rowid, value) of a shadow table: the record of NULL
- * (the INTEGER PRIMARY KEY) and value, an integer or a blob (the body
- * then, not copied). */
-static tt_status shadow_row(tt__sqlite_table *t, int64_t rowid,
-                            const tt__sqlite_value *value, int format)
+/* Appends the %_node row (nodeno, blob): the record of NULL (the INTEGER
+ * PRIMARY KEY) and the blob, which is its body as it is (no copy). */
+static tt_status node_row(tt__sqlite_table *t, int64_t nodeno,
+                          const unsigned char *blob, size_t size, int format)
 {
   unsigned char body[16];
   tt__sqlite_rec r;
   tt__sqlite_rec_begin(&r, body, format);
   tt__sqlite_rec_null(&r);
-  const unsigned char *b = body;
-  if (value->type == TT__SQV_BLOB) {
-    tt__sqlite_rec_bytes_type(&r, value->n, 0);
-    b = value->p;
-    r.nb = value->n;
-  } else {
-    tt__sqlite_rec_int(&r, value->i);
-  }
+  tt__sqlite_rec_bytes_type(&r, size, 0);
   const unsigned char *head;
   size_t nh = tt__sqlite_rec_head(&r, &head);
-  return tt__sqlite_table_append2(t, rowid, head, nh, b, r.nb);
+  return tt__sqlite_table_append2(t, nodeno, head, nh, blob, size);
 }
 
 /* The node blob of items[0..n) (depth: the root's) into blob. */
@@ -1533,11 +1525,10 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
   name = sqlite3_mprintf("%s_node", sh->rtree);
   s = name ? tt__sqlite_table_begin(f, name, sh->root[0], &t)
            : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  tt__sqlite_value v = {TT__SQV_BLOB, 0, 0, blob, sh->node_size};
   if (s == TT_OK) {
     node_blob(blob, sh->node_size, pk->level[top], pk->n[top],
               (unsigned)top);
-    s = shadow_row(t, 1, &v, format);
+    s = node_row(t, 1, blob, sh->node_size, format);
   }
   for (int d = 0; d < top && s == TT_OK; d++) {
     size_t ngroups = pk->n[d + 1];
@@ -1545,7 +1536,8 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
       size_t e0 = group_start(g, pk->n[d], ngroups);
       size_t e1 = group_start(g + 1, pk->n[d], ngroups);
       node_blob(blob, sh->node_size, pk->level[d] + e0, e1 - e0, 0);
-      s = shadow_row(t, pk->base[d] + (int64_t)g, &v, format);
+      s = node_row(t, pk->base[d] + (int64_t)g, blob, sh->node_size,
+                   format);
     }
   }
   done_rows += pk->nodes_total;
@@ -1564,11 +1556,8 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
   if (s == TT_OK)
     s = name ? tt__sqlite_table_begin(f, name, sh->root[1], &t)
              : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  v.type = TT__SQV_INT;
-  for (size_t m = 2; m <= pk->nodes_total && s == TT_OK; m++) {
-    v.i = parent[m];
-    s = shadow_row(t, (int64_t)m, &v, format);
-  }
+  for (size_t m = 2; m <= pk->nodes_total && s == TT_OK; m++)
+    s = tt__sqlite_table_append_int(t, (int64_t)m, parent[m]);
   done_rows += pk->nodes_total;
   if (s == TT_OK) {
     s = tt__sqlite_table_finish(t);
@@ -1582,8 +1571,7 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
     s = name ? tt__sqlite_table_begin(f, name, sh->root[2], &t)
              : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
   for (size_t i = 0; i < pk->nitems && s == TT_OK; i++) {
-    v.i = node_of[i];
-    s = shadow_row(t, (int64_t)i + 1, &v, format);
+    s = tt__sqlite_table_append_int(t, (int64_t)i + 1, node_of[i]);
     if (s == TT_OK && progress && (i & 0xffff) == 0xffff &&
         !progress((double)(done_rows + i) / (double)total, "indexing",
                   progress_arg))

@@ -392,14 +392,13 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
   const size_t nt = tt_tin_triangle_count(tin);
   for (size_t i = 0; i < nt && s == TT_OK; i++) {
     tt_triangle_info t;
-    tt_vertex_info v[3];
-    double px[3], py[3];
-    s = tt__records_triangle(&w->rec, w->ctx, i, &t, v, px, py);
+    double px[3], py[3], pz[3];
+    s = tt__records_triangle(&w->rec, w->ctx, i, &t, px, py, pz);
     if (s != TT_OK)
       break;
     ring = OGR_G_GetGeometryRef(poly, 0);
     for (int k = 0; k < 4; k++)
-      OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], v[k % 3].z);
+      OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], pz[k % 3]);
     OGR_F_SetGeometry(f, poly);
     set_int(f, idx[TT__TF_V0], t.v[0]);
     set_int(f, idx[TT__TF_V1], t.v[1]);

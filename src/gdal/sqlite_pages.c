@@ -79,21 +79,25 @@
 
 /* --- varints and big-endian integers -------------------------------------- */
 
-static int varint_len(uint64_t v)
+static inline int varint_len(uint64_t v)
 {
-  int n = 1;
+  if (v <= 0x7f)
+    return 1;
+  if (v <= 0x3fff)
+    return 2;
+  if (v <= 0x1fffff)
+    return 3;
   if (v >> 56)
     return 9;
-  while (v > 0x7f) {
-    v >>= 7;
+  int n = 4;
+  for (v >>= 28; v; v >>= 7)
     n++;
-  }
   return n;
 }
 
 /* SQLite's varint: 7 bits a byte, most significant first, the high bit set
  * on every byte but the last; a ninth byte holds 8 bits. */
-static int put_varint(unsigned char *p, uint64_t v)
+static inline int put_varint(unsigned char *p, uint64_t v)
 {
   if (v <= 0x7f) {
     p[0] = (unsigned char)v;
@@ -768,11 +772,26 @@ static tt_status emit_leaf(tt__sqlite_table *t)
   return push_child(t, 1, pgno, t->last);
 }
 
-tt_status tt__sqlite_table_append2(tt__sqlite_table *t, int64_t rowid,
-                                   const unsigned char *a, size_t na,
-                                   const unsigned char *b, size_t nb)
+/* Room for a cell of size bytes in the leaf (the leaf written out first
+ * when it is full); its place returned. */
+static tt_status cell_room(tt__sqlite_table *t, size_t size,
+                           unsigned char **out)
 {
-  const size_t n = na + nb;
+  if (t->content < size + 8 + 2 * (t->nc + 1)) {
+    tt_status s = emit_leaf(t);
+    if (s != TT_OK)
+      return s;
+  }
+  t->content -= size;
+  put_be16(t->leaf + 8 + 2 * t->nc, (unsigned)t->content);
+  t->nc++;
+  t->rows++;
+  *out = t->leaf + t->content;
+  return TT_OK;
+}
+
+static tt_status row_checks(tt__sqlite_table *t, int64_t rowid, size_t n)
+{
   if (t->rows && rowid <= t->last)
     return tt__error(t->f->ctx, TT_ERR_INTERNAL, "%s: table %s: rowid %lld "
                      "after %lld", t->f->path, t->name, (long long)rowid,
@@ -782,25 +801,54 @@ tt_status tt__sqlite_table_append2(tt__sqlite_table *t, int64_t rowid,
                      "bytes does not fit in a page (at most %zu without "
                      "overflow pages)", t->f->path, t->name, n,
                      t->max_payload);
-  unsigned char pre[18]; /* payload size and rowid, varints */
-  size_t npre = (size_t)put_varint(pre, n);
-  npre += (size_t)put_varint(pre + npre, (uint64_t)rowid);
-  size_t cell = npre + n;
-  if (t->content < cell + 8 + 2 * (t->nc + 1)) {
-    tt_status s = emit_leaf(t);
-    if (s != TT_OK)
-      return s;
-  }
-  t->content -= cell;
-  unsigned char *p = t->leaf + t->content;
-  memcpy(p, pre, npre);
-  memcpy(p + npre, a, na);
+  return TT_OK;
+}
+
+tt_status tt__sqlite_table_append2(tt__sqlite_table *t, int64_t rowid,
+                                   const unsigned char *a, size_t na,
+                                   const unsigned char *b, size_t nb)
+{
+  const size_t n = na + nb;
+  if ((t->rows && rowid <= t->last) || n > t->max_payload)
+    return row_checks(t, rowid, n);
+  int lp = varint_len(n), lr = varint_len((uint64_t)rowid);
+  unsigned char *p;
+  tt_status s = cell_room(t, (size_t)(lp + lr) + n, &p);
+  if (s != TT_OK)
+    return s;
+  p += put_varint(p, n);
+  p += put_varint(p, (uint64_t)rowid);
+  memcpy(p, a, na);
   if (nb)
-    memcpy(p + npre + na, b, nb);
-  put_be16(t->leaf + 8 + 2 * t->nc, (unsigned)t->content);
-  t->nc++;
+    memcpy(p + na, b, nb);
   t->last = rowid;
-  t->rows++;
+  return TT_OK;
+}
+
+tt_status tt__sqlite_table_append_int(tt__sqlite_table *t, int64_t rowid,
+                                      int64_t value)
+{
+  /* the record of NULL and value: a header of 3 bytes, the value's bytes */
+  tt__sqlite_rec r;
+  unsigned char body[16];
+  tt__sqlite_rec_begin(&r, body, t->f->format);
+  tt__sqlite_rec_null(&r);
+  tt__sqlite_rec_int(&r, value);
+  const size_t n = 3 + r.nb;
+  if (t->rows && rowid <= t->last)
+    return row_checks(t, rowid, n);
+  int lr = varint_len((uint64_t)rowid);
+  unsigned char *p;
+  tt_status s = cell_room(t, 1 + (size_t)lr + n, &p);
+  if (s != TT_OK)
+    return s;
+  *p++ = (unsigned char)n; /* a payload of at most 11 bytes */
+  p += put_varint(p, (uint64_t)rowid);
+  p[0] = 3;
+  p[1] = 0;
+  p[2] = r.head[10];
+  memcpy(p + 3, body, r.nb);
+  t->last = rowid;
   return TT_OK;
 }
 

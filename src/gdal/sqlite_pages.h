@@ -278,6 +278,12 @@ TT_HIDDEN tt_status tt__sqlite_table_append2(tt__sqlite_table *t,
                                              size_t na,
                                              const unsigned char *b,
                                              size_t nb);
+/* The same for the record of (NULL, value), an integer: a row of a table
+ * (INTEGER PRIMARY KEY, value) as the R*Tree module's %_rowid and
+ * %_parent. */
+TT_HIDDEN tt_status tt__sqlite_table_append_int(tt__sqlite_table *t,
+                                                int64_t rowid,
+                                                int64_t value);
 /* Ends the table: its last pages and its root (kept for the commit).
  * Frees t, also on failure. */
 TT_HIDDEN tt_status tt__sqlite_table_finish(tt__sqlite_table *t);
