@@ -432,6 +432,12 @@ write:;
    * valid), and GDAL 3.6's GPKG driver builds its creation option list for
    * the check by parsing its tiling schemes through PROJ: 38 M
    * instructions, 2 % of a Crater Lake run. */
+  /* A GeoPackage in the temporary file: its rollback journal in memory
+   * while GDAL makes the layers too (a file created and deleted for each
+   * of GDAL's transactions otherwise); unset after the close. */
+  const int gpkg_temp = !database && tt__app_str_ieq(drvname, "GPKG");
+  if (gpkg_temp)
+    CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", "MEMORY");
   if (!database) {
     int validate = s->dsco && s->dsco[0];
     if (!validate)
@@ -552,8 +558,11 @@ write:;
   int direct_rows = tt__app_str_ieq(drvname, "GPKG");
   if (direct_rows) {
     wopts = CSLSetNameValue(wopts, "ROWS", "DEFERRED");
-    /* a temporary file: removed on failure, renamed only when complete */
+    /* a temporary file: removed on failure, renamed only when complete,
+     * so the journal can stay in memory and the big tables can be written
+     * as database pages with SQLite closed (io_gpkg_rows.c) */
     wopts = CSLSetNameValue(wopts, "JOURNAL", "MEMORY");
+    wopts = CSLSetNameValue(wopts, "PAGES", "YES");
     if (ro.threads > 0) /* -threads 1: no thread making the rows either */
       wopts = CSLSetNameValue(wopts, "THREADS",
                               CPLSPrintf("%d", ro.threads));
@@ -589,6 +598,8 @@ write:;
   unsigned failures = r->msg.failures;
   GDALClose(dst);
   dst = NULL;
+  if (gpkg_temp)
+    CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", NULL);
   if (!tt__app_continue(r, r->prog.hi)) {
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
     goto done;
@@ -640,6 +651,7 @@ written:
 done:
   if (dst)
     GDALClose(dst);
+  CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", NULL);
   if (src)
     GDALClose(src);
   tt_output_destroy(outp); /* removes the temporary files unless committed */

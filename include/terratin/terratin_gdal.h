@@ -163,9 +163,15 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
  * the rows on the calling thread only; otherwise a second thread makes
  * them while SQLite inserts (tt_ogr_write_tin() accepts and ignores
  * THREADS too). JOURNAL=MEMORY keeps SQLite's rollback journal in memory
- * (for a file that is deleted unless the write completes). Any failure or
- * an interruption (progress returns 0:
- * TT_ERR_INTERRUPTED) rolls back and leaves the layers empty. */
+ * (for a file that is deleted unless the write completes). PAGES=YES
+ * writes the two tables and their R-trees as SQLite database pages with
+ * SQLite closed, several times faster; it is for a file nothing else has
+ * open and that is deleted unless the write completes (a crash in the
+ * middle can leave it unsound; the command's temporary output); when the
+ * file does not allow it (WAL mode, auto-vacuum, an index on a table) the
+ * rows go through SQLite. Any failure or an interruption (progress returns
+ * 0: TT_ERR_INTERRUPTED) leaves the layers empty, without an index (with
+ * PAGES=YES too, but for an I/O error in its last few writes). */
 tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
                              const tt_tin *tin, OGRSpatialReferenceH srs,
                              char **options, tt_progress_fn progress,

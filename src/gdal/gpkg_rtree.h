@@ -11,6 +11,8 @@
 
 #include <sqlite3.h>
 
+typedef struct tt__sqlite_file tt__sqlite_file;
+
 /* A feature's id (its fid) and the 2-D box of its geometry, in doubles:
  * the loader rounds them outward to floats as SQLite's R*Tree does. */
 typedef struct tt__rtree_box {
@@ -49,5 +51,46 @@ TT_HIDDEN tt_status tt__gpkg_rtree_from_boxes(
     const char *geom_column, const tt__rtree_box *boxes, size_t n,
     const tt__rtree_packed *packed, int check, tt_progress_fn progress,
     void *progress_arg);
+
+/* --- the index written as pages (sqlite_pages.h) --------------------------
+ * What the page writer needs of an index made empty by
+ * tt__gpkg_rtree_create_empty(): its name, the node size the module chose,
+ * and the root pages of its shadow tables. */
+typedef struct tt__rtree_shadow {
+  char *rtree;        /* rtree_<t>_<c> as stored (sqlite3_malloc) */
+  size_t node_size, node_cap;
+  uint32_t root[3];   /* %_node, %_parent, %_rowid */
+} tt__rtree_shadow;
+
+/* Makes the gpkg_rtree_index of table.geom_column in db (whose caller holds
+ * an open write transaction) as tt__gpkg_rtree_from_boxes() does, the
+ * virtual table, its triggers and the gpkg_extensions row, but with its
+ * shadow tables left empty (not even the root node), for
+ * tt__rtree_write_pages() to fill with SQLite closed. TT_ERR_FORMAT when a
+ * shadow table is not the plain two-column table it should be. */
+TT_HIDDEN tt_status tt__gpkg_rtree_create_empty(tt_context *ctx, sqlite3 *db,
+                                                const char *gpkg_path,
+                                                const char *table,
+                                                const char *geom_column,
+                                                tt__rtree_shadow *out);
+TT_HIDDEN void tt__rtree_shadow_free(tt__rtree_shadow *sh);
+
+/* Writes the nodes, parents and rowid map of the n boxes (or of packed,
+ * the same boxes packed by tt__rtree_pack(), packed again when its node
+ * capacity is not the index's) into the empty shadow tables of sh, as pages
+ * of f (not committed): the same rows tt__gpkg_rtree_from_boxes() would
+ * insert. progress gets [0, 1]. */
+TT_HIDDEN tt_status tt__rtree_write_pages(
+    tt_context *ctx, const char *what, const tt__rtree_box *boxes, size_t n,
+    const tt__rtree_packed *packed, const tt__rtree_shadow *sh,
+    tt__sqlite_file *f, tt_progress_fn progress, void *progress_arg);
+
+/* Removes the gpkg_rtree_index of table.geom_column from db (in its
+ * caller's write transaction): the virtual table and its shadow tables,
+ * the triggers, the gpkg_extensions row. What is not there is skipped. */
+TT_HIDDEN tt_status tt__gpkg_rtree_drop(tt_context *ctx, sqlite3 *db,
+                                        const char *gpkg_path,
+                                        const char *table,
+                                        const char *geom_column);
 
 #endif /* TERRATIN_GPKG_RTREE_H */

@@ -1,19 +1,17 @@
 /*
  * io_gpkg_rows.c -- the rows of a TIN's triangles and vertices layers
- * written straight into a closed GeoPackage with the sqlite3 C API.
+ * written straight into a closed GeoPackage: as SQLite database pages
+ * (PAGES=YES, the command's way) or through the sqlite3 C API.
  *
  * tt_ogr_write_tin(ROWS=DEFERRED) makes the layers through OGR (tables,
  * fields, gpkg_contents, gpkg_geometry_columns, the feature-count triggers
  * and gpkg_ogr_contents: the metadata GDAL knows how to get right) and the
- * run_parameters row; this file then fills the two big tables, one
- * INSERT ... SELECT a layer from a virtual table whose cursor hands SQLite
- * the rows (see "the rows as a virtual table" below), as OGR would have
- * filled them feature by feature but without a feature object, a geometry
- * object and a statement per row. A second thread makes the rows while
- * SQLite inserts them, then packs the R-trees. The content is the same:
- * the same fids (1..n in TIN
- * order, given by SQLite's append path in a table that never had rows),
- * the same columns and values (NaN as NULL), the same geometry
+ * run_parameters row; this file then fills the two big tables and their
+ * R-trees, as OGR would have filled them feature by feature. A second
+ * thread makes the rows (values, geometry blobs, R-tree boxes, extents)
+ * while the first writes them, then packs the R-trees. The content is the
+ * same as OGR's: the same fids (1..n in TIN order, in tables that never
+ * had rows), the same columns and values (NaN as NULL), the same geometry
  * blobs, which are the GeoPackage binary header ("GP", version 0, flags,
  * srs_id, envelope) followed by ISO WKB, byte for byte as GDAL 3.6 writes
  * them:
@@ -23,32 +21,53 @@
  *   vertices:  flags 0x01 (little endian, no envelope, as GDAL writes
  *              points), WKB Point Z (1001).
  * Afterwards gpkg_contents gets the layers' extents and gpkg_ogr_contents
- * their feature counts, which GDAL would have set at close. The
- * feature-count triggers would update gpkg_ogr_contents once per row: they
- * are dropped for the inserts and re-created from their own SQL, as GDAL
- * itself does around bulk writes.
+ * their feature counts, which GDAL would have set at close, and the
+ * R-trees of both layers are written from the boxes of the rows
+ * (gpkg_rtree.h), unless LCO=SPATIAL_INDEX=NO. tests/gdal/test_gpkg_rows.c
+ * compares every row, blob and index table with the OGR writer's, both
+ * ways.
  *
- * The R-trees of both layers are then written from the boxes of the rows
- * (gpkg_rtree.h), unless LCO=SPATIAL_INDEX=NO. Everything happens in one
- * IMMEDIATE transaction: a failure (disk full, an interruption through
- * progress) rolls back and leaves the file with its empty layers, as it
- * was. tests/gdal/test_gpkg_rows.c compares every row, blob and index
- * table with the OGR writer's.
+ * As pages (PAGES=YES; "the rows as database pages" below): the tables'
+ * B-trees are built bottom-up, in rowid order, and written into the file
+ * with SQLite closed (sqlite_pages.c, from SQLite's documented file
+ * format), SQLite only making the R-trees' schema before and setting
+ * sqlite_sequence, the extents and counts after: a fifth of the
+ * instructions of the inserts (docs/speed.md). Nothing journals the page
+ * writes: a failure or an interruption before the last few writes still
+ * leaves the layers empty and unindexed (the pages are cut off, the
+ * R-trees' schema dropped), but a crash during the write can leave the
+ * file unsound. That
+ * is acceptable for the command, which writes into a temporary file that
+ * no one else opens, removed on failure and renamed to the output only
+ * when the write completed; a library caller writing in place leaves
+ * PAGES off (the default) and gets the SQLite path, whose one transaction
+ * is crash-safe. A file the pages cannot be written into (WAL, auto-vacuum,
+ * an index on a table, ...) also gets the SQLite path.
  *
- * JOURNAL=MEMORY (the command's temporary files, which a failure removes
- * and only a finished write renames to the output) keeps SQLite's rollback
- * journal in memory: the roll-back still works, only a crash in the middle
- * of the write could leave the file unsound, and that file is never
- * renamed. Otherwise the journal is SQLite's default, on disk.
+ * Through SQLite (the default): one INSERT ... SELECT a layer from a
+ * virtual table whose cursor hands SQLite the rows (see "the rows as a
+ * virtual table" below), without a feature object, a geometry object and
+ * a statement per row. The feature-count triggers would update
+ * gpkg_ogr_contents once per row: they are dropped for the inserts and
+ * re-created from their own SQL, as GDAL itself does around bulk writes.
+ * Everything happens in one IMMEDIATE transaction: a failure (disk full,
+ * an interruption through progress) rolls back and leaves the file with
+ * its empty layers, as it was. JOURNAL=MEMORY (the command's temporary
+ * files) keeps SQLite's rollback journal in memory: the roll-back still
+ * works, only a crash in the middle of the write could leave the file
+ * unsound, and that file is never renamed. Otherwise the journal is
+ * SQLite's default, on disk.
  *
- * Workload: O(triangles + vertices) inserts of fixed-size rows (a 165-byte
- * and a 37-byte blob); about 5,000 instructions a triangle in SQLite
- * (Crater Lake, 108 k triangles), which no bind, batch or page size
- * lowered much: the floor of this path. Memory 40 bytes a feature for the
- * boxes, 2 MB of rows in flight, SQLite's page cache and, with T_SRS, 16
- * bytes a vertex.
+ * Workload: O(triangles + vertices) rows of fixed size (a 165-byte and a
+ * 37-byte blob). As pages, about 1,400 instructions a triangle row on the
+ * writing thread (Crater Lake: 219 M for 108 k triangles, 54 k vertices
+ * and both R-trees) and the row making on the other; through SQLite about
+ * 5,000 a triangle row in SQLite itself, the floor of that path. Memory 40
+ * bytes a feature for the boxes, 2 MB of rows in flight, a few pages per
+ * table or SQLite's page cache, and, with T_SRS, 16 bytes a vertex.
  */
 #include "gdal/gpkg_rtree.h"
+#include "gdal/sqlite_pages.h"
 #include "gdal/tin_records.h"
 
 #include <cpl_conv.h>
@@ -402,6 +421,7 @@ typedef struct rows_pipe {
    * here; the SQLite thread packs what is not packed) */
   size_t node_cap;
   tt__rtree_packed *packed[2];
+  int claimed[2];    /* the tree is (being) packed by one of the threads */
 } rows_pipe;
 
 static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
@@ -410,14 +430,13 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
 {
   layer_table *t = p->layer[0];
   tt_triangle_info tr;
-  tt_vertex_info v[3];
-  double px[3], py[3];
-  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, v, px, py);
+  double px[3], py[3], pz[3];
+  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, px, py, pz);
   if (s != TT_OK)
     return s;
-  double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
+  double lo[3] = {px[0], py[0], pz[0]}, hi[3] = {px[0], py[0], pz[0]};
   for (int k = 1; k < 3; k++) {
-    double c[3] = {px[k], py[k], v[k].z};
+    double c[3] = {px[k], py[k], pz[k]};
     for (int d = 0; d < 3; d++) {
       if (c[d] < lo[d]) lo[d] = c[d];
       if (c[d] > hi[d]) hi[d] = c[d];
@@ -435,7 +454,7 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
   for (int k = 0; k < 4; k++) {
     q = put_f64(q, px[k % 3]);
     q = put_f64(q, py[k % 3]);
-    q = put_f64(q, v[k % 3].z);
+    q = put_f64(q, pz[k % 3]);
   }
   *blob_len = (int)(q - blob);
   extend(t, lo[0], lo[1]);
@@ -549,11 +568,14 @@ static void *maker_main(void *arg)
    * inserts the last rows. The boxes are not needed after it. */
   for (int k = 0; k < 2 && p->node_cap && !p->failed; k++) {
     pthread_mutex_lock(&p->lock);
-    int stop = p->stop;
+    int stop = p->stop, claimed = p->claimed[k];
+    p->claimed[k] = 1;
     pthread_mutex_unlock(&p->lock);
     layer_table *t = p->layer[k];
     if (stop)
       break;
+    if (claimed)
+      continue; /* the other thread packs it */
     if (!t->boxes || p->count[k] == 0)
       continue; /* a layer left out by LAYERS */
     if (tt__rtree_pack(p->m_ctx, t->name, t->boxes, p->count[k],
@@ -615,6 +637,34 @@ static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
   p->blob_len = ch->blob_len[r];
   p->row = i;
   return report(w);
+}
+
+/* The writing thread, its rows all written, packs the R-trees the maker
+ * has not begun (the vertices' first: the maker begins with the
+ * triangles'), so that the two share the sorts. Returns the trees it
+ * packed (bit k: layer k). */
+static unsigned pipe_pack_too(rows_pipe *p, size_t node_cap)
+{
+  unsigned mine = 0;
+  if (!p->threaded || !node_cap)
+    return 0;
+  for (int k = 1; k >= 0; k--) {
+    pthread_mutex_lock(&p->lock);
+    int claimed = p->claimed[k], failed = p->failed;
+    p->claimed[k] = 1;
+    pthread_mutex_unlock(&p->lock);
+    layer_table *t = p->layer[k];
+    if (claimed || failed || !t->boxes || p->count[k] == 0)
+      continue;
+    /* a failure (out of memory) leaves the boxes for the page writer */
+    if (tt__rtree_pack(NULL, t->name, t->boxes, p->count[k], node_cap,
+                       &p->packed[k]) == TT_OK) {
+      free(t->boxes);
+      t->boxes = NULL;
+    }
+    mine |= 1u << k;
+  }
+  return mine;
 }
 
 /* Joins the maker: after its packing when the rows went in (ok), else
@@ -928,6 +978,462 @@ static tt_status finish_layer(rows_state *w, const layer_table *t,
   return s;
 }
 
+/* --- the rows as database pages -------------------------------------------
+ * PAGES=YES: the tables' B-trees are written as pages (sqlite_pages.h)
+ * instead of inserted. In three steps:
+ *   1. in SQLite, in the one transaction that also checked the layers: the
+ *      R-trees' virtual tables, triggers and gpkg_extensions rows, their
+ *      shadow tables left empty; commit, close;
+ *   2. with SQLite closed: the rows of both layers and the R-trees' shadow
+ *      tables appended as pages to the file, then their root pages and the
+ *      database header (sqlite_pages.c);
+ *   3. in SQLite again: sqlite_sequence (the AUTOINCREMENT fids), the
+ *      extents and feature counts, rtreecheck() on request; commit (which
+ *      syncs the file).
+ * A failure or an interruption in step 2 cuts the file back to its size
+ * after step 1, then the R-trees of step 1 are dropped: the layers are left
+ * empty and unindexed, as the SQL path leaves them. A crash, or a failure
+ * in writing the last pages of step 2 (the roots and the header), can
+ * leave the file unsound: hence PAGES=YES only for a file that is thrown
+ * away unless the write completes (the command's temporary output), and
+ * nothing else may have it open. Otherwise, and when the file does not
+ * allow pages (WAL, auto-vacuum, an index on a table, a text or defaulted
+ * column, rows too large for a page), the SQL path below runs. */
+
+enum { SRC_NULL = -2, SRC_GEOM = -1 };
+
+/* How a layer's rows map onto its table's columns. */
+typedef struct page_layout {
+  char *table;    /* the name in sqlite_schema */
+  uint32_t root;
+  int autoinc;    /* AUTOINCREMENT: sqlite_sequence gets the last fid */
+  int ncols;
+  int *src;       /* per column: SRC_NULL, SRC_GEOM or a field's index */
+  int *aff;       /* per column: tt__sqlite_affinity() */
+} page_layout;
+
+static void layout_free(page_layout *l)
+{
+  sqlite3_free(l->table);
+  free(l->src);
+  free(l->aff);
+  memset(l, 0, sizeof *l);
+}
+
+/* The columns of t for rows of the nfields fields and a geometry blob of at
+ * most blob_bytes. TT_OK with *why NULL: pages can take them; *why set: a
+ * reason they cannot (the SQL path writes them). */
+static tt_status layout_find(rows_state *w, const layer_table *t,
+                             const tt__field_spec *fields, int nfields,
+                             size_t blob_bytes, size_t max_payload,
+                             page_layout *out, const char **why)
+{
+  memset(out, 0, sizeof *out);
+  *why = NULL;
+  sqlite3_stmt *st = NULL;
+  tt_status s = TT_OK;
+  if (sqlite3_prepare_v2(w->db,
+                         "SELECT name, rootpage, sql FROM sqlite_master "
+                         "WHERE type = 'table' AND lower(name) = lower(?)",
+                         -1, &st, NULL) != SQLITE_OK)
+    return db_error(w, "cannot read the schema");
+  sqlite3_bind_text(st, 1, t->name, -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(st) == SQLITE_ROW) {
+    out->table = sqlite3_mprintf("%s", sqlite3_column_text(st, 0));
+    sqlite3_int64 root = sqlite3_column_int64(st, 1);
+    out->root = root > 1 && root < 0xffffffff ? (uint32_t)root : 0;
+    const char *sql = (const char *)sqlite3_column_text(st, 2);
+    out->autoinc = sql && sqlite3_strlike("%AUTOINCREMENT%", sql, 0) == 0;
+  }
+  sqlite3_finalize(st);
+  st = NULL;
+  if (!out->table || !out->root) {
+    *why = "its table is not in sqlite_schema";
+    return TT_OK;
+  }
+  if (sqlite3_prepare_v2(w->db,
+                         "SELECT count(*) FROM sqlite_master WHERE type = "
+                         "'index' AND lower(tbl_name) = lower(?)",
+                         -1, &st, NULL) != SQLITE_OK)
+    return db_error(w, "cannot read the schema");
+  sqlite3_bind_text(st, 1, out->table, -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_int(st, 0) > 0)
+    *why = "the table has an index";
+  sqlite3_finalize(st);
+  st = NULL;
+  if (*why)
+    return TT_OK;
+
+  char *sql = sqlite3_mprintf("PRAGMA table_info(\"%w\")", out->table);
+  int rc = sql ? sqlite3_prepare_v2(w->db, sql, -1, &st, NULL) : SQLITE_NOMEM;
+  sqlite3_free(sql);
+  if (rc != SQLITE_OK)
+    return db_error(w, "cannot read the table's columns");
+  int cap = 0, npk = 0, geom = 0, mapped = 0;
+  while (s == TT_OK && !*why && sqlite3_step(st) == SQLITE_ROW) {
+    if (out->ncols == cap) {
+      cap = cap ? 2 * cap : 32;
+      int *a = realloc(out->src, (size_t)cap * sizeof *a);
+      if (a)
+        out->src = a;
+      int *b = a ? realloc(out->aff, (size_t)cap * sizeof *b) : NULL;
+      if (b)
+        out->aff = b;
+      if (!a || !b) {
+        s = tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
+        break;
+      }
+    }
+    const char *name = (const char *)sqlite3_column_text(st, 1);
+    const char *type = (const char *)sqlite3_column_text(st, 2);
+    int has_default = sqlite3_column_type(st, 4) != SQLITE_NULL;
+    int pk = sqlite3_column_int(st, 5);
+    int src = SRC_NULL;
+    if (pk) {
+      npk++;
+      if (!type || sqlite3_stricmp(type, "INTEGER") != 0 ||
+          sqlite3_stricmp(name, t->fid) != 0)
+        *why = "the table's primary key is not its INTEGER fid";
+    } else if (name && sqlite3_stricmp(name, t->geom) == 0) {
+      src = SRC_GEOM;
+      geom++;
+    } else {
+      for (int k = 0; name && k < nfields; k++)
+        if (sqlite3_stricmp(name, fields[k].name) == 0)
+          src = k;
+      if (src >= 0)
+        mapped++;
+      else if (has_default)
+        *why = "a column the rows leave out has a default";
+    }
+    out->src[out->ncols] = src;
+    out->aff[out->ncols] = tt__sqlite_affinity(type);
+    if (src >= 0 && out->aff[out->ncols] == TT__AFF_TEXT)
+      *why = "a field's column has text affinity";
+    out->ncols++;
+  }
+  sqlite3_finalize(st);
+  if (s != TT_OK || *why)
+    return s;
+  if (npk != 1 || geom != 1 || mapped != nfields)
+    *why = "the table's columns are not the layer's";
+  /* header and body of the largest row: 9 bytes a serial type and 8 a
+   * value, the blob */
+  else if (9 + 17 * (size_t)out->ncols + blob_bytes > max_payload)
+    *why = "rows too large for a page";
+  return TT_OK;
+}
+
+/* Whether PAGES=YES can be followed for the layers made (lay[0]:
+ * triangles, lay[1]: vertices, when written); why not in *why. */
+static tt_status pages_possible(rows_state *w, const layer_table *tri,
+                                const layer_table *vtx, int do_tri,
+                                int do_vtx, int rtree, int nvfields,
+                                page_layout lay[2], const char **why)
+{
+  *why = NULL;
+  sqlite3_stmt *st = NULL;
+  char mode[16] = "";
+  int autovac = 0, page = 0;
+  if (sqlite3_prepare_v2(w->db, "PRAGMA journal_mode", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
+    snprintf(mode, sizeof mode, "%s", sqlite3_column_text(st, 0));
+  sqlite3_finalize(st);
+  if (sqlite3_prepare_v2(w->db, "PRAGMA auto_vacuum", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    autovac = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  if (sqlite3_prepare_v2(w->db, "PRAGMA page_size", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    page = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  int reserve = -1; /* asks, changes nothing */
+  if (sqlite3_file_control(w->db, "main", SQLITE_FCNTL_RESERVE_BYTES,
+                           &reserve) != SQLITE_OK)
+    reserve = -1;
+  if (strcasecmp(mode, "wal") == 0)
+    *why = "the database is in WAL mode";
+  else if (autovac)
+    *why = "the database has auto-vacuum";
+  else if (page < 512 || reserve < 0 || page - reserve < 480)
+    *why = "unknown page size";
+  if (*why)
+    return TT_OK;
+  const size_t max_payload = tt__sqlite_max_payload((size_t)(page - reserve));
+  /* R-tree nodes: the page size less 64 (whatever the reserved bytes), at
+   * most 51 cells of 24 bytes (tt__gpkg_rtree_node_cap()), a blob in a
+   * record of a NULL and the blob: a header of 4 bytes */
+  size_t node = (size_t)page - 64 < 4 + 51 * 24 ? (size_t)page - 64
+                                                : 4 + 51 * 24;
+  if (rtree && node + 4 > max_payload) {
+    *why = "R-tree nodes too large for a page";
+    return TT_OK;
+  }
+  tt_status s = TT_OK;
+  if (do_tri)
+    s = layout_find(w, tri, tt__triangle_fields, TT__TF_COUNT,
+                    TRI_BLOB_BYTES, max_payload, &lay[0], why);
+  if (s == TT_OK && !*why && do_vtx)
+    s = layout_find(w, vtx, tt__vertex_fields, nvfields, PT_BLOB_BYTES,
+                    max_payload, &lay[1], why);
+  return s;
+}
+
+/* Appends the rows of layer (0: triangles, 1: vertices) to t: the values
+ * the maker made, as records of the table's columns. */
+static tt_status append_layer(rows_state *w, rows_pipe *p, int layer,
+                              const page_layout *lay, tt__sqlite_table *t,
+                              int format)
+{
+  if (lay->ncols > TT__SQLITE_REC_COLS)
+    return tt__error(w->ctx, TT_ERR_FORMAT, "%s: table %s has more than %d "
+                     "columns", w->path, lay->table, TT__SQLITE_REC_COLS);
+  unsigned char body[8 * TT__SQLITE_REC_COLS + TRI_BLOB_BYTES + 8];
+  tt__sqlite_rec r;
+  tt_status s = TT_OK;
+  p->layer_now = layer;
+  for (size_t i = 0; i < p->count[layer] && s == TT_OK; i++) {
+    s = pipe_row(p, w, i);
+    if (s != TT_OK)
+      break;
+    tt__sqlite_rec_begin(&r, body, format);
+    for (int c = 0; c < lay->ncols; c++) {
+      int src = lay->src[c];
+      if (src == SRC_GEOM) {
+        tt__sqlite_rec_bytes(&r, p->blob, (size_t)p->blob_len, 0);
+        continue;
+      }
+      const row_value *rv = src >= 0 ? &p->vals[1 + src] : NULL;
+      if (!rv || rv->type == V_NULL) {
+        tt__sqlite_rec_null(&r);
+        continue;
+      }
+      tt__sqlite_value x;
+      x.type = rv->type == V_INT ? TT__SQV_INT : TT__SQV_REAL;
+      x.i = rv->i;
+      x.d = rv->d;
+      tt__sqlite_apply_affinity(&x, lay->aff[c]);
+      if (x.type == TT__SQV_INT)
+        tt__sqlite_rec_int(&r, x.i);
+      else
+        tt__sqlite_rec_real(&r, x.d);
+    }
+    const unsigned char *head;
+    size_t nh = tt__sqlite_rec_head(&r, &head);
+    s = tt__sqlite_table_append2(t, (int64_t)i + 1, head, nh, body, r.nb);
+  }
+  return s;
+}
+
+/* sqlite_sequence's row of an AUTOINCREMENT table: seq, the last fid, as
+ * SQLite's inserts would have left it. */
+static tt_status set_sequence(rows_state *w, const page_layout *lay,
+                              size_t count)
+{
+  if (!count || !lay->autoinc)
+    return TT_OK;
+  sqlite3_stmt *st = NULL;
+  tt_status s = TT_OK;
+  if (sqlite3_prepare_v2(w->db,
+                         "UPDATE sqlite_sequence SET seq = ?1 WHERE name = "
+                         "?2",
+                         -1, &st, NULL) != SQLITE_OK)
+    return db_error(w, "cannot update sqlite_sequence");
+  sqlite3_bind_int64(st, 1, (sqlite3_int64)count);
+  sqlite3_bind_text(st, 2, lay->table, -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(st) != SQLITE_DONE)
+    s = db_error(w, "cannot update sqlite_sequence");
+  sqlite3_finalize(st);
+  if (s != TT_OK || sqlite3_changes(w->db) > 0)
+    return s;
+  if (sqlite3_prepare_v2(w->db,
+                         "INSERT INTO sqlite_sequence (name, seq) VALUES "
+                         "(?2, ?1)",
+                         -1, &st, NULL) != SQLITE_OK)
+    return db_error(w, "cannot update sqlite_sequence");
+  sqlite3_bind_int64(st, 1, (sqlite3_int64)count);
+  sqlite3_bind_text(st, 2, lay->table, -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(st) != SQLITE_DONE)
+    s = db_error(w, "cannot update sqlite_sequence");
+  sqlite3_finalize(st);
+  return s;
+}
+
+/* What the page path works with. */
+typedef struct pages_job {
+  rows_state *w;
+  rows_pipe *pipe;
+  const tt__records *rec;
+  layer_table *layer[2];
+  page_layout lay[2];
+  size_t count[2];
+  int todo[2];
+  int rtree, rtree_check, threads, journal_memory;
+  int had_extensions;    /* gpkg_extensions was there before step 1 */
+  tt__rtree_shadow sh[2];
+} pages_job;
+
+/* Step 2: the rows and the R-trees as pages. */
+static tt_status pages_write(pages_job *j)
+{
+  rows_state *w = j->w;
+  tt__sqlite_file *f = NULL;
+  tt__sqlite_table *t[2] = {NULL, NULL};
+  tt_status s = tt__sqlite_file_open(w->ctx, w->path, &f);
+  const int format = s == TT_OK ? tt__sqlite_file_format(f) : 4;
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k])
+      s = tt__sqlite_table_begin(f, j->lay[k].table, j->lay[k].root, &t[k]);
+  if (s == TT_OK)
+    s = pipe_begin(j->pipe, w, j->rec, j->layer[0], j->layer[1],
+                   j->count[0], j->count[1], j->threads,
+                   j->rtree ? j->sh[j->todo[0] ? 0 : 1].node_cap : 0);
+  w->pipe = j->pipe;
+  w->lo = 0.0;
+  w->hi = 0.9;
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k])
+      s = append_layer(w, j->pipe, k, &j->lay[k], t[k], format);
+  unsigned mine = 0;
+  if (s == TT_OK && j->rtree)
+    mine = pipe_pack_too(j->pipe, j->pipe->node_cap);
+  /* The tables, and the R-trees this thread packed, while the maker packs
+   * the others; then those. */
+  for (int k = 0; k < 2; k++)
+    if (t[k] && s == TT_OK) {
+      s = tt__sqlite_table_finish(t[k]);
+      t[k] = NULL;
+      j->layer[k]->last_fid = (sqlite3_int64)j->count[k];
+    }
+  int written = 0; /* trees written: progress 0.9 to 0.95 to 0.99 */
+  for (int pass = 0; pass < 2; pass++) {
+    if (pass == 1) {
+      pipe_join(j->pipe, s == TT_OK); /* the boxes, extents, trees done */
+      w->pipe = NULL;
+    }
+    for (int k = 1; k >= 0 && s == TT_OK; k--) {
+      if (!j->rtree || !j->todo[k] || ((mine >> k) & 1) != (pass == 0))
+        continue;
+      w->lo = written ? 0.95 : 0.9;
+      w->hi = written++ ? 0.99 : 0.95;
+      s = tt__rtree_write_pages(w->ctx, j->layer[k]->name,
+                                j->layer[k]->boxes, j->count[k],
+                                j->pipe->packed[k], &j->sh[k], f,
+                                rtree_progress, w);
+    }
+  }
+  if (s == TT_OK)
+    s = tt__sqlite_file_commit(f);
+  /* without the commit the file is cut back to its size after step 1 */
+  tt_status c = tt__sqlite_file_close(f);
+  return s != TT_OK ? s : c;
+}
+
+/* Undoes step 1 after a failure in step 2 (w->db idle). */
+static void pages_undo(pages_job *j)
+{
+  rows_state *w = j->w;
+  if (!j->rtree)
+    return;
+  tt_context *quiet = tt_context_create(); /* keeps the first message */
+  tt_context *ctx = quiet ? quiet : w->ctx;
+  if (sqlite3_exec(w->db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK)
+    goto done;
+  tt_status s = TT_OK;
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k])
+      s = tt__gpkg_rtree_drop(ctx, w->db, w->path, j->layer[k]->name,
+                              j->layer[k]->geom);
+  if (s == TT_OK && !j->had_extensions &&
+      sqlite3_exec(w->db, "DROP TABLE IF EXISTS gpkg_extensions", NULL,
+                   NULL, NULL) != SQLITE_OK)
+    s = TT_ERR_IO;
+  sqlite3_exec(w->db, s == TT_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL);
+done:
+  if (quiet)
+    tt_context_destroy(quiet);
+}
+
+/* Steps 1 (from the open transaction of w->db, which it ends) to 3. Between
+ * steps 1 and 3 the connection stays open but idle: in rollback-journal
+ * mode it then holds no lock (which the page writer's own descriptor,
+ * closed after step 2, would cancel) and no page it trusts: the change
+ * counter the page writer raises makes SQLite drop its cache at the next
+ * transaction, and the schema is unchanged. */
+static tt_status pages_run(pages_job *j)
+{
+  rows_state *w = j->w;
+  tt_status s = TT_OK;
+  j->had_extensions =
+      sqlite3_table_column_metadata(w->db, NULL, "gpkg_extensions",
+                                    "extension_name", NULL, NULL, NULL, NULL,
+                                    NULL) == SQLITE_OK;
+  /* Step 1 needs no sync: a crash before step 3 ends loses the file. The
+   * transaction so far only read; the setting needs none open. */
+  int sync = 2;
+  sqlite3_stmt *st = NULL;
+  if (sqlite3_prepare_v2(w->db, "PRAGMA synchronous", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    sync = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  s = exec(w, "COMMIT; PRAGMA synchronous = OFF; BEGIN IMMEDIATE",
+           "cannot start a transaction");
+  for (int k = 0; k < 2 && s == TT_OK && j->rtree; k++)
+    if (j->todo[k])
+      s = tt__gpkg_rtree_create_empty(w->ctx, w->db, w->path,
+                                      j->layer[k]->name, j->layer[k]->geom,
+                                      &j->sh[k]);
+  if (s == TT_OK)
+    s = exec(w, "COMMIT", "cannot commit the spatial indexes");
+  if (s != TT_OK) {
+    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
+    return s;
+  }
+  char pragma[48];
+  snprintf(pragma, sizeof pragma, "PRAGMA synchronous = %d", sync);
+  s = exec(w, pragma, "cannot set synchronous");
+
+  if (s == TT_OK)
+    s = pages_write(j);
+  if (s != TT_OK) {
+    pages_undo(j);
+    return s;
+  }
+
+  s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k]) {
+      s = set_sequence(w, &j->lay[k], j->count[k]);
+      if (s == TT_OK)
+        s = finish_layer(w, j->layer[k], j->count[k]);
+    }
+  for (int k = 0; k < 2 && s == TT_OK && j->rtree_check && j->rtree; k++) {
+    if (!j->todo[k])
+      continue;
+    char *sql = sqlite3_mprintf("SELECT rtreecheck(%Q)", j->sh[k].rtree);
+    int rc = sql ? sqlite3_prepare_v2(w->db, sql, -1, &st, NULL)
+                 : SQLITE_NOMEM;
+    sqlite3_free(sql);
+    const char *msg = rc == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW
+                          ? (const char *)sqlite3_column_text(st, 0) : NULL;
+    if (!msg || strcmp(msg, "ok") != 0)
+      s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s: the R-tree %s fails "
+                    "rtreecheck(): %.300s", w->path, j->sh[k].rtree,
+                    msg ? msg : sqlite3_errmsg(w->db));
+    sqlite3_finalize(st);
+    st = NULL;
+  }
+  if (s == TT_OK)
+    s = exec(w, "COMMIT", "cannot commit the TIN");
+  else
+    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
+  return s;
+}
+
 tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
                              const tt_tin *tin, OGRSpatialReferenceH srs,
                              char **options, tt_progress_fn progress,
@@ -948,10 +1454,12 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   w.progress_arg = progress_arg;
   const char *prefix = "", *t_srs = NULL;
   int in_transaction = 0, rtree = 1, rtree_check = 0, threads = 0;
-  int journal_memory = 0;
+  int journal_memory = 0, pages = 0;
   unsigned layers = TT__LAYERS_ALL;
   rows_pipe pipe;
   memset(&pipe, 0, sizeof pipe);
+  pages_job job; /* PAGES=YES */
+  memset(&job, 0, sizeof job);
   char *tri_name = NULL, *vtx_name = NULL;
   tt_status s = TT_OK;
 
@@ -979,12 +1487,14 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       threads = atoi(value);
     else if (strcasecmp(key, "JOURNAL") == 0)
       journal_memory = strcasecmp(value, "MEMORY") == 0;
+    else if (strcasecmp(key, "PAGES") == 0)
+      pages = CPLTestBool(value);
     else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0 &&
              strcasecmp(key, "STYLE") != 0 &&
              strcasecmp(key, "OVERWRITE") != 0)
       s = tt__error(ctx, TT_ERR_ARG, "unknown write option \"%s\" (known: "
-                    "JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, ROWS, "
-                    "RTREE, RTREE_CHECK, STYLE, T_SRS, THREADS)", key);
+                    "JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, PAGES, "
+                    "ROWS, RTREE, RTREE_CHECK, STYLE, T_SRS, THREADS)", key);
     CPLFree(key);
     if (s != TT_OK)
       return s;
@@ -1042,6 +1552,33 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
       s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
                     "index of %zu features", gpkg_path, nt + nv);
   }
+  const char *why = NULL;
+  if (s == TT_OK && pages)
+    s = pages_possible(&w, &tri, &vtx, do_tri, do_vtx, rtree,
+                       tt__records_vertex_fields(tin), job.lay, &why);
+  if (s == TT_OK && pages && why)
+    CPLDebug("terratin", "%s: the rows go through SQLite, not as pages: %s",
+             gpkg_path, why);
+  if (s == TT_OK && pages && !why) {
+    job.w = &w;
+    job.pipe = &pipe;
+    job.rec = &rec;
+    job.layer[0] = &tri;
+    job.layer[1] = &vtx;
+    job.count[0] = nt;
+    job.count[1] = nv;
+    job.todo[0] = do_tri;
+    job.todo[1] = do_vtx;
+    job.rtree = rtree;
+    job.rtree_check = rtree_check;
+    job.threads = threads;
+    job.journal_memory = journal_memory;
+    in_transaction = 0; /* pages_run ends it */
+    s = pages_run(&job);
+    if (s == TT_OK && progress)
+      progress(1.0, "writing", progress_arg); /* done: too late to stop */
+    goto done;
+  }
   if (s == TT_OK && do_tri)
     s = triggers_drop(&w, &tri);
   if (s == TT_OK && do_vtx)
@@ -1089,6 +1626,10 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     progress(1.0, "writing", progress_arg); /* done: too late to stop */
 done:
   pipe_free(&pipe); /* before the tables the maker fills */
+  for (int k = 0; k < 2; k++) {
+    layout_free(&job.lay[k]);
+    tt__rtree_shadow_free(&job.sh[k]);
+  }
   if (in_transaction)
     sqlite3_exec(w.db, "ROLLBACK", NULL, NULL, NULL);
   if (w.db && sqlite3_close(w.db) != SQLITE_OK && s == TT_OK)

@@ -46,6 +46,7 @@
  * feature.
  */
 #include "gdal/gpkg_rtree.h"
+#include "gdal/sqlite_pages.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -1277,5 +1278,320 @@ done:
   if (b.db && sqlite3_close(b.db) != SQLITE_OK && s == TT_OK)
     s = db_error(&b, TT_ERR_IO, "cannot close");
   build_free(&b);
+  return s;
+}
+
+/* --- the index written as pages ------------------------------------------- */
+
+void tt__rtree_shadow_free(tt__rtree_shadow *sh)
+{
+  sqlite3_free(sh->rtree);
+  memset(sh, 0, sizeof *sh);
+}
+
+/* The root page of shadow table rtree<suffix>, checked to be the module's
+ * plain (INTEGER PRIMARY KEY, value) table. */
+static tt_status shadow_root(rt_build *b, const char *suffix, uint32_t *root)
+{
+  sqlite3_stmt *st = NULL;
+  char *name = sqlite3_mprintf("%s%s", b->rtree, suffix);
+  tt_status s = name ? TT_OK
+                     : tt__error(b->ctx, TT_ERR_NOMEM, "out of memory");
+  if (s == TT_OK)
+    s = prepare_owned(b,
+                      sqlite3_mprintf("SELECT rootpage FROM sqlite_master "
+                                      "WHERE type = 'table' AND name = %Q",
+                                      name),
+                      &st, "cannot read the schema");
+  if (s == TT_OK) {
+    sqlite3_int64 r = sqlite3_step(st) == SQLITE_ROW
+                          ? sqlite3_column_int64(st, 0) : 0;
+    if (r < 2 || r > 0xfffffffe)
+      s = tt__error(b->ctx, TT_ERR_FORMAT, "%s: no table %s", b->path,
+                    name);
+    *root = (uint32_t)r;
+  }
+  sqlite3_finalize(st);
+  st = NULL;
+  if (s == TT_OK)
+    s = prepare_owned(b, sqlite3_mprintf("PRAGMA table_info(\"%w\")", name),
+                      &st, "cannot read the index's columns");
+  int ncols = 0, plain = 1;
+  while (s == TT_OK && sqlite3_step(st) == SQLITE_ROW) {
+    const char *type = (const char *)sqlite3_column_text(st, 2);
+    int pk = sqlite3_column_int(st, 5);
+    if (ncols == 0)
+      plain = plain && pk == 1 && type && sqlite3_stricmp(type, "INTEGER") == 0;
+    else
+      plain = plain && pk == 0;
+    ncols++;
+  }
+  if (s == TT_OK && (ncols != 2 || !plain))
+    s = tt__error(b->ctx, TT_ERR_FORMAT, "%s: index table %s is not "
+                  "(INTEGER PRIMARY KEY, value)", b->path, name);
+  sqlite3_finalize(st);
+  sqlite3_free(name);
+  return s;
+}
+
+tt_status tt__gpkg_rtree_create_empty(tt_context *ctx, sqlite3 *db,
+                                      const char *gpkg_path,
+                                      const char *table,
+                                      const char *geom_column,
+                                      tt__rtree_shadow *out)
+{
+  memset(out, 0, sizeof *out);
+  rt_build b;
+  memset(&b, 0, sizeof b);
+  b.ctx = ctx;
+  b.db = db;
+  b.path = gpkg_path;
+  sqlite3_stmt *uv = NULL;
+  if (sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &uv, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(uv) == SQLITE_ROW)
+    b.gpkg_version = sqlite3_column_int(uv, 0);
+  sqlite3_finalize(uv);
+  tt_status s = describe(&b, table, geom_column);
+  if (s == TT_OK)
+    s = create_schema(&b); /* and the root node deleted */
+  static const char *const parts[3] = {"_node", "_parent", "_rowid"};
+  for (int k = 0; k < 3 && s == TT_OK; k++)
+    s = shadow_root(&b, parts[k], &out->root[k]);
+  if (s == TT_OK) {
+    out->rtree = sqlite3_mprintf("%s", b.rtree);
+    out->node_size = b.node_size;
+    out->node_cap = b.node_cap;
+    if (!out->rtree)
+      s = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  }
+  build_free(&b);
+  return s;
+}
+
+tt_status tt__gpkg_rtree_drop(tt_context *ctx, sqlite3 *db,
+                              const char *gpkg_path, const char *table,
+                              const char *geom_column)
+{
+  char *r = sqlite3_mprintf("rtree_%s_%s", table, geom_column);
+  if (!r)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  static const char *const triggers[] = {
+      "_insert", "_update1", "_update2", "_update3", "_update4",
+      "_update5", "_update6", "_update7", "_delete"};
+  char *sql = sqlite3_mprintf("DROP TABLE IF EXISTS \"%w\";", r);
+  for (size_t k = 0; sql && k < sizeof triggers / sizeof triggers[0]; k++) {
+    char *more = sqlite3_mprintf("%sDROP TRIGGER IF EXISTS \"%w%s\";", sql,
+                                 r, triggers[k]);
+    sqlite3_free(sql);
+    sql = more;
+  }
+  tt_status s = TT_OK;
+  if (!sql)
+    s = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  else if (sqlite3_exec(db, sql, NULL, NULL, NULL) != SQLITE_OK)
+    s = tt__error(ctx, TT_ERR_IO, "%s: cannot remove the index %s: %s",
+                  gpkg_path, r, sqlite3_errmsg(db));
+  sqlite3_free(sql);
+  if (s == TT_OK &&
+      sqlite3_table_column_metadata(db, NULL, "gpkg_extensions",
+                                    "extension_name", NULL, NULL, NULL, NULL,
+                                    NULL) == SQLITE_OK) {
+    sql = sqlite3_mprintf("DELETE FROM gpkg_extensions WHERE "
+                          "lower(table_name) = lower(%Q) AND "
+                          "lower(column_name) = lower(%Q) AND "
+                          "extension_name = 'gpkg_rtree_index'",
+                          table, geom_column);
+    if (!sql || sqlite3_exec(db, sql, NULL, NULL, NULL) != SQLITE_OK)
+      s = tt__error(ctx, TT_ERR_IO, "%s: cannot remove the index's "
+                    "gpkg_extensions row: %s", gpkg_path,
+                    sqlite3_errmsg(db));
+    sqlite3_free(sql);
+  }
+  sqlite3_free(r);
+  return s;
+}
+
+/* Appends the %_node row (nodeno, blob): the record of NULL (the INTEGER
+ * PRIMARY KEY) and the blob, which is its body as it is (no copy). */
+static tt_status node_row(tt__sqlite_table *t, int64_t nodeno,
+                          const unsigned char *blob, size_t size, int format)
+{
+  unsigned char body[16];
+  tt__sqlite_rec r;
+  tt__sqlite_rec_begin(&r, body, format);
+  tt__sqlite_rec_null(&r);
+  tt__sqlite_rec_bytes_type(&r, size, 0);
+  const unsigned char *head;
+  size_t nh = tt__sqlite_rec_head(&r, &head);
+  return tt__sqlite_table_append2(t, nodeno, head, nh, blob, size);
+}
+
+/* The node blob of items[0..n) (depth: the root's) into blob. */
+static void node_blob(unsigned char *blob, size_t node_size,
+                      const rt_item *items, size_t n, unsigned depth)
+{
+  put_be16(blob, depth);
+  put_be16(blob + 2, (unsigned)n);
+  for (size_t i = 0; i < n; i++) {
+    unsigned char *c = blob + 4 + i * RT_CELL_BYTES;
+    uint64_t id = TT__BE64(items[i].id);
+    uint32_t f[4];
+    memcpy(f, items[i].box, sizeof f);
+    for (int k = 0; k < 4; k++)
+      f[k] = TT__BE32(f[k]);
+    memcpy(c, &id, 8);
+    memcpy(c + 8, f, 16);
+  }
+  size_t used = 4 + n * RT_CELL_BYTES;
+  memset(blob + used, 0, node_size - used);
+}
+
+tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
+                                const tt__rtree_box *boxes, size_t n,
+                                const tt__rtree_packed *packed,
+                                const tt__rtree_shadow *sh,
+                                tt__sqlite_file *f, tt_progress_fn progress,
+                                void *progress_arg)
+{
+  tt__rtree_packed *own = NULL;
+  tt_status s = TT_OK;
+  if (!packed || packed->node_cap != sh->node_cap) {
+    /* packed for nodes of another size (or not at all): again, from its
+     * leaves (the order is total: the same tree as from the boxes) */
+    size_t m = packed ? packed->nitems : n;
+    rt_item *items = malloc((m ? m : 1) * sizeof *items);
+    if (!items)
+      return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the "
+                       "spatial index", what);
+    if (packed)
+      memcpy(items, packed->items, m * sizeof *items);
+    for (size_t i = 0; !packed && i < m; i++) {
+      items[i].id = boxes[i].id;
+      items[i].box[0] = round_down(boxes[i].minx);
+      items[i].box[1] = round_up(boxes[i].maxx);
+      items[i].box[2] = round_down(boxes[i].miny);
+      items[i].box[3] = round_up(boxes[i].maxy);
+    }
+    s = pack_items(ctx, what, items, m, sh->node_cap, &own);
+    if (s != TT_OK)
+      return s;
+    packed = own;
+  }
+  const tt__rtree_packed *pk = packed;
+  const int format = tt__sqlite_file_format(f);
+  unsigned char *blob = malloc(sh->node_size);
+  uint32_t *node_of = calloc(pk->nitems ? pk->nitems : 1, sizeof *node_of);
+  uint32_t *parent = malloc((pk->nodes_total + 1) * sizeof *parent);
+  tt__sqlite_table *t = NULL;
+  char *name = NULL;
+  if (!blob || !node_of || !parent) {
+    s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
+                  "index", what);
+    goto done;
+  }
+  const int top = pk->nlevels - 1;
+  const size_t total = pk->nodes_total * 2 + pk->nitems;
+  size_t done_rows = 0;
+
+  /* Where each node and each feature hangs: level e's groups are nodes
+   * base[e] + g (the top level's one group is the root, node 1), the items
+   * of level e + 1 are level e's nodes. */
+  for (size_t i = 0; i <= pk->nodes_total; i++)
+    parent[i] = 0;
+  for (int e = 0; e <= top; e++) {
+    size_t ngroups = e == top ? 1 : pk->n[e + 1];
+    for (size_t g = 0; g < ngroups; g++) {
+      size_t e0 = e == top ? 0 : group_start(g, pk->n[e], ngroups);
+      size_t e1 = e == top ? pk->n[e] : group_start(g + 1, pk->n[e], ngroups);
+      uint32_t node = e == top ? 1u : (uint32_t)(pk->base[e] + (int64_t)g);
+      for (size_t i = e0; i < e1; i++) {
+        int64_t id = pk->level[e][i].id;
+        if (e > 0) {
+          parent[id] = node;
+        } else if (id < 1 || (uint64_t)id > pk->nitems ||
+                   node_of[id - 1] != 0) {
+          s = tt__error(ctx, TT_ERR_INTERNAL, "%s: the features' ids are "
+                        "not 1..%zu", what, pk->nitems);
+          goto done;
+        } else {
+          node_of[id - 1] = node;
+        }
+      }
+    }
+  }
+
+  /* %_node: the root, then every level's nodes, in node number order */
+  name = sqlite3_mprintf("%s_node", sh->rtree);
+  s = name ? tt__sqlite_table_begin(f, name, sh->root[0], &t)
+           : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  if (s == TT_OK) {
+    node_blob(blob, sh->node_size, pk->level[top], pk->n[top],
+              (unsigned)top);
+    s = node_row(t, 1, blob, sh->node_size, format);
+  }
+  for (int d = 0; d < top && s == TT_OK; d++) {
+    size_t ngroups = pk->n[d + 1];
+    for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
+      size_t e0 = group_start(g, pk->n[d], ngroups);
+      size_t e1 = group_start(g + 1, pk->n[d], ngroups);
+      node_blob(blob, sh->node_size, pk->level[d] + e0, e1 - e0, 0);
+      s = node_row(t, pk->base[d] + (int64_t)g, blob, sh->node_size,
+                   format);
+    }
+  }
+  done_rows += pk->nodes_total;
+  if (s == TT_OK) {
+    s = tt__sqlite_table_finish(t);
+    t = NULL;
+  }
+  if (s == TT_OK && progress &&
+      !progress((double)done_rows / (double)total, "indexing", progress_arg))
+    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial index "
+                  "was interrupted", what);
+
+  /* %_parent: every node but the root */
+  sqlite3_free(name);
+  name = s == TT_OK ? sqlite3_mprintf("%s_parent", sh->rtree) : NULL;
+  if (s == TT_OK)
+    s = name ? tt__sqlite_table_begin(f, name, sh->root[1], &t)
+             : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  for (size_t m = 2; m <= pk->nodes_total && s == TT_OK; m++)
+    s = tt__sqlite_table_append_int(t, (int64_t)m, parent[m]);
+  done_rows += pk->nodes_total;
+  if (s == TT_OK) {
+    s = tt__sqlite_table_finish(t);
+    t = NULL;
+  }
+
+  /* %_rowid: every feature, by id */
+  sqlite3_free(name);
+  name = s == TT_OK ? sqlite3_mprintf("%s_rowid", sh->rtree) : NULL;
+  if (s == TT_OK)
+    s = name ? tt__sqlite_table_begin(f, name, sh->root[2], &t)
+             : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  for (size_t i = 0; i < pk->nitems && s == TT_OK; i++) {
+    s = tt__sqlite_table_append_int(t, (int64_t)i + 1, node_of[i]);
+    if (s == TT_OK && progress && (i & 0xffff) == 0xffff &&
+        !progress((double)(done_rows + i) / (double)total, "indexing",
+                  progress_arg))
+      s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
+                    "index was interrupted", what);
+  }
+  if (s == TT_OK) {
+    s = tt__sqlite_table_finish(t);
+    t = NULL;
+  }
+  if (s == TT_OK && progress &&
+      !progress(1.0, "indexing", progress_arg))
+    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial index "
+                  "was interrupted", what);
+done:
+  /* a table not finished (t) is freed with the file, never committed */
+  sqlite3_free(name);
+  free(blob);
+  free(node_of);
+  free(parent);
+  tt__rtree_packed_free(own);
   return s;
 }

@@ -166,11 +166,12 @@ static tt_status parse_options(write_state *w, char **options)
         s = tt__error(w->ctx, TT_ERR_ARG, "RTREE=%s: expected NOW or "
                       "DEFERRED", value);
     } else if (strcasecmp(key, "THREADS") != 0 &&
-               strcasecmp(key, "JOURNAL") != 0) {
-      /* THREADS and JOURNAL are tt_gpkg_write_rows()'s */
+               strcasecmp(key, "JOURNAL") != 0 &&
+               strcasecmp(key, "PAGES") != 0) {
+      /* THREADS, JOURNAL and PAGES are tt_gpkg_write_rows()'s */
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
                     "(known: JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, "
-                    "ROWS, RTREE, STYLE, T_SRS, THREADS)", key);
+                    "PAGES, ROWS, RTREE, STYLE, T_SRS, THREADS)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -391,14 +392,13 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
   const size_t nt = tt_tin_triangle_count(tin);
   for (size_t i = 0; i < nt && s == TT_OK; i++) {
     tt_triangle_info t;
-    tt_vertex_info v[3];
-    double px[3], py[3];
-    s = tt__records_triangle(&w->rec, w->ctx, i, &t, v, px, py);
+    double px[3], py[3], pz[3];
+    s = tt__records_triangle(&w->rec, w->ctx, i, &t, px, py, pz);
     if (s != TT_OK)
       break;
     ring = OGR_G_GetGeometryRef(poly, 0);
     for (int k = 0; k < 4; k++)
-      OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], v[k % 3].z);
+      OGR_G_SetPoint(ring, k, px[k % 3], py[k % 3], pz[k % 3]);
     OGR_F_SetGeometry(f, poly);
     set_int(f, idx[TT__TF_V0], t.v[0]);
     set_int(f, idx[TT__TF_V1], t.v[1]);

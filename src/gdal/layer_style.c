@@ -26,6 +26,7 @@
  */
 #include "gdal/layer_style.h"
 #include "gdal/tin_records.h"
+#include "tin/tin.h"
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
@@ -105,6 +106,45 @@ static int cmp_double(const void *a, const void *b)
   return x < y ? -1 : x > y;
 }
 
+/* Puts the k-th smallest of v[lo..hi) at v[k], the smaller ones before it
+ * and the others after (quickselect with a three-way partition, so that
+ * runs of equal values, common in errors of integer DEMs, cost one pass;
+ * a sort when it goes badly). The same value as sorting v would put at k. */
+static void select_kth(double *v, size_t lo, size_t hi, size_t k)
+{
+  int budget = 64;
+  while (hi - lo > 16) {
+    if (--budget == 0) {
+      qsort(v + lo, hi - lo, sizeof *v, cmp_double);
+      return;
+    }
+    double a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi - 1];
+    double pivot = a < b ? (b < c ? b : (a < c ? c : a))
+                         : (a < c ? a : (b < c ? c : b));
+    /* v[lo..lt) < pivot, v[lt..i) == pivot, v[gt..hi) > pivot */
+    size_t lt = lo, i = lo, gt = hi;
+    while (i < gt) {
+      double x = v[i];
+      if (x < pivot) {
+        v[i++] = v[lt];
+        v[lt++] = x;
+      } else if (x > pivot) {
+        v[i] = v[--gt];
+        v[gt] = x;
+      } else {
+        i++;
+      }
+    }
+    if (k < lt)
+      hi = lt;
+    else if (k >= gt)
+      lo = gt;
+    else
+      return; /* v[k] == pivot, in place */
+  }
+  qsort(v + lo, hi - lo, sizeof *v, cmp_double);
+}
+
 static void add_symbol(text *t, int name, const char *colour, int point)
 {
   if (point)
@@ -146,51 +186,60 @@ static void add_symbol(text *t, int name, const char *colour, int point)
         name, colour);
 }
 
-/* Equal intervals from v[0] to v[m-1] (sorted, m > 0) into breaks. */
-static int equal_breaks(const double *v, size_t m, double *breaks)
-{
-  int nb = 0;
-  breaks[nb++] = v[0];
-  for (int k = 1; k <= N_CLASSES; k++) {
-    double b = k == N_CLASSES ? v[m - 1]
-                              : v[0] + (v[m - 1] - v[0]) * k / N_CLASSES;
-    if (b > breaks[nb - 1])
-      breaks[nb++] = b;
-  }
-  return nb;
-}
-
 char *tt__style_graduated_qml(const char *attr, const double *values,
                               size_t n, int point, int nan_class,
                               int quantiles)
 {
-  /* The finite values, sorted: the quantile breaks. */
-  double *v = malloc((n ? n : 1) * sizeof *v);
-  if (!v)
-    return NULL;
+  /* The breaks: the smallest and largest finite values, and for
+   * quantiles the order statistics between them, each found by selection
+   * in what lies above the one before (no sort). */
+  double breaks[N_CLASSES + 1], lo = INFINITY, hi = -INFINITY;
+  int nb = 0;
   size_t m = 0;
   for (size_t i = 0; i < n; i++)
-    if (isfinite(values[i]))
-      v[m++] = values[i];
-  qsort(v, m, sizeof *v, cmp_double);
-  double breaks[N_CLASSES + 1];
-  int nb = 0;
+    if (isfinite(values[i])) {
+      m++;
+      if (values[i] < lo) lo = values[i];
+      if (values[i] > hi) hi = values[i];
+    }
   if (m > 0 && quantiles) {
-    breaks[nb++] = v[0];
+    double *v = malloc(m * sizeof *v);
+    if (!v)
+      return NULL;
+    m = 0;
+    for (size_t i = 0; i < n; i++)
+      if (isfinite(values[i]))
+        v[m++] = values[i];
+    breaks[nb++] = lo;
+    size_t from = 0;
     for (int k = 1; k <= N_CLASSES; k++) {
       size_t at = k == N_CLASSES ? m - 1 : (size_t)((double)(m - 1) * k /
                                                    N_CLASSES + 0.5);
-      if (v[at] > breaks[nb - 1])
-        breaks[nb++] = v[at];
+      double q = hi;
+      if (k < N_CLASSES) {
+        if (at >= from) /* else the one before, in place */
+          select_kth(v, from, m, at);
+        q = v[at];
+        from = at + 1;
+      }
+      if (q > breaks[nb - 1])
+        breaks[nb++] = q;
     }
+    free(v);
     if (nb < 4) /* fewer than three classes */
       quantiles = 0;
   }
-  if (m > 0 && !quantiles)
-    nb = equal_breaks(v, m, breaks);
+  if (m > 0 && !quantiles) {
+    nb = 0;
+    breaks[nb++] = lo;
+    for (int k = 1; k <= N_CLASSES; k++) {
+      double b = k == N_CLASSES ? hi : lo + (hi - lo) * k / N_CLASSES;
+      if (b > breaks[nb - 1])
+        breaks[nb++] = b;
+    }
+  }
   if (nb == 1) /* every value the same: one class around it */
-    breaks[nb++] = v[0];
-  free(v);
+    breaks[nb++] = lo;
 
   text t;
   memset(&t, 0, sizeof t);
@@ -318,16 +367,9 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
     if (!values)
       return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the style's "
                        "classes of %zu features", n);
-    for (size_t i = 0; i < n; i++) {
-      if (tri) {
-        tt_triangle_info t;
-        values[i] = tt_tin_triangle(tin, i, &t) == TT_OK ? t.max_error : NAN;
-      } else {
-        tt_vertex_info v;
-        values[i] = tt_tin_vertex(tin, i, &v) == TT_OK ? v.insert_error
-                                                       : NAN;
-      }
-    }
+    /* the TIN's own arrays (tt_tin_triangle() would work out every field
+     * of the triangle for its max_error) */
+    memcpy(values, tri ? tin->t_max : tin->v_ins_err, n * sizeof *values);
     char *qml = tt__style_graduated_qml(
         tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri,
         !tri);

@@ -207,41 +207,60 @@ void tt__records_free(tt__records *r)
   r->out_srs = NULL;
 }
 
+/* Vertex v's map x, y: tt_tin_vertex()'s (the same doubles). */
+static void map_xy(const tt_tin *tin, size_t v, double *x, double *y)
+{
+  const double *gt = tin->gt;
+  double px = tin->vc[v] + 0.5, py = tin->vr[v] + 0.5;
+  *x = gt[0] + px * gt[1] + py * gt[2];
+  *y = gt[3] + px * gt[4] + py * gt[5];
+}
+
+/* Vertex v's output x, y: its map coordinates, or the T_SRS ones. */
+static void output_xy(const tt__records *r, size_t v, double *x, double *y)
+{
+  if (r->xy) {
+    *x = r->xy[2 * v];
+    *y = r->xy[2 * v + 1];
+    return;
+  }
+  map_xy(r->tin, v, x, y);
+}
+
 tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
                                size_t i, tt_triangle_info *out_t,
-                               tt_vertex_info out_v[3], double out_x[3],
-                               double out_y[3])
+                               double out_x[3], double out_y[3],
+                               double out_z[3])
 {
   tt_triangle_info *t = out_t;
-  if (tt_tin_triangle(r->tin, i, t) != TT_OK ||
-      tt_tin_vertex(r->tin, (size_t)t->v[0], &out_v[0]) != TT_OK ||
-      tt_tin_vertex(r->tin, (size_t)t->v[1], &out_v[1]) != TT_OK ||
-      tt_tin_vertex(r->tin, (size_t)t->v[2], &out_v[2]) != TT_OK)
+  const tt_tin *tin = r->tin;
+  if (tt_tin_triangle(tin, i, t) != TT_OK)
     return tt__error(ctx, TT_ERR_INTERNAL, "triangle %zu of %zu could not "
-                     "be read from the TIN", i,
-                     tt_tin_triangle_count(r->tin));
+                     "be read from the TIN", i, tt_tin_triangle_count(tin));
   for (int k = 0; k < 3; k++) {
     size_t v = (size_t)t->v[k];
-    out_x[k] = r->xy ? r->xy[2 * v] : out_v[k].x;
-    out_y[k] = r->xy ? r->xy[2 * v + 1] : out_v[k].y;
+    output_xy(r, v, &out_x[k], &out_y[k]);
+    out_z[k] = tt__tin_z(tin, v);
   }
   /* Counter-clockwise in the coordinates written: T_SRS may mirror the
    * plane (a CRS whose x axis points west), the TIN's order is that of the
    * input map. Corners 1 and 2 swap, with their vertices and indices. */
   if ((out_x[1] - out_x[0]) * (out_y[2] - out_y[0]) -
           (out_y[1] - out_y[0]) * (out_x[2] - out_x[0]) < 0) {
-    double sx = out_x[1], sy = out_y[1];
-    out_x[1] = out_x[2], out_y[1] = out_y[2], out_x[2] = sx, out_y[2] = sy;
-    tt_vertex_info sv = out_v[1];
-    out_v[1] = out_v[2], out_v[2] = sv;
+    double sx = out_x[1], sy = out_y[1], sz = out_z[1];
+    out_x[1] = out_x[2], out_y[1] = out_y[2], out_z[1] = out_z[2];
+    out_x[2] = sx, out_y[2] = sy, out_z[2] = sz;
     int32_t si = t->v[1];
     t->v[1] = t->v[2], t->v[2] = si;
   }
   if (r->geodesic) {
     double lats[3], lons[3], area = 0, perimeter = 0;
     for (int k = 0; k < 3; k++) {
-      lons[k] = (r->geodesic == 1 ? out_x[k] : out_v[k].x) * r->deg_per_unit;
-      lats[k] = (r->geodesic == 1 ? out_y[k] : out_v[k].y) * r->deg_per_unit;
+      double x = out_x[k], y = out_y[k];
+      if (r->geodesic != 1) /* the input's own (geographic) coordinates */
+        map_xy(tin, (size_t)t->v[k], &x, &y);
+      lons[k] = x * r->deg_per_unit;
+      lats[k] = y * r->deg_per_unit;
     }
     geod_polygonarea(&r->geod, lats, lons, 3, &area, &perimeter);
     area = fabs(area);
@@ -249,22 +268,6 @@ tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
     t->area_2d = area;
   }
   return TT_OK;
-}
-
-/* Vertex v's output x, y: tt_tin_vertex()'s map coordinates (the same
- * doubles), or the T_SRS ones. */
-static void output_xy(const tt__records *r, size_t v, double *x, double *y)
-{
-  const tt_tin *tin = r->tin;
-  if (r->xy) {
-    *x = r->xy[2 * v];
-    *y = r->xy[2 * v + 1];
-    return;
-  }
-  const double *gt = tin->gt;
-  double px = tin->vc[v] + 0.5, py = tin->vr[v] + 0.5;
-  *x = gt[0] + px * gt[1] + py * gt[2];
-  *y = gt[3] + px * gt[4] + py * gt[5];
 }
 
 tt_status tt__records_face(const tt__records *r, tt_context *ctx, size_t i,

@@ -73,15 +73,15 @@ TT_HIDDEN tt_status tt__records_init(tt__records *r, tt_context *ctx,
                                      const char *t_srs);
 TT_HIDDEN void tt__records_free(tt__records *r);
 
-/* Triangle i: its record (areas in the output CRS's terms), its three
- * vertices, and their output x, y, counter-clockwise in those coordinates
+/* Triangle i: its record (areas in the output CRS's terms) and its three
+ * vertices' output x, y and z, counter-clockwise in those coordinates
  * (out_t->v in the same order). TT_ERR_INTERNAL when the TIN cannot give
  * them. */
 TT_HIDDEN tt_status tt__records_triangle(const tt__records *r,
                                          tt_context *ctx, size_t i,
                                          tt_triangle_info *out_t,
-                                         tt_vertex_info out_v[3],
-                                         double out_x[3], double out_y[3]);
+                                         double out_x[3], double out_y[3],
+                                         double out_z[3]);
 /* Triangle i as the mesh writers need it, without the derived fields:
  * out_t->v (counter-clockwise in the output coordinates, as
  * tt__records_triangle() orders them), max_error, rmse and samples; the

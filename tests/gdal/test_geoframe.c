@@ -447,12 +447,13 @@ static void test_ten_degrees(void)
     double worst = 0;
     for (size_t t = 0; t < tt_tin_triangle_count(tin); t += 97) {
       tt_triangle_info ti;
-      tt_vertex_info v[3];
-      double x[3], y[3], lat[3], lon[3], a = 0, p = 0;
-      CHECK_OK(ctx, tt__records_triangle(&rec, ctx, t, &ti, v, x, y));
+      tt_vertex_info v;
+      double x[3], y[3], z[3], lat[3], lon[3], a = 0, p = 0;
+      CHECK_OK(ctx, tt__records_triangle(&rec, ctx, t, &ti, x, y, z));
       for (int j = 0; j < 3; j++) {
-        lon[j] = v[j].x;
-        lat[j] = v[j].y;
+        CHECK_OK(ctx, tt_tin_vertex(tin, (size_t)ti.v[j], &v));
+        lon[j] = v.x;
+        lat[j] = v.y;
       }
       geod_polygonarea(&wgs84, lat, lon, 3, &a, &p);
       worst = fmax(worst, fabs(ti.area_2d / fabs(a) - 1));

@@ -88,9 +88,8 @@ static void expected_init(expected *e, tt_context *ctx, const tt_tin *tin,
     e->xyz[3 * i + 2] = e->v[i].z;
   }
   for (size_t i = 0; i < e->nt; i++) {
-    tt_vertex_info tv[3];
-    double tx[3], ty[3];
-    CHECK_OK(ctx, tt__records_triangle(&rec, ctx, i, &e->t[i], tv, tx, ty));
+    double tx[3], ty[3], tz[3];
+    CHECK_OK(ctx, tt__records_triangle(&rec, ctx, i, &e->t[i], tx, ty, tz));
     memcpy(&e->tri[3 * i], e->t[i].v, sizeof e->t[i].v);
     /* counter-clockwise in the output coordinates */
     CHECK((tx[1] - tx[0]) * (ty[2] - ty[0]) -
