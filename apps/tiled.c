@@ -13,9 +13,11 @@
  * main thread merges the pieces strictly in tile order, so the TIN is the
  * same for any thread count, and a worker does not start a tile more than
  * 2 x threads ahead of the merge, so at most that many windows and pieces
- * are held:
- * memory is bounded by the tile size and the threads, not by the DEM
- * (the merged TIN's own records grow with its vertices, as in any run).
+ * are held: memory is bounded by the tile size and the threads, not by
+ * the DEM. With r->sink (a GeoPackage file, tiled_stream.c) the pieces go
+ * through a tt__tin_stream and their rows are written as each merges;
+ * otherwise a tt_tin_merger holds the merged TIN (its records grow with
+ * its vertices, as in any run) for the caller to write.
  * The first failure in tile order, or an interruption, stops the workers
  * at their next check (refinement polls the stop flag every 256
  * insertions).

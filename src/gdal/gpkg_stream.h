@@ -49,11 +49,13 @@ TT_HIDDEN tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer,
                                        const unsigned char *blob,
                                        size_t blob_len);
 /* Ends the tables (count[k] rows each), writes the R-trees of the boxes
- * (one per row, fid order; NULL without R-trees) as pages, commits them,
+ * (one per row, fid order, malloc'd; NULL without R-trees) as pages,
+ * freeing each array once its index is written (boxes[k] set NULL),
+ * commits them,
  * then sets sqlite_sequence, the extents ext[k] (min x, min y, max x,
  * max y) and counts, and runs rtreecheck() when RTREE_CHECK asked. */
 TT_HIDDEN tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
-                                          tt__rtree_box *const boxes[2],
+                                          tt__rtree_box *boxes[2],
                                           const size_t count[2],
                                           const double ext[2][4],
                                           tt_progress_fn progress,

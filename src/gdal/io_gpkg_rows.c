@@ -1829,8 +1829,7 @@ tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer, int64_t fid,
   return tt__sqlite_table_append2(p->t[layer], fid, head, nh, body, r.nb);
 }
 
-tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
-                                tt__rtree_box *const boxes[2],
+tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p, tt__rtree_box *boxes[2],
                                 const size_t count[2],
                                 const double ext[2][4],
                                 tt_progress_fn progress, void *progress_arg)
@@ -1849,14 +1848,18 @@ tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
       p->layer[k].last_fid = (sqlite3_int64)j->count[k];
     }
   }
-  for (int k = 0; k < 2 && s == TT_OK; k++) {
+  /* the vertices' index first: its boxes are freed before the
+   * triangles' (twice as many) are packed */
+  for (int k = 1; k >= 0 && s == TT_OK; k--) {
     if (!j->rtree || !j->todo[k])
       continue;
-    w->lo = k ? 0.5 : 0.0;
-    w->hi = k ? 0.9 : 0.5;
+    w->lo = k ? 0.0 : 0.3;
+    w->hi = k ? 0.3 : 0.9;
     s = tt__rtree_write_pages(w->ctx, p->layer[k].name, boxes[k],
                               j->count[k], NULL, &j->sh[k], p->f,
                               rtree_progress, w);
+    free(boxes[k]);
+    boxes[k] = NULL;
   }
   if (s == TT_OK)
     s = tt__sqlite_file_commit(p->f);

@@ -38,8 +38,9 @@ def rows(db, table):
 
 
 def main():
-    a = sqlite3.connect(sys.argv[1])
-    b = sqlite3.connect(sys.argv[2])
+    # read-only: a missing file is an error, not a new empty database
+    a = sqlite3.connect("file:%s?mode=ro" % sys.argv[1], uri=True)
+    b = sqlite3.connect("file:%s?mode=ro" % sys.argv[2], uri=True)
     sa, sb = schema(a), schema(b)
     if sa != sb:
         print("schemas differ:", [x for x in sa if x not in sb][:3],
@@ -47,6 +48,9 @@ def main():
         return 1
     tables = [name for kind, name, _, sql in sa if kind == "table" and
               not (sql or "").upper().startswith("CREATE VIRTUAL")]
+    if not tables:
+        print("no tables")
+        return 1
     n = 0
     for t in tables:
         ca, ra = rows(a, t)
