@@ -78,7 +78,9 @@ static tt_status stream_open(tt_app_tile_sink *sink,
                      r->msg.last[0] ? r->msg.last : "unknown reason");
   /* an empty TIN of the run's frame: the layers, their fields and CRS */
   tt_tin empty;
+  double none = 0; /* arrays of no element, never read */
   memset(&empty, 0, sizeof empty);
+  empty.t_max = empty.v_ins_err = &none;
   empty.summary.criterion = so->ro->criterion;
   st = tt_ogr_write_tin(r->ctx, dst, &empty, *so->srs, allf, nallf,
                         *so->wopts, NULL, NULL);
