@@ -323,11 +323,12 @@ static tt_status stream_piece(tiled *T, size_t k)
                  48 * tt__tin_stream_pending(T->stream) + 4 * nv;
   if (T->max_memory && bytes + T->inflight_bytes > T->max_memory) {
     snprintf(T->merge_msg, sizeof T->merge_msg, "while merging tile %zu of "
-             "%zu, at %zu vertices written: the writer's records take %zu "
-             "MiB, with the tiles in flight (%zu MiB) more than the memory "
-             "limit of %zu MiB (-max_memory); nothing written", k + 1,
-             T->ntiles, nv, bytes >> 20, T->inflight_bytes >> 20,
-             T->max_memory >> 20);
+             "%zu, at %zu vertices written and %zu waiting for their last "
+             "tile: the writer's records take %zu MiB, with the tiles in "
+             "flight (%zu MiB) more than the memory limit of %zu MiB "
+             "(-max_memory); nothing written", k + 1, T->ntiles, nv,
+             tt__tin_stream_pending(T->stream), bytes >> 20,
+             T->inflight_bytes >> 20, T->max_memory >> 20);
     return TT_ERR_NOMEM;
   }
   return TT_OK;

@@ -249,6 +249,27 @@ static size_t last_tile(const tt__tin_stream *s, size_t c, size_t r)
   return j * s->ntx + i;
 }
 
+/* The first n pending vertices as out->vtx, popped at the next add. */
+static void hand_out(tt__tin_stream *s, size_t n,
+                     tt__stream_batch *out)
+{
+  tt_tin *v = &s->vtx;
+  memset(v, 0, sizeof *v);
+  v->nv = n;
+  v->vc = s->pc + s->off;
+  v->vr = s->pr + s->off;
+  v->vzd = s->pz + s->off;
+  v->v_ins_err = s->pins + s->off;
+  v->v_star_max = s->psmax + s->off;
+  v->v_star_rmse = s->pssq + s->off;
+  v->v_star_n = s->pn + s->off;
+  memcpy(v->gt, s->gt, sizeof v->gt);
+  memcpy(v->frame, s->frame, sizeof v->frame);
+  out->vtx = v;
+  out->vtx_first = s->base;
+  s->handed = n;
+}
+
 tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
                              const tt_tin *piece, const tt_tile *tile,
                              size_t k, tt__stream_batch *out)
@@ -403,33 +424,13 @@ tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
     s->pssq[at] = s->pn[at] ? sqrt(s->pssq[at] / (double)s->pn[at]) : 0.0;
     n++;
   }
-  tt__tin_stream_vertices(s, n, out);
+  hand_out(s, n, out);
   return TT_OK;
 oom:
   return tt__error(ctx, TT_ERR_NOMEM, "out of memory while merging the "
                    "tile at column %zu, row %zu (%zu vertices and %zu "
                    "triangles so far)", tile->col0, tile->row0, s->nv,
                    s->nt);
-}
-
-void tt__tin_stream_vertices(tt__tin_stream *s, size_t n,
-                             tt__stream_batch *out)
-{
-  tt_tin *v = &s->vtx;
-  memset(v, 0, sizeof *v);
-  v->nv = n;
-  v->vc = s->pc + s->off;
-  v->vr = s->pr + s->off;
-  v->vzd = s->pz + s->off;
-  v->v_ins_err = s->pins + s->off;
-  v->v_star_max = s->psmax + s->off;
-  v->v_star_rmse = s->pssq + s->off;
-  v->v_star_n = s->pn + s->off;
-  memcpy(v->gt, s->gt, sizeof v->gt);
-  memcpy(v->frame, s->frame, sizeof v->frame);
-  out->vtx = v;
-  out->vtx_first = s->base;
-  s->handed = n;
 }
 
 size_t tt__tin_stream_pending(const tt__tin_stream *s)

@@ -118,9 +118,6 @@ TT_HIDDEN tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
                                        const tt_tin *piece,
                                        const tt_tile *tile, size_t k,
                                        tt__stream_batch *out);
-/* (internal to stream.c) the first n pending vertices as out->vtx. */
-TT_HIDDEN void tt__tin_stream_vertices(tt__tin_stream *s, size_t n,
-                                       tt__stream_batch *out);
 /* Vertices merged but not yet handed out (the reorder buffer). */
 TT_HIDDEN size_t tt__tin_stream_pending(const tt__tin_stream *s);
 /* The whole TIN's summary as tt_tin_merger_finish() sets it, and the range
