@@ -316,11 +316,11 @@ static tt_status stream_piece(tiled *T, size_t k)
     return st;
   }
   /* -max_memory: what grows with the TIN here, beside the tiles in
-   * flight: the boxes kept for the R-trees, the pending vertices (48 bytes
+   * flight: the boxes kept for the R-trees, the pending vertices (56 bytes
    * each), 4 bytes a vertex for the components */
   size_t nv = b.vtx_first + (b.vtx ? tt_tin_vertex_count(b.vtx) : 0);
   size_t bytes = tt__gpkg_stream_bytes(sink->out) +
-                 48 * tt__tin_stream_pending(T->stream) + 4 * nv;
+                 56 * tt__tin_stream_pending(T->stream) + 4 * nv;
   if (T->max_memory && bytes + T->inflight_bytes > T->max_memory) {
     snprintf(T->merge_msg, sizeof T->merge_msg, "while merging tile %zu of "
              "%zu, at %zu vertices written and %zu waiting for their last "

@@ -21,7 +21,7 @@
  *    order, so the final ones wait behind the first that is not: a border
  *    vertex on the bottom side of a row of tiles waits for the next row,
  *    and holds back what came after it. Pending vertices are therefore
- *    those of about one row of tiles (48 bytes each).
+ *    those of about one row of tiles (56 bytes each).
  * The pieces (components) are counted by union-find over every vertex id:
  * 4 bytes a vertex until the end, the one array that grows with the TIN.
  *
