@@ -25,10 +25,10 @@
  * The pieces (components) are counted by union-find over every vertex id:
  * 4 bytes a vertex until the end, the one array that grows with the TIN.
  *
- * Memory: the pending vertices, the open outline vertices' table (16
+ * Memory: the pending vertices, the open outline vertices' table (about 40
  * bytes each, a row of tile borders), 4 bytes a vertex for the
  * components, and per piece, while its batch is out, 16 bytes a triangle
- * and 28 a vertex.
+ * and 20 a vertex.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"
