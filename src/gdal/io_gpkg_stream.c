@@ -183,14 +183,13 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
   tt__gpkg_value f[TT__TF_COUNT];
   for (size_t i = 0; i < tt_tin_triangle_count(tin) && s == TT_OK; i++) {
     tt_triangle_info tr;
-    tt_vertex_info v[3];
-    double px[3], py[3];
-    s = tt__records_triangle(&rec, g->ctx, i, &tr, v, px, py);
+    double px[3], py[3], pz[3];
+    s = tt__records_triangle(&rec, g->ctx, i, &tr, px, py, pz);
     if (s != TT_OK)
       break;
-    double lo[3] = {px[0], py[0], v[0].z}, hi[3] = {px[0], py[0], v[0].z};
+    double lo[3] = {px[0], py[0], pz[0]}, hi[3] = {px[0], py[0], pz[0]};
     for (int k = 1; k < 3; k++) {
-      double c[3] = {px[k], py[k], v[k].z};
+      double c[3] = {px[k], py[k], pz[k]};
       for (int d = 0; d < 3; d++) {
         if (c[d] < lo[d]) lo[d] = c[d];
         if (c[d] > hi[d]) hi[d] = c[d];
@@ -208,7 +207,7 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     for (int k = 0; k < 4; k++) {
       q = put_f64(q, px[k % 3]);
       q = put_f64(q, py[k % 3]);
-      q = put_f64(q, v[k % 3].z);
+      q = put_f64(q, pz[k % 3]);
     }
     size_t fid = b->tri_first + i + 1;
     extend(g->ext[0], lo[0], lo[1]);
