@@ -142,6 +142,8 @@ typedef struct app_run {
   app_messages msg;
   app_phase prog;
   double t0;
+  struct tt_app_tile_sink *sink; /* a tiled run's streamed GeoPackage, or
+                                    NULL (tiled_stream.c) */
 } app_run;
 
 /* Records the run's failure "<file>: <problem>" (or "<problem>" when file
@@ -266,6 +268,16 @@ typedef struct app_simplify_report {
   int budget_passes;  /* tiled runs to a budget: the runs at a bound */
 } app_simplify_report;
 
+/* simplify.c: the run_parameters fields of a run from its report so far
+ * (created, and start_name of 48 bytes, hold strings they point to); allf
+ * has room for TT__APP_RUN_FIELDS. Returns the count used. */
+#define TT__APP_RUN_FIELDS 48
+size_t tt__app_simplify_fields(app_run *r, const app_simplify_report *rep,
+                               const tt_refine_options *ro,
+                               const tt_raster_info *info,
+                               const char *created, char *start_name,
+                               tt_run_field *allf);
+
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p);
 void tt__app_print_simplify_summary(app_run *r,
                                     const app_simplify_report *p);
@@ -362,6 +374,44 @@ void tt__app_curve_free(app_curve *c);
 bool tt__app_curves_bound(const app_curve *c, size_t n, size_t target,
                           double above, double below, double *out_bound,
                           size_t *out_estimate);
+/* A tiled run's GeoPackage built as the tiles merge (tiled_stream.c,
+ * docs/scale.md): with r->sink set, tt__app_simplify_tiled() calls open
+ * before merging the first piece (tile 0's raster facts, the bound), then
+ * hands every piece's rows to out as it is merged, and returns no TIN but
+ * the whole TIN's summary and height range here; the caller finishes and
+ * closes out. */
+typedef struct tt_app_tile_sink {
+  tt_status (*open)(struct tt_app_tile_sink *sink,
+                    const tt_raster_info *info, double max_error);
+  struct tt__gpkg_stream *out;
+  tt_tin_summary sum;
+  double zmin, zmax;
+} tt_app_tile_sink;
+/* tiled_stream.c: the sink of simplify's streamed GeoPackage. */
+typedef struct tt_app_stream {
+  tt_app_tile_sink sink; /* first: the sink tiled.c calls */
+  app_run *r;
+  tt_output *outp;
+  GDALDriverH drv;
+  char **dsco, ***wopts;
+  OGRSpatialReferenceH *srs;
+  app_simplify_report *rep;
+  tt_refine_options *ro;
+} tt_app_stream;
+/* Whether a tiled run into drvname streams (GPKG files, unless
+ * TERRATIN_TILE_STREAM=NO). */
+int tt__app_stream_wanted(const char *drvname, int database, int mesh);
+void tt__app_stream_init(tt_app_stream *so, app_run *r, tt_output *outp,
+                         GDALDriverH drv, char **dsco, char ***wopts,
+                         OGRSpatialReferenceH *srs,
+                         app_simplify_report *rep, tt_refine_options *ro);
+/* After the last tile: the R-trees, extents, counts, the final
+ * run_parameters (fields) and styles; closes the writer. */
+tt_status tt__app_stream_finish(tt_app_stream *so, const tt_run_field *fields,
+                                size_t nfields);
+/* Closes the writer (an unfinished write undone; the caller's tt_output
+ * removes the file). */
+void tt__app_stream_close(tt_app_stream *so);
 /* `terratin tiles run` and `tiles merge` (tiles_*.c) run simplify's tiled
  * path with this set: save, the one tile given is computed and handed to
  * it (nothing else written); load, every tile's piece is read by it

@@ -73,6 +73,114 @@ static void decimate_options(const tt_app_settings *s,
   dopt->threads = ro->threads;
 }
 
+/* The run_parameters fields of a run (simplify's report so far): created
+ * and start_name (48 bytes) hold strings the fields point to; allf has
+ * room for TT__APP_RUN_FIELDS. Returns how many are used. */
+size_t tt__app_simplify_fields(app_run *r, const app_simplify_report *rep,
+                               const tt_refine_options *ro,
+                               const tt_raster_info *info,
+                               const char *created, char *start_name,
+                               tt_run_field *allf)
+{
+  const tt_app_settings *s = r->s;
+  const tt_error_stats *e = &rep->sum.errors;
+  const tt_run_field fields[] = {
+      {"input", TT_FIELD_STRING, s->input, 0, 0},
+      {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
+      {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
+      {"method", TT_FIELD_STRING, s->decimate ? "decimate" : "insert", 0,
+       0},
+      {"criterion", TT_FIELD_STRING, tt_criterion_name(ro->criterion), 0, 0},
+      {"repair", TT_FIELD_STRING,
+       tt_repair_name(tt_repair_resolve(ro->repair, ro->criterion)), 0, 0},
+      {"optimize", TT_FIELD_STRING,
+       tt_optimize_name(tt_optimize_resolve(ro->optimize, ro->criterion,
+                                            ro->repair)), 0, 0},
+      {"max_error", TT_FIELD_REAL, NULL, 0, ro->max_error},
+      {"max_points", TT_FIELD_INTEGER, NULL, (int64_t)ro->max_points, 0},
+      {"max_tris", TT_FIELD_INTEGER, NULL, (int64_t)ro->max_triangles, 0},
+      {"percent", TT_FIELD_REAL, NULL, 0, ro->percent},
+      {"stop", TT_FIELD_STRING, tt_stop_reason_name(rep->sum.stop_reason), 0,
+       0},
+      {"vertices", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.vertices, 0},
+      {"triangles", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.triangles, 0},
+      {"cells", TT_FIELD_INTEGER, NULL, (int64_t)rep->cells, 0},
+      {"valid", TT_FIELD_INTEGER, NULL, (int64_t)rep->valid, 0},
+      {"lone", TT_FIELD_INTEGER, NULL,
+       (int64_t)(e->samples - e->covered), 0},
+      {"pieces", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.components, 0},
+      {"ach_max", TT_FIELD_REAL, NULL, 0, e->max_error},
+      {"ach_rmse", TT_FIELD_REAL, NULL, 0, e->rmse},
+      {"ach_mean", TT_FIELD_REAL, NULL, 0, e->mean_abs},
+      {"ach_l2", TT_FIELD_REAL, NULL, 0, e->l2},
+      {"z_unit", TT_FIELD_STRING, info->z_unit ? info->z_unit : "", 0, 0},
+      {"z_unit_in", TT_FIELD_STRING,
+       info->z_unit_declared ? info->z_unit_declared : "", 0, 0},
+      {"z_factor", TT_FIELD_REAL, NULL, 0, info->z_unit_factor *
+                                               info->z_factor},
+      {"pixel_is", TT_FIELD_STRING,
+       info->area_or_point ? info->area_or_point : "", 0, 0},
+      {"crs", TT_FIELD_STRING, info->crs_name ? info->crs_name : "", 0, 0},
+      {"out_crs", TT_FIELD_STRING, s->t_srs ? s->t_srs : "", 0, 0},
+      {"frame", TT_FIELD_STRING, info->frame_name ? info->frame_name : "", 0,
+       0},
+      {"scale_err", TT_FIELD_REAL, NULL, 0, info->frame_scale_error},
+      {"version", TT_FIELD_STRING, tt_version(), 0, 0},
+      {"t_read", TT_FIELD_REAL, NULL, 0, rep->t_read},
+      {"t_simplify", TT_FIELD_REAL, NULL, 0, rep->t_simplify},
+      {"t_mesh", TT_FIELD_REAL, NULL, 0, rep->sum.seconds_mesh},
+      {"t_stats", TT_FIELD_REAL, NULL, 0, rep->sum.seconds_statistics},
+      {"created", TT_FIELD_STRING, created, 0, 0},
+  };
+  /* Decimation adds what it ran with: start, importance, selection, hole
+   * rule (resolved), rounds, and the vertex counts. */
+    snprintf(start_name, 48, "greedy:%zu", s->start_points);
+  tt_importance imp_used = s->importance != TT_IMPORTANCE_AUTO ? s->importance
+                           : ro->max_error >= 0 ? TT_IMPORTANCE_ERROR
+                                               : TT_IMPORTANCE_HDH;
+  tt_hole hole_used = s->hole != TT_HOLE_AUTO ? s->hole
+                      : ro->criterion == TT_CRITERION_DELAUNAY
+                          ? TT_HOLE_CIRCUMRADIUS
+                          : TT_HOLE_MINANGLE;
+  const tt_run_field dfields[] = {
+      {"start", TT_FIELD_STRING,
+       s->start == TT_DSTART_GREEDY_N ? start_name
+                                      : tt_decimate_start_name(s->start),
+       0, 0},
+      {"importance", TT_FIELD_STRING, tt_importance_name(imp_used), 0, 0},
+      {"selection", TT_FIELD_STRING,
+       s->selection == TT_SELECTION_SEQUENTIAL ? "sequential"
+       : s->onepass                           ? "independent onepass"
+                                              : "independent multipass",
+       0, 0},
+      {"hole", TT_FIELD_STRING, tt_hole_name(hole_used), 0, 0},
+      {"rounds", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.rounds, 0},
+      {"start_vtx", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.start_vertices,
+       0},
+      {"removed", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.removed_vertices,
+       0},
+      {"refused", TT_FIELD_INTEGER, NULL, (int64_t)rep->sum.refused_bound, 0},
+  };
+  /* A tiled run adds its tiling (docs/scale.md). */
+  const tt_run_field tfields[] = {
+      {"tile_size", TT_FIELD_INTEGER, NULL, (int64_t)rep->tile_size, 0},
+      {"tiles", TT_FIELD_INTEGER, NULL, (int64_t)rep->tiles, 0},
+      {"tile_auto", TT_FIELD_INTEGER, NULL, rep->auto_tiled, 0},
+  };
+  enum { NF = sizeof fields / sizeof fields[0],
+         ND = sizeof dfields / sizeof dfields[0],
+         NT = sizeof tfields / sizeof tfields[0] };
+  _Static_assert(NF + ND + NT <= TT__APP_RUN_FIELDS, "run_parameters");
+  memcpy(allf, fields, sizeof fields);
+  memcpy(allf + NF, dfields, sizeof dfields);
+  size_t nallf = NF + (s->decimate ? ND : 0);
+  if (rep->tiles) {
+    memcpy(allf + nallf, tfields, sizeof tfields);
+    nallf += NT;
+  }
+  return nallf;
+}
+
 tt_status tt__app_simplify(app_run *r)
 {
   const tt_app_settings *s = r->s;
@@ -91,6 +199,9 @@ tt_status tt__app_simplify(app_run *r)
   size_t valid = 0;
   memset(&rep, 0, sizeof rep);
   tt_decimate_options_init(&dopt);
+  tt_app_stream so; /* a tiled GeoPackage built as tiles merge */
+  memset(&so, 0, sizeof so);
+  int streamed = 0;
 
   if (tt__app_same_file(s->input, s->output))
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output,
@@ -311,12 +422,26 @@ planned:;
       decimate_options(s, &ro, &dopt);
       rep.dopt = &dopt;
     }
+    /* The rows written as the tiles merge (tiled_stream.c): insertion to a
+     * bound in the projected frame only. The streamed merge (stream.c)
+     * carries neither the vertices' ground points (geographic and Web
+     * Mercator DEMs) nor decimation's importances, and a budget runs the
+     * tiles more than once: those merge the whole TIN first. */
+    if (!tt__app_tiles_hook.save && !s->decimate && !ground &&
+        !ro.max_points && !ro.max_triangles && !(ro.percent > 0) &&
+        tt__app_stream_wanted(drvname, database, mesh != TT_MESH_NONE)) {
+      tt__app_stream_init(&so, r, outp, drv, dsco, &wopts, &srs, &rep, &ro);
+      r->sink = &so.sink;
+      streamed = 1;
+    }
     st = tt__app_simplify_tiled(r, band, s->input, tile, &ro,
                                 s->decimate ? &dopt : NULL,
                                 &rep.default_error, &tin, &info, &valid,
                                 &rep.zmin, &rep.zmax, &rep.tiles,
                                 &rep.tile_threads, &rep.budget_passes);
-    if (st != TT_OK || !tin) /* no TIN: one tile of `tiles run`, saved */
+    r->sink = NULL;
+    /* no TIN: one tile of `tiles run`, saved, or streamed */
+    if (st != TT_OK || (!tin && !streamed))
       goto done;
     GDALClose(src);
     src = NULL;
@@ -325,7 +450,10 @@ planned:;
     rep.cells = cells;
     rep.valid = valid;
     rep.t_simplify = tt__app_now() - t_tiles;
-    tt_tin_get_summary(tin, &rep.sum);
+    if (streamed)
+      rep.sum = so.sink.sum;
+    else
+      tt_tin_get_summary(tin, &rep.sum);
     goto write;
   }
   st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog, &grid,
@@ -398,6 +526,25 @@ write:;
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
     goto done;
   }
+  if (streamed) {
+    /* the rows are in: the R-trees, extents, counts, the run's values */
+    char created[32], start_name[48];
+    tt__app_iso8601_utc(created, sizeof created);
+    tt_run_field allf[TT__APP_RUN_FIELDS];
+    size_t nallf = tt__app_simplify_fields(r, &rep, &ro, info, created,
+                                           start_name, allf);
+    st = tt__app_stream_finish(&so, allf, nallf);
+    if (st == TT_ERR_INTERRUPTED || st == TT_ERR_NOMEM) {
+      tt__app_fail_tt(r, st, s->output);
+      goto done;
+    }
+    if (st != TT_OK) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, st, s->output, "%s",
+                   tt__app_why(r, st, tt_output_temp_path(outp)));
+      goto done;
+    }
+    goto commit;
+  }
   if (info->crs_wkt && *info->crs_wkt) {
     srs = OSRNewSpatialReference(info->crs_wkt);
     if (srs)
@@ -454,104 +601,11 @@ write:;
     goto done;
   }
 
-  char created[32];
+  char created[32], start_name[48];
   tt__app_iso8601_utc(created, sizeof created);
-  const tt_error_stats *e = &rep.sum.errors;
-  const tt_run_field fields[] = {
-      {"input", TT_FIELD_STRING, s->input, 0, 0},
-      {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
-      {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
-      {"method", TT_FIELD_STRING, s->decimate ? "decimate" : "insert", 0,
-       0},
-      {"criterion", TT_FIELD_STRING, tt_criterion_name(ro.criterion), 0, 0},
-      {"repair", TT_FIELD_STRING,
-       tt_repair_name(tt_repair_resolve(ro.repair, ro.criterion)), 0, 0},
-      {"optimize", TT_FIELD_STRING,
-       tt_optimize_name(tt_optimize_resolve(ro.optimize, ro.criterion,
-                                            ro.repair)), 0, 0},
-      {"max_error", TT_FIELD_REAL, NULL, 0, ro.max_error},
-      {"max_points", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_points, 0},
-      {"max_tris", TT_FIELD_INTEGER, NULL, (int64_t)ro.max_triangles, 0},
-      {"percent", TT_FIELD_REAL, NULL, 0, ro.percent},
-      {"stop", TT_FIELD_STRING, tt_stop_reason_name(rep.sum.stop_reason), 0,
-       0},
-      {"vertices", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.vertices, 0},
-      {"triangles", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.triangles, 0},
-      {"cells", TT_FIELD_INTEGER, NULL, (int64_t)rep.cells, 0},
-      {"valid", TT_FIELD_INTEGER, NULL, (int64_t)rep.valid, 0},
-      {"lone", TT_FIELD_INTEGER, NULL,
-       (int64_t)(e->samples - e->covered), 0},
-      {"pieces", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.components, 0},
-      {"ach_max", TT_FIELD_REAL, NULL, 0, e->max_error},
-      {"ach_rmse", TT_FIELD_REAL, NULL, 0, e->rmse},
-      {"ach_mean", TT_FIELD_REAL, NULL, 0, e->mean_abs},
-      {"ach_l2", TT_FIELD_REAL, NULL, 0, e->l2},
-      {"z_unit", TT_FIELD_STRING, info->z_unit ? info->z_unit : "", 0, 0},
-      {"z_unit_in", TT_FIELD_STRING,
-       info->z_unit_declared ? info->z_unit_declared : "", 0, 0},
-      {"z_factor", TT_FIELD_REAL, NULL, 0, info->z_unit_factor *
-                                               info->z_factor},
-      {"pixel_is", TT_FIELD_STRING,
-       info->area_or_point ? info->area_or_point : "", 0, 0},
-      {"crs", TT_FIELD_STRING, info->crs_name ? info->crs_name : "", 0, 0},
-      {"out_crs", TT_FIELD_STRING, s->t_srs ? s->t_srs : "", 0, 0},
-      {"frame", TT_FIELD_STRING, info->frame_name ? info->frame_name : "", 0,
-       0},
-      {"scale_err", TT_FIELD_REAL, NULL, 0, info->frame_scale_error},
-      {"version", TT_FIELD_STRING, tt_version(), 0, 0},
-      {"t_read", TT_FIELD_REAL, NULL, 0, rep.t_read},
-      {"t_simplify", TT_FIELD_REAL, NULL, 0, rep.t_simplify},
-      {"t_mesh", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_mesh},
-      {"t_stats", TT_FIELD_REAL, NULL, 0, rep.sum.seconds_statistics},
-      {"created", TT_FIELD_STRING, created, 0, 0},
-  };
-  /* Decimation adds what it ran with: start, importance, selection, hole
-   * rule (resolved), rounds, and the vertex counts. */
-  char start_name[48];
-  snprintf(start_name, sizeof start_name, "greedy:%zu", s->start_points);
-  tt_importance imp_used = s->importance != TT_IMPORTANCE_AUTO ? s->importance
-                           : ro.max_error >= 0 ? TT_IMPORTANCE_ERROR
-                                               : TT_IMPORTANCE_HDH;
-  tt_hole hole_used = s->hole != TT_HOLE_AUTO ? s->hole
-                      : ro.criterion == TT_CRITERION_DELAUNAY
-                          ? TT_HOLE_CIRCUMRADIUS
-                          : TT_HOLE_MINANGLE;
-  const tt_run_field dfields[] = {
-      {"start", TT_FIELD_STRING,
-       s->start == TT_DSTART_GREEDY_N ? start_name
-                                      : tt_decimate_start_name(s->start),
-       0, 0},
-      {"importance", TT_FIELD_STRING, tt_importance_name(imp_used), 0, 0},
-      {"selection", TT_FIELD_STRING,
-       s->selection == TT_SELECTION_SEQUENTIAL ? "sequential"
-       : s->onepass                           ? "independent onepass"
-                                              : "independent multipass",
-       0, 0},
-      {"hole", TT_FIELD_STRING, tt_hole_name(hole_used), 0, 0},
-      {"rounds", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.rounds, 0},
-      {"start_vtx", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.start_vertices,
-       0},
-      {"removed", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.removed_vertices,
-       0},
-      {"refused", TT_FIELD_INTEGER, NULL, (int64_t)rep.sum.refused_bound, 0},
-  };
-  /* A tiled run adds its tiling (docs/scale.md). */
-  const tt_run_field tfields[] = {
-      {"tile_size", TT_FIELD_INTEGER, NULL, (int64_t)rep.tile_size, 0},
-      {"tiles", TT_FIELD_INTEGER, NULL, (int64_t)rep.tiles, 0},
-      {"tile_auto", TT_FIELD_INTEGER, NULL, rep.auto_tiled, 0},
-  };
-  enum { NF = sizeof fields / sizeof fields[0],
-         ND = sizeof dfields / sizeof dfields[0],
-         NT = sizeof tfields / sizeof tfields[0] };
-  tt_run_field allf[NF + ND + NT];
-  memcpy(allf, fields, sizeof fields);
-  memcpy(allf + NF, dfields, sizeof dfields);
-  size_t nallf = NF + (s->decimate ? ND : 0);
-  if (rep.tiles) {
-    memcpy(allf + nallf, tfields, sizeof tfields);
-    nallf += NT;
-  }
+  tt_run_field allf[TT__APP_RUN_FIELDS];
+  size_t nallf = tt__app_simplify_fields(r, &rep, &ro, info, created,
+                                         start_name, allf);
   /* GPKG: the layers through OGR, then their rows and R-trees straight
    * into the closed file by tt_gpkg_write_rows() (OGR writes a feature at a
    * time and GDAL 3.6 inserts R-tree entries one by one). */
@@ -654,6 +708,7 @@ done:
   CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", NULL);
   if (src)
     GDALClose(src);
+  tt__app_stream_close(&so); /* an unfinished write: before the removal */
   tt_output_destroy(outp); /* removes the temporary files unless committed */
   if (srs)
     OSRDestroySpatialReference(srs);

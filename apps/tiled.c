@@ -13,9 +13,11 @@
  * main thread merges the pieces strictly in tile order, so the TIN is the
  * same for any thread count, and a worker does not start a tile more than
  * 2 x threads ahead of the merge, so at most that many windows and pieces
- * are held:
- * memory is bounded by the tile size and the threads, not by the DEM
- * (the merged TIN's own records grow with its vertices, as in any run).
+ * are held: memory is bounded by the tile size and the threads, not by
+ * the DEM. With r->sink (a GeoPackage file, tiled_stream.c) the pieces go
+ * through a tt__tin_stream and their rows are written as each merges;
+ * otherwise a tt_tin_merger holds the merged TIN (its records grow with
+ * its vertices, as in any run) for the caller to write.
  * The first failure in tile order, or an interruption, stops the workers
  * at their next check (refinement polls the stop flag every 256
  * insertions).
@@ -44,6 +46,8 @@
  */
 #include "app.h"
 #include "gdal/georef.h" /* tt__georef_is_web_mercator */
+#include "gdal/gpkg_stream.h"
+#include "tile/tile.h"
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
@@ -89,6 +93,10 @@ typedef struct tiled {
   size_t max_memory;        /* -max_memory, 0: not given */
   size_t inflight_bytes;    /* what the tiles in flight may hold */
   char merge_msg[TT_APP_MESSAGE_MAX]; /* the main thread's failure */
+  /* a streamed GeoPackage (r->sink, tiled_stream.c): the pieces merged
+   * by the stream and their rows written at once, instead of a merger */
+  tt__tin_stream *stream;
+  tt_app_tile_sink *sink;
 } tiled;
 
 static void tile_of(const tiled *T, size_t k, tt_tile *t)
@@ -285,6 +293,47 @@ static void *worker(void *arg)
   return NULL;
 }
 
+/* Tile k's piece into the stream, its rows to the GeoPackage (opened
+ * before the first piece: tile 0's raster facts give its CRS). A failure
+ * is the run's, with the message in T->merge_msg. */
+static tt_status stream_piece(tiled *T, size_t k)
+{
+  app_run *r = T->r;
+  tt_app_tile_sink *sink = T->sink;
+  tt_status st = TT_OK;
+  if (!sink->out)
+    st = sink->open(sink, T->info, T->ro.max_error);
+  tt__stream_batch b;
+  tt_tile t;
+  tile_of(T, k, &t);
+  if (st == TT_OK)
+    st = tt__tin_stream_add(r->ctx, T->stream, T->pieces[k], &t, k, &b);
+  if (st == TT_OK)
+    st = tt__gpkg_stream_batch(sink->out, &b);
+  if (st != TT_OK) {
+    snprintf(T->merge_msg, sizeof T->merge_msg, "%s",
+             tt_context_errmsg(r->ctx));
+    return st;
+  }
+  /* -max_memory: what grows with the TIN here, beside the tiles in
+   * flight: the boxes kept for the R-trees, the pending vertices (56 bytes
+   * each), 4 bytes a vertex for the components */
+  size_t nv = b.vtx_first + (b.vtx ? tt_tin_vertex_count(b.vtx) : 0);
+  size_t bytes = tt__gpkg_stream_bytes(sink->out) +
+                 56 * tt__tin_stream_pending(T->stream) + 4 * nv;
+  if (T->max_memory && bytes + T->inflight_bytes > T->max_memory) {
+    snprintf(T->merge_msg, sizeof T->merge_msg, "while merging tile %zu of "
+             "%zu, at %zu vertices written and %zu waiting for their last "
+             "tile: the writer's records take %zu MiB, with the tiles in "
+             "flight (%zu MiB) more than the memory limit of %zu MiB "
+             "(-max_memory); nothing written", k + 1, T->ntiles, nv,
+             tt__tin_stream_pending(T->stream), bytes >> 20,
+             T->inflight_bytes >> 20, T->max_memory >> 20);
+    return TT_ERR_NOMEM;
+  }
+  return TT_OK;
+}
+
 /* Runs every tile on the workers; the main thread takes the results in
  * tile order (merging them unless merger is NULL) and polls for an
  * interruption. */
@@ -330,7 +379,15 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
       st = TT_ERR_INTERRUPTED;
       break;
     }
-    if (merger && T->pieces[k]) {
+    if (T->stream && T->pieces[k]) {
+      st = stream_piece(T, k);
+      tt_tin_destroy(T->pieces[k]);
+      T->pieces[k] = NULL;
+      if (st != TT_OK) {
+        atomic_store(&T->stop, 1);
+        break;
+      }
+    } else if (merger && T->pieces[k]) {
       tt_tile t;
       tile_of(T, k, &t);
       st = tt_tin_merger_add(r->ctx, merger, T->pieces[k], &t);
@@ -376,6 +433,10 @@ static tt_status run_all(tiled *T, tt_tin_merger *merger)
   }
   if (st == TT_ERR_NOMEM && T->merge_msg[0])
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, T->path, "%s",
+                        T->merge_msg);
+  if (st != TT_OK && st != TT_ERR_INTERRUPTED && T->stream &&
+      T->merge_msg[0] && T->failed == T->ntiles)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, r->s->output, "%s",
                         T->merge_msg);
   if (T->failed < T->ntiles && T->fail_status == TT_ERR_INTERRUPTED)
     return tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
@@ -703,19 +764,44 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     st = tt__app_tiles_hook.save(tt__app_tiles_hook.arg, r, k, T.pieces[k]);
     goto done;
   }
-  st = budget ? budget_run(&T, ro, gt, out_tin, out_passes)
-              : merge_all(&T, gt, out_tin);
-  if (st != TT_OK)
-    goto done;
   tt_tin_summary sum;
-  tt_tin_get_summary(*out_tin, &sum);
+  if (r->sink) {
+    /* streamed: the rows go out as the pieces merge (tiled_stream.c) */
+    T.sink = r->sink;
+    st = tt__tin_stream_create(r->ctx, T.W, T.H, T.N, gt, &T.stream);
+    if (st != TT_OK) {
+      tt__app_fail_tt(r, st, path);
+      goto done;
+    }
+    st = run_all(&T, NULL);
+    if (st != TT_OK)
+      goto done;
+    tt__tin_stream_summary(T.stream, &sum, &r->sink->zmin, &r->sink->zmax);
+    if (sum.triangles == 0) {
+      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, path, "no "
+                        "triangle can be made: no grid cell has three valid "
+                        "corners (the valid samples are isolated by "
+                        "nodata)");
+      goto done;
+    }
+    r->sink->sum = sum;
+  } else {
+    st = budget ? budget_run(&T, ro, gt, out_tin, out_passes)
+                : merge_all(&T, gt, out_tin);
+    if (st != TT_OK)
+      goto done;
+    tt_tin_get_summary(*out_tin, &sum);
+  }
   if (T.info) {
     T.info->width = T.W;
     T.info->height = T.H;
     T.info->valid_samples = sum.valid_samples;
     T.info->nodata_samples = T.W * T.H - sum.valid_samples;
   }
-  if (!(zmin <= zmax)) {
+  if (!(zmin <= zmax) && T.stream) {
+    zmin = r->sink->zmin;
+    zmax = r->sink->zmax;
+  } else if (!(zmin <= zmax)) {
     /* the range of the vertices' heights (the report's; the bound was
      * given) */
     for (size_t v = 0; v < sum.vertices; v++) {
@@ -743,6 +829,7 @@ done:
     for (size_t k = 0; k < T.ntiles; k++)
       tt__app_curve_free(&T.curves[k]);
   free(T.curves);
+  tt__tin_stream_destroy(T.stream);
   if (tt__app_tiles_hook.save && T.pieces && tt__app_tiles_hook.tile < T.ntiles)
     tt_tin_destroy(T.pieces[tt__app_tiles_hook.tile]);
   tt_raster_info_destroy(T.info);

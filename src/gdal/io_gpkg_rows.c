@@ -1642,3 +1642,281 @@ done:
   tt__records_free(&rec);
   return s;
 }
+
+/* --- the pages row by row, for a streamed write (gpkg_stream.h) -----------
+ * pages_run()'s steps 1 to 3 split so that a tiled run
+ * (io_gpkg_stream.c) can append rows as its tiles finish instead of from a
+ * whole TIN: open makes step 1 and begins the tables, each row is
+ * encoded as append_layer() encodes it, finish ends step 2 and makes step
+ * 3. Nothing above changes. */
+#include "gdal/gpkg_stream.h"
+
+struct tt__gpkg_pages {
+  rows_state w;
+  layer_table layer[2];
+  pages_job job;
+  tt__sqlite_file *f;
+  tt__sqlite_table *t[2];
+  int format;
+  int finished;
+  char *names[2];
+};
+
+tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
+                              char **options, int nvfields,
+                              tt__gpkg_pages **out)
+{
+  *out = NULL;
+  tt__gpkg_pages *p = calloc(1, sizeof *p);
+  if (!p)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  rows_state *w = &p->w;
+  pages_job *j = &p->job;
+  w->ctx = ctx;
+  w->path = path;
+  j->w = w;
+  j->layer[0] = &p->layer[0];
+  j->layer[1] = &p->layer[1];
+  j->rtree = 1;
+  const char *prefix = "";
+  unsigned layers = TT__LAYERS_ALL;
+  int journal_memory = 0;
+  tt_status s = TT_OK;
+  for (char **o = options; o && *o && s == TT_OK; o++) {
+    char *key = NULL;
+    const char *value = CPLParseNameValue(*o, &key);
+    if (!key || !value)
+      s = tt__error(ctx, TT_ERR_ARG, "write option \"%s\" is not "
+                    "NAME=VALUE", *o);
+    else if (strcasecmp(key, "NLN_PREFIX") == 0)
+      prefix = value;
+    else if (strcasecmp(key, "LCO") == 0) {
+      char *lkey = NULL;
+      const char *lvalue = CPLParseNameValue(value, &lkey);
+      if (lkey && lvalue && strcasecmp(lkey, "SPATIAL_INDEX") == 0)
+        j->rtree = CPLTestBool(lvalue);
+      CPLFree(lkey);
+    } else if (strcasecmp(key, "RTREE_CHECK") == 0)
+      j->rtree_check = CPLTestBool(value);
+    else if (strcasecmp(key, "LAYERS") == 0)
+      s = tt__records_parse_layers(ctx, value, &layers);
+    else if (strcasecmp(key, "JOURNAL") == 0)
+      journal_memory = strcasecmp(value, "MEMORY") == 0;
+    CPLFree(key);
+  }
+  j->todo[0] = (layers & TT__LAYER_TRIANGLES) != 0;
+  j->todo[1] = (layers & TT__LAYER_VERTICES) != 0;
+  p->names[0] = CPLStrdup(CPLSPrintf("%striangles", prefix));
+  p->names[1] = CPLStrdup(CPLSPrintf("%svertices", prefix));
+  *out = p;
+  if (s != TT_OK)
+    return s;
+  if (sqlite3_open_v2(path, &w->db,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, NULL) !=
+      SQLITE_OK)
+    return tt__error(ctx, TT_ERR_IO, "%s: cannot open the GeoPackage: %s",
+                     path, w->db ? sqlite3_errmsg(w->db) : "out of memory");
+  sqlite3_extended_result_codes(w->db, 1);
+  if (journal_memory)
+    s = exec(w, "PRAGMA journal_mode = MEMORY", "cannot set the journal");
+  if (s == TT_OK)
+    s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k])
+      s = layer_find(w, p->names[k], &p->layer[k]);
+  const char *why = NULL;
+  if (s == TT_OK)
+    s = pages_possible(w, &p->layer[0], &p->layer[1], j->todo[0],
+                       j->todo[1], j->rtree, nvfields, j->lay, &why);
+  if (s == TT_OK && why)
+    s = tt__error(ctx, TT_ERR_FORMAT, "%s: the rows cannot be written as "
+                  "pages: %s", path, why);
+  if (s != TT_OK) {
+    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
+    return s;
+  }
+  /* step 1, as pages_run() makes it */
+  j->had_extensions =
+      sqlite3_table_column_metadata(w->db, NULL, "gpkg_extensions",
+                                    "extension_name", NULL, NULL, NULL, NULL,
+                                    NULL) == SQLITE_OK;
+  int sync = 2;
+  sqlite3_stmt *st = NULL;
+  if (sqlite3_prepare_v2(w->db, "PRAGMA synchronous", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    sync = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  s = exec(w, "COMMIT; PRAGMA synchronous = OFF; BEGIN IMMEDIATE",
+           "cannot start a transaction");
+  for (int k = 0; k < 2 && s == TT_OK && j->rtree; k++)
+    if (j->todo[k])
+      s = tt__gpkg_rtree_create_empty(ctx, w->db, path, p->layer[k].name,
+                                      p->layer[k].geom, &j->sh[k]);
+  if (s == TT_OK)
+    s = exec(w, "COMMIT", "cannot commit the spatial indexes");
+  if (s != TT_OK) {
+    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
+    memset(j->sh, 0, sizeof j->sh); /* rolled back: nothing to undo */
+    j->rtree = 0;
+    return s;
+  }
+  char pragma[48];
+  snprintf(pragma, sizeof pragma, "PRAGMA synchronous = %d", sync);
+  s = exec(w, pragma, "cannot set synchronous");
+  /* step 2 begins */
+  if (s == TT_OK)
+    s = tt__sqlite_file_open(ctx, path, &p->f);
+  p->format = s == TT_OK ? tt__sqlite_file_format(p->f) : 4;
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k]) {
+      if (j->lay[k].ncols > TT__SQLITE_REC_COLS)
+        s = tt__error(ctx, TT_ERR_FORMAT, "%s: table %s has more than %d "
+                      "columns", path, j->lay[k].table, TT__SQLITE_REC_COLS);
+      else
+        s = tt__sqlite_table_begin(p->f, j->lay[k].table, j->lay[k].root,
+                                   &p->t[k]);
+    }
+  return s;
+}
+
+int tt__gpkg_pages_has(const tt__gpkg_pages *p, int layer)
+{
+  return p->job.todo[layer];
+}
+
+int32_t tt__gpkg_pages_srs_id(const tt__gpkg_pages *p, int layer)
+{
+  return p->layer[layer].srs_id;
+}
+
+int tt__gpkg_pages_rtree(const tt__gpkg_pages *p)
+{
+  return p->job.rtree;
+}
+
+tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer, int64_t fid,
+                             const tt__gpkg_value *fields,
+                             const unsigned char *blob, size_t blob_len)
+{
+  const page_layout *lay = &p->job.lay[layer];
+  unsigned char body[8 * TT__SQLITE_REC_COLS + TRI_BLOB_BYTES + 8];
+  tt__sqlite_rec r;
+  tt__sqlite_rec_begin(&r, body, p->format);
+  for (int c = 0; c < lay->ncols; c++) {
+    int src = lay->src[c];
+    if (src == SRC_GEOM) {
+      tt__sqlite_rec_bytes(&r, blob, blob_len, 0);
+      continue;
+    }
+    const tt__gpkg_value *v = src >= 0 ? &fields[src] : NULL;
+    if (!v || v->type == TT__GV_NULL) {
+      tt__sqlite_rec_null(&r);
+      continue;
+    }
+    tt__sqlite_value x;
+    x.type = v->type == TT__GV_INT ? TT__SQV_INT : TT__SQV_REAL;
+    x.i = v->i;
+    x.d = v->d;
+    tt__sqlite_apply_affinity(&x, lay->aff[c]);
+    if (x.type == TT__SQV_INT)
+      tt__sqlite_rec_int(&r, x.i);
+    else
+      tt__sqlite_rec_real(&r, x.d);
+  }
+  const unsigned char *head;
+  size_t nh = tt__sqlite_rec_head(&r, &head);
+  return tt__sqlite_table_append2(p->t[layer], fid, head, nh, body, r.nb);
+}
+
+tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p, tt__rtree_box *boxes[2],
+                                const size_t count[2],
+                                const double ext[2][4],
+                                tt_progress_fn progress, void *progress_arg)
+{
+  rows_state *w = &p->w;
+  pages_job *j = &p->job;
+  tt_status s = TT_OK;
+  w->progress = progress;
+  w->progress_arg = progress_arg;
+  for (int k = 0; k < 2; k++) {
+    j->count[k] = j->todo[k] ? count[k] : 0;
+    memcpy(p->layer[k].ext, ext[k], sizeof p->layer[k].ext);
+    if (p->t[k] && s == TT_OK) {
+      s = tt__sqlite_table_finish(p->t[k]);
+      p->t[k] = NULL;
+      p->layer[k].last_fid = (sqlite3_int64)j->count[k];
+    }
+  }
+  /* the vertices' index first: its boxes are freed before the
+   * triangles' (twice as many) are packed */
+  for (int k = 1; k >= 0 && s == TT_OK; k--) {
+    if (!j->rtree || !j->todo[k])
+      continue;
+    w->lo = k ? 0.0 : 0.3;
+    w->hi = k ? 0.3 : 0.9;
+    s = tt__rtree_write_pages(w->ctx, p->layer[k].name, boxes[k],
+                              j->count[k], NULL, &j->sh[k], p->f,
+                              rtree_progress, w);
+    free(boxes[k]);
+    boxes[k] = NULL;
+  }
+  if (s == TT_OK)
+    s = tt__sqlite_file_commit(p->f);
+  tt_status c = tt__sqlite_file_close(p->f);
+  p->f = NULL;
+  if (s == TT_OK)
+    s = c;
+  if (s != TT_OK)
+    return s; /* close() undoes step 1 */
+  p->finished = 1; /* the pages are in: step 3 */
+  s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
+  for (int k = 0; k < 2 && s == TT_OK; k++)
+    if (j->todo[k]) {
+      s = set_sequence(w, &j->lay[k], j->count[k]);
+      if (s == TT_OK)
+        s = finish_layer(w, &p->layer[k], j->count[k]);
+    }
+  for (int k = 0; k < 2 && s == TT_OK && j->rtree_check && j->rtree; k++) {
+    if (!j->todo[k])
+      continue;
+    sqlite3_stmt *st = NULL;
+    char *sql = sqlite3_mprintf("SELECT rtreecheck(%Q)", j->sh[k].rtree);
+    int rc = sql ? sqlite3_prepare_v2(w->db, sql, -1, &st, NULL)
+                 : SQLITE_NOMEM;
+    sqlite3_free(sql);
+    const char *msg = rc == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW
+                          ? (const char *)sqlite3_column_text(st, 0) : NULL;
+    if (!msg || strcmp(msg, "ok") != 0)
+      s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s: the R-tree %s fails "
+                    "rtreecheck(): %.300s", w->path, j->sh[k].rtree,
+                    msg ? msg : sqlite3_errmsg(w->db));
+    sqlite3_finalize(st);
+  }
+  if (s == TT_OK)
+    s = exec(w, "COMMIT", "cannot commit the TIN");
+  else
+    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
+  if (s == TT_OK && progress)
+    progress(1.0, "writing", progress_arg);
+  return s;
+}
+
+void tt__gpkg_pages_close(tt__gpkg_pages *p)
+{
+  if (!p)
+    return;
+  if (p->f) /* not committed: the file is cut back to step 1's size */
+    tt__sqlite_file_close(p->f);
+  if (!p->finished && p->w.db && p->job.rtree)
+    pages_undo(&p->job);
+  if (p->w.db)
+    sqlite3_close(p->w.db);
+  for (int k = 0; k < 2; k++) {
+    layout_free(&p->job.lay[k]);
+    tt__rtree_shadow_free(&p->job.sh[k]);
+    layer_free(&p->layer[k]);
+    CPLFree(p->names[k]);
+  }
+  free(p);
+}

@@ -86,4 +86,44 @@ TT_HIDDEN tt_status tt__decimate_tile(tt_context *ctx, const tt_grid *grid,
                                       const tt__tile_borders *borders,
                                       tt_tin **out_tin);
 
+/* --- the streamed merge (stream.c) ----------------------------------------
+ * The pieces of a tiled run joined in tile order, as tt_tin_merger joins
+ * them, but handed out as batches of rows instead of kept: each add gives
+ * the piece's triangles (tri: the piece's vertex arrays, its triangles
+ * with the merged sample counts and rmse; map: its vertex indices to the
+ * global ids; tri_first: the global index of its first triangle; tri NULL
+ * when the piece has none) and the vertices that became final (vtx: their
+ * values with the star statistics of every tile touching them, in id
+ * order from vtx_first; its rank is the index plus vtx_first). The batch
+ * is valid until the next add; the writer makes the rows
+ * tt_tin_merger_finish()'s TIN would give. */
+typedef struct tt__tin_stream tt__tin_stream;
+typedef struct tt__stream_batch {
+  const tt_tin *tri;
+  const int32_t *map;
+  size_t tri_first;
+  const tt_tin *vtx;
+  size_t vtx_first;
+} tt__stream_batch;
+
+/* The caller frees *out with tt__tin_stream_destroy(). */
+TT_HIDDEN tt_status tt__tin_stream_create(tt_context *ctx, size_t dem_width,
+                                          size_t dem_height, size_t tile_size,
+                                          const double gt[6],
+                                          tt__tin_stream **out);
+TT_HIDDEN void tt__tin_stream_destroy(tt__tin_stream *s);
+/* Adds tile k's piece (k: the tile order index, every tile once, in
+ * order). */
+TT_HIDDEN tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
+                                       const tt_tin *piece,
+                                       const tt_tile *tile, size_t k,
+                                       tt__stream_batch *out);
+/* Vertices merged but not yet handed out (the reorder buffer). */
+TT_HIDDEN size_t tt__tin_stream_pending(const tt__tin_stream *s);
+/* The whole TIN's summary as tt_tin_merger_finish() sets it, and the range
+ * of the vertices' heights. */
+TT_HIDDEN void tt__tin_stream_summary(const tt__tin_stream *s,
+                                      tt_tin_summary *out, double *out_zmin,
+                                      double *out_zmax);
+
 #endif /* TT_TILE_H */

@@ -129,6 +129,62 @@ check "nodata: the same uncovered samples as untiled" \
 run simplify -q -max_error 4 -tile_size 100 -threads 1 in/n.tif out/n1.gpkg
 check "nodata: threads 1 vs 2, the same layers" [ "$(dump out/n1.gpkg)" = "$(dump out/n100.gpkg)" ]
 
+# --- streamed (the default for a GeoPackage: rows written as the tiles
+# merge, tiled_stream.c) against the merged-TIN path
+# (TERRATIN_TILE_STREAM=NO): the same rows, byte for byte, the same
+# R-tree nodes, extents, counts, run_parameters (but times), styles ---
+SAME="$(cd "$(dirname "$0")" && pwd)/same_gpkg.py"
+same() { # same NAME A B: the files' tables hold the same content
+  if python3 "$SAME" "$2" "$3" >same.txt 2>&1; then pass; else
+    fail "$1: streamed and merged differ: $(head -c 600 same.txt)"; fi
+}
+streamed_vs_merged() { # NAME DEM OPTIONS...
+  local name=$1 dem=$2
+  shift 2
+  rm -f out/sv_s.gpkg out/sv_m.gpkg
+  "$T" simplify -q -json "$@" "$dem" out/sv_s.gpkg >s.json 2>err.txt
+  rc=$?
+  check "$name: streamed exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
+  TERRATIN_TILE_STREAM=NO "$T" simplify -q -json "$@" "$dem" out/sv_m.gpkg >m.json 2>err.txt
+  rc=$?
+  check "$name: merged exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
+  same "$name" out/sv_s.gpkg out/sv_m.gpkg
+  local la=$(ogrinfo -ro -al -q out/sv_s.gpkg ${LAYERS_OF:-triangles vertices} | md5sum)
+  local lb=$(ogrinfo -ro -al -q out/sv_m.gpkg ${LAYERS_OF:-triangles vertices} | md5sum)
+  check "$name: the same ogrinfo -al of the layers" [ "$la" = "$lb" ]
+  for k in vertices triangles components max_error rmse covered_samples \
+           lone_samples forced_vertices valid_samples z_min z_max; do
+    check "$name: JSON $k the same ($(jget s.json $k), $(jget m.json $k))" \
+      [ "$(jget s.json $k)" = "$(jget m.json $k)" ]
+  done
+}
+streamed_vs_merged "fractal, tiles of 128, 2 threads" in/ds.tif -max_error 6 -tile_size 128 -threads 2
+streamed_vs_merged "fractal, tiles of 100, 1 thread" in/ds.tif -max_error 6 -tile_size 100 -threads 1
+streamed_vs_merged "fractal, tiles of 500, 2 threads" in/ds.tif -max_error 6 -tile_size 500 -threads 2
+streamed_vs_merged "fractal, default bound, tiles of 64" in/ds.tif -tile_size 64 -threads 2
+check "streamed: threads 1 vs 2, the same layers" [ "$(dump out/t1.gpkg)" = "$(dump out/t128.gpkg)" ]
+streamed_vs_merged "nodata, tiles of 50, 2 threads" in/n.tif -max_error 4 -tile_size 50 -threads 2
+streamed_vs_merged "nodata, tiles of 128, 1 thread" in/n.tif -max_error 4 -tile_size 128 -threads 1
+streamed_vs_merged "fault, minmax_angle + lookahead" in/f.tif -max_error 0.5 -tile_size 64 -criterion minmax_angle -optimize lookahead
+JB="$(cd "$(dirname "$0")/../../testdata" && pwd)/jacksboro_fault_dem.tif"
+LAYERS_OF="x_triangles x_vertices" streamed_vs_merged "-t_srs, -nln, -layers" "$JB" -max_error 2 -tile_size 64 -t_srs EPSG:3857 -nln x_ -layers vertices,triangles
+streamed_vs_merged "-lco SPATIAL_INDEX=NO, -nostyle" in/ds.tif -max_error 6 -tile_size 128 -lco SPATIAL_INDEX=NO -nostyle
+# GDAL's spatial filter goes through the streamed R-tree
+"$T" simplify -q -max_error 6 -tile_size 100 in/ds.tif out/sf.gpkg 2>err.txt
+# a window in the middle of the layer's extent
+win=$(python3 -c 'import sqlite3,sys
+x0,y0,x1,y1=sqlite3.connect(sys.argv[1]).execute("select min_x,min_y,max_x,max_y from gpkg_contents where table_name=\"triangles\"").fetchone()
+w,h=x1-x0,y1-y0
+print(x0+0.3*w, y0+0.3*h, x0+0.6*w, y0+0.55*h)' out/sf.gpkg)
+n1=$(ogrinfo -ro -so out/sf.gpkg triangles -spat $win 2>/dev/null | sed -n 's/Feature Count: //p')
+# the same window by a scan of the geometries (no index)
+n2=$(ogrinfo -ro -q -sql "SELECT count(*) AS n FROM triangles WHERE ST_MaxX(geom) >= $(echo $win | cut -d' ' -f1) AND ST_MinX(geom) <= $(echo $win | cut -d' ' -f3) AND ST_MaxY(geom) >= $(echo $win | cut -d' ' -f2) AND ST_MinY(geom) <= $(echo $win | cut -d' ' -f4)" out/sf.gpkg 2>/dev/null | sed -n 's/.*n (Integer[64]*) = //p')
+check "streamed: a spatial filter finds triangles ($n1)" [ "${n1:-0}" -gt 0 ]
+check "streamed: the R-tree's answer ($n1) is the scan's ($n2)" [ "$n1" = "$n2" ]
+check "streamed: rtreecheck ok" [ "$(python3 -c 'import sqlite3,sys
+db=sqlite3.connect(sys.argv[1])
+print(" ".join(db.execute("select rtreecheck(?)",(t,)).fetchone()[0] for t in ("rtree_triangles_geom","rtree_vertices_geom")))' out/sf.gpkg 2>&1)" = "ok ok" ]
+
 # --- the memory limit chooses tiles ---
 run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg
 check "-max_memory 1500K: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
@@ -143,6 +199,7 @@ run simplify -q -max_error 0.5 -tile_size 64 -max_memory 2M in/ds.tif out/mm.gpk
 check "-max_memory 2M, a dense tiled TIN: exit 1 ($rc)" [ "$rc" -eq 1 ]
 check "-max_memory 2M: says while merging ($(cat err.txt))" grep -q "while merging tile .* more than the memory limit of 2 MiB" err.txt
 check "-max_memory 2M: nothing written" [ ! -e out/mm.gpkg ]
+check "-max_memory 2M: no temporary file" bash -c "! ls -A out | grep -q '^\\.tt'"
 
 # --- refusals: usage errors, nothing written ---
 refused() {
@@ -178,6 +235,27 @@ else
   check "SIGTERM: says interrupted ($(cat err.txt))" grep -q "interrupted" err.txt
 fi
 check "SIGTERM: no temporary file" bash -c "! ls -A out | grep -q '^\\.tt'"
+# the same while the streamed GeoPackage is being written: at several
+# moments, from the first tiles to the R-trees
+for d in 0.3 0.8 1.5 2.5 4; do
+  rm -f out/int.gpkg
+  "$T" simplify -q -max_error 0.3 -tile_size 64 -threads 2 in/big.tif out/int.gpkg 2>err.txt &
+  pid=$!
+  sleep $d
+  kill -TERM $pid 2>/dev/null
+  wait $pid
+  rc=$?
+  if [ -e out/int.gpkg ]; then
+    check "streamed, SIGTERM at $d s: finished before it ($rc)" [ "$rc" -eq 0 ]
+    check "streamed, SIGTERM at $d s: a whole file" \
+      [ "$(sqlite3 out/int.gpkg 'pragma integrity_check' 2>&1 || echo bad)" = ok ]
+  else
+    check "streamed, SIGTERM at $d s: ended by it ($rc)" [ "$rc" -ne 0 ]
+    check "streamed, SIGTERM at $d s: says interrupted ($(cat err.txt))" grep -q "interrupted" err.txt
+  fi
+  check "streamed, SIGTERM at $d s: no temporary file ($(ls -A out | grep '^\.tt'))" \
+    bash -c "! ls -A out | grep -q '^\\.tt'"
+done
 
 # --- real DEMs, when the shared test data are there ---
 S=${TT_SHARED_TESTDATA:-}

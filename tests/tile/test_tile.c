@@ -12,11 +12,17 @@
  *  - decimation in tiles keeps the border polylines' vertices, with every
  *    decimation option; no optimiser swaps a border edge;
  *  - a tile's error-against-count curve (budgets) matches untiled runs;
- *  - bad tiles and budgets are refused. */
+ *  - bad tiles and budgets are refused;
+ *  - the streamed merge (src/tile/stream.c) hands out every triangle and
+ *    vertex of the merged TIN once, in order, with the same values and
+ *    star statistics bit for bit, and the same summary (projected frames,
+ *    insertion: what the command streams). */
 #include "terratin/terratin.h"
 #include "tt_test.h"
 #include "tt_tin_conform.h"
 #include "tt_tin_oracle.h"
+#include "tile/tile.h"
+#include "tin/tin.h"
 
 #include <stdbool.h>
 
@@ -48,6 +54,79 @@ static tt_grid *window_of(const tt_grid *g, const tt_tile *t)
   free(z);
   free(zf);
   return win;
+}
+
+/* The pieces through tt__tin_stream against the merged TIN: the same
+ * triangles (corners mapped to the global ids, counts, rmse), the same
+ * vertices in id order with the same star statistics, the same summary;
+ * the reorder buffer stays within about a row of tiles. */
+static void check_stream(tt_tin *const *pieces, const tt_tile *tiles,
+                         size_t nt, size_t n, const double gt[6],
+                         const tt_tin *tin)
+{
+  size_t W = tiles[0].dem_width, H = tiles[0].dem_height;
+  size_t ntx = (W - 2) / n + 1;
+  tt__tin_stream *s = NULL;
+  CHECK(tt__tin_stream_create(ctx, W, H, n, gt, &s) == TT_OK);
+  size_t tri = 0, vtx = 0, max_pending = 0, row_max = 0, bad = 0;
+  for (size_t k = 0; k < nt; k++) {
+    tt__stream_batch b;
+    CHECK(tt__tin_stream_add(ctx, s, pieces[k], &tiles[k], k, &b) == TT_OK);
+    if (b.tri) {
+      CHECK(b.tri_first == tri);
+      for (size_t i = 0; i < b.tri->nt; i++, tri++)
+        for (int c = 0; c < 3; c++)
+          bad += b.map[b.tri->tv[3 * i + c]] != tin->tv[3 * tri + c];
+      for (size_t i = 0; i < b.tri->nt; i++) {
+        size_t j = b.tri_first + i;
+        bad += b.tri->t_n[i] != tin->t_n[j];
+        bad += memcmp(&b.tri->t_rmse[i], &tin->t_rmse[j], sizeof(double)) != 0;
+        bad += b.tri->t_max[i] != tin->t_max[j];
+      }
+    }
+    CHECK(b.vtx_first == vtx);
+    for (size_t i = 0; b.vtx && i < b.vtx->nv; i++, vtx++) {
+      bad += b.vtx->vc[i] != tin->vc[vtx] || b.vtx->vr[i] != tin->vr[vtx];
+      bad += b.vtx->vzd[i] != tt__tin_z(tin, vtx);
+      bad += memcmp(&b.vtx->v_ins_err[i], &tin->v_ins_err[vtx],
+                    sizeof(double)) != 0;
+      bad += b.vtx->v_star_max[i] != tin->v_star_max[vtx];
+      bad += memcmp(&b.vtx->v_star_rmse[i], &tin->v_star_rmse[vtx],
+                    sizeof(double)) != 0;
+      bad += b.vtx->v_star_n[i] != tin->v_star_n[vtx];
+    }
+    size_t p = tt__tin_stream_pending(s);
+    max_pending = p > max_pending ? p : max_pending;
+    /* the vertices a row of tiles and one more tile made */
+    size_t row = 0;
+    for (size_t q = k + 1 > ntx + 1 ? k - ntx : 0; q <= k; q++)
+      row += pieces[q]->nv;
+    row_max = row > row_max ? row : row_max;
+    CHECK(p <= row);
+  }
+  if (bad)
+    fprintf(stderr, "stream: %zu values differ from the merged TIN's\n",
+            bad);
+  CHECK(bad == 0);
+  CHECK(tri == tin->nt);
+  CHECK(vtx == tin->nv);
+  tt_tin_summary a, m;
+  double zmin, zmax;
+  tt__tin_stream_summary(s, &a, &zmin, &zmax);
+  tt_tin_get_summary(tin, &m);
+  CHECK(a.vertices == m.vertices && a.triangles == m.triangles);
+  CHECK(a.components == m.components);
+  CHECK(a.valid_samples == m.valid_samples);
+  CHECK(a.forced_vertices == m.forced_vertices);
+  CHECK(a.errors.covered == m.errors.covered);
+  CHECK(a.errors.max_error == m.errors.max_error);
+  CHECK(a.errors.max_col == m.errors.max_col &&
+        a.errors.max_row == m.errors.max_row);
+  CHECK(a.errors.rmse == m.errors.rmse && a.errors.l2 == m.errors.l2);
+  CHECK(a.errors.total_abs == m.errors.total_abs);
+  printf("stream, tiles of %zu: %zu vertices, at most %zu pending (a row "
+         "of tiles and one: at most %zu)\n", n, vtx, max_pending, row_max);
+  tt__tin_stream_destroy(s);
 }
 
 /* Tiles of n cells; run in reverse order when reverse, merged in order. */
@@ -90,6 +169,7 @@ static tt_tin *run_tiled_by(const tt_grid *g, size_t n,
       CHECK(tt_tin_merger_add(ctx, m, pieces[i], &tiles[i]) == TT_OK);
   CHECK(tt_tin_merger_finish(ctx, m, &tin) == TT_OK);
   tt_tin_merger_destroy(m);
+  check_stream(pieces, tiles, nt, n, gt, tin);
   for (size_t i = 0; i < nt; i++)
     tt_tin_destroy(pieces[i]);
   free(pieces);

@@ -1,0 +1,94 @@
+/*
+ * gpkg_stream.h -- a tiled run's GeoPackage written as its tiles finish
+ * (io_gpkg_stream.c), and what it needs of the page writer of
+ * io_gpkg_rows.c: the two layers' tables filled row by row as database
+ * pages, in fid order, with SQLite closed, then their R-trees, extents and
+ * counts (tt__gpkg_pages_*).
+ */
+#ifndef TERRATIN_GPKG_STREAM_H
+#define TERRATIN_GPKG_STREAM_H
+
+#include "base/internal.h"
+#include "gdal/gpkg_rtree.h"
+#include "terratin/terratin_gdal.h"
+#include "tile/tile.h"
+
+/* One field value of a row: NULL, an integer or a real. */
+enum { TT__GV_NULL, TT__GV_INT, TT__GV_REAL };
+typedef struct tt__gpkg_value {
+  int type;
+  int64_t i;
+  double d;
+} tt__gpkg_value;
+
+/* --- io_gpkg_rows.c: the layers' pages appended row by row ---------------
+ * Opens the GeoPackage whose empty layers tt_ogr_write_tin(ROWS=DEFERRED)
+ * made (closed by GDAL), with the write options it got (NLN_PREFIX,
+ * LAYERS, LCO=SPATIAL_INDEX, RTREE_CHECK, JOURNAL; the rest ignored), makes
+ * the R-trees' schema (committed), and opens both tables for appending as
+ * pages (io_gpkg_rows.c's PAGES=YES, steps 1 and 2). TT_ERR_FORMAT when the
+ * file cannot take pages. nvfields: the vertices layer's fields. Only for
+ * a file no one else opens and that is thrown away unless
+ * tt__gpkg_pages_finish() succeeds. The caller frees *out with
+ * tt__gpkg_pages_close(), which, unless finished, cuts the file back and
+ * drops the R-trees' schema. layer: 0 triangles, 1 vertices. */
+typedef struct tt__gpkg_pages tt__gpkg_pages;
+TT_HIDDEN tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
+                                        char **options, int nvfields,
+                                        tt__gpkg_pages **out);
+/* Whether the layer is written (LAYERS), its srs_id; whether R-trees are
+ * made. */
+TT_HIDDEN int tt__gpkg_pages_has(const tt__gpkg_pages *p, int layer);
+TT_HIDDEN int32_t tt__gpkg_pages_srs_id(const tt__gpkg_pages *p, int layer);
+TT_HIDDEN int tt__gpkg_pages_rtree(const tt__gpkg_pages *p);
+/* Appends a row: fid (1, 2, ... in order), the layer's fields in
+ * tin_records.h's order, the geometry blob. */
+TT_HIDDEN tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer,
+                                       int64_t fid,
+                                       const tt__gpkg_value *fields,
+                                       const unsigned char *blob,
+                                       size_t blob_len);
+/* Ends the tables (count[k] rows each), writes the R-trees of the boxes
+ * (one per row, fid order, malloc'd; NULL without R-trees) as pages,
+ * freeing each array once its index is written (boxes[k] set NULL),
+ * commits them,
+ * then sets sqlite_sequence, the extents ext[k] (min x, min y, max x,
+ * max y) and counts, and runs rtreecheck() when RTREE_CHECK asked. */
+TT_HIDDEN tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
+                                          tt__rtree_box *boxes[2],
+                                          const size_t count[2],
+                                          const double ext[2][4],
+                                          tt_progress_fn progress,
+                                          void *progress_arg);
+TT_HIDDEN void tt__gpkg_pages_close(tt__gpkg_pages *p);
+
+/* --- io_gpkg_stream.c: the rows of a streamed merge ----------------------
+ * tt__gpkg_stream_open() after the layers were made (as above, srs the
+ * layers' input CRS, options those of tt_gpkg_write_rows(), T_SRS
+ * included); tt__gpkg_stream_batch() for each batch tt__tin_stream_add()
+ * gave, in order; tt__gpkg_stream_finish() after the last tile. The rows,
+ * blobs, boxes, extents and counts are those tt_gpkg_write_rows() writes
+ * for the merged TIN, byte for byte. The caller frees *out with
+ * tt__gpkg_stream_close() (which undoes an unfinished write, as above). */
+typedef struct tt__gpkg_stream tt__gpkg_stream;
+TT_HIDDEN tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
+                                         OGRSpatialReferenceH srs,
+                                         char **options,
+                                         tt__gpkg_stream **out);
+TT_HIDDEN tt_status tt__gpkg_stream_batch(tt__gpkg_stream *g,
+                                          const tt__stream_batch *b);
+/* Ends the tables and writes the R-trees, extents and counts
+ * (tt__gpkg_pages_finish), then sets the run_parameters row (made with
+ * provisional values) to fields and the default styles (STYLE=YES) to the
+ * classes of the rows written. */
+TT_HIDDEN tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
+                                           const tt_run_field *fields,
+                                           size_t nfields,
+                                           tt_progress_fn progress,
+                                           void *progress_arg);
+TT_HIDDEN void tt__gpkg_stream_close(tt__gpkg_stream *g);
+/* The bytes the writer holds: the boxes kept for the R-trees, the
+ * vertices' insertion errors for the style. */
+TT_HIDDEN size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g);
+
+#endif /* TERRATIN_GPKG_STREAM_H */
