@@ -366,6 +366,12 @@ typedef struct app_curve {
  * out of memory. */
 bool tt__app_curve_add(app_curve *c, size_t vertices, double err);
 bool tt__app_curve_end(app_curve *c);
+/* tiled_tiles.c: tt_tile_curve's callback recording into an app_curve
+ * (arg); the valid samples tile t counts in its window win (less the
+ * margins and its shared right column and bottom row, as tt_tile_run's
+ * pieces). */
+void tt__app_curve_point(void *arg, size_t vertices, double max_error);
+size_t tt__app_tile_owned_valid(const tt_grid *win, const tt_tile *t);
 void tt__app_curve_free(app_curve *c);
 /* The smallest error of any of the n curves (or 0 when above < 0)
  * strictly between above and below at which the tiles' counts summed are

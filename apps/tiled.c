@@ -32,10 +32,9 @@
  * -max_triangles, -percent) is turned into one bound (budget_run): a
  * pass records every tile's error-against-count curve (tt_tile_curve,
  * tiled_budget.c), then the tiles are run at the bound the curves give,
- * again while the TIN passes the budget (docs/scale.md).
- *
- * Without -max_error the bound is 0.5 % of the height range, as untiled:
- * one more pass over the tiles finds the range first.
+ * again while the TIN passes the budget (docs/scale.md). Without
+ * -max_error the bound is 0.5 % of the height range, as untiled (one more
+ * pass over the tiles finds the range first).
  *
  * GDAL's block cache (5 % of the memory by default) would keep every
  * block read, the whole DEM in the end: unless GDAL_CACHEMAX is set, it
@@ -45,14 +44,12 @@
  * in tiles of 1024 this took the peak from 344 to 130 MB.
  */
 #include "app.h"
-#include "gdal/georef.h" /* tt__georef_is_web_mercator */
 #include "gdal/gpkg_stream.h"
 #include "tile/tile.h"
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
-#include <ogr_srs_api.h>
 
 #include <math.h>
 #include <pthread.h>
@@ -136,27 +133,6 @@ static void fail(tiled *T, size_t k, tt_status st, const char *msg)
   pthread_mutex_unlock(&T->lock);
 }
 
-static void curve_point(void *arg, size_t vertices, double max_error)
-{
-  app_curve *c = arg;
-  if (!c->failed && !tt__app_curve_add(c, vertices, max_error))
-    c->failed = true;
-}
-
-/* The valid samples a tile counts (its window less the margins and its
- * shared right column and bottom row, as tt_tile_run's pieces). */
-static size_t owned_valid(const tt_grid *win, const tt_tile *t)
-{
-  size_t c0, r0, w, h, n = 0;
-  tt_tile_window(t, &c0, &r0, &w, &h);
-  size_t x1 = t->col1 - (t->col1 + 1 < t->dem_width);
-  size_t y1 = t->row1 - (t->row1 + 1 < t->dem_height);
-  for (size_t y = t->row0; y <= y1; y++)
-    for (size_t x = t->col0; x <= x1; x++)
-      n += !isnan(tt_grid_sample(win, x - c0, y - r0));
-  return n;
-}
-
 /* One tile: read (from own, a worker's own dataset's band, or the shared
  * band under the mutex when own is NULL), then refine (or measure the
  * range). */
@@ -217,8 +193,8 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k,
     /* a budget's first pass: the tile's curve, its valid samples */
     size_t cells = (t.col1 - t.col0 + 1) * (t.row1 - t.row0 + 1);
     size_t cap = (size_t)ceil(T->curve_per_cell * (double)cells) + 64;
-    T->valid[k] = owned_valid(win, &t);
-    st = tt_tile_curve(ctx, win, &t, &T->ro, cap, curve_point,
+    T->valid[k] = tt__app_tile_owned_valid(win, &t);
+    st = tt_tile_curve(ctx, win, &t, &T->ro, cap, tt__app_curve_point,
                        &T->curves[k]);
     if (st == TT_OK && (T->curves[k].failed ||
                         !tt__app_curve_end(&T->curves[k]))) {
@@ -583,28 +559,6 @@ static tt_status budget_run(tiled *T, tt_refine_options *ro,
 }
 
 tt_app_tiles_hook tt__app_tiles_hook;
-
-int tt__app_ground_points(GDALRasterBandH band)
-{
-  GDALDatasetH ds = GDALGetBandDataset(band);
-  OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
-  return srs && (OSRIsGeographic(srs) || tt__georef_is_web_mercator(srs));
-}
-
-size_t tt__app_tile_bytes(size_t N, size_t width, size_t height,
-                          int threads, int ground)
-{
-  /* per tile in flight: the window and the tile's copy as doubles at
-   * worst (16 bytes a sample), the scans' bounds, and refinement's state
-   * and the piece for a vertex every 4 samples at most (~60 bytes a
-   * vertex): about 32 bytes a sample; with ground points (a geographic
-   * or Web Mercator DEM) 16 bytes a sample more in the window and in the
-   * tile's copy: 64; up to 2 x threads tiles */
-  size_t w = (N < width ? N : width) + 3, h = (N < height ? N : height) + 3;
-  size_t tiles = ((width - 2) / N + 1) * ((height - 2) / N + 1);
-  size_t inflight = 2 * (size_t)(threads > 0 ? threads : 1);
-  return (inflight < tiles ? inflight : tiles) * (ground ? 64 : 32) * w * h;
-}
 
 tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
                                  const char *path, size_t tile_size,
