@@ -296,7 +296,7 @@ static void one_case(const char *name, int page, int reserve, int ntables,
   make_db(pb, page, reserve, ntables);
   uint32_t roots[4];
   for (int t = 0; t < ntables; t++) {
-    char tn[8];
+    char tn[16];
     snprintf(tn, sizeof tn, "t%d", t);
     roots[t] = root_of(pa, tn);
   }
@@ -319,7 +319,7 @@ static void one_case(const char *name, int page, int reserve, int ntables,
   const int format = tt__sqlite_file_format(f);
   tt__sqlite_table *tab[4];
   for (int t = 0; t < ntables; t++) {
-    char tn[8];
+    char tn[16];
     snprintf(tn, sizeof tn, "t%d", t);
     CHECK_OK(ctx, tt__sqlite_table_begin(f, tn, roots[t], &tab[t]));
   }
@@ -357,7 +357,7 @@ static void one_case(const char *name, int page, int reserve, int ntables,
   text_is(db, "PRAGMA integrity_check", "ok");
   sqlite3_close(db);
   for (int t = 0; t < ntables; t++) {
-    char tn[8];
+    char tn[16];
     snprintf(tn, sizeof tn, "t%d", t);
     same_rows(pa, pb, tn);
     if (nrows)
