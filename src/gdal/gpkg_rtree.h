@@ -13,22 +13,55 @@
 
 typedef struct tt__sqlite_file tt__sqlite_file;
 
-/* A feature's id (its fid) and the 2-D box of its geometry, in doubles:
- * the loader rounds them outward to floats as SQLite's R*Tree does. */
+/* A feature's id (its fid) and the 2-D box of its geometry (minx, maxx,
+ * miny, maxy) in floats, rounded outward as SQLite's R*Tree module rounds
+ * the doubles it is given (tt__rtree_box_set): a cell of the index as it
+ * is packed, 24 bytes a feature. */
 typedef struct tt__rtree_box {
   int64_t id;
-  double minx, maxx, miny, maxy;
+  float box[4];
 } tt__rtree_box;
+
+/* The module's rounding of a double to the float it stores: a min never
+ * above the value, a max never below it (SQLite's rtreeValueDown/Up rule:
+ * when the nearest float lies on the wrong side, scale by 1 -/+ 2^-23). */
+static inline float tt__rtree_down(double d)
+{
+  float f = (float)d;
+  if ((double)f > d)
+    f = (float)(d * (d < 0 ? 1.0 + 1.0 / 8388608.0 : 1.0 - 1.0 / 8388608.0));
+  return f;
+}
+
+static inline float tt__rtree_up(double d)
+{
+  float f = (float)d;
+  if ((double)f < d)
+    f = (float)(d * (d < 0 ? 1.0 - 1.0 / 8388608.0 : 1.0 + 1.0 / 8388608.0));
+  return f;
+}
+
+static inline void tt__rtree_box_set(tt__rtree_box *b, int64_t id,
+                                     double minx, double maxx, double miny,
+                                     double maxy)
+{
+  b->id = id;
+  b->box[0] = tt__rtree_down(minx);
+  b->box[1] = tt__rtree_up(maxx);
+  b->box[2] = tt__rtree_down(miny);
+  b->box[3] = tt__rtree_up(maxy);
+}
 
 /* A tree packed beforehand (Sort-Tile-Recursive, see io_gpkg_rtree.c),
  * without a database: the row writer packs on its second thread while
  * SQLite inserts rows. */
 typedef struct tt__rtree_packed tt__rtree_packed;
 
-/* Packs the n boxes into nodes of node_cap cells; what names the index in
- * messages. */
+/* Packs the n boxes into nodes of node_cap cells, taking the array over:
+ * on success it belongs to *out (reordered, freed with it), on failure it
+ * stays the caller's. what names the index in messages. */
 TT_HIDDEN tt_status tt__rtree_pack(tt_context *ctx, const char *what,
-                                   const tt__rtree_box *boxes, size_t n,
+                                   tt__rtree_box *boxes, size_t n,
                                    size_t node_cap,
                                    tt__rtree_packed **out);
 TT_HIDDEN void tt__rtree_packed_free(tt__rtree_packed *pk);

@@ -59,12 +59,15 @@
  * SQLite's default, on disk.
  *
  * Workload: O(triangles + vertices) rows of fixed size (a 165-byte and a
- * 37-byte blob). As pages, about 1,400 instructions a triangle row on the
- * writing thread (Crater Lake: 219 M for 108 k triangles, 54 k vertices
- * and both R-trees) and the row making on the other; through SQLite about
- * 5,000 a triangle row in SQLite itself, the floor of that path. Memory 40
- * bytes a feature for the boxes, 2 MB of rows in flight, a few pages per
- * table or SQLite's page cache, and, with T_SRS, 16 bytes a vertex.
+ * 37-byte blob). As pages, on Crater Lake (108 k triangles, 54 k vertices)
+ * 242 M instructions on the writing thread (records, pages, one R-tree's
+ * packing and both trees' pages) and 246 M on the row maker (the rows'
+ * values and blobs, the other packing); through SQLite about 5,000 a
+ * triangle row in SQLite itself, the floor of that path. Memory: the
+ * boxes, 24 bytes a feature, which become the packed trees' leaves, and
+ * 24 more a feature of the tree being packed; 2 MB of rows in flight; a
+ * few pages per table (or SQLite's page cache); with T_SRS, 16 bytes a
+ * vertex.
  */
 #include "gdal/gpkg_rtree.h"
 #include "gdal/sqlite_pages.h"
@@ -162,12 +165,13 @@ static unsigned char *put_header(unsigned char *p, unsigned flags,
   return put_u32(p, (uint32_t)srs_id);
 }
 
-static void extend(layer_table *t, double x, double y)
+/* ext (minx, miny, maxx, maxy) grown to (x, y). */
+static void extend(double *ext, double x, double y)
 {
-  if (x < t->ext[0]) t->ext[0] = x;
-  if (y < t->ext[1]) t->ext[1] = y;
-  if (x > t->ext[2]) t->ext[2] = x;
-  if (y > t->ext[3]) t->ext[3] = y;
+  if (x < ext[0]) ext[0] = x;
+  if (y < ext[1]) ext[1] = y;
+  if (x > ext[2]) ext[2] = x;
+  if (y > ext[3]) ext[3] = y;
 }
 
 static tt_status report(rows_state *w)
@@ -381,10 +385,13 @@ static void set_real(row_value *v, double d)
   v->d = d;
 }
 
+enum { CH_EMPTY, CH_MAKING, CH_FULL };
+
 typedef struct chunk {
   int layer;         /* 0: triangles, 1: vertices */
   size_t first, n;   /* rows [first, first + n) of the layer */
-  int full;          /* made, not yet inserted */
+  int state;         /* CH_*: CH_FULL made, not yet written */
+  double ext[4];     /* the extent of its rows */
   row_value v[CHUNK_ROWS][MAX_COLS];
   unsigned char blob[CHUNK_ROWS][TRI_BLOB_BYTES];
   int blob_len[CHUNK_ROWS];
@@ -397,12 +404,14 @@ typedef struct rows_pipe {
   int ncols[2];
   int decimated;
   chunk *ring;       /* NCHUNKS */
-  /* the maker's side */
+  /* the rows not yet given to a chunk: from row m_first of layer m_layer;
+   * chunk number claim is the next to be given them (shared) */
   int m_layer;
   size_t m_first;
-  size_t m_slot;
+  size_t claim;
+  size_t made[2];    /* rows made, of each layer (shared) */
   tt_context *m_ctx; /* the maker thread's own messages */
-  /* the SQLite side */
+  /* the writing side */
   int layer_now;     /* the layer being inserted */
   size_t c_slot;     /* the chunk being read, when c_held */
   int c_held;
@@ -426,7 +435,8 @@ typedef struct rows_pipe {
 
 static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
                                size_t i, row_value *vals,
-                               unsigned char *blob, int *blob_len)
+                               unsigned char *blob, int *blob_len,
+                               double *ext)
 {
   layer_table *t = p->layer[0];
   tt_triangle_info tr;
@@ -457,11 +467,11 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
     q = put_f64(q, pz[k % 3]);
   }
   *blob_len = (int)(q - blob);
-  extend(t, lo[0], lo[1]);
-  extend(t, hi[0], hi[1]);
+  extend(ext, lo[0], lo[1]);
+  extend(ext, hi[0], hi[1]);
   if (t->boxes)
-    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, lo[0], hi[0], lo[1],
-                                  hi[1]};
+    tt__rtree_box_set(&t->boxes[i], (int64_t)i + 1, lo[0], hi[0], lo[1],
+                      hi[1]);
   row_value *f = vals + 1;
   set_int(&f[TT__TF_V0], tr.v[0]);
   set_int(&f[TT__TF_V1], tr.v[1]);
@@ -480,7 +490,7 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
 
 static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
                              row_value *vals, unsigned char *blob,
-                             int *blob_len)
+                             int *blob_len, double *ext)
 {
   layer_table *t = p->layer[1];
   tt_vertex_info v;
@@ -495,9 +505,9 @@ static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
   q = put_f64(q, y);
   q = put_f64(q, v.z);
   *blob_len = (int)(q - blob);
-  extend(t, x, y);
+  extend(ext, x, y);
   if (t->boxes)
-    t->boxes[i] = (tt__rtree_box){(int64_t)i + 1, x, x, y, y};
+    tt__rtree_box_set(&t->boxes[i], (int64_t)i + 1, x, x, y, y);
   row_value *f = vals + 1;
   set_int(&f[TT__VF_ID], (sqlite3_int64)i);
   set_int(&f[TT__VF_COL], v.col);
@@ -515,12 +525,10 @@ static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
   return TT_OK;
 }
 
-/* Makes the next chunk (the maker's position) into ch; 0 when every row is
- * made. Errors go to ctx. */
-static int make_chunk(rows_pipe *p, chunk *ch, tt_context *ctx,
-                      tt_status *out_s)
+/* The rows of chunk number p->claim given to ch (p->claim then the next
+ * one); 0 when every row has been given. Called with the lock held. */
+static int claim_rows(rows_pipe *p, chunk *ch)
 {
-  *out_s = TT_OK;
   while (p->m_layer < 2 && p->m_first >= p->count[p->m_layer]) {
     p->m_layer++;
     p->m_first = 0;
@@ -531,44 +539,85 @@ static int make_chunk(rows_pipe *p, chunk *ch, tt_context *ctx,
   ch->layer = p->m_layer;
   ch->first = p->m_first;
   ch->n = left < CHUNK_ROWS ? left : CHUNK_ROWS;
-  for (size_t r = 0; r < ch->n && *out_s == TT_OK; r++)
-    *out_s = (ch->layer == 0 ? fill_triangle : fill_vertex)(
-        p, ctx, ch->first + r, ch->v[r], ch->blob[r], &ch->blob_len[r]);
+  ch->state = CH_MAKING;
   p->m_first += ch->n;
+  p->claim++;
   return 1;
 }
 
+/* Makes the rows given to ch (either thread, without the lock: the rows,
+ * boxes and extent are the chunk's own). Errors go to ctx. */
+static tt_status fill_chunk(rows_pipe *p, chunk *ch, tt_context *ctx)
+{
+  tt_status s = TT_OK;
+  ch->ext[0] = ch->ext[1] = INFINITY;
+  ch->ext[2] = ch->ext[3] = -INFINITY;
+  for (size_t r = 0; r < ch->n && s == TT_OK; r++)
+    s = (ch->layer == 0 ? fill_triangle : fill_vertex)(
+        p, ctx, ch->first + r, ch->v[r], ch->blob[r], &ch->blob_len[r],
+        ch->ext);
+  return s;
+}
+
+static void pipe_lock(rows_pipe *p)
+{
+  if (p->threaded)
+    pthread_mutex_lock(&p->lock);
+}
+
+static void pipe_unlock(rows_pipe *p)
+{
+  if (p->threaded)
+    pthread_mutex_unlock(&p->lock);
+}
+
+/* ch made (lock held): its rows count, the other side may go on. */
+static void chunk_made(rows_pipe *p, chunk *ch)
+{
+  ch->state = CH_FULL;
+  p->made[ch->layer] += ch->n;
+  if (p->threaded)
+    pthread_cond_broadcast(&p->cond);
+}
+
+/* The maker: takes the next chunk of rows when its slot of the ring is
+ * free and makes it, until every row is given (the writing side makes the
+ * chunks it finds not yet taken: neither waits for the other but for a
+ * chunk being made); then packs the R-trees. */
 static void *maker_main(void *arg)
 {
   rows_pipe *p = arg;
   for (;;) {
-    chunk *ch = &p->ring[p->m_slot % NCHUNKS];
     pthread_mutex_lock(&p->lock);
-    while (ch->full && !p->stop)
+    chunk *ch = &p->ring[p->claim % NCHUNKS];
+    while (!p->stop && ch->state != CH_EMPTY) {
       pthread_cond_wait(&p->cond, &p->lock);
-    int stop = p->stop;
+      ch = &p->ring[p->claim % NCHUNKS];
+    }
+    int more = !p->stop && claim_rows(p, ch);
     pthread_mutex_unlock(&p->lock);
-    if (stop)
+    if (!more)
       break;
-    tt_status s;
-    int more = make_chunk(p, ch, p->m_ctx, &s);
+    tt_status s = fill_chunk(p, ch, p->m_ctx);
     pthread_mutex_lock(&p->lock);
     if (s != TT_OK)
       p->failed = 1;
-    else if (more) {
-      ch->full = 1;
-      p->m_slot++;
-    }
+    else
+      chunk_made(p, ch);
     pthread_cond_broadcast(&p->cond);
     pthread_mutex_unlock(&p->lock);
-    if (s != TT_OK || !more)
+    if (s != TT_OK)
       break;
   }
-  /* Every row made: the R-trees' packing (sorts) goes on here while SQLite
-   * inserts the last rows. The boxes are not needed after it. */
-  for (int k = 0; k < 2 && p->node_cap && !p->failed; k++) {
+  /* Every row given: the R-trees' packing (sorts) goes on here while the
+   * writing side writes the last rows, each tree once all its rows are
+   * made (the writing side may make the last ones). The boxes become the
+   * packed trees' leaves. */
+  for (int k = 0; k < 2 && p->node_cap; k++) {
     pthread_mutex_lock(&p->lock);
-    int stop = p->stop, claimed = p->claimed[k];
+    while (!p->stop && !p->failed && p->made[k] < p->count[k])
+      pthread_cond_wait(&p->cond, &p->lock);
+    int stop = p->stop || p->failed, claimed = p->claimed[k];
     p->claimed[k] = 1;
     pthread_mutex_unlock(&p->lock);
     layer_table *t = p->layer[k];
@@ -580,56 +629,66 @@ static void *maker_main(void *arg)
       continue; /* a layer left out by LAYERS */
     if (tt__rtree_pack(p->m_ctx, t->name, t->boxes, p->count[k],
                        p->node_cap, &p->packed[k]) != TT_OK)
-      break; /* the SQLite thread packs from the boxes */
-    free(t->boxes);
-    t->boxes = NULL;
+      break; /* the writing side packs from the boxes */
+    t->boxes = NULL; /* the packed tree's */
   }
   return NULL;
 }
 
-/* The SQLite side: points p at row i of layer p->layer_now, taking the
- * next chunk when row i is past the one held. */
+/* The writing side: points p at row i of layer p->layer_now, taking the
+ * next chunk when row i is past the one held: made by the maker, or made
+ * here when the maker has not taken it yet. */
 static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
 {
   chunk *ch = p->c_held ? &p->ring[p->c_slot % NCHUNKS] : NULL;
   if (!ch || ch->layer != p->layer_now || i < ch->first ||
       i >= ch->first + ch->n) {
+    pipe_lock(p);
     if (ch) { /* done with it */
-      if (p->threaded)
-        pthread_mutex_lock(&p->lock);
-      ch->full = 0;
+      ch->state = CH_EMPTY;
       p->c_slot++;
       p->c_held = 0;
-      if (p->threaded) {
+      if (p->threaded)
         pthread_cond_broadcast(&p->cond);
-        pthread_mutex_unlock(&p->lock);
-      }
     }
     ch = &p->ring[p->c_slot % NCHUNKS];
-    if (p->threaded) {
-      pthread_mutex_lock(&p->lock);
-      while (!ch->full && !p->failed)
-        pthread_cond_wait(&p->cond, &p->lock);
-      int failed = !ch->full && p->failed;
-      pthread_mutex_unlock(&p->lock);
-      if (failed)
-        return tt__error(w->ctx, TT_ERR_INTERNAL, "%s",
-                         tt_context_errmsg(p->m_ctx));
-    } else {
-      tt_status s;
-      if (!make_chunk(p, ch, w->ctx, &s))
-        return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: row %zu of layer %s "
-                         "asked for past its end", w->path, i,
-                         p->layer[p->layer_now]->name);
-      if (s != TT_OK)
-        return s;
-      ch->full = 1;
+    tt_status s = TT_OK;
+    while (ch->state != CH_FULL) {
+      if (ch->state == CH_EMPTY && p->claim == p->c_slot) {
+        /* not taken: made here */
+        if (!claim_rows(p, ch)) {
+          s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s: row %zu of layer %s "
+                        "asked for past its end", w->path, i,
+                        p->layer[p->layer_now]->name);
+          break;
+        }
+        pipe_unlock(p);
+        s = fill_chunk(p, ch, w->ctx);
+        pipe_lock(p);
+        if (s != TT_OK)
+          break;
+        chunk_made(p, ch);
+        break;
+      }
+      if (p->failed || !p->threaded) {
+        s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s", p->failed
+                      ? tt_context_errmsg(p->m_ctx) : "rows out of order");
+        break;
+      }
+      pthread_cond_wait(&p->cond, &p->lock); /* the maker's, being made */
     }
+    pipe_unlock(p);
+    if (s != TT_OK)
+      return s;
     p->c_held = 1;
     if (ch->layer != p->layer_now || i != ch->first)
       return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: rows of layer %s out "
                        "of order (%zu)", w->path,
                        p->layer[p->layer_now]->name, i);
+    /* the chunks' extents, merged in order on this side */
+    double *ext = p->layer[ch->layer]->ext;
+    extend(ext, ch->ext[0], ch->ext[1]);
+    extend(ext, ch->ext[2], ch->ext[3]);
   }
   size_t r = i - ch->first;
   p->vals = ch->v[r];
@@ -658,10 +717,8 @@ static unsigned pipe_pack_too(rows_pipe *p, size_t node_cap)
       continue;
     /* a failure (out of memory) leaves the boxes for the page writer */
     if (tt__rtree_pack(NULL, t->name, t->boxes, p->count[k], node_cap,
-                       &p->packed[k]) == TT_OK) {
-      free(t->boxes);
-      t->boxes = NULL;
-    }
+                       &p->packed[k]) == TT_OK)
+      t->boxes = NULL; /* the packed tree's */
     mine |= 1u << k;
   }
   return mine;

@@ -59,10 +59,7 @@
 #define LINK_BATCH 128   /* %_rowid rows per INSERT statement */
 
 /* One cell: a feature (leaves) or a child node (inner levels). */
-typedef struct rt_item {
-  int64_t id;
-  float box[4]; /* minx, maxx, miny, maxy */
-} rt_item;
+typedef tt__rtree_box rt_item;
 
 typedef struct rt_link {
   int64_t rowid, nodeno;
@@ -134,24 +131,8 @@ static tt_status report(rt_build *b, double complete)
   return TT_OK;
 }
 
-/* The module's rounding of a double to the float it stores: a min never
- * above the value, a max never below it (SQLite's rtreeValueDown/Up rule:
- * when the nearest float lies on the wrong side, scale by 1 -/+ 2^-23). */
-static float round_down(double d)
-{
-  float f = (float)d;
-  if ((double)f > d)
-    f = (float)(d * (d < 0 ? 1.0 + 1.0 / 8388608.0 : 1.0 - 1.0 / 8388608.0));
-  return f;
-}
-
-static float round_up(double d)
-{
-  float f = (float)d;
-  if ((double)f < d)
-    f = (float)(d * (d < 0 ? 1.0 - 1.0 / 8388608.0 : 1.0 + 1.0 / 8388608.0));
-  return f;
-}
+#define round_down tt__rtree_down
+#define round_up tt__rtree_up
 
 /* --- GeoPackage geometry blobs -------------------------------------------- */
 
@@ -689,7 +670,8 @@ void tt__rtree_packed_free(tt__rtree_packed *pk)
   free(pk);
 }
 
-/* Packs items (n, taken over) into nodes of node_cap cells. */
+/* Packs items (n) into nodes of node_cap cells: on success items belong
+ * to *out, on failure they stay the caller's. */
 static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
                             size_t n, size_t node_cap,
                             tt__rtree_packed **out)
@@ -700,7 +682,6 @@ static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
   if (!pk || (n > node_cap && !tmp)) {
     free(pk);
     free(tmp);
-    free(items);
     return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
                      "index", what);
   }
@@ -751,6 +732,7 @@ static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
   }
   free(tmp);
   if (s != TT_OK) {
+    pk->items = NULL; /* the caller's again */
     tt__rtree_packed_free(pk);
     return s;
   }
@@ -759,25 +741,14 @@ static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
 }
 
 tt_status tt__rtree_pack(tt_context *ctx, const char *what,
-                         const tt__rtree_box *boxes, size_t n,
-                         size_t node_cap, tt__rtree_packed **out)
+                         tt__rtree_box *boxes, size_t n, size_t node_cap,
+                         tt__rtree_packed **out)
 {
   *out = NULL;
   if (node_cap < 2)
     return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells",
                      what, node_cap);
-  rt_item *items = malloc((n ? n : 1) * sizeof *items);
-  if (!items)
-    return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for %zu index "
-                     "entries", what, n);
-  for (size_t i = 0; i < n; i++) {
-    items[i].id = boxes[i].id;
-    items[i].box[0] = round_down(boxes[i].minx);
-    items[i].box[1] = round_up(boxes[i].maxx);
-    items[i].box[2] = round_down(boxes[i].miny);
-    items[i].box[3] = round_up(boxes[i].maxy);
-  }
-  return pack_items(ctx, what, items, n, node_cap, out);
+  return pack_items(ctx, what, boxes, n, node_cap, out);
 }
 
 size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
@@ -1148,7 +1119,8 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
   }
   if (s == TT_OK && !packed) {
     s = pack_items(b->ctx, b->path, b->items, b->nitems, b->node_cap, &own);
-    b->items = NULL; /* taken over */
+    if (s == TT_OK)
+      b->items = NULL; /* taken over */
     packed = own;
   }
   if (s == TT_OK)
@@ -1211,13 +1183,9 @@ tt_status tt__gpkg_rtree_from_boxes(tt_context *ctx, sqlite3 *db,
   }
   memcpy(b.table, table, strlen(table) + 1);
   b.cap_items = n ? n : 1;
-  for (size_t i = 0; !packed && i < n; i++) {
-    rt_item *it = &b.items[b.nitems++];
-    it->id = boxes[i].id;
-    it->box[0] = round_down(boxes[i].minx);
-    it->box[1] = round_up(boxes[i].maxx);
-    it->box[2] = round_down(boxes[i].miny);
-    it->box[3] = round_up(boxes[i].maxy);
+  if (!packed) {
+    memcpy(b.items, boxes, n * sizeof *b.items);
+    b.nitems = n;
   }
   s = build_in_transaction(&b, table, geom_column, 0, packed, check);
 done:
@@ -1464,18 +1432,12 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
     if (!items)
       return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the "
                        "spatial index", what);
-    if (packed)
-      memcpy(items, packed->items, m * sizeof *items);
-    for (size_t i = 0; !packed && i < m; i++) {
-      items[i].id = boxes[i].id;
-      items[i].box[0] = round_down(boxes[i].minx);
-      items[i].box[1] = round_up(boxes[i].maxx);
-      items[i].box[2] = round_down(boxes[i].miny);
-      items[i].box[3] = round_up(boxes[i].maxy);
-    }
+    memcpy(items, packed ? packed->items : boxes, m * sizeof *items);
     s = pack_items(ctx, what, items, m, sh->node_cap, &own);
-    if (s != TT_OK)
+    if (s != TT_OK) {
+      free(items);
       return s;
+    }
     packed = own;
   }
   const tt__rtree_packed *pk = packed;

@@ -213,8 +213,8 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     extend(g->ext[0], lo[0], lo[1]);
     extend(g->ext[0], hi[0], hi[1]);
     if (g->rtree)
-      g->boxes[0][g->count[0]] = (tt__rtree_box){(int64_t)fid, lo[0], hi[0],
-                                                 lo[1], hi[1]};
+      tt__rtree_box_set(&g->boxes[0][g->count[0]], (int64_t)fid, lo[0],
+                        hi[0], lo[1], hi[1]);
     set_int(&f[TT__TF_V0], b->map[tr.v[0]]);
     set_int(&f[TT__TF_V1], b->map[tr.v[1]]);
     set_int(&f[TT__TF_V2], b->map[tr.v[2]]);
@@ -266,8 +266,8 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     q = put_f64(q, v.z);
     extend(g->ext[1], x, y);
     if (g->rtree)
-      g->boxes[1][g->count[1]] = (tt__rtree_box){(int64_t)id + 1, x, x, y,
-                                                 y};
+      tt__rtree_box_set(&g->boxes[1][g->count[1]], (int64_t)id + 1, x, x,
+                        y, y);
     set_int(&f[TT__VF_ID], (int64_t)id);
     set_int(&f[TT__VF_COL], v.col);
     set_int(&f[TT__VF_ROW], v.row);

@@ -52,11 +52,14 @@
  * on success). Durability is the caller's: no fsync here (the row writer's
  * last SQLite transaction syncs the file).
  *
- * Workload: one pass over the rows; per row a cell copy and a pointer, per
- * page a copy into a write buffer of 256 pages written with pwrite.
- * Memory: that buffer, a leaf and two pages of children for each interior
- * level of each open table, and one page per finished root until the
- * commit.
+ * Workload: one pass over the rows; per row a cell copy and a pointer;
+ * the pages done are handed over (not copied) to a queue of up to 256,
+ * written with one pwritev, and their writeback started at once
+ * (sync_file_range, Linux: a hint, so that the caller's final sync has
+ * little left to wait for). Memory: the queue (1 MiB with pages of 4 KiB)
+ * and its spare buffers, a leaf and two pages of children for each
+ * interior level of each open table, and one page per finished root until
+ * the commit.
  */
 #define _GNU_SOURCE 1 /* pwritev, sync_file_range */
 #include "gdal/sqlite_pages.h"
