@@ -1,7 +1,8 @@
 /*
  * decimate.h -- what the files of vertex decimation share (SPEC section
  * 3.6): the run's state, the evaluation of one vertex's removal
- * (importance.c), the starting TIN (start.c). decimate.c holds the loop.
+ * (importance.c), the starting TIN (start.c), the names and options
+ * (options.c). decimate.c holds the loop.
  *
  * Vertices keep their mesh index for the whole run (removal frees
  * triangle slots, never vertex records), so per-vertex arrays are indexed
@@ -44,6 +45,13 @@ typedef struct tt__dec {
   size_t nvert;               /* vertices alive */
   const tt__tile_borders *borders; /* tile runs (tile.h), else NULL */
 } tt__dec;
+
+/* TT_OK when every field of o is in range and the set is coherent (a
+ * stop condition, onepass with independent sets only, hole dp with a
+ * decomposable criterion, the optimiser's own options), else TT_ERR_ARG
+ * with the reason (options.c). */
+TT_HIDDEN tt_status tt__decimate_check_options(tt_context *ctx,
+                                               const tt_decimate_options *o);
 
 /* What tt__dec_evaluate computes. */
 typedef enum tt__dec_eval {
