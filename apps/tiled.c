@@ -14,10 +14,11 @@
  * same for any thread count, and a worker does not start a tile more than
  * 2 x threads ahead of the merge, so at most that many windows and pieces
  * are held: memory is bounded by the tile size and the threads, not by
- * the DEM. With r->sink (a GeoPackage file, tiled_stream.c) the pieces go
- * through a tt__tin_stream and their rows are written as each merges;
- * otherwise a tt_tin_merger holds the merged TIN (its records grow with
- * its vertices, as in any run) for the caller to write.
+ * the DEM. With r->sink (a GeoPackage file, tiled_stream.c: every method,
+ * bound, budget and frame) the pieces go through a tt__tin_stream and
+ * their rows are written as each merges; otherwise a tt_tin_merger holds
+ * the merged TIN (its records grow with its vertices, as in any run) for
+ * the caller to write.
  * The first failure in tile order, or an interruption, stops the workers
  * at their next check (refinement polls the stop flag every 256
  * insertions).
@@ -25,14 +26,17 @@
  * A geographic or Web Mercator DEM is measured on the ground as untiled:
  * every window comes with the whole raster's ground points of its samples
  * (tt_gdal_read_grid), the pieces with their vertices' (src/tile/), and
- * the merger takes the geodesic area function from tile 0's window.
+ * the merger or the stream takes the geodesic area function from tile 0's
+ * window.
  *
  * With -method decimate each tile is decimated instead (tt_tile_decimate),
  * with the same borders. A budget of the whole DEM (-max_points,
  * -max_triangles, -percent) is turned into one bound (budget_run): a
  * pass records every tile's error-against-count curve (tt_tile_curve,
  * tiled_budget.c), then the tiles are run at the bound the curves give,
- * again while the TIN passes the budget (docs/scale.md). Without
+ * again while the TIN passes the budget (tt__app_budget_passes decides,
+ * docs/scale.md); streamed, a pass writes as if kept, and has its rows
+ * dropped if it is not (at once when its counts pass the budget). Without
  * -max_error the bound is 0.5 % of the height range, as untiled (one more
  * pass over the tiles finds the range first).
  *
