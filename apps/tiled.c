@@ -473,8 +473,7 @@ static tt_status merge_all(tiled *T, const double gt[6], tt_tin **out_tin)
 }
 
 /* Every tile run and streamed (r->sink): the rows written as each piece
- * merges (T->write, unless a budget pass drops them), the whole TIN's
- * summary and height range left in the sink. */
+ * merges (unless a budget pass drops them), the summary in the sink. */
 static tt_status stream_all(tiled *T, const double gt[6])
 {
   app_run *r = T->r;
@@ -501,7 +500,8 @@ static tt_status stream_all(tiled *T, const double gt[6])
 }
 
 /* One pass of a budget (tt__app_budget_passes): every tile run at bound
- * e, merged into *T->out_tin or streamed, its counts; keep 0 drops it. */
+ * e, merged into *T->out_tin or streamed, its counts; budget_drop drops
+ * it when it is not kept. */
 static tt_status budget_pass(void *arg, double e, size_t max_v, size_t max_t,
                              size_t *out_nv, size_t *out_nt)
 {
