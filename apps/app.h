@@ -266,6 +266,7 @@ typedef struct app_simplify_report {
   size_t tiles, tile_size, tile_bytes;
   int tile_threads, auto_tiled;
   int budget_passes;  /* tiled runs to a budget: the runs at a bound */
+  int streamed;       /* the GeoPackage written as the tiles merged */
 } app_simplify_report;
 
 /* simplify.c: the run_parameters fields of a run from its report so far
@@ -380,15 +381,37 @@ void tt__app_curve_free(app_curve *c);
 bool tt__app_curves_bound(const app_curve *c, size_t n, size_t target,
                           double above, double below, double *out_bound,
                           size_t *out_estimate);
+/* tiled_budget.c: the passes of a budget after the curve pass. run: every
+ * tile at bound e, merged or streamed (a streamed pass may drop its rows
+ * once its counts pass max_v vertices or max_t triangles), the TIN's
+ * counts; drop: the last pass is not kept. */
+typedef struct app_budget_pass {
+  tt_status (*run)(void *arg, double e, size_t max_v, size_t max_t,
+                   size_t *out_nv, size_t *out_nt);
+  void (*drop)(void *arg);
+  void *arg;
+} app_budget_pass;
+/* Runs passes at the bounds the n curves give for ro's budget (valid: the
+ * DEM's valid samples, for -percent; ro->max_error >= 0: the smallest
+ * bound) until one fits the budget and is kept (docs/scale.md), or
+ * refuses the budget (exit 2); *out_bound is the kept pass's bound,
+ * *out_passes the passes run. The failure is recorded. */
+tt_status tt__app_budget_passes(app_run *r, const char *path,
+                                const app_curve *curves, size_t n,
+                                size_t valid, const tt_refine_options *ro,
+                                const app_budget_pass *p, double *out_bound,
+                                int *out_passes);
 /* A tiled run's GeoPackage built as the tiles merge (tiled_stream.c,
  * docs/scale.md): with r->sink set, tt__app_simplify_tiled() calls open
  * before merging the first piece (tile 0's raster facts, the bound), then
  * hands every piece's rows to out as it is merged, and returns no TIN but
  * the whole TIN's summary and height range here; the caller finishes and
- * closes out. */
+ * closes out. discard drops what out wrote (a budget pass not kept) and
+ * closes it; the next open starts the file again. */
 typedef struct tt_app_tile_sink {
   tt_status (*open)(struct tt_app_tile_sink *sink,
                     const tt_raster_info *info, double max_error);
+  void (*discard)(struct tt_app_tile_sink *sink);
   struct tt__gpkg_stream *out;
   tt_tin_summary sum;
   double zmin, zmax;

@@ -270,6 +270,7 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
     tt__json_bool(&j, "automatic", p->auto_tiled);
     tt__json_size(&j, "memory_in_flight", p->tile_bytes);
     tt__json_size(&j, "budget_passes", (size_t)p->budget_passes);
+    tt__json_bool(&j, "streamed", p->streamed);
     tt__json_close(&j);
   }
   tt__json_open(&j, "seconds");

@@ -422,17 +422,18 @@ planned:;
       decimate_options(s, &ro, &dopt);
       rep.dopt = &dopt;
     }
-    /* The rows written as the tiles merge (tiled_stream.c): insertion to a
-     * bound in the projected frame only. The streamed merge (stream.c)
-     * carries neither the vertices' ground points (geographic and Web
-     * Mercator DEMs) nor decimation's importances, and a budget runs the
-     * tiles more than once: those merge the whole TIN first. */
-    if (!tt__app_tiles_hook.save && !s->decimate && !ground &&
-        !ro.max_points && !ro.max_triangles && !(ro.percent > 0) &&
+    /* A GeoPackage file is written as the tiles merge (tiled_stream.c):
+     * every method, bound or budget, and frame. The triangles of a
+     * geographic or Web Mercator DEM are measured on their pieces' ground
+     * points, a decimated TIN's vertices carry their importances, and a
+     * budget's passes not kept have their rows dropped (tiled.c). The
+     * other formats take the merged TIN, written after the last tile. */
+    if (!tt__app_tiles_hook.save &&
         tt__app_stream_wanted(drvname, database, mesh != TT_MESH_NONE)) {
       tt__app_stream_init(&so, r, outp, drv, dsco, &wopts, &srs, &rep, &ro);
       r->sink = &so.sink;
       streamed = 1;
+      rep.streamed = 1;
     }
     st = tt__app_simplify_tiled(r, band, s->input, tile, &ro,
                                 s->decimate ? &dopt : NULL,

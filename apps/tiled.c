@@ -14,10 +14,11 @@
  * same for any thread count, and a worker does not start a tile more than
  * 2 x threads ahead of the merge, so at most that many windows and pieces
  * are held: memory is bounded by the tile size and the threads, not by
- * the DEM. With r->sink (a GeoPackage file, tiled_stream.c) the pieces go
- * through a tt__tin_stream and their rows are written as each merges;
- * otherwise a tt_tin_merger holds the merged TIN (its records grow with
- * its vertices, as in any run) for the caller to write.
+ * the DEM. With r->sink (a GeoPackage file, tiled_stream.c: every method,
+ * bound, budget and frame) the pieces go through a tt__tin_stream and
+ * their rows are written as each merges; otherwise a tt_tin_merger holds
+ * the merged TIN (its records grow with its vertices, as in any run) for
+ * the caller to write.
  * The first failure in tile order, or an interruption, stops the workers
  * at their next check (refinement polls the stop flag every 256
  * insertions).
@@ -25,14 +26,17 @@
  * A geographic or Web Mercator DEM is measured on the ground as untiled:
  * every window comes with the whole raster's ground points of its samples
  * (tt_gdal_read_grid), the pieces with their vertices' (src/tile/), and
- * the merger takes the geodesic area function from tile 0's window.
+ * the merger or the stream takes the geodesic area function from tile 0's
+ * window.
  *
  * With -method decimate each tile is decimated instead (tt_tile_decimate),
  * with the same borders. A budget of the whole DEM (-max_points,
  * -max_triangles, -percent) is turned into one bound (budget_run): a
  * pass records every tile's error-against-count curve (tt_tile_curve,
  * tiled_budget.c), then the tiles are run at the bound the curves give,
- * again while the TIN passes the budget (docs/scale.md). Without
+ * again while the TIN passes the budget (tt__app_budget_passes decides,
+ * docs/scale.md); streamed, a pass writes as if kept, and has its rows
+ * dropped if it is not (at once when its counts pass the budget). Without
  * -max_error the bound is 0.5 % of the height range, as untiled (one more
  * pass over the tiles finds the range first).
  *
@@ -94,6 +98,11 @@ typedef struct tiled {
    * by the stream and their rows written at once, instead of a merger */
   tt__tin_stream *stream;
   tt_app_tile_sink *sink;
+  bool write;               /* this pass's rows are written (stream_all) */
+  size_t max_v, max_t;      /* a budget pass: the most vertices and
+                               triangles a kept TIN may have */
+  double gt[6];             /* the DEM's geotransform */
+  tt_tin **out_tin;         /* the merged TIN (not streamed) */
 } tiled;
 
 static void tile_of(const tiled *T, size_t k, tt_tile *t)
@@ -159,9 +168,12 @@ static void run_tile(tiled *T, tt_context *ctx, size_t k,
     pthread_mutex_unlock(&T->gdal);
   }
   CSLDestroy(ro);
+  /* the area function (geographic DEMs) from tile 0's window, set
+   * before done[0]: merged after it */
   if (st == TT_OK && k == 0 && T->merger)
-    tt_tin_merger_set_ground(T->merger, win); /* before done[0]: merged
-                                                 after it */
+    tt_tin_merger_set_ground(T->merger, win);
+  if (st == TT_OK && k == 0 && T->stream)
+    tt__tin_stream_set_ground(T->stream, win);
   tt_tin *piece = NULL;
   if (st == TT_OK && hook->load && !T->minmax_only) {
     char msg[TT_APP_MESSAGE_MAX];
@@ -270,21 +282,29 @@ static void *worker(void *arg)
 }
 
 /* Tile k's piece into the stream, its rows to the GeoPackage (opened
- * before the first piece: tile 0's raster facts give its CRS). A failure
- * is the run's, with the message in T->merge_msg. */
+ * before the first piece written: tile 0's raster facts give its CRS). A
+ * budget pass whose counts pass the budget is not kept: its rows are
+ * dropped at once and the rest of the pass only counts. A failure is the
+ * run's, with the message in T->merge_msg. */
 static tt_status stream_piece(tiled *T, size_t k)
 {
   app_run *r = T->r;
   tt_app_tile_sink *sink = T->sink;
   tt_status st = TT_OK;
-  if (!sink->out)
+  if (T->write && !sink->out)
     st = sink->open(sink, T->info, T->ro.max_error);
   tt__stream_batch b;
   tt_tile t;
   tile_of(T, k, &t);
   if (st == TT_OK)
     st = tt__tin_stream_add(r->ctx, T->stream, T->pieces[k], &t, k, &b);
-  if (st == TT_OK)
+  size_t nv, nt;
+  tt__tin_stream_counts(T->stream, &nv, &nt);
+  if (st == TT_OK && T->write && (nv > T->max_v || nt > T->max_t)) {
+    sink->discard(sink);
+    T->write = false;
+  }
+  if (st == TT_OK && T->write)
     st = tt__gpkg_stream_batch(sink->out, &b);
   if (st != TT_OK) {
     snprintf(T->merge_msg, sizeof T->merge_msg, "%s",
@@ -292,11 +312,11 @@ static tt_status stream_piece(tiled *T, size_t k)
     return st;
   }
   /* -max_memory: what grows with the TIN here, beside the tiles in
-   * flight: the boxes kept for the R-trees, the pending vertices (56 bytes
-   * each), 4 bytes a vertex for the components */
-  size_t nv = b.vtx_first + (b.vtx ? tt_tin_vertex_count(b.vtx) : 0);
+   * flight: the writer's boxes kept for the R-trees and style values,
+   * the stream's pending vertices (64 bytes each), outline table,
+   * components (4 bytes a vertex) and batch */
   size_t bytes = tt__gpkg_stream_bytes(sink->out) +
-                 56 * tt__tin_stream_pending(T->stream) + 4 * nv;
+                 tt__tin_stream_bytes(T->stream);
   if (T->max_memory && bytes + T->inflight_bytes > T->max_memory) {
     snprintf(T->merge_msg, sizeof T->merge_msg, "while merging tile %zu of "
              "%zu, at %zu vertices written and %zu waiting for their last "
@@ -452,14 +472,70 @@ static tt_status merge_all(tiled *T, const double gt[6], tt_tin **out_tin)
   return st;
 }
 
+/* Every tile run and streamed (r->sink): the rows written as each piece
+ * merges (unless a budget pass drops them), the summary in the sink. */
+static tt_status stream_all(tiled *T, const double gt[6])
+{
+  app_run *r = T->r;
+  tt_status st = tt__tin_stream_create(r->ctx, T->W, T->H, T->N, gt,
+                                       &T->stream);
+  if (st != TT_OK)
+    return tt__app_fail_tt(r, st, T->path);
+  for (size_t k = 0; k < T->ntiles; k++)
+    T->done[k] = false;
+  T->write = true;
+  st = run_all(T, NULL);
+  if (st == TT_OK) {
+    tt__tin_stream_summary(T->stream, &T->sink->sum, &T->sink->zmin,
+                           &T->sink->zmax);
+    if (T->sink->sum.triangles == 0)
+      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, T->path, "no "
+                        "triangle can be made: no grid cell has three "
+                        "valid corners (the valid samples are isolated by "
+                        "nodata)");
+  }
+  tt__tin_stream_destroy(T->stream);
+  T->stream = NULL;
+  return st;
+}
+
+/* One pass of a budget (tt__app_budget_passes): every tile run at bound
+ * e, merged into *T->out_tin or streamed, its counts; budget_drop drops
+ * it when it is not kept. */
+static tt_status budget_pass(void *arg, double e, size_t max_v, size_t max_t,
+                             size_t *out_nv, size_t *out_nt)
+{
+  tiled *T = arg;
+  T->ro.max_error = e;
+  T->dec.max_error = e;
+  T->max_v = max_v;
+  T->max_t = max_t;
+  tt_status st = T->sink ? stream_all(T, T->gt)
+                         : merge_all(T, T->gt, T->out_tin);
+  if (st != TT_OK)
+    return st;
+  *out_nv = T->sink ? T->sink->sum.vertices
+                    : tt_tin_vertex_count(*T->out_tin);
+  *out_nt = T->sink ? T->sink->sum.triangles
+                    : tt_tin_triangle_count(*T->out_tin);
+  return TT_OK;
+}
+
+static void budget_drop(void *arg)
+{
+  tiled *T = arg;
+  if (T->sink && T->sink->out)
+    T->sink->discard(T->sink); /* the rows of a pass not kept */
+  tt_tin_destroy(*T->out_tin);
+  *T->out_tin = NULL;
+}
+
 /* A budget of the whole DEM (-max_points, -max_triangles, -percent;
- * tiled_budget.c): the curve pass, then the tiles at the bound whose
- * curves meet the budget, and again at a larger one while the TIN has
- * more vertices or triangles than the budget allows. ro->max_error, when
- * set, is a floor of the bound (its stop may come first, as untiled). */
-#define BUDGET_PASSES 6
+ * tiled_budget.c): the curve pass, then the passes at the bounds the
+ * curves give until one is kept. ro->max_error, when set, is a floor of
+ * the bound (its stop may come first, as untiled); it is set to the bound
+ * kept. */
 static tt_status budget_run(tiled *T, tt_refine_options *ro,
-                            const double gt[6], tt_tin **out_tin,
                             int *out_passes)
 {
   app_run *r = T->r;
@@ -489,73 +565,9 @@ static tt_status budget_run(tiled *T, tt_refine_options *ro,
   size_t valid = 0;
   for (size_t k = 0; k < T->ntiles; k++)
     valid += T->valid[k];
-  size_t max_v = ro->max_points ? ro->max_points : SIZE_MAX;
-  if (ro->percent > 0) {
-    size_t p = (size_t)floor(ro->percent / 100.0 * (double)valid);
-    max_v = p < max_v ? (p ? p : 1) : max_v;
-  }
-  size_t max_t = ro->max_triangles ? ro->max_triangles : SIZE_MAX;
-  size_t target = max_v < max_t / 2 ? max_v : max_t / 2;
-  /* The bounds run: a first from the curves; while the TIN passes the
-   * budget, a larger one aimed lower by the excess; once it fits but
-   * keeps less than 98 % of the budget, one smaller bound aimed higher by
-   * the shortfall, and if that passes the budget, the fitting bound again
-   * (the same TIN: runs are deterministic). */
-  double above = -1, below = INFINITY, e = 0, good = NAN;
-  bool calibrated = false;
-  size_t nv = 0, nt = 0;
-  for (int pass = 1;; pass++) {
-    size_t estimate;
-    double next;
-    if (!tt__app_curves_bound(T->curves, T->ntiles, target, above, below,
-                              &next, &estimate))
-      return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
-                          "out of memory for the curves");
-    if (isnan(next) && !isnan(good))
-      next = good; /* nothing between: back to the fitting bound */
-    if (isnan(next) || pass > BUDGET_PASSES)
-      return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_LIMIT, T->path,
-                          "the budget of %zu %s is below what %zu tiles make "
-                          "at the bound %g (%zu vertices, %zu triangles: "
-                          "their corners and borders); ask for more, or use "
-                          "a larger -tile_size", nv > max_v ? max_v : max_t,
-                          nv > max_v ? "vertices" : "triangles", T->ntiles,
-                          e, nv, nt);
-    e = next;
-    if (ro->max_error >= 0 && e < ro->max_error)
-      e = ro->max_error;
-    T->ro.max_error = e;
-    T->dec.max_error = e;
-    st = merge_all(T, gt, out_tin);
-    if (st != TT_OK)
-      return st;
-    nv = tt_tin_vertex_count(*out_tin);
-    nt = tt_tin_triangle_count(*out_tin);
-    *out_passes = pass;
-    bool fits = nv <= max_v && nt <= max_t;
-    double f = fmin(max_v < SIZE_MAX ? (double)max_v / (double)nv : INFINITY,
-                    max_t < SIZE_MAX ? (double)max_t / (double)nt : INFINITY);
-    if (fits && (calibrated || f <= 1 / 0.98 || e == good ||
-                 (ro->max_error >= 0 && e == ro->max_error)))
-      break;
-    tt_tin_destroy(*out_tin);
-    *out_tin = NULL;
-    size_t aim = (size_t)floor((double)target * f * (fits ? 0.995 : 1.0));
-    if (fits) {
-      /* short of the budget: once, a smaller bound */
-      calibrated = true;
-      good = e;
-      below = e;
-      above = -1;
-      target = aim > target ? aim : target + 1;
-    } else {
-      /* over: a larger bound (below the fitting one, if any) */
-      above = e;
-      target = aim < target ? aim : target - 1;
-    }
-  }
-  ro->max_error = e;
-  return TT_OK;
+  app_budget_pass pass = {budget_pass, budget_drop, T};
+  return tt__app_budget_passes(r, T->path, T->curves, T->ntiles, valid, ro,
+                               &pass, &ro->max_error, out_passes);
 }
 
 tt_app_tiles_hook tt__app_tiles_hook;
@@ -718,41 +730,29 @@ tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
     st = tt__app_tiles_hook.save(tt__app_tiles_hook.arg, r, k, T.pieces[k]);
     goto done;
   }
-  tt_tin_summary sum;
-  if (r->sink) {
-    /* streamed: the rows go out as the pieces merge (tiled_stream.c) */
-    T.sink = r->sink;
-    st = tt__tin_stream_create(r->ctx, T.W, T.H, T.N, gt, &T.stream);
-    if (st != TT_OK) {
-      tt__app_fail_tt(r, st, path);
-      goto done;
-    }
-    st = run_all(&T, NULL);
-    if (st != TT_OK)
-      goto done;
-    tt__tin_stream_summary(T.stream, &sum, &r->sink->zmin, &r->sink->zmax);
-    if (sum.triangles == 0) {
-      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, path, "no "
-                        "triangle can be made: no grid cell has three valid "
-                        "corners (the valid samples are isolated by "
-                        "nodata)");
-      goto done;
-    }
-    r->sink->sum = sum;
-  } else {
-    st = budget ? budget_run(&T, ro, gt, out_tin, out_passes)
+  /* streamed (r->sink, tiled_stream.c): the rows go out as the pieces
+   * merge, no TIN is made */
+  T.sink = r->sink;
+  T.max_v = T.max_t = SIZE_MAX;
+  memcpy(T.gt, gt, sizeof gt);
+  T.out_tin = out_tin;
+  st = budget   ? budget_run(&T, ro, out_passes)
+       : T.sink ? stream_all(&T, gt)
                 : merge_all(&T, gt, out_tin);
-    if (st != TT_OK)
-      goto done;
+  if (st != TT_OK)
+    goto done;
+  tt_tin_summary sum;
+  if (T.sink)
+    sum = T.sink->sum;
+  else
     tt_tin_get_summary(*out_tin, &sum);
-  }
   if (T.info) {
     T.info->width = T.W;
     T.info->height = T.H;
     T.info->valid_samples = sum.valid_samples;
     T.info->nodata_samples = T.W * T.H - sum.valid_samples;
   }
-  if (!(zmin <= zmax) && T.stream) {
+  if (!(zmin <= zmax) && T.sink) {
     zmin = r->sink->zmin;
     zmax = r->sink->zmax;
   } else if (!(zmin <= zmax)) {

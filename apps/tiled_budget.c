@@ -13,8 +13,12 @@
  * low is followed by a kept one with more vertices and a lower error, so
  * the count a thinned curve gives at E is never below the unthinned one's.
  * The bound is the smallest error of any curve at which the counts summed
- * over the tiles meet the target (tiled.c then runs the tiles at it and
- * corrects the target by what the real count says).
+ * over the tiles meet the target; the passes (tt__app_budget_passes) run
+ * the tiles at it (tiled.c) and correct the target by what the real count
+ * says, until a pass is kept. A pass not kept is dropped by the caller's
+ * drop(): its merged TIN freed, or, streamed, the rows it wrote removed
+ * (the caller writes each pass as if it were kept, and drops the rows of
+ * one whose counts pass the budget as soon as they do).
  */
 #include "app.h"
 
@@ -146,4 +150,78 @@ bool tt__app_curves_bound(const app_curve *c, size_t n, size_t target,
   *out_estimate = sum_at(c, n, e[lo]);
   free(e);
   return true;
+}
+
+/* At most this many passes at a bound. */
+#define BUDGET_PASSES 6
+
+tt_status tt__app_budget_passes(app_run *r, const char *path,
+                                const app_curve *curves, size_t ntiles,
+                                size_t valid, const tt_refine_options *ro,
+                                const app_budget_pass *p, double *out_bound,
+                                int *out_passes)
+{
+  size_t max_v = ro->max_points ? ro->max_points : SIZE_MAX;
+  if (ro->percent > 0) {
+    size_t pc = (size_t)floor(ro->percent / 100.0 * (double)valid);
+    max_v = pc < max_v ? (pc ? pc : 1) : max_v;
+  }
+  size_t max_t = ro->max_triangles ? ro->max_triangles : SIZE_MAX;
+  size_t target = max_v < max_t / 2 ? max_v : max_t / 2;
+  const double floor_e = ro->max_error; /* < 0: none */
+  /* A first bound from the curves; while the TIN passes the budget, a
+   * larger one aimed lower by the excess; once it fits but keeps less
+   * than 98 % of the budget, one smaller bound aimed higher by the
+   * shortfall, and if that passes the budget, the fitting bound again
+   * (the same TIN: runs are deterministic). */
+  double above = -1, below = INFINITY, e = 0, good = NAN;
+  bool calibrated = false;
+  size_t nv = 0, nt = 0;
+  for (int pass = 1;; pass++) {
+    size_t estimate;
+    double next;
+    if (!tt__app_curves_bound(curves, ntiles, target, above, below, &next,
+                              &estimate))
+      return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
+                          "out of memory for the curves");
+    if (isnan(next) && !isnan(good))
+      next = good; /* nothing between: back to the fitting bound */
+    if (isnan(next) || pass > BUDGET_PASSES)
+      return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_LIMIT, path,
+                          "the budget of %zu %s is below what %zu tiles make "
+                          "at the bound %g (%zu vertices, %zu triangles: "
+                          "their corners and borders); ask for more, or use "
+                          "a larger -tile_size", nv > max_v ? max_v : max_t,
+                          nv > max_v ? "vertices" : "triangles", ntiles, e,
+                          nv, nt);
+    e = next;
+    if (floor_e >= 0 && e < floor_e)
+      e = floor_e;
+    tt_status st = p->run(p->arg, e, max_v, max_t, &nv, &nt);
+    if (st != TT_OK)
+      return st;
+    *out_passes = pass;
+    bool fits = nv <= max_v && nt <= max_t;
+    double f = fmin(max_v < SIZE_MAX ? (double)max_v / (double)nv : INFINITY,
+                    max_t < SIZE_MAX ? (double)max_t / (double)nt : INFINITY);
+    if (fits && (calibrated || f <= 1 / 0.98 || e == good ||
+                 (floor_e >= 0 && e == floor_e)))
+      break;
+    p->drop(p->arg);
+    size_t aim = (size_t)floor((double)target * f * (fits ? 0.995 : 1.0));
+    if (fits) {
+      /* short of the budget: once, a smaller bound */
+      calibrated = true;
+      good = e;
+      below = e;
+      above = -1;
+      target = aim > target ? aim : target + 1;
+    } else {
+      /* over: a larger bound (below the fitting one, if any) */
+      above = e;
+      target = aim < target ? aim : target - 1;
+    }
+  }
+  *out_bound = e;
+  return TT_OK;
 }

@@ -10,6 +10,16 @@
  * writer keeps for the end (40 bytes a feature for the R-trees, 8 a
  * vertex for the style, 4 a vertex for the count of pieces).
  *
+ * Every tiled run into a GeoPackage file streams: insertion and
+ * decimation (the vertices layer then has the importance field), to a
+ * bound or a budget, projected, geographic or Web Mercator DEMs (the
+ * triangles measured on their pieces' ground points). A budget's pass
+ * whose TIN is not kept (tiled.c: it passes the budget, or falls short of
+ * it before the bound is calibrated) has its rows dropped (discard: the
+ * writer closed, the temporary file removed) and the next pass creates
+ * the file again when its first piece merges, so the file written is the
+ * last pass's alone, made exactly as a single pass makes it.
+ *
  * Like every output, the file is the temporary name of tt_output (removed
  * on any failure or interruption, renamed only when complete).
  *
@@ -82,6 +92,8 @@ static tt_status stream_open(tt_app_tile_sink *sink,
   memset(&empty, 0, sizeof empty);
   empty.t_max = empty.v_ins_err = &none;
   empty.summary.criterion = so->ro->criterion;
+  /* decimated (tt__records_decimated): the vertices' importance field */
+  empty.summary.start_vertices = s->decimate ? 1 : 0;
   st = tt_ogr_write_tin(r->ctx, dst, &empty, *so->srs, allf, nallf,
                         *so->wopts, NULL, NULL);
   unsigned failures = r->msg.failures;
@@ -91,8 +103,18 @@ static tt_status stream_open(tt_app_tile_sink *sink,
                    r->msg.last);
   if (st == TT_OK)
     st = tt__gpkg_stream_open(r->ctx, temp, *so->srs, *so->wopts,
-                              &sink->out);
+                              s->decimate, &sink->out);
   return st;
+}
+
+/* The rows written so far dropped: the writer closed (its page writer cuts
+ * the file back) and the file removed, for open to create it again. */
+static void stream_discard(tt_app_tile_sink *sink)
+{
+  tt_app_stream *so = (tt_app_stream *)sink;
+  tt__gpkg_stream_close(sink->out);
+  sink->out = NULL;
+  tt_output_clear(so->outp);
 }
 
 void tt__app_stream_init(tt_app_stream *so, app_run *r, tt_output *outp,
@@ -102,6 +124,7 @@ void tt__app_stream_init(tt_app_stream *so, app_run *r, tt_output *outp,
 {
   memset(so, 0, sizeof *so);
   so->sink.open = stream_open;
+  so->sink.discard = stream_discard;
   so->r = r;
   so->outp = outp;
   so->drv = drv;

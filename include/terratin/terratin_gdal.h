@@ -339,6 +339,12 @@ tt_status tt_output_protect_dataset(tt_context *ctx, tt_output *out,
  * names are put back if a move fails). TT_ERR_INTERRUPTED after
  * tt_output_abandon_all(). */
 tt_status tt_output_commit(tt_context *ctx, tt_output *out);
+/* Removes the temporary files written so far (the dataset and its
+ * sidecars), so that the dataset can be created again under the same
+ * temporary name: for a writer that drops what it wrote and starts over
+ * (a tiled run's budget pass that is not kept). Nothing after commit or
+ * tt_output_abandon_all(). Thread-safe. */
+void tt_output_clear(tt_output *out);
 void tt_output_destroy(tt_output *out);
 /* Removes the temporary files of every live tt_output of the process that
  * is not committed, and makes their commit fail: for a watchdog thread

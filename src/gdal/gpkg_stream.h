@@ -66,14 +66,16 @@ TT_HIDDEN void tt__gpkg_pages_close(tt__gpkg_pages *p);
  * tt__gpkg_stream_open() after the layers were made (as above, srs the
  * layers' input CRS, options those of tt_gpkg_write_rows(), T_SRS
  * included); tt__gpkg_stream_batch() for each batch tt__tin_stream_add()
- * gave, in order; tt__gpkg_stream_finish() after the last tile. The rows,
+ * gave, in order; tt__gpkg_stream_finish() after the last tile. decimated:
+ * the vertices layer has the importance field (the TIN is decimated,
+ * tt__records_decimated). The rows,
  * blobs, boxes, extents and counts are those tt_gpkg_write_rows() writes
  * for the merged TIN, byte for byte. The caller frees *out with
  * tt__gpkg_stream_close() (which undoes an unfinished write, as above). */
 typedef struct tt__gpkg_stream tt__gpkg_stream;
 TT_HIDDEN tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
                                          OGRSpatialReferenceH srs,
-                                         char **options,
+                                         char **options, int decimated,
                                          tt__gpkg_stream **out);
 TT_HIDDEN tt_status tt__gpkg_stream_batch(tt__gpkg_stream *g,
                                           const tt__stream_batch *b);

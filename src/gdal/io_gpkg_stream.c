@@ -19,6 +19,12 @@
  * the merged-TIN path does; that is the one store here that grows with
  * the TIN.
  *
+ * A geographic or Web Mercator DEM's triangles come with their piece's
+ * ground points and the area function (src/tile/stream.c), so
+ * tt__records_triangle() measures them as for the merged TIN; a decimated
+ * TIN's vertex rows have the importance field and no ins_rank, as
+ * io_gpkg_rows.c writes them.
+ *
  * Workload: per triangle row tt_tin_triangle()'s arithmetic and a 165-byte
  * blob, per vertex a 37-byte one; T_SRS transforms each piece's vertices
  * once per piece (tt__records_init), border vertices once per piece that
@@ -61,6 +67,7 @@ struct tt__gpkg_stream {
   size_t nins, inscap;
   char *prefix;
   unsigned layers;
+  int decimated; /* the importance field; ins_rank NULL */
 };
 
 static unsigned char *put_u32(unsigned char *p, uint32_t v)
@@ -129,7 +136,7 @@ static tt_status box_room(tt__gpkg_stream *g, int k, size_t n)
 
 tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
                                OGRSpatialReferenceH srs, char **options,
-                               tt__gpkg_stream **out)
+                               int decimated, tt__gpkg_stream **out)
 {
   *out = NULL;
   tt__gpkg_stream *g = calloc(1, sizeof *g);
@@ -156,8 +163,12 @@ tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
     g->ext[k][0] = g->ext[k][1] = INFINITY;
     g->ext[k][2] = g->ext[k][3] = -INFINITY;
   }
-  /* a tiled run's TIN is refined, never decimated: no importance field */
-  tt_status s = tt__gpkg_pages_open(ctx, path, options, TT__VF_COUNT - 1,
+  /* a decimated TIN's vertices have the importance field (the layer
+   * was made with it, tt__records_vertex_fields) */
+  g->decimated = decimated;
+  tt_status s = tt__gpkg_pages_open(ctx, path, options,
+                                    decimated ? TT__VF_COUNT
+                                              : TT__VF_COUNT - 1,
                                     &g->pages);
   if (s != TT_OK)
     return s;
@@ -286,10 +297,15 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
       }
       g->ins[g->nins++] = v.insert_error;
     }
-    set_int(&f[TT__VF_INS_RANK], (int64_t)id);
+    if (g->decimated)
+      f[TT__VF_INS_RANK].type = TT__GV_NULL; /* no insertion */
+    else
+      set_int(&f[TT__VF_INS_RANK], (int64_t)id);
     set_real(&f[TT__VF_STAR_MAX], v.star_max_error);
     set_real(&f[TT__VF_STAR_RMSE], v.star_rmse);
     set_int(&f[TT__VF_STAR_N], (int64_t)v.star_samples);
+    if (g->decimated)
+      set_real(&f[TT__VF_IMPORTANCE], v.importance);
     s = tt__gpkg_pages_row(g->pages, 1, (int64_t)id + 1, f, blob,
                            (size_t)(q - blob));
     g->count[1]++;

@@ -40,7 +40,8 @@
  * registered with tt_output_add_sidecar(): written under the temporary
  * stem, checked like the output, renamed with it.
  * The checks run at begin (fail early) and again at commit.
- * destroy() removes whatever temporary files remain, folders included.
+ * destroy() removes whatever temporary files remain, folders included;
+ * clear() removes them earlier, for a writer that starts over.
  * Live outputs are kept in a process-wide list, so tt_output_abandon_all()
  * (a signal's watchdog thread) can remove their temporary files while the
  * main thread is stuck in a driver; a mutex orders it with commit and
@@ -209,6 +210,15 @@ static void remove_temp(tt_output *out)
     free(p);
   }
   closedir(d);
+}
+
+void tt_output_clear(tt_output *out)
+{
+  if (!out)
+    return;
+  pthread_mutex_lock(&live_lock);
+  remove_temp(out);
+  pthread_mutex_unlock(&live_lock);
 }
 
 void tt_output_destroy(tt_output *out)

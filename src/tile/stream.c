@@ -21,14 +21,29 @@
  *    order, so the final ones wait behind the first that is not: a border
  *    vertex on the bottom side of a row of tiles waits for the next row,
  *    and holds back what came after it. Pending vertices are therefore
- *    those of about one row of tiles (56 bytes each).
+ *    those of about one row of tiles (64 bytes each).
  * The pieces (components) are counted by union-find over every vertex id:
  * 4 bytes a vertex until the end, the one array that grows with the TIN.
+ *
+ * A geographic or Web Mercator DEM's pieces carry their vertices' ground
+ * points, scale factors and convergences (tile.c). Only the triangles'
+ * areas, slopes, aspects and angles use them, and a triangle's batch is
+ * its own piece's arrays, so they are handed out with it and never kept:
+ * a border vertex's are the same bits in every piece that holds it (from
+ * the DEM's column and row, and the window beyond the border), so the
+ * triangles of a later piece measure it as the merged TIN's copy of the
+ * first piece's would. The area function (geodesic areas) comes from tile
+ * 0's window (tt__tin_stream_set_ground) or the first piece that has it,
+ * as tt_tin_merger takes it.
+ * A decimated piece's vertices have importances: kept with the pending
+ * vertex (8 bytes) and handed out with it, NaN from a piece without them;
+ * the decimation counts (start, removed, refused; rounds: the most of any
+ * piece) are summed as merge.c sums them.
  *
  * Memory: the pending vertices, the open outline vertices' table (about 40
  * bytes each, a row of tile borders), 4 bytes a vertex for the
  * components, and per piece, while its batch is out, 16 bytes a triangle
- * and 20 a vertex.
+ * and 20 a vertex (tt__tin_stream_bytes counts them all).
  */
 #include "tile/tile.h"
 #include "tin/tin.h"
@@ -44,7 +59,7 @@ struct tt__tin_stream {
   size_t nv, nt;         /* ids given so far */
   /* pending vertices: ids [base, base + np) at [off, off + np) */
   int32_t *pc, *pr;
-  double *pz, *pins, *psmax, *pssq;
+  double *pz, *pins, *psmax, *pssq, *pimp;
   uint64_t *pn;
   size_t *plast;         /* the last tile holding the vertex's sample */
   size_t base, off, np, pcap;
@@ -66,6 +81,12 @@ struct tt__tin_stream {
   tt_tin tri, vtx;       /* shallow views handed out */
   /* sums, in piece order */
   size_t covered, valid, forced;
+  size_t start_vertices, removed, rounds, refused; /* decimated pieces */
+  /* the vertices' ground points: every piece has them or none (ground,
+   * decided by the first piece with triangles); the area function */
+  bool ground;
+  tt_area_fn area_fn;
+  double area_par[4];
   double sum_abs, sum_sq, max_err, zmin, zmax;
   int64_t max_index;
   double seconds_mesh, seconds_stats;
@@ -106,6 +127,7 @@ void tt__tin_stream_destroy(tt__tin_stream *s)
   free(s->pins);
   free(s->psmax);
   free(s->pssq);
+  free(s->pimp);
   free(s->pn);
   free(s->plast);
   free(s->hkey);
@@ -188,6 +210,7 @@ static bool pending_room(tt__tin_stream *s, size_t n)
     memmove(s->pins, s->pins + o, k * sizeof *s->pins);
     memmove(s->psmax, s->psmax + o, k * sizeof *s->psmax);
     memmove(s->pssq, s->pssq + o, k * sizeof *s->pssq);
+    memmove(s->pimp, s->pimp + o, k * sizeof *s->pimp);
     memmove(s->pn, s->pn + o, k * sizeof *s->pn);
     memmove(s->plast, s->plast + o, k * sizeof *s->plast);
     s->off = 0;
@@ -201,6 +224,7 @@ static bool pending_room(tt__tin_stream *s, size_t n)
     GROW(s->pins, c);
     GROW(s->psmax, c);
     GROW(s->pssq, c);
+    GROW(s->pimp, c);
     GROW(s->pn, c);
     GROW(s->plast, c);
     s->pcap = c;
@@ -263,11 +287,28 @@ static void hand_out(tt__tin_stream *s, size_t n,
   v->v_star_max = s->psmax + s->off;
   v->v_star_rmse = s->pssq + s->off;
   v->v_star_n = s->pn + s->off;
+  v->v_importance = s->pimp + s->off;
+  v->area_fn = s->area_fn;
+  memcpy(v->area_par, s->area_par, sizeof v->area_par);
   memcpy(v->gt, s->gt, sizeof v->gt);
   memcpy(v->frame, s->frame, sizeof v->frame);
   out->vtx = v;
   out->vtx_first = s->base;
   s->handed = n;
+}
+
+/* The batches' area function (geodesic areas of a geographic DEM). */
+static void set_area(tt__tin_stream *s, tt_area_fn fn, const double params[4])
+{
+  s->area_fn = fn;
+  for (int k = 0; k < 4; k++)
+    s->area_par[k] = fn ? params[k] : 0;
+}
+
+void tt__tin_stream_set_ground(tt__tin_stream *s, const tt_grid *window)
+{
+  if (window->area_fn)
+    set_area(s, window->area_fn, window->area_par);
 }
 
 tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
@@ -286,11 +327,25 @@ tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
   s->seconds_mesh += piece->summary.seconds_mesh;
   s->seconds_stats += piece->summary.seconds_statistics;
   s->criterion = piece->summary.criterion;
+  s->start_vertices += piece->summary.start_vertices;
+  s->removed += piece->summary.removed_vertices;
+  s->refused += piece->summary.refused_bound;
+  if (piece->summary.rounds > s->rounds)
+    s->rounds = piece->summary.rounds;
   if (piece->nt > 0) {
     if (!s->have_frame) {
       memcpy(s->frame, piece->frame, sizeof s->frame);
       s->have_frame = true;
+      s->ground = piece->vgxy != NULL;
     }
+    if ((piece->vgxy != NULL) != s->ground)
+      return tt__error(ctx, TT_ERR_ARG, "the piece of the tile at column "
+                       "%zu, row %zu is %s ground points, the pieces before "
+                       "it %s", tile->col0, tile->row0, piece->vgxy
+                       ? "measured on" : "without", s->ground ? "on them"
+                       : "without them");
+    if (piece->area_fn && !s->area_fn)
+      set_area(s, piece->area_fn, piece->area_par);
     if (s->nv + piece->nv > INT32_MAX)
       return tt__error(ctx, TT_ERR_LIMIT, "more than %d vertices",
                        INT32_MAX);
@@ -326,6 +381,7 @@ tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
       s->pr[at] = r;
       s->pz[at] = piece->vzd ? piece->vzd[v] : (double)piece->vz[v];
       s->pins[at] = piece->v_ins_err ? piece->v_ins_err[v] : NAN;
+      s->pimp[at] = piece->v_importance ? piece->v_importance[v] : NAN;
       s->psmax[at] = 0;
       s->pssq[at] = 0;
       s->pn[at] = 0;
@@ -388,6 +444,11 @@ tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
     t->t_max = piece->t_max;
     t->t_rmse = s->b_rmse;
     t->t_n = s->b_n;
+    t->vgxy = piece->vgxy;
+    t->vgk = piece->vgk;
+    t->vgconv = piece->vgconv;
+    t->area_fn = s->area_fn;
+    memcpy(t->area_par, s->area_par, sizeof t->area_par);
     memcpy(t->gt, s->gt, sizeof t->gt);
     memcpy(t->frame, s->frame, sizeof t->frame);
     out->tri = t;
@@ -438,6 +499,24 @@ size_t tt__tin_stream_pending(const tt__tin_stream *s)
   return s->np - s->handed;
 }
 
+void tt__tin_stream_counts(const tt__tin_stream *s, size_t *out_vertices,
+                           size_t *out_triangles)
+{
+  *out_vertices = s->nv;
+  *out_triangles = s->nt;
+}
+
+size_t tt__tin_stream_bytes(const tt__tin_stream *s)
+{
+  if (!s)
+    return 0;
+  /* pending: col, row (4 each), height, insertion error, star max, sum of
+   * squares, count, last tile, importance (8 each); the table and the
+   * open list; the components; the batch's arrays */
+  return s->pcap * (4 + 4 + 7 * 8) + s->hcap * (8 + 4) + s->opencap * 4 +
+         s->ufcap * 4 + s->bvcap * (4 + 8 + 8) + s->btcap * (8 + 8);
+}
+
 void tt__tin_stream_summary(const tt__tin_stream *s, tt_tin_summary *out,
                             double *out_zmin, double *out_zmax)
 {
@@ -454,6 +533,10 @@ void tt__tin_stream_summary(const tt__tin_stream *s, tt_tin_summary *out,
   out->stop_reason = TT_STOP_MAX_ERROR;
   out->components = pieces;
   out->forced_vertices = s->forced;
+  out->start_vertices = s->start_vertices;
+  out->removed_vertices = s->removed;
+  out->rounds = s->rounds;
+  out->refused_bound = s->refused;
   out->seconds_mesh = s->seconds_mesh;
   out->seconds_statistics = s->seconds_stats;
   tt_error_stats *e = &out->errors;

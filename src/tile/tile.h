@@ -94,9 +94,11 @@ TT_HIDDEN tt_status tt__decimate_tile(tt_context *ctx, const tt_grid *grid,
  * global ids; tri_first: the global index of its first triangle; tri NULL
  * when the piece has none) and the vertices that became final (vtx: their
  * values with the star statistics of every tile touching them, in id
- * order from vtx_first; its rank is the index plus vtx_first). The batch
- * is valid until the next add; the writer makes the rows
- * tt_tin_merger_finish()'s TIN would give. */
+ * order from vtx_first; its rank is the index plus vtx_first; with their
+ * importances when decimated, NaN otherwise). A geographic or Web
+ * Mercator DEM's triangles come with their piece's ground points and the
+ * area function. The batch is valid until the next add; the writer makes
+ * the rows tt_tin_merger_finish()'s TIN would give. */
 typedef struct tt__tin_stream tt__tin_stream;
 typedef struct tt__stream_batch {
   const tt_tin *tri;
@@ -118,8 +120,20 @@ TT_HIDDEN tt_status tt__tin_stream_add(tt_context *ctx, tt__tin_stream *s,
                                        const tt_tin *piece,
                                        const tt_tile *tile, size_t k,
                                        tt__stream_batch *out);
+/* The area function of a geographic DEM's triangles, from tile 0's window
+ * (set before tile 0 is added; else the first piece that has one gives
+ * it), as tt_tin_merger_set_ground() does. */
+TT_HIDDEN void tt__tin_stream_set_ground(tt__tin_stream *s,
+                                         const tt_grid *window);
 /* Vertices merged but not yet handed out (the reorder buffer). */
 TT_HIDDEN size_t tt__tin_stream_pending(const tt__tin_stream *s);
+/* The vertices and triangles numbered so far (the TIN's counts once every
+ * tile is added; they only grow). */
+TT_HIDDEN void tt__tin_stream_counts(const tt__tin_stream *s,
+                                     size_t *out_vertices,
+                                     size_t *out_triangles);
+/* The bytes the stream holds (its arrays' capacities); 0 for NULL. */
+TT_HIDDEN size_t tt__tin_stream_bytes(const tt__tin_stream *s);
 /* The whole TIN's summary as tt_tin_merger_finish() sets it, and the range
  * of the vertices' heights. */
 TT_HIDDEN void tt__tin_stream_summary(const tt__tin_stream *s,

@@ -11,9 +11,11 @@
 # of an untiled run's; the default bound is the untiled one; -max_memory
 # too small for the heights tiles by itself (with a budget too); bad
 # -tile_size values are refused with nothing written (decimation and
-# budgets in tiles: test_tiles_methods.sh); an interrupted
-# tiled run leaves nothing behind. Prints "N passed, M failed"; exits 1 on
-# any failure, 77 when a tool is missing.
+# budgets in tiles: test_tiles_methods.sh); an interrupted tiled run
+# leaves nothing behind; the GeoPackage written as the tiles merge is the
+# merged TIN's, table by table (geographic DEMs: test_tiles_geo.sh;
+# decimation and budgets: test_tiles_methods.sh). Prints "N passed, M
+# failed"; exits 1 on any failure, 77 when a tool is missing.
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
@@ -133,31 +135,6 @@ check "nodata: threads 1 vs 2, the same layers" [ "$(dump out/n1.gpkg)" = "$(dum
 # merge, tiled_stream.c) against the merged-TIN path
 # (TERRATIN_TILE_STREAM=NO): the same rows, byte for byte, the same
 # R-tree nodes, extents, counts, run_parameters (but times), styles ---
-SAME="$(cd "$(dirname "$0")" && pwd)/same_gpkg.py"
-same() { # same NAME A B: the files' tables hold the same content
-  if python3 "$SAME" "$2" "$3" >same.txt 2>&1; then pass; else
-    fail "$1: streamed and merged differ: $(head -c 600 same.txt)"; fi
-}
-streamed_vs_merged() { # NAME DEM OPTIONS...
-  local name=$1 dem=$2
-  shift 2
-  rm -f out/sv_s.gpkg out/sv_m.gpkg
-  "$T" simplify -q -json "$@" "$dem" out/sv_s.gpkg >s.json 2>err.txt
-  rc=$?
-  check "$name: streamed exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
-  TERRATIN_TILE_STREAM=NO "$T" simplify -q -json "$@" "$dem" out/sv_m.gpkg >m.json 2>err.txt
-  rc=$?
-  check "$name: merged exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
-  same "$name" out/sv_s.gpkg out/sv_m.gpkg
-  local la=$(ogrinfo -ro -al -q out/sv_s.gpkg ${LAYERS_OF:-triangles vertices} | md5sum)
-  local lb=$(ogrinfo -ro -al -q out/sv_m.gpkg ${LAYERS_OF:-triangles vertices} | md5sum)
-  check "$name: the same ogrinfo -al of the layers" [ "$la" = "$lb" ]
-  for k in vertices triangles components max_error rmse covered_samples \
-           lone_samples forced_vertices valid_samples z_min z_max; do
-    check "$name: JSON $k the same ($(jget s.json $k), $(jget m.json $k))" \
-      [ "$(jget s.json $k)" = "$(jget m.json $k)" ]
-  done
-}
 streamed_vs_merged "fractal, tiles of 128, 2 threads" in/ds.tif -max_error 6 -tile_size 128 -threads 2
 streamed_vs_merged "fractal, tiles of 100, 1 thread" in/ds.tif -max_error 6 -tile_size 100 -threads 1
 streamed_vs_merged "fractal, tiles of 500, 2 threads" in/ds.tif -max_error 6 -tile_size 500 -threads 2
@@ -238,48 +215,11 @@ check "SIGTERM: no temporary file" bash -c "! ls -A out | grep -q '^\\.tt'"
 # the same while the streamed GeoPackage is being written: at several
 # moments, from the first tiles to the R-trees
 for d in 0.3 0.8 1.5 2.5 4; do
-  rm -f out/int.gpkg
-  "$T" simplify -q -max_error 0.3 -tile_size 64 -threads 2 in/big.tif out/int.gpkg 2>err.txt &
-  pid=$!
-  sleep $d
-  kill -TERM $pid 2>/dev/null
-  wait $pid
-  rc=$?
-  if [ -e out/int.gpkg ]; then
-    check "streamed, SIGTERM at $d s: finished before it ($rc)" [ "$rc" -eq 0 ]
-    check "streamed, SIGTERM at $d s: a whole file" \
-      [ "$(sqlite3 out/int.gpkg 'pragma integrity_check' 2>&1 || echo bad)" = ok ]
-  else
-    check "streamed, SIGTERM at $d s: ended by it ($rc)" [ "$rc" -ne 0 ]
-    check "streamed, SIGTERM at $d s: says interrupted ($(cat err.txt))" grep -q "interrupted" err.txt
-  fi
-  check "streamed, SIGTERM at $d s: no temporary file ($(ls -A out | grep '^\.tt'))" \
-    bash -c "! ls -A out | grep -q '^\\.tt'"
+  interrupted "streamed" $d -max_error 0.3 -tile_size 64 -threads 2 in/big.tif
 done
 
 # --- real DEMs, when the shared test data are there ---
-S=${TT_SHARED_TESTDATA:-}
-for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschgau.tif:20; do
-  p=${rel%%:*}
-  e=${rel##*:}
-  if [ -z "$S" ] || [ ! -f "$S/$p" ]; then
-    echo "note: $p not in TT_SHARED_TESTDATA; skipped"
-    continue
-  fi
-  b=$(basename "$p" .tif)
-  gdal_translate -q -of AAIGrid "$S/$p" in/$b.asc
-  run simplify -q -json -max_error $e "$S/$p" out/${b}_u.gpkg
-  cp out.txt ${b}_u.json
-  run simplify -q -json -max_error $e -tile_size 128 "$S/$p" out/${b}_t.gpkg
-  check "$b: tiled exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-  cp out.txt ${b}_t.json
-  nu=$(jget ${b}_u.json vertices)
-  nv=$(jget ${b}_t.json vertices)
-  echo "note: $b, max error $e: tiles of 128: $nv vertices, untiled $nu"
-  check "$b: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
-  conforming "$b, tiles of 128" out/${b}_t.gpkg in/$b.asc 1
-  bounded "$b, tiles of 128" "$S/$p" out/${b}_t.gpkg $e
-done
+real_dems ""
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

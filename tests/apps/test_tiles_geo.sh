@@ -15,7 +15,11 @@
 # corners, and so the rounding, may differ; in the affine frame of the
 # whole raster that tiles had before, slopes differed by up to 1.2 % in
 # the UTM case and 17 % in the stereographic one); 1 thread gives
-# the same layers; and
+# the same layers; the GeoPackage written as the tiles merge (the
+# default) is the merged TIN's (TERRATIN_TILE_STREAM=NO) table by table,
+# with 1 and 2 threads, decimated and to a budget too (the triangles
+# measured on their pieces' ground points); SIGTERM during a streamed
+# geographic run leaves nothing; and
 # `tiles plan/run/merge` gives the same layers as `simplify -tile_size`
 # (the pieces carry the ground points, the merge the geodesic areas).
 # Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
@@ -23,36 +27,7 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
 
-T=${TT_TERRATIN:-}
-if [ -z "$T" ] || [ ! -x "$T" ]; then
-  echo "SKIP: TT_TERRATIN is not set or not executable"
-  exit 77
-fi
-for tool in gdal_translate ogrinfo python3 md5sum; do
-  if ! command -v "$tool" >/dev/null 2>&1; then
-    echo "SKIP: $tool is missing"
-    exit 77
-  fi
-done
-TOPO="$(cd "$(dirname "$0")" && pwd)/tin_topology.py"
-
-W=$(mktemp -d "${TMPDIR:-/tmp}/tt_tiles_geo.XXXXXX") || exit 1
-trap 'rm -rf "$W"' EXIT
-cd "$W" || exit 1
-
-rc=0
-run() {
-  "$T" "$@" >out.txt 2>err.txt
-  rc=$?
-}
-jget() { # jget FILE KEY[.KEY...]
-  python3 -c 'import json,sys
-d=json.load(open(sys.argv[1]))
-for k in sys.argv[2].split("."): d=d[k]
-print(d)' "$1" "$2"
-}
-dump() { ogrinfo -ro -al -q "$1" triangles vertices 2>/dev/null | md5sum | cut -d' ' -f1; }
-within() { python3 -c 'import sys; a,b,p=map(float,sys.argv[1:]); sys.exit(0 if abs(a/b-1)*100<=p else 1)' "$1" "$2" "$3"; }
+. "$(dirname "${BASH_SOURCE[0]}")/tt_tiles_lib.sh" || exit 1
 
 # same_triangles A.gpkg B.gpkg: the attributes of the triangles both TINs
 # have (the same three samples) are equal; prints how many there are
@@ -124,9 +99,25 @@ for c in "${cases[@]}"; do
   src=$?
   check "$name: common triangles' attributes equal ($(cat same.txt))" [ $src -eq 0 ]
   echo "note: $name: $(cat same.txt)"
-  run simplify -q -max_error $E -tile_size 64 -threads 1 $name.tif t1_$name.gpkg
+  # written as the tiles merge against the merged TIN, 2 and 1 threads
+  streamed_vs_merged "$name, streamed, 2 threads" $name.tif -max_error $E -tile_size 64 -threads 2
+  streamed_vs_merged "$name, streamed, 1 thread" $name.tif -max_error $E -tile_size 64 -threads 1
   check "$name: 1 and 2 threads give the same layers" \
-    [ "$(dump t1_$name.gpkg)" = "$(dump t_$name.gpkg)" ]
+    [ "$(dump out/sv_s.gpkg)" = "$(dump t_$name.gpkg)" ]
+done
+# decimation and budgets of geographic and Web Mercator DEMs, streamed
+streamed_vs_merged "stereo, decimation, 2 threads" stereo.tif -method decimate -max_error $E -tile_size 64 -threads 2
+streamed_vs_merged "webmerc, decimation, 1 thread" webmerc.tif -method decimate -max_error $E -tile_size 64 -threads 1
+streamed_vs_merged "stereo, -max_points 8000, 2 threads" stereo.tif -max_points 8000 -tile_size 64 -threads 2
+streamed_vs_merged "webmerc, -percent 3, 1 thread" webmerc.tif -percent 3 -tile_size 64 -threads 1
+streamed_vs_merged "utm, decimation -max_triangles 12000, 2 threads" utm.tif -method decimate -max_triangles 12000 -tile_size 64 -threads 2
+check "utm, decimation -max_triangles 12000: $(jget s.json triangles) <= 12000" [ "$(jget s.json triangles)" -le 12000 ]
+
+# interrupted while a geographic DEM's GeoPackage is streamed
+run generate diamond_square in/big.tif -size 1025 -seed 1 -q
+gdal_translate -q -a_srs EPSG:4326 -a_ullr 10 76 20 70 in/big.tif in/big_geo.tif
+for d in 0.5 1.5 3; do
+  interrupted "geographic, streamed" $d -max_error 0.5 -tile_size 128 -threads 2 in/big_geo.tif
 done
 
 # tiles plan/run/merge of the stereographic DEM: the pieces keep the
@@ -143,6 +134,12 @@ run tiles merge p.json m.gpkg -q
 check "merge: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "merge: the layers of simplify -tile_size" \
   [ "$(dump m.gpkg)" = "$(dump t_stereo.gpkg)" ]
+# the merge streamed (its pieces read back have no area function: tile 0's
+# window gives it) against the merged TIN
+TERRATIN_TILE_STREAM=NO "$T" tiles merge p.json m2.gpkg -q 2>err.txt
+rc=$?
+check "merge, TERRATIN_TILE_STREAM=NO: exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
+same "tiles merge, streamed and merged" m.gpkg m2.gpkg
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

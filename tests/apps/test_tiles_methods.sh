@@ -12,8 +12,14 @@
 #    for decimation), conforming, within the bound the run reports, the
 #    same for 1 and 2 threads; with -max_error the larger bound wins; a
 #    budget below the tiles' corners is refused with nothing written;
+#  - the GeoPackage written as the tiles merge (the default) is the merged
+#    TIN's (TERRATIN_TILE_STREAM=NO), table by table (same_gpkg.py), for
+#    decimation (with options, on nodata) and each budget kind, with 1 and
+#    2 threads; a budget's passes not kept leave no row behind; SIGTERM
+#    during a streamed decimation and a streamed budget run (its curve
+#    pass, a pass dropped, the pass kept) leaves nothing;
 #  - Mt Hood and Vinschgau decimated in tiles, when TT_SHARED_TESTDATA has
-#    them.
+#    them (streamed against merged too).
 # Prints "N passed, M failed"; exits 1 on any failure, 77 when a tool is
 # missing.
 set -u
@@ -51,9 +57,9 @@ run simplify -q -json -max_error 3 -tile_size 64 -threads 2 in/ds.tif out/t64.gp
 check "insertion, tiles of 64: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 run simplify -q -json -method decimate -max_error 3 in/ds.tif out/du.gpkg
 cp out.txt du.json
-run simplify -q -json -method decimate -max_error 3 -tile_size 64 -threads 2 in/ds.tif out/dt.gpkg
-check "decimate, tiles of 64: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-cp out.txt dt.json
+streamed_vs_merged "decimate, tiles of 64, 2 threads" in/ds.tif -method decimate -max_error 3 -tile_size 64 -threads 2
+mv out/sv_s.gpkg out/dt.gpkg
+cp s.json dt.json
 nu=$(jget du.json vertices)
 nv=$(jget dt.json vertices)
 echo "note: fractal 257, decimation at 3: tiles of 64: $nv vertices, untiled $nu"
@@ -62,8 +68,14 @@ check "decimate, tiles of 64: method reported" [ "$(jget dt.json method)" = deci
 conforming "decimate, tiles of 64" out/dt.gpkg
 bounded "decimate, tiles of 64" in/ds.tif out/dt.gpkg 3
 check "decimate: uncovered 0" [ "$(jget eval.json uncovered)" = 0 ]
-run simplify -q -method decimate -max_error 3 -tile_size 64 -threads 1 in/ds.tif out/dt1.gpkg
-check "decimate: threads 1 vs 2, the same layers" [ "$(dump out/dt1.gpkg)" = "$(dump out/dt.gpkg)" ]
+streamed_vs_merged "decimate, tiles of 64, 1 thread" in/ds.tif -method decimate -max_error 3 -tile_size 64 -threads 1
+check "decimate: threads 1 vs 2, the same layers" [ "$(dump out/sv_s.gpkg)" = "$(dump out/dt.gpkg)" ]
+# the importance field, NULL for the vertices no removal measured (the
+# corners and border vertices), and no ins_rank
+read -r n_imp n_rank <<<"$(sqlite3 -separator ' ' out/dt.gpkg 'select count(importance), count(ins_rank) from vertices')"
+check "decimate: $n_imp of $nv vertices have an importance" \
+  python3 -c 'import sys; a,b=map(int,sys.argv[1:]); sys.exit(0 if 0.9*b<a<b else 1)' "$n_imp" "$nv"
+check "decimate: no ins_rank ($n_rank)" [ "$n_rank" = 0 ]
 # the border vertices are those of insertion's tiles (the border polylines)
 python3 - out/dt.gpkg out/t64.gpkg 64 257 >bv.txt <<'PY'
 import sqlite3, sys
@@ -79,8 +91,8 @@ read -r nba nbb nbx <bv.txt
 check "decimate: $nba border vertices, insertion's $nbb, $nbx differ" eval '[ "$nbx" = 0 ] && [ "$nba" -gt 0 ]'
 for opts in "-start greedy -importance drop" "-selection sequential -hole minangle" \
             "-onepass -importance volume" "-start greedy:5000 -importance hdh"; do
-  run simplify -q -json -method decimate -max_error 2 -tile_size 64 -threads 2 $opts in/n.tif out/dn.gpkg -overwrite
-  check "decimate $opts, nodata: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  streamed_vs_merged "decimate $opts, nodata" in/n.tif -method decimate -max_error 2 -tile_size 64 -threads 2 $opts
+  mv out/sv_s.gpkg out/dn.gpkg
   conforming "decimate $opts, nodata" out/dn.gpkg in/n.asc "$n_euler"
   case $opts in
     *greedy:*) ;; # starts above the bound: no removal lowers its error
@@ -91,12 +103,13 @@ for opts in "-start greedy -importance drop" "-selection sequential -hole minang
 done
 
 # --- budgets of the whole DEM in tiles: never over, a few per cent below ---
-# budget DEM TILE FLAG N KEY [ASC EULER]: exit 0, count <= max, within 3 %
+# budget DEM TILE FLAG N KEY [ASC EULER]: exit 0, count <= max, within 3 %;
+# streamed as the merged TIN, with 1 and 2 threads
 budget() {
   local dem=$1 n=$2 flag=$3 val=$4 key=$5
-  run simplify -q -json -$flag $val -tile_size $n -threads 2 $dem out/b.gpkg -overwrite
-  check "-$flag $val, tiles of $n: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-  cp out.txt b.json
+  streamed_vs_merged "-$flag $val, tiles of $n, 2 threads" $dem -$flag $val -tile_size $n -threads 2
+  mv out/sv_s.gpkg out/b.gpkg
+  cp s.json b.json
   local got max e
   got=$(jget b.json $key)
   if [ "$flag" = percent ]; then
@@ -110,8 +123,8 @@ budget() {
   check "-$flag $val: $got $key within 3 % below $max" within "$got" "$max" 3
   conforming "-$flag $val, tiles of $n" out/b.gpkg "${6:-}" "${7-1}"
   bounded "-$flag $val, tiles of $n" $dem out/b.gpkg "$e"
-  run simplify -q -$flag $val -tile_size $n -threads 1 $dem out/b1.gpkg -overwrite
-  check "-$flag $val: threads 1 vs 2, the same layers" [ "$(dump out/b1.gpkg)" = "$(dump out/b.gpkg)" ]
+  streamed_vs_merged "-$flag $val, tiles of $n, 1 thread" $dem -$flag $val -tile_size $n -threads 1
+  check "-$flag $val: threads 1 vs 2, the same layers" [ "$(dump out/sv_s.gpkg)" = "$(dump out/b.gpkg)" ]
 }
 budget in/ds.tif 64 max_points 8000 vertices
 budget in/ds.tif 64 percent 1 vertices
@@ -119,16 +132,16 @@ budget in/ds.tif 50 max_triangles 10000 triangles
 budget in/ds.tif 64 max_points 300 vertices
 budget in/n.tif 64 percent 2 vertices in/n.asc "$n_euler"
 # decimation to a budget: the same bound search, decimated runs
-run simplify -q -json -method decimate -max_points 2000 -tile_size 64 -threads 2 in/ds.tif out/bd.gpkg
-check "decimate -max_points 2000: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-cp out.txt bd.json
+streamed_vs_merged "decimate -max_points 2000, 2 threads" in/ds.tif -method decimate -max_points 2000 -tile_size 64 -threads 2
+mv out/sv_s.gpkg out/bd.gpkg
+cp s.json bd.json
 echo "note: fractal 257, decimate -max_points 2000 in tiles of 64: $(jget bd.json vertices) vertices at the bound $(jget bd.json limits.max_error), $(jget bd.json tiling.budget_passes) runs"
 check "decimate -max_points 2000: $(jget bd.json vertices) <= 2000" [ "$(jget bd.json vertices)" -le 2000 ]
 check "decimate -max_points 2000: within 5 % below" within "$(jget bd.json vertices)" 2000 5
 conforming "decimate -max_points 2000" out/bd.gpkg
 bounded "decimate -max_points 2000" in/ds.tif out/bd.gpkg "$(jget bd.json limits.max_error)"
-run simplify -q -method decimate -max_points 2000 -tile_size 64 -threads 1 in/ds.tif out/bd1.gpkg
-check "decimate -max_points 2000: threads 1 vs 2, the same layers" [ "$(dump out/bd1.gpkg)" = "$(dump out/bd.gpkg)" ]
+streamed_vs_merged "decimate -max_points 2000, 1 thread" in/ds.tif -method decimate -max_points 2000 -tile_size 64 -threads 1
+check "decimate -max_points 2000: threads 1 vs 2, the same layers" [ "$(dump out/sv_s.gpkg)" = "$(dump out/bd.gpkg)" ]
 # with -max_error too, the first stop wins: the bound is the larger
 run simplify -q -json -max_points 8000 -max_error 9 -tile_size 64 in/ds.tif out/b.gpkg -overwrite
 check "-max_points with -max_error 9: bound 9 ($(jget out.txt limits.max_error))" [ "$(jget out.txt limits.max_error)" = 9 ]
@@ -141,30 +154,19 @@ check "-max_points 10: one line" [ "$(wc -l <err.txt)" -eq 1 ]
 check "-max_points 10: says the budget is below ($(cat err.txt))" grep -q "budget of 10 vertices is below" err.txt
 check "-max_points 10: nothing written" [ ! -e out/x.gpkg ]
 
-# --- real DEMs decimated in tiles, when the shared test data are there ---
-S=${TT_SHARED_TESTDATA:-}
-for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschgau.tif:20; do
-  p=${rel%%:*}
-  e=${rel##*:}
-  if [ -z "$S" ] || [ ! -f "$S/$p" ]; then
-    echo "note: $p not in TT_SHARED_TESTDATA; skipped"
-    continue
-  fi
-  b=$(basename "$p" .tif)
-  gdal_translate -q -of AAIGrid "$S/$p" in/$b.asc
-  # decimation
-  run simplify -q -json -method decimate -max_error $e "$S/$p" out/${b}_du.gpkg
-  cp out.txt ${b}_du.json
-  run simplify -q -json -method decimate -max_error $e -tile_size 128 "$S/$p" out/${b}_dt.gpkg
-  check "$b: tiled decimation exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-  cp out.txt ${b}_dt.json
-  nu=$(jget ${b}_du.json vertices)
-  nv=$(jget ${b}_dt.json vertices)
-  echo "note: $b, decimation at $e: tiles of 128: $nv vertices, untiled $nu"
-  check "$b, decimation: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
-  conforming "$b, decimation in tiles of 128" out/${b}_dt.gpkg in/$b.asc 1
-  bounded "$b, decimation in tiles of 128" "$S/$p" out/${b}_dt.gpkg $e
+# --- interrupted while streamed: nothing left (a budget's dropped passes
+# and the file made again included) ---
+run generate diamond_square in/big.tif -size 1025 -seed 1 -q
+for d in 0.5 1.5 3; do
+  interrupted "decimation, streamed" $d -method decimate -max_error 1 -tile_size 128 -threads 2 in/big.tif
 done
+# two passes of about 1.4 s after a curve pass (Release, 2 cores)
+for d in 0.5 1.5 2.5; do
+  interrupted "-max_points 150000, streamed" $d -max_points 150000 -tile_size 128 -threads 2 in/big.tif
+done
+
+# --- real DEMs decimated in tiles, when the shared test data are there ---
+real_dems ", decimation" -method decimate
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -1,22 +1,27 @@
 # tt_tiles_lib.sh -- what the tiled-run command tests share (sourced by
-# test_tiles.sh and test_tiles_methods.sh after tt_check.sh): the checks
-# for TT_TERRATIN and the tools (exit 77 when missing), a work folder
-# removed at exit (in/ and out/), and the helpers: run (the command, its
-# output in out.txt and err.txt, its status in rc), jget (a JSON field),
-# dump (the md5 of the triangles and vertices layers), within (a ratio),
-# conforming (tin_topology.py) and bounded (terratin eval).
+# test_tiles.sh, test_tiles_methods.sh and test_tiles_geo.sh after
+# tt_check.sh): the checks for TT_TERRATIN and the tools (exit 77 when
+# missing), a work folder removed at exit (in/ and out/), and the helpers:
+# run (the command, its output in out.txt and err.txt, its status in rc),
+# jget (a JSON field), dump (the md5 of the triangles and vertices layers),
+# within (a ratio), conforming (tin_topology.py), bounded (terratin eval),
+# streamed_vs_merged (a GeoPackage written as the tiles merge against the
+# merged TIN's, table by table), interrupted (SIGTERM during a run leaves
+# nothing) and real_dems (Mt Hood and Vinschgau in tiles, when the shared
+# test data have them).
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then
   echo "SKIP: TT_TERRATIN is not set or not executable"
   exit 77
 fi
-for tool in gdal_translate gdal_rasterize ogrinfo python3 md5sum; do
+for tool in gdal_translate gdal_rasterize ogrinfo python3 md5sum sqlite3; do
   if ! command -v "$tool" >/dev/null 2>&1; then
     echo "SKIP: $tool is missing"
     exit 77
   fi
 done
 TOPO="$(cd "$(dirname "$0")" && pwd)/tin_topology.py"
+SAME="$(cd "$(dirname "$0")" && pwd)/same_gpkg.py"
 
 W=$(mktemp -d "${TMPDIR:-/tmp}/tt_tiles.XXXXXX") || exit 1
 trap 'rm -rf "$W"' EXIT
@@ -58,3 +63,105 @@ bounded() {
   check "$name: no sample overlapped" [ "$(jget eval.json overlapped)" = 0 ]
 }
 
+# same NAME A B: the files' tables hold the same content (same_gpkg.py)
+same() {
+  if python3 "$SAME" "$2" "$3" >same.txt 2>&1; then pass; else
+    fail "$1: streamed and merged differ: $(head -c 600 same.txt)"; fi
+}
+# streamed_vs_merged NAME DEM OPTIONS...: `simplify -q -json OPTIONS DEM`
+# into a GeoPackage written as the tiles merge (the default, JSON
+# tiling.streamed true) and with TERRATIN_TILE_STREAM=NO (the merged TIN,
+# tiling.streamed false): the same tables row by row (R-tree nodes,
+# extents, counts, run_parameters but its times, styles), the same
+# ogrinfo -al of the layers (LAYERS_OF, default triangles vertices), the
+# same JSON statistics, bound and budget passes, as many database pages
+# (none free).
+streamed_vs_merged() {
+  local name=$1 dem=$2
+  shift 2
+  rm -f out/sv_s.gpkg out/sv_m.gpkg
+  "$T" simplify -q -json "$@" "$dem" out/sv_s.gpkg >s.json 2>err.txt
+  rc=$?
+  check "$name: streamed exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
+  TERRATIN_TILE_STREAM=NO "$T" simplify -q -json "$@" "$dem" out/sv_m.gpkg >m.json 2>err.txt
+  rc=$?
+  check "$name: merged exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
+  check "$name: written as the tiles merged" [ "$(jget s.json tiling.streamed)" = True ]
+  check "$name: TERRATIN_TILE_STREAM=NO merged first" [ "$(jget m.json tiling.streamed)" = False ]
+  same "$name" out/sv_s.gpkg out/sv_m.gpkg
+  # no page of a dropped budget pass left over: as many pages, none free
+  local ps pm
+  ps=$(sqlite3 out/sv_s.gpkg 'pragma page_count; pragma freelist_count' | tr '\n' ' ')
+  pm=$(sqlite3 out/sv_m.gpkg 'pragma page_count; pragma freelist_count' | tr '\n' ' ')
+  check "$name: the same pages and free pages ($ps, $pm)" [ "$ps" = "$pm" ]
+  local la lb
+  la=$(ogrinfo -ro -al -q out/sv_s.gpkg ${LAYERS_OF:-triangles vertices} | md5sum)
+  lb=$(ogrinfo -ro -al -q out/sv_m.gpkg ${LAYERS_OF:-triangles vertices} | md5sum)
+  check "$name: the same ogrinfo -al of the layers" [ "$la" = "$lb" ]
+  for k in vertices triangles components max_error rmse covered_samples \
+           lone_samples forced_vertices valid_samples z_min z_max \
+           limits.max_error tiling.budget_passes; do
+    check "$name: JSON $k the same ($(jget s.json $k), $(jget m.json $k))" \
+      [ "$(jget s.json $k)" = "$(jget m.json $k)" ]
+  done
+}
+
+# interrupted NAME DELAY OPTIONS...: `simplify -q OPTIONS out/int.gpkg`
+# in the background, SIGTERM after DELAY seconds (a background job ignores
+# SIGINT, and terratin keeps what its parent ignores): either it finished
+# first (exit 0, a whole file) or it says it was interrupted; no temporary
+# file either way.
+interrupted() {
+  local name=$1 d=$2 pid
+  shift 2
+  rm -f out/int.gpkg
+  "$T" simplify -q "$@" out/int.gpkg 2>err.txt &
+  pid=$!
+  sleep "$d"
+  kill -TERM $pid 2>/dev/null
+  wait $pid
+  rc=$?
+  if [ -e out/int.gpkg ]; then
+    check "$name, SIGTERM at $d s: finished before it ($rc)" [ "$rc" -eq 0 ]
+    check "$name, SIGTERM at $d s: a whole file" \
+      [ "$(sqlite3 out/int.gpkg 'pragma integrity_check' 2>&1 || echo bad)" = ok ]
+  else
+    check "$name, SIGTERM at $d s: ended by it ($rc)" [ "$rc" -ne 0 ]
+    check "$name, SIGTERM at $d s: says interrupted ($(cat err.txt))" grep -q "interrupted" err.txt
+  fi
+  check "$name, SIGTERM at $d s: no temporary file ($(ls -A out | grep '^\.tt'))" \
+    bash -c "! ls -A out | grep -q '^\\.tt'"
+}
+
+# real_dems LABEL OPTIONS...: Mt Hood (nodata collar) and Vinschgau, when
+# TT_SHARED_TESTDATA has them, simplified with OPTIONS at max error 20
+# untiled and in tiles of 128 on 2 threads: the tiled TIN within 5 % of
+# the untiled vertices, conforming (Euler characteristic 1), every valid
+# sample within the bound, and its GeoPackage written as the tiles merged
+# the same as the merged TIN's (streamed_vs_merged).
+real_dems() {
+  local label=$1
+  shift
+  local S=${TT_SHARED_TESTDATA:-} rel p e b nu nv
+  for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschgau.tif:20; do
+    p=${rel%%:*}
+    e=${rel##*:}
+    if [ -z "$S" ] || [ ! -f "$S/$p" ]; then
+      echo "note: $p not in TT_SHARED_TESTDATA; skipped"
+      continue
+    fi
+    b=$(basename "$p" .tif)
+    gdal_translate -q -of AAIGrid "$S/$p" in/$b.asc
+    run simplify -q -json "$@" -max_error $e "$S/$p" out/${b}_u.gpkg -overwrite
+    cp out.txt ${b}_u.json
+    streamed_vs_merged "$b$label, tiles of 128" "$S/$p" "$@" -max_error $e -tile_size 128 -threads 2
+    mv out/sv_s.gpkg out/${b}_t.gpkg
+    cp s.json ${b}_t.json
+    nu=$(jget ${b}_u.json vertices)
+    nv=$(jget ${b}_t.json vertices)
+    echo "note: $b$label, max error $e: tiles of 128: $nv vertices, untiled $nu"
+    check "$b$label: vertices $nv within 5 % of untiled $nu" within "$nv" "$nu" 5
+    conforming "$b$label, tiles of 128" out/${b}_t.gpkg in/$b.asc 1
+    bounded "$b$label, tiles of 128" "$S/$p" out/${b}_t.gpkg $e
+  done
+}

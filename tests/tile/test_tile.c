@@ -14,9 +14,12 @@
  *  - a tile's error-against-count curve (budgets) matches untiled runs;
  *  - bad tiles and budgets are refused;
  *  - the streamed merge (src/tile/stream.c) hands out every triangle and
- *    vertex of the merged TIN once, in order, with the same values and
- *    star statistics bit for bit, and the same summary (projected frames,
- *    insertion: what the command streams). */
+ *    vertex of the merged TIN once, in order, with the same values, star
+ *    statistics and importances bit for bit, triangles whose records
+ *    (areas, slope, aspect, angles) are the merged TIN's bit for bit, and
+ *    the same summary: insertion and decimation, in the affine frame and
+ *    on ground points with an area function (as a geographic DEM's
+ *    windows have them). */
 #include "terratin/terratin.h"
 #include "tt_test.h"
 #include "tt_tin_conform.h"
@@ -24,9 +27,43 @@
 #include "tile/tile.h"
 #include "tin/tin.h"
 
+#include <math.h>
 #include <stdbool.h>
 
 static tt_context *ctx;
+/* window_of gives the windows ground points and an area function */
+static bool ground_windows;
+
+/* A geodesic-like area: the plane's, scaled by the mean map y. */
+static double warped_area(const double p[4], const double x[3],
+                          const double y[3])
+{
+  double a = 0.5 * fabs((x[1] - x[0]) * (y[2] - y[0]) -
+                        (x[2] - x[0]) * (y[1] - y[0]));
+  return a * (1 + p[0] * (y[0] + y[1] + y[2]) / 3);
+}
+
+/* Ground points of window win (its first sample at column c0, row r0 of
+ * the raster of geotransform gt): the map coordinates, warped smoothly,
+ * computed from the raster's column and row as the GDAL reader does, so
+ * two windows agree on every sample they share. */
+static void add_ground(tt_grid *win, size_t c0, size_t r0, const double gt[6])
+{
+  CHECK(tt_grid_alloc_ground_points(ctx, win) == TT_OK);
+  double *xy = tt_grid_ground_xy(win);
+  size_t w = tt_grid_width(win), h = tt_grid_height(win);
+  for (size_t y = 0; y < h; y++)
+    for (size_t x = 0; x < w; x++) {
+      double c = (double)(c0 + x) + 0.5, r = (double)(r0 + y) + 0.5;
+      double mx = gt[0] + c * gt[1] + r * gt[2];
+      double my = gt[3] + c * gt[4] + r * gt[5];
+      xy[2 * (y * w + x)] = mx * (1 + 1e-3 * sin(my * 0.013));
+      xy[2 * (y * w + x) + 1] = my * (1 + 1e-3 * cos(mx * 0.011));
+    }
+  tt__grid_set_ground_origin(win, c0, r0, gt);
+  const double par[4] = {1e-4, 0, 0, 0};
+  tt_grid_set_area_fn(win, warped_area, par);
+}
 
 /* The window of a tile cut from an in-memory grid, as a reader gives it:
  * its geotransform that of its first sample, the grid's ground frame. */
@@ -51,6 +88,10 @@ static tt_grid *window_of(const tt_grid *g, const tt_tile *t)
   tt_grid_set_geotransform(ctx, win, gt);
   tt_grid_get_ground_frame(g, fr);
   tt_grid_set_ground_frame(ctx, win, fr);
+  if (ground_windows) {
+    tt_grid_get_geotransform(g, gt);
+    add_ground(win, c0, r0, gt);
+  }
   free(z);
   free(zf);
   return win;
@@ -82,7 +123,19 @@ static void check_stream(tt_tin *const *pieces, const tt_tile *tiles,
         bad += b.tri->t_n[i] != tin->t_n[j];
         bad += memcmp(&b.tri->t_rmse[i], &tin->t_rmse[j], sizeof(double)) != 0;
         bad += b.tri->t_max[i] != tin->t_max[j];
+        /* the record a writer makes: on the ground points, with the area
+         * function, when the TIN has them */
+        tt_triangle_info x, y;
+        CHECK(tt_tin_triangle(b.tri, i, &x) == TT_OK);
+        CHECK(tt_tin_triangle(tin, j, &y) == TT_OK);
+        const double a[] = {x.area_2d, x.area_3d, x.slope_deg, x.aspect_deg,
+                            x.min_angle_deg, x.max_angle_deg};
+        const double m[] = {y.area_2d, y.area_3d, y.slope_deg, y.aspect_deg,
+                            y.min_angle_deg, y.max_angle_deg};
+        bad += memcmp(a, m, sizeof a) != 0;
       }
+      bad += (b.tri->vgxy != NULL) != (tin->vgxy != NULL);
+      bad += (b.tri->area_fn != NULL) != (tin->area_fn != NULL);
     }
     CHECK(b.vtx_first == vtx);
     for (size_t i = 0; b.vtx && i < b.vtx->nv; i++, vtx++) {
@@ -94,6 +147,10 @@ static void check_stream(tt_tin *const *pieces, const tt_tile *tiles,
       bad += memcmp(&b.vtx->v_star_rmse[i], &tin->v_star_rmse[vtx],
                     sizeof(double)) != 0;
       bad += b.vtx->v_star_n[i] != tin->v_star_n[vtx];
+      tt_vertex_info x, y;
+      CHECK(tt_tin_vertex(b.vtx, i, &x) == TT_OK);
+      CHECK(tt_tin_vertex(tin, vtx, &y) == TT_OK);
+      bad += memcmp(&x.importance, &y.importance, sizeof(double)) != 0;
     }
     size_t p = tt__tin_stream_pending(s);
     max_pending = p > max_pending ? p : max_pending;
@@ -124,6 +181,9 @@ static void check_stream(tt_tin *const *pieces, const tt_tile *tiles,
         a.errors.max_row == m.errors.max_row);
   CHECK(a.errors.rmse == m.errors.rmse && a.errors.l2 == m.errors.l2);
   CHECK(a.errors.total_abs == m.errors.total_abs);
+  CHECK(a.start_vertices == m.start_vertices);
+  CHECK(a.removed_vertices == m.removed_vertices);
+  CHECK(a.rounds == m.rounds && a.refused_bound == m.refused_bound);
   printf("stream, tiles of %zu: %zu vertices, at most %zu pending (a row "
          "of tiles and one: at most %zu)\n", n, vtx, max_pending, row_max);
   tt__tin_stream_destroy(s);
@@ -662,6 +722,32 @@ static void test_curve(void)
   tt_grid_destroy(g);
 }
 
+/* The streamed merge on ground points (a geographic DEM's windows):
+ * insertion and decimation, each triangle's record the merged TIN's bit
+ * for bit (check_stream), the TIN measured on the ground. */
+static void test_stream_ground(void)
+{
+  tt_grid *g = fractal(129, 5);
+  ground_windows = true;
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.max_error = 3.0;
+  o.threads = 1;
+  tt_tin *tin = run_tiled(g, 40, &o, false);
+  CHECK(tin->vgxy != NULL && tin->area_fn != NULL);
+  check_tin("ground points, tiles of 40", g, tin, o.max_error, true);
+  tt_tin_destroy(tin);
+  tt_decimate_options d;
+  tt_decimate_options_init(&d);
+  d.max_error = 3.0;
+  d.threads = 1;
+  tin = run_tiled_dec(g, 40, &d, false);
+  CHECK(tin->vgxy != NULL && tin->v_importance != NULL);
+  tt_tin_destroy(tin);
+  ground_windows = false;
+  tt_grid_destroy(g);
+}
+
 static void test_refusals(void)
 {
   tt_grid *g = fractal(65, 1);
@@ -695,6 +781,7 @@ int main(void)
   test_decimate();
   test_optimizers();
   test_curve();
+  test_stream_ground();
   test_refusals();
   tt_context_destroy(ctx);
   return tt_test_failures ? 1 : 0;
