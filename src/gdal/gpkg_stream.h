@@ -24,7 +24,9 @@ typedef struct tt__gpkg_value {
 /* --- io_gpkg_rows.c: the layers' pages appended row by row ---------------
  * Opens the GeoPackage whose empty layers tt_ogr_write_tin(ROWS=DEFERRED)
  * made (closed by GDAL), with the write options it got (NLN_PREFIX,
- * LAYERS, LCO=SPATIAL_INDEX, RTREE_CHECK, JOURNAL; the rest ignored), makes
+ * LAYERS, LCO=SPATIAL_INDEX, RTREE_CHECK, JOURNAL; RTREE_BLOCK, the boxes
+ * an R-tree block gathers before its leaves are written, default 65,536:
+ * tt__rtree_stream in gpkg_rtree.h; the rest ignored), makes
  * the R-trees' schema (committed), and opens both tables for appending as
  * pages (io_gpkg_rows.c's PAGES=YES, steps 1 and 2). TT_ERR_FORMAT when the
  * file cannot take pages. nvfields: the vertices layer's fields. Only for
@@ -42,20 +44,26 @@ TT_HIDDEN int tt__gpkg_pages_has(const tt__gpkg_pages *p, int layer);
 TT_HIDDEN int32_t tt__gpkg_pages_srs_id(const tt__gpkg_pages *p, int layer);
 TT_HIDDEN int tt__gpkg_pages_rtree(const tt__gpkg_pages *p);
 /* Appends a row: fid (1, 2, ... in order), the layer's fields in
- * tin_records.h's order, the geometry blob. */
+ * tin_records.h's order, the geometry blob, and its box for the R-tree
+ * (id the fid; needed when tt__gpkg_pages_rtree(), else NULL): the
+ * R-tree's leaves are packed and written block by block
+ * (tt__rtree_stream). */
 TT_HIDDEN tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer,
                                        int64_t fid,
                                        const tt__gpkg_value *fields,
                                        const unsigned char *blob,
-                                       size_t blob_len);
-/* Ends the tables (count[k] rows each), writes the R-trees of the boxes
- * (one per row, fid order, malloc'd; NULL without R-trees) as pages,
- * freeing each array once its index is written (boxes[k] set NULL),
- * commits them,
- * then sets sqlite_sequence, the extents ext[k] (min x, min y, max x,
- * max y) and counts, and runs rtreecheck() when RTREE_CHECK asked. */
+                                       size_t blob_len,
+                                       const tt__rtree_box *box);
+/* The layer's rows so far make whole pieces (a tiled run's batch): a
+ * block of the R-tree may end here (tt__rtree_stream_cut). */
+TT_HIDDEN tt_status tt__gpkg_pages_cut(tt__gpkg_pages *p, int layer);
+/* The bytes the R-trees hold: the blocks gathering, the leaves' boxes. */
+TT_HIDDEN size_t tt__gpkg_pages_bytes(const tt__gpkg_pages *p);
+/* Ends the tables (count[k] rows each), writes the R-trees' last blocks,
+ * upper levels and roots as pages, commits them, then sets
+ * sqlite_sequence, the extents ext[k] (min x, min y, max x, max y) and
+ * counts, and runs rtreecheck() when RTREE_CHECK asked. */
 TT_HIDDEN tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
-                                          tt__rtree_box *boxes[2],
                                           const size_t count[2],
                                           const double ext[2][4],
                                           tt_progress_fn progress,
@@ -87,8 +95,8 @@ TT_HIDDEN tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
                                            tt_progress_fn progress,
                                            void *progress_arg);
 TT_HIDDEN void tt__gpkg_stream_close(tt__gpkg_stream *g);
-/* The bytes the writer holds: the boxes kept for the R-trees, the
- * vertices' insertion errors for the style. */
+/* The bytes the writer holds: the R-trees' blocks and leaves' boxes
+ * (tt__gpkg_pages_bytes), the vertices' insertion errors for the style. */
 TT_HIDDEN size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g);
 
 #endif /* TERRATIN_GPKG_STREAM_H */

@@ -1708,12 +1708,17 @@ done:
  * 3. Nothing above changes. */
 #include "gdal/gpkg_stream.h"
 
+/* The boxes an R-tree block gathers at least before its leaves are
+ * packed and written (RTREE_BLOCK; docs/scale.md has the measurements). */
+#define STREAM_RTREE_BLOCK 65536
+
 struct tt__gpkg_pages {
   rows_state w;
   layer_table layer[2];
   pages_job job;
   tt__sqlite_file *f;
   tt__sqlite_table *t[2];
+  tt__rtree_stream *rs[2]; /* the R-trees, leaves packed as rows come */
   int format;
   int finished;
   char *names[2];
@@ -1738,6 +1743,7 @@ tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
   const char *prefix = "";
   unsigned layers = TT__LAYERS_ALL;
   int journal_memory = 0;
+  size_t block = STREAM_RTREE_BLOCK;
   tt_status s = TT_OK;
   for (char **o = options; o && *o && s == TT_OK; o++) {
     char *key = NULL;
@@ -1759,6 +1765,15 @@ tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
       s = tt__records_parse_layers(ctx, value, &layers);
     else if (strcasecmp(key, "JOURNAL") == 0)
       journal_memory = strcasecmp(value, "MEMORY") == 0;
+    else if (strcasecmp(key, "RTREE_BLOCK") == 0) {
+      char *end = NULL;
+      long long v = strtoll(value, &end, 10);
+      if (!end || *end || v < 1)
+        s = tt__error(ctx, TT_ERR_ARG, "RTREE_BLOCK must be a count of "
+                      "features, got \"%s\"", value);
+      else
+        block = (size_t)v;
+    }
     CPLFree(key);
   }
   j->todo[0] = (layers & TT__LAYER_TRIANGLES) != 0;
@@ -1833,6 +1848,9 @@ tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
       else
         s = tt__sqlite_table_begin(p->f, j->lay[k].table, j->lay[k].root,
                                    &p->t[k]);
+      if (s == TT_OK && j->rtree)
+        s = tt__rtree_stream_create(ctx, p->layer[k].name, &j->sh[k], p->f,
+                                    block, &p->rs[k]);
     }
   return s;
 }
@@ -1854,7 +1872,8 @@ int tt__gpkg_pages_rtree(const tt__gpkg_pages *p)
 
 tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer, int64_t fid,
                              const tt__gpkg_value *fields,
-                             const unsigned char *blob, size_t blob_len)
+                             const unsigned char *blob, size_t blob_len,
+                             const tt__rtree_box *box)
 {
   const page_layout *lay = &p->job.lay[layer];
   unsigned char body[8 * TT__SQLITE_REC_COLS + TRI_BLOB_BYTES + 8];
@@ -1883,11 +1902,28 @@ tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer, int64_t fid,
   }
   const unsigned char *head;
   size_t nh = tt__sqlite_rec_head(&r, &head);
-  return tt__sqlite_table_append2(p->t[layer], fid, head, nh, body, r.nb);
+  tt_status s = tt__sqlite_table_append2(p->t[layer], fid, head, nh, body,
+                                         r.nb);
+  if (s == TT_OK && p->rs[layer])
+    s = box ? tt__rtree_stream_add(p->rs[layer], box)
+            : tt__error(p->w.ctx, TT_ERR_INTERNAL, "%s: a row without its "
+                        "box for the R-tree", p->w.path);
+  return s;
 }
 
-tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p, tt__rtree_box *boxes[2],
-                                const size_t count[2],
+tt_status tt__gpkg_pages_cut(tt__gpkg_pages *p, int layer)
+{
+  return p->rs[layer] ? tt__rtree_stream_cut(p->rs[layer]) : TT_OK;
+}
+
+size_t tt__gpkg_pages_bytes(const tt__gpkg_pages *p)
+{
+  return p ? tt__rtree_stream_bytes(p->rs[0]) +
+                 tt__rtree_stream_bytes(p->rs[1])
+           : 0;
+}
+
+tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p, const size_t count[2],
                                 const double ext[2][4],
                                 tt_progress_fn progress, void *progress_arg)
 {
@@ -1905,18 +1941,16 @@ tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p, tt__rtree_box *boxes[2],
       p->layer[k].last_fid = (sqlite3_int64)j->count[k];
     }
   }
-  /* the vertices' index first: its boxes are freed before the
-   * triangles' (twice as many) are packed */
+  /* the vertices' index first: what it holds is freed before the
+   * triangles' (twice as many) is finished */
   for (int k = 1; k >= 0 && s == TT_OK; k--) {
-    if (!j->rtree || !j->todo[k])
+    if (!p->rs[k])
       continue;
     w->lo = k ? 0.0 : 0.3;
     w->hi = k ? 0.3 : 0.9;
-    s = tt__rtree_write_pages(w->ctx, p->layer[k].name, boxes[k],
-                              j->count[k], NULL, &j->sh[k], p->f,
-                              rtree_progress, w);
-    free(boxes[k]);
-    boxes[k] = NULL;
+    s = tt__rtree_stream_finish(p->rs[k], rtree_progress, w);
+    tt__rtree_stream_free(p->rs[k]);
+    p->rs[k] = NULL;
   }
   if (s == TT_OK)
     s = tt__sqlite_file_commit(p->f);
@@ -1963,6 +1997,8 @@ void tt__gpkg_pages_close(tt__gpkg_pages *p)
 {
   if (!p)
     return;
+  tt__rtree_stream_free(p->rs[0]);
+  tt__rtree_stream_free(p->rs[1]);
   if (p->f) /* not committed: the file is cut back to step 1's size */
     tt__sqlite_file_close(p->f);
   if (!p->finished && p->w.db && p->job.rtree)

@@ -568,12 +568,37 @@ static size_t group_start(size_t g, size_t n, size_t ngroups)
 }
 
 /* Orders items for ngroups consecutive groups: STR slices by x, then y.
- * tmp holds n items. */
-static void str_order(rt_item *items, size_t n, size_t ngroups, rt_item *tmp)
+ * tmp holds n items. fit: slices in proportion to the extent of the
+ * items' centres (a block of a streamed tree, a strip of a few tiles, gets
+ * about square leaves), else ceil(sqrt(ngroups)) as STR has it (the whole
+ * layer). */
+static void str_order(rt_item *items, size_t n, size_t ngroups, rt_item *tmp,
+                      int fit)
 {
-  size_t nslices = (size_t)ceil(sqrt((double)ngroups));
-  if (nslices < 1)
-    nslices = 1;
+  double ratio = 1.0;
+  if (fit && n) {
+    double lo[2], hi[2];
+    for (int a = 0; a < 2; a++)
+      lo[a] = hi[a] = (double)items[0].box[2 * a] +
+                      (double)items[0].box[2 * a + 1];
+    for (size_t i = 1; i < n; i++)
+      for (int a = 0; a < 2; a++) {
+        double c = (double)items[i].box[2 * a] +
+                   (double)items[i].box[2 * a + 1];
+        if (c < lo[a]) lo[a] = c;
+        if (c > hi[a]) hi[a] = c;
+      }
+    double w = hi[0] - lo[0], h = hi[1] - lo[1];
+    if (w > 0 && h > 0)
+      ratio = w / h;
+    else if (w > 0)
+      ratio = (double)ngroups; /* a row: every group its own slice */
+    else if (h > 0)
+      ratio = 1.0 / (double)ngroups;
+  }
+  double want = ceil(sqrt((double)ngroups * ratio));
+  size_t nslices = want < 1 ? 1 : want > (double)ngroups ? ngroups
+                                                          : (size_t)want;
   sort_items(items, n, 0, tmp);
   for (size_t sl = 0; sl < nslices; sl++) {
     size_t g0 = sl * ngroups / nslices, g1 = (sl + 1) * ngroups / nslices;
@@ -670,10 +695,11 @@ void tt__rtree_packed_free(tt__rtree_packed *pk)
   free(pk);
 }
 
-/* Packs items (n) into nodes of node_cap cells: on success items belong
+/* Packs items (n) into nodes of node_cap cells, the nodes above items
+ * numbered from next_nodeno on (the root is 1): on success items belong
  * to *out, on failure they stay the caller's. */
 static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
-                            size_t n, size_t node_cap,
+                            size_t n, size_t node_cap, int64_t next_nodeno,
                             tt__rtree_packed **out)
 {
   *out = NULL;
@@ -692,7 +718,6 @@ static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
   pk->n[0] = n;
   pk->nlevels = 1;
   pk->nodes_total = 1;
-  int64_t next_nodeno = 2;
   tt_status s = TT_OK;
   for (int depth = 0; n > node_cap; depth++) {
     if (depth >= RT_MAX_DEPTH) {
@@ -702,7 +727,7 @@ static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
     }
     rt_item *level = pk->level[depth];
     size_t ngroups = (n + node_cap - 1) / node_cap;
-    str_order(level, n, ngroups, tmp);
+    str_order(level, n, ngroups, tmp, 0);
     rt_item *next = malloc(ngroups * sizeof *next);
     if (!next) {
       s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
@@ -748,7 +773,7 @@ tt_status tt__rtree_pack(tt_context *ctx, const char *what,
   if (node_cap < 2)
     return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells",
                      what, node_cap);
-  return pack_items(ctx, what, boxes, n, node_cap, out);
+  return pack_items(ctx, what, boxes, n, node_cap, 2, out);
 }
 
 size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
@@ -1118,7 +1143,8 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
     packed = NULL;
   }
   if (s == TT_OK && !packed) {
-    s = pack_items(b->ctx, b->path, b->items, b->nitems, b->node_cap, &own);
+    s = pack_items(b->ctx, b->path, b->items, b->nitems, b->node_cap, 2,
+                   &own);
     if (s == TT_OK)
       b->items = NULL; /* taken over */
     packed = own;
@@ -1433,7 +1459,7 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
       return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the "
                        "spatial index", what);
     memcpy(items, packed ? packed->items : boxes, m * sizeof *items);
-    s = pack_items(ctx, what, items, m, sh->node_cap, &own);
+    s = pack_items(ctx, what, items, m, sh->node_cap, 2, &own);
     if (s != TT_OK) {
       free(items);
       return s;
@@ -1555,5 +1581,303 @@ done:
   free(node_of);
   free(parent);
   tt__rtree_packed_free(own);
+  return s;
+}
+
+/* --- the index written as the rows stream in ------------------------------
+ * tt__rtree_stream (gpkg_rtree.h): the boxes of a layer whose rows are
+ * appended in id order (1, 2, ...) are gathered into a block; at a cut
+ * (the end of a piece of a tiled run) once the block holds at least
+ * `block` boxes, it is STR-ordered into leaves (str_order with the slices
+ * fitted to the block's extent: a block is a strip of a few tiles) whose
+ * node blobs go to %_node and whose features' (rowid, leaf) pairs go to
+ * %_rowid at once, both in rowid order; only each leaf's number and box
+ * is kept. After the last row the leaves are packed like any level
+ * (pack_items, STR over the whole layer) into the upper levels, written
+ * after them, then %_parent.
+ *
+ * Node numbers: the root is node 1, which SQLite's module reads first (its
+ * depth, and the node size as the length of its blob), and %_node rows
+ * must go in rowid order; but the root is known last. So before the first
+ * leaf, node 1 is appended with a placeholder blob of the node size (all
+ * zero) and its place kept (tt__sqlite_table_append2_spot); at the end
+ * the root's blob is written over it (tt__sqlite_file_patch, same length,
+ * so the page's cells and pointers stand). Leaves are nodes 2..L+1 in the
+ * order written, the upper levels L+2 on, level by level.
+ *
+ * A layer that never fills a block (up to `block` features) is packed at
+ * the end from its boxes, all of them, by tt__rtree_write_pages(): the
+ * same tree as the merged path's, byte for byte.
+ *
+ * Memory: the block (24 bytes a box, and 24 + 4 of scratch for the
+ * sorting and the rowid pairs), 24 bytes a leaf (about one per 50
+ * features) until the end, then the upper levels' packing (24 + 4 bytes a
+ * leaf). */
+
+/* Blocks bigger than this many times `block` are packed without waiting
+ * for a cut: memory stays bounded for a caller that gives no cuts. */
+#define RT_STREAM_HARD 16
+
+struct tt__rtree_stream {
+  tt_context *ctx;
+  const char *what;
+  const tt__rtree_shadow *sh;
+  tt__sqlite_file *f;
+  int format;
+  size_t block;
+  rt_item *buf, *tmp; /* the block's boxes in id order; sorting scratch */
+  size_t nbuf, cap_buf, cap_tmp;
+  uint32_t *node_of; /* the block's features' leaves, in id order */
+  size_t cap_node_of;
+  int64_t first_id;  /* the id of buf[0] */
+  rt_item *leaves;   /* every leaf written: node number, box */
+  size_t nleaves, cap_leaves;
+  unsigned char *blob;
+  tt__sqlite_table *node_t, *rowid_t; /* open while streaming */
+  tt__sqlite_spot root_spot;          /* node 1's payload */
+  size_t root_head;                   /* its record header's bytes */
+  int streaming;                      /* a block was written */
+};
+
+tt_status tt__rtree_stream_create(tt_context *ctx, const char *what,
+                                  const tt__rtree_shadow *sh,
+                                  tt__sqlite_file *f, size_t block,
+                                  tt__rtree_stream **out)
+{
+  *out = NULL;
+  if (sh->node_cap < 2 || sh->node_size < 4 + sh->node_cap * RT_CELL_BYTES)
+    return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells "
+                     "in %zu bytes", what, sh->node_cap, sh->node_size);
+  tt__rtree_stream *rs = calloc(1, sizeof *rs);
+  unsigned char *blob = malloc(sh->node_size);
+  if (!rs || !blob) {
+    free(rs);
+    free(blob);
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  }
+  rs->ctx = ctx;
+  rs->what = what;
+  rs->sh = sh;
+  rs->f = f;
+  rs->format = tt__sqlite_file_format(f);
+  /* more than a node: a block packed makes two leaves at least, so the
+   * root (node 1) is never a leaf itself */
+  rs->block = block > sh->node_cap ? block : sh->node_cap + 1;
+  rs->first_id = 1;
+  rs->blob = blob;
+  *out = rs;
+  return TT_OK;
+}
+
+size_t tt__rtree_stream_bytes(const tt__rtree_stream *rs)
+{
+  if (!rs)
+    return 0;
+  return (rs->cap_buf + rs->cap_tmp + rs->cap_leaves) * sizeof(rt_item) +
+         rs->cap_node_of * sizeof(uint32_t) + rs->sh->node_size;
+}
+
+void tt__rtree_stream_free(tt__rtree_stream *rs)
+{
+  if (!rs)
+    return;
+  /* tables not finished belong to the file, which frees them */
+  free(rs->buf);
+  free(rs->tmp);
+  free(rs->node_of);
+  free(rs->leaves);
+  free(rs->blob);
+  free(rs);
+}
+
+/* %_node and %_rowid begun, node 1's placeholder appended. */
+static tt_status stream_begin(tt__rtree_stream *rs)
+{
+  const tt__rtree_shadow *sh = rs->sh;
+  char *name = sqlite3_mprintf("%s_node", sh->rtree);
+  tt_status s = name ? tt__sqlite_table_begin(rs->f, name, sh->root[0],
+                                              &rs->node_t)
+                     : tt__error(rs->ctx, TT_ERR_NOMEM, "out of memory");
+  sqlite3_free(name);
+  name = s == TT_OK ? sqlite3_mprintf("%s_rowid", sh->rtree) : NULL;
+  if (s == TT_OK)
+    s = name ? tt__sqlite_table_begin(rs->f, name, sh->root[2], &rs->rowid_t)
+             : tt__error(rs->ctx, TT_ERR_NOMEM, "out of memory");
+  sqlite3_free(name);
+  if (s != TT_OK)
+    return s;
+  /* the record of (NULL, blob of node_size bytes): its header, then the
+   * blob, zero until the root is known */
+  unsigned char body[16];
+  tt__sqlite_rec r;
+  tt__sqlite_rec_begin(&r, body, rs->format);
+  tt__sqlite_rec_null(&r);
+  tt__sqlite_rec_bytes_type(&r, sh->node_size, 0);
+  const unsigned char *head;
+  rs->root_head = tt__sqlite_rec_head(&r, &head);
+  memset(rs->blob, 0, sh->node_size);
+  s = tt__sqlite_table_append2_spot(rs->node_t, 1, head, rs->root_head,
+                                    rs->blob, sh->node_size, &rs->root_spot);
+  rs->streaming = 1;
+  return s;
+}
+
+/* The block buf[0..nbuf) as leaves: nodes, rowid pairs, leaf boxes. */
+static tt_status stream_pack(tt__rtree_stream *rs)
+{
+  const size_t n = rs->nbuf, cap = rs->sh->node_cap;
+  if (n == 0)
+    return TT_OK;
+  tt_status s = rs->streaming ? TT_OK : stream_begin(rs);
+  if (s != TT_OK)
+    return s;
+  const size_t ngroups = (n + cap - 1) / cap;
+  if (!tt__grow((void **)&rs->tmp, &rs->cap_tmp, n, sizeof *rs->tmp) ||
+      !tt__grow((void **)&rs->node_of, &rs->cap_node_of, n,
+                sizeof *rs->node_of) ||
+      !tt__grow((void **)&rs->leaves, &rs->cap_leaves,
+                rs->nleaves + ngroups, sizeof *rs->leaves))
+    return tt__error(rs->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
+                     "spatial index", rs->what);
+  if ((uint64_t)rs->nleaves + ngroups + 1 > 0xffffffffu)
+    return tt__error(rs->ctx, TT_ERR_INTERNAL, "%s: more than 2^32 R-tree "
+                     "leaves", rs->what);
+  str_order(rs->buf, n, ngroups, rs->tmp, 1);
+  for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
+    size_t e0 = group_start(g, n, ngroups), e1 = group_start(g + 1, n,
+                                                              ngroups);
+    rt_item *leaf = &rs->leaves[rs->nleaves];
+    leaf->id = (int64_t)rs->nleaves + 2;
+    memcpy(leaf->box, rs->buf[e0].box, sizeof leaf->box);
+    for (size_t i = e0; i < e1; i++) {
+      const float *bx = rs->buf[i].box;
+      if (bx[0] < leaf->box[0]) leaf->box[0] = bx[0];
+      if (bx[1] > leaf->box[1]) leaf->box[1] = bx[1];
+      if (bx[2] < leaf->box[2]) leaf->box[2] = bx[2];
+      if (bx[3] > leaf->box[3]) leaf->box[3] = bx[3];
+      rs->node_of[rs->buf[i].id - rs->first_id] = (uint32_t)leaf->id;
+    }
+    node_blob(rs->blob, rs->sh->node_size, rs->buf + e0, e1 - e0, 0);
+    s = node_row(rs->node_t, leaf->id, rs->blob, rs->sh->node_size,
+                 rs->format);
+    rs->nleaves++;
+  }
+  for (size_t i = 0; i < n && s == TT_OK; i++)
+    s = tt__sqlite_table_append_int(rs->rowid_t, rs->first_id + (int64_t)i,
+                                    rs->node_of[i]);
+  rs->first_id += (int64_t)n;
+  rs->nbuf = 0;
+  return s;
+}
+
+tt_status tt__rtree_stream_add(tt__rtree_stream *rs, const tt__rtree_box *b)
+{
+  if (b->id != rs->first_id + (int64_t)rs->nbuf)
+    return tt__error(rs->ctx, TT_ERR_INTERNAL, "%s: R-tree box of id %lld "
+                     "where %lld was due", rs->what, (long long)b->id,
+                     (long long)(rs->first_id + (int64_t)rs->nbuf));
+  if (!tt__grow((void **)&rs->buf, &rs->cap_buf, rs->nbuf + 1,
+                sizeof *rs->buf))
+    return tt__error(rs->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
+                     "spatial index", rs->what);
+  rs->buf[rs->nbuf++] = *b;
+  if (rs->nbuf >= RT_STREAM_HARD * rs->block)
+    return stream_pack(rs);
+  return TT_OK;
+}
+
+tt_status tt__rtree_stream_cut(tt__rtree_stream *rs)
+{
+  return rs->nbuf >= rs->block ? stream_pack(rs) : TT_OK;
+}
+
+tt_status tt__rtree_stream_finish(tt__rtree_stream *rs,
+                                  tt_progress_fn progress,
+                                  void *progress_arg)
+{
+  if (!rs->streaming) /* one block at most: the whole layer's STR */
+    return tt__rtree_write_pages(rs->ctx, rs->what, rs->buf, rs->nbuf,
+                                 NULL, rs->sh, rs->f, progress,
+                                 progress_arg);
+  const tt__rtree_shadow *sh = rs->sh;
+  tt__rtree_packed *pk = NULL;
+  uint32_t *parent = NULL;
+  char *name = NULL;
+  tt__sqlite_table *t = NULL;
+  tt_status s = stream_pack(rs);
+  if (s == TT_OK && progress && !progress(0.5, "indexing", progress_arg))
+    s = tt__error(rs->ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
+                  "index was interrupted", rs->what);
+  /* the upper levels: the leaves packed as any level is, numbered on */
+  const size_t L = rs->nleaves;
+  if (s == TT_OK) {
+    s = pack_items(rs->ctx, rs->what, rs->leaves, L, sh->node_cap,
+                   (int64_t)L + 2, &pk);
+    if (s == TT_OK) { /* the leaves are pk's now */
+      rs->leaves = NULL;
+      rs->cap_leaves = 0;
+    }
+  }
+  const int top = pk ? pk->nlevels - 1 : 0;
+  for (int d = 0; d < top && s == TT_OK; d++) {
+    size_t ngroups = pk->n[d + 1];
+    for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
+      size_t e0 = group_start(g, pk->n[d], ngroups);
+      size_t e1 = group_start(g + 1, pk->n[d], ngroups);
+      node_blob(rs->blob, sh->node_size, pk->level[d] + e0, e1 - e0, 0);
+      s = node_row(rs->node_t, pk->base[d] + (int64_t)g, rs->blob,
+                   sh->node_size, rs->format);
+    }
+  }
+  if (s == TT_OK) {
+    s = tt__sqlite_table_finish(rs->node_t);
+    rs->node_t = NULL;
+  }
+  if (s == TT_OK) { /* node 1: the root, a level above the top's cells */
+    node_blob(rs->blob, sh->node_size, pk->level[top], pk->n[top],
+              (unsigned)top + 1);
+    s = tt__sqlite_file_patch(rs->f, &rs->root_spot, rs->root_head,
+                              rs->blob, sh->node_size);
+  }
+  if (s == TT_OK) {
+    s = tt__sqlite_table_finish(rs->rowid_t);
+    rs->rowid_t = NULL;
+  }
+  /* %_parent: every node but the root, leaves 2..L+1 then the levels
+   * above */
+  const size_t last = pk ? L + pk->nodes_total : 0;
+  if (s == TT_OK) {
+    parent = calloc(last + 1, sizeof *parent);
+    if (!parent)
+      s = tt__error(rs->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
+                    "spatial index", rs->what);
+  }
+  for (int e = 0; e <= top && s == TT_OK; e++) {
+    size_t ngroups = e == top ? 1 : pk->n[e + 1];
+    for (size_t g = 0; g < ngroups; g++) {
+      size_t e0 = e == top ? 0 : group_start(g, pk->n[e], ngroups);
+      size_t e1 = e == top ? pk->n[e] : group_start(g + 1, pk->n[e],
+                                                    ngroups);
+      uint32_t node = e == top ? 1u : (uint32_t)(pk->base[e] + (int64_t)g);
+      for (size_t i = e0; i < e1; i++)
+        parent[pk->level[e][i].id] = node;
+    }
+  }
+  name = s == TT_OK ? sqlite3_mprintf("%s_parent", sh->rtree) : NULL;
+  if (s == TT_OK)
+    s = name ? tt__sqlite_table_begin(rs->f, name, sh->root[1], &t)
+             : tt__error(rs->ctx, TT_ERR_NOMEM, "out of memory");
+  for (size_t m = 2; m <= last && s == TT_OK; m++)
+    s = tt__sqlite_table_append_int(t, (int64_t)m, parent[m]);
+  if (s == TT_OK) {
+    s = tt__sqlite_table_finish(t);
+    t = NULL;
+  }
+  if (s == TT_OK && progress && !progress(1.0, "indexing", progress_arg))
+    s = tt__error(rs->ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
+                  "index was interrupted", rs->what);
+  sqlite3_free(name);
+  free(parent);
+  tt__rtree_packed_free(pk);
   return s;
 }

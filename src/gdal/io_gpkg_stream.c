@@ -50,8 +50,6 @@ struct tt__gpkg_stream {
   int32_t srs_id[2];
   size_t count[2];
   double ext[2][4];
-  tt__rtree_box *boxes[2];
-  size_t cap[2];
   /* the layers' default style (STYLE=YES), whose classes the whole TIN's
    * values make: the triangles' max_err range, every vertex's finite
    * ins_err (quantiles: 8 bytes a vertex) */
@@ -109,24 +107,6 @@ static void set_real(tt__gpkg_value *v, double d)
   v->d = d;
 }
 
-/* Room for n more boxes of layer k. */
-static tt_status box_room(tt__gpkg_stream *g, int k, size_t n)
-{
-  if (!g->rtree || g->count[k] + n <= g->cap[k])
-    return TT_OK;
-  size_t c = g->cap[k] + g->cap[k] / 2;
-  if (c < g->count[k] + n)
-    c = g->count[k] + n;
-  tt__rtree_box *b = realloc(g->boxes[k], c * sizeof *b);
-  if (!b)
-    return tt__error(g->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                     "spatial index of %zu features", g->path,
-                     g->count[k] + n);
-  g->boxes[k] = b;
-  g->cap[k] = c;
-  return TT_OK;
-}
-
 tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
                                OGRSpatialReferenceH srs, char **options,
                                tt__gpkg_stream **out)
@@ -175,10 +155,7 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   const tt_tin *tin = b->tri;
   tt__records rec;
-  tt_status s = box_room(g, 0, tt_tin_triangle_count(tin));
-  if (s != TT_OK)
-    return s;
-  s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
+  tt_status s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
   unsigned char blob[TRI_BLOB];
   tt__gpkg_value f[TT__TF_COUNT];
   for (size_t i = 0; i < tt_tin_triangle_count(tin) && s == TT_OK; i++) {
@@ -212,9 +189,8 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     size_t fid = b->tri_first + i + 1;
     extend(g->ext[0], lo[0], lo[1]);
     extend(g->ext[0], hi[0], hi[1]);
-    if (g->rtree)
-      tt__rtree_box_set(&g->boxes[0][g->count[0]], (int64_t)fid, lo[0],
-                        hi[0], lo[1], hi[1]);
+    tt__rtree_box box;
+    tt__rtree_box_set(&box, (int64_t)fid, lo[0], hi[0], lo[1], hi[1]);
     set_int(&f[TT__TF_V0], b->map[tr.v[0]]);
     set_int(&f[TT__TF_V1], b->map[tr.v[1]]);
     set_int(&f[TT__TF_V2], b->map[tr.v[2]]);
@@ -232,7 +208,7 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
     set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
     s = tt__gpkg_pages_row(g->pages, 0, (int64_t)fid, f, blob,
-                           (size_t)(q - blob));
+                           (size_t)(q - blob), g->rtree ? &box : NULL);
     g->count[0]++;
   }
   tt__records_free(&rec);
@@ -245,10 +221,7 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   const tt_tin *tin = b->vtx;
   tt__records rec;
-  tt_status s = box_room(g, 1, tt_tin_vertex_count(tin));
-  if (s != TT_OK)
-    return s;
-  s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
+  tt_status s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
   unsigned char blob[PT_BLOB];
   tt__gpkg_value f[TT__VF_COUNT];
   for (size_t i = 0; i < tt_tin_vertex_count(tin) && s == TT_OK; i++) {
@@ -265,9 +238,8 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     q = put_f64(q, y);
     q = put_f64(q, v.z);
     extend(g->ext[1], x, y);
-    if (g->rtree)
-      tt__rtree_box_set(&g->boxes[1][g->count[1]], (int64_t)id + 1, x, x,
-                        y, y);
+    tt__rtree_box box;
+    tt__rtree_box_set(&box, (int64_t)id + 1, x, x, y, y);
     set_int(&f[TT__VF_ID], (int64_t)id);
     set_int(&f[TT__VF_COL], v.col);
     set_int(&f[TT__VF_ROW], v.row);
@@ -291,7 +263,7 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     set_real(&f[TT__VF_STAR_RMSE], v.star_rmse);
     set_int(&f[TT__VF_STAR_N], (int64_t)v.star_samples);
     s = tt__gpkg_pages_row(g->pages, 1, (int64_t)id + 1, f, blob,
-                           (size_t)(q - blob));
+                           (size_t)(q - blob), g->rtree ? &box : NULL);
     g->count[1]++;
   }
   tt__records_free(&rec);
@@ -301,17 +273,25 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
 tt_status tt__gpkg_stream_batch(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   tt_status s = TT_OK;
+  /* a batch is a piece's triangles and the vertices final after it: an
+   * R-tree block may end after either (tt__gpkg_pages_cut) */
   if (b->tri && tt_tin_triangle_count(b->tri)) {
-    if (g->todo[0])
+    if (g->todo[0]) {
       s = triangles(g, b);
-    else
+      if (s == TT_OK)
+        s = tt__gpkg_pages_cut(g->pages, 0);
+    } else {
       g->count[0] += tt_tin_triangle_count(b->tri);
+    }
   }
   if (s == TT_OK && b->vtx && tt_tin_vertex_count(b->vtx)) {
-    if (g->todo[1])
+    if (g->todo[1]) {
       s = vertices(g, b);
-    else
+      if (s == TT_OK)
+        s = tt__gpkg_pages_cut(g->pages, 1);
+    } else {
       g->count[1] += tt_tin_vertex_count(b->vtx);
+    }
   }
   return s;
 }
@@ -411,7 +391,7 @@ tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
   size_t count[2];
   for (int k = 0; k < 2; k++)
     count[k] = g->todo[k] ? g->count[k] : 0;
-  tt_status s = tt__gpkg_pages_finish(g->pages, g->boxes, count,
+  tt_status s = tt__gpkg_pages_finish(g->pages, count,
                                       (const double(*)[4])g->ext, progress,
                                       progress_arg);
   tt__gpkg_pages_close(g->pages); /* SQLite's connection too */
@@ -423,8 +403,7 @@ tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
 
 size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g)
 {
-  return g ? (g->cap[0] + g->cap[1]) * sizeof(tt__rtree_box) +
-                 g->inscap * sizeof(double)
+  return g ? tt__gpkg_pages_bytes(g->pages) + g->inscap * sizeof(double)
            : 0;
 }
 
@@ -433,8 +412,6 @@ void tt__gpkg_stream_close(tt__gpkg_stream *g)
   if (!g)
     return;
   tt__gpkg_pages_close(g->pages);
-  free(g->boxes[0]);
-  free(g->boxes[1]);
   free(g->ins);
   CPLFree(g->t_srs);
   CPLFree(g->prefix);
