@@ -75,8 +75,9 @@ TT_HIDDEN void tt__gpkg_pages_close(tt__gpkg_pages *p);
  * layers' input CRS, options those of tt_gpkg_write_rows(), T_SRS
  * included); tt__gpkg_stream_batch() for each batch tt__tin_stream_add()
  * gave, in order; tt__gpkg_stream_finish() after the last tile. The rows,
- * blobs, boxes, extents and counts are those tt_gpkg_write_rows() writes
- * for the merged TIN, byte for byte. The caller frees *out with
+ * blobs, extents and counts are those tt_gpkg_write_rows() writes for the
+ * merged TIN, byte for byte; the R-trees hold the same boxes (their nodes
+ * the same only for a layer of one block). The caller frees *out with
  * tt__gpkg_stream_close() (which undoes an unfinished write, as above). */
 typedef struct tt__gpkg_stream tt__gpkg_stream;
 TT_HIDDEN tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,

@@ -1704,8 +1704,18 @@ done:
  * pages_run()'s steps 1 to 3 split so that a tiled run
  * (io_gpkg_stream.c) can append rows as its tiles finish instead of from a
  * whole TIN: open makes step 1 and begins the tables, each row is
- * encoded as append_layer() encodes it, finish ends step 2 and makes step
- * 3. Nothing above changes. */
+ * encoded as append_layer() encodes it and its box handed to its layer's
+ * R-tree, which writes its leaves block by block (tt__rtree_stream), a
+ * block ending at a cut the caller marks; finish ends step 2 (the last
+ * blocks, the trees' upper levels and roots) and makes step 3. Nothing
+ * above changes.
+ *
+ * The block: 65,536 boxes. On the 8193² fractal (2.0 M features, tiles of
+ * 1,024) blocks of 16,384, 65,536 and 262,144 gave trees whose 1,000
+ * random windows of 0.1, 1 and 5 % of the extent's side visit as many
+ * nodes as the whole-layer STR tree's (within 1 %); a block a batch gave
+ * up to 4 times as many for the vertices, whose batches split tiles.
+ * 65,536 boxes cost about 5 MB a layer with their scratch. */
 #include "gdal/gpkg_stream.h"
 
 /* The boxes an R-tree block gathers at least before its leaves are

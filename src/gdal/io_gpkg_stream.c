@@ -14,10 +14,17 @@
  * (tests/apps/test_tiles.sh compares them). The extents are min/max over
  * the rows, whatever the order.
  *
- * The R-trees need every box: they are kept (40 bytes a feature, about
- * 120 bytes a vertex with its two triangles) and packed at the end, as
- * the merged-TIN path does; that is the one store here that grows with
- * the TIN.
+ * Each row's box (rounded outward to the floats the index stores) goes
+ * with it to the page writer, whose R-trees pack their leaves block by
+ * block as the rows come (tt__rtree_stream, io_gpkg_rtree.c): a block ends
+ * after a batch, a piece's triangles or the vertices final after it
+ * (tt__gpkg_pages_cut), once it holds 65,536 boxes, so a block is a strip
+ * of whole pieces, a few tiles of 1,024 at 1 % of the samples. Only the
+ * leaves' boxes (24 bytes a leaf of about 51 features) are kept until the
+ * end, when the upper levels and the root are written: the trees hold the
+ * same boxes as the merged-TIN path's but not the same nodes (their
+ * queries visit as many: docs/scale.md). Left to grow with the TIN: 8
+ * bytes a vertex for the style's quantile classes.
  *
  * Workload: per triangle row tt_tin_triangle()'s arithmetic and a 165-byte
  * blob, per vertex a 37-byte one; T_SRS transforms each piece's vertices

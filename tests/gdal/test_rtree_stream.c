@@ -221,39 +221,96 @@ static tt_status stream_boxes(const char *path, const tt__rtree_shadow *sh,
   return s != TT_OK ? s : c;
 }
 
-/* The nodes the stream makes: leaves block by block as the cuts and the
- * hard limit pack them, then the levels above; a layer never packed in
- * blocks is the whole-layer STR tree. *depth: the root's. */
-static size_t expected_nodes(size_t n, size_t block, size_t piece, size_t cap,
+/* The stream's blocks replayed (io_gpkg_rtree.c, tt__rtree_stream_cut):
+ * at a cut the boxes since the last one join the block, and when they lie
+ * apart from it (a row of tiles wrapped) the block may end before them; a
+ * full block ends there if it can, else at the cut; 16 times the block
+ * size ends it anywhere. */
+typedef struct replay {
+  const tt__rtree_box *boxes;
+  size_t cap, block, b0, mark, split, leaves;
+  float so_far[4];
+  int streamed;
+} replay;
+
+static void bounds_of(const tt__rtree_box *b, size_t n, float out[4])
+{
+  memcpy(out, b[0].box, sizeof b[0].box);
+  for (size_t i = 1; i < n; i++) {
+    out[0] = fminf(out[0], b[i].box[0]);
+    out[1] = fmaxf(out[1], b[i].box[1]);
+    out[2] = fminf(out[2], b[i].box[2]);
+    out[3] = fmaxf(out[3], b[i].box[3]);
+  }
+}
+
+static void replay_pack(replay *r, size_t k, size_t end)
+{
+  r->leaves += (k + r->cap - 1) / r->cap;
+  r->b0 += k;
+  r->streamed = 1;
+  r->mark = r->split = 0;
+  if (end > r->b0) {
+    bounds_of(r->boxes + r->b0, end - r->b0, r->so_far);
+    r->mark = end - r->b0;
+  }
+}
+
+static void replay_cut(replay *r, size_t end)
+{
+  size_t n = end - r->b0, m = r->mark;
+  if (n == m)
+    return;
+  float bb[4];
+  bounds_of(r->boxes + r->b0 + m, n - m, bb);
+  if (m == 0) {
+    memcpy(r->so_far, bb, sizeof bb);
+  } else {
+    float *sf = r->so_far;
+    if (bb[0] > sf[1] || bb[1] < sf[0] || bb[2] > sf[3] || bb[3] < sf[2])
+      r->split = m;
+    sf[0] = fminf(sf[0], bb[0]);
+    sf[1] = fmaxf(sf[1], bb[1]);
+    sf[2] = fminf(sf[2], bb[2]);
+    sf[3] = fmaxf(sf[3], bb[3]);
+  }
+  r->mark = n;
+  if (n < r->block)
+    return;
+  replay_pack(r, r->split ? r->split : n, end);
+  if (end - r->b0 >= r->block)
+    replay_pack(r, end - r->b0, end);
+}
+
+/* The nodes the stream makes of boxes[0..n): leaves block by block, then
+ * the levels above; a layer never packed in blocks is the whole-layer STR
+ * tree. *depth: the root's. */
+static size_t expected_nodes(const tt__rtree_box *boxes, size_t n,
+                             size_t block, size_t piece, size_t cap,
                              int *depth)
 {
-  if (block <= cap)
-    block = cap + 1;
-  size_t leaves = 0, buffered = 0;
-  int streamed = 0;
+  replay r;
+  memset(&r, 0, sizeof r);
+  r.boxes = boxes;
+  r.cap = cap;
+  r.block = block <= cap ? cap + 1 : block;
   for (size_t i = 0; i < n; i++) {
-    buffered++;
-    if (buffered >= 16 * block ||
-        (piece && (i + 1) % piece == 0 && buffered >= block)) {
-      leaves += (buffered + cap - 1) / cap;
-      buffered = 0;
-      streamed = 1;
-    }
+    if (i + 1 - r.b0 >= 16 * r.block)
+      replay_pack(&r, i + 1 - r.b0, i + 1);
+    if (piece && (i + 1) % piece == 0)
+      replay_cut(&r, i + 1);
   }
-  if (piece && buffered >= block) {
-    leaves += (buffered + cap - 1) / cap;
-    buffered = 0;
-    streamed = 1;
-  }
-  size_t level = leaves, nodes = leaves;
-  *depth = 1;
-  if (!streamed) { /* the features are the bottom level */
+  if (piece)
+    replay_cut(&r, n);
+  size_t level, nodes;
+  if (!r.streamed) { /* the features are the bottom level */
     level = n;
     nodes = 0;
     *depth = 0;
   } else {
-    level += (buffered + cap - 1) / cap;
+    level = r.leaves + (n - r.b0 + cap - 1) / cap;
     nodes = level;
+    *depth = 1;
   }
   while (level > cap) {
     level = (level + cap - 1) / cap;
@@ -261,6 +318,40 @@ static size_t expected_nodes(size_t n, size_t block, size_t piece, size_t cap,
     (*depth)++;
   }
   return nodes + 1; /* the root */
+}
+
+/* The widest leaf of path (its x extent). */
+static double widest_leaf(const char *path)
+{
+  sqlite3 *db = db_open(path);
+  if (!db)
+    return -1;
+  sqlite3_stmt *st = NULL;
+  sqlite3_prepare_v2(db, "SELECT data FROM rtree_t_geom_node WHERE nodeno "
+                     "IN (SELECT nodeno FROM rtree_t_geom_rowid)", -1, &st,
+                     NULL);
+  double most = 0;
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    const unsigned char *d = sqlite3_column_blob(st, 0);
+    int nc = d[2] << 8 | d[3];
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < nc; i++) {
+      const unsigned char *c = d + 4 + 24 * i + 8; /* minx, maxx */
+      for (int k = 0; k < 2; k++) {
+        uint32_t u = (uint32_t)c[4 * k] << 24 | (uint32_t)c[4 * k + 1] << 16 |
+                     (uint32_t)c[4 * k + 2] << 8 | c[4 * k + 3];
+        float f;
+        memcpy(&f, &u, sizeof f);
+        lo = fmin(lo, f);
+        hi = fmax(hi, f);
+      }
+    }
+    if (nc && hi - lo > most)
+      most = hi - lo;
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  return most;
 }
 
 /* --- checks -------------------------------------------------------------- */
@@ -404,7 +495,7 @@ static long long node_count(const char *path)
 
 /* One case: n boxes in pieces, streamed in blocks, checked. */
 static void one_case(const char *name, int page, size_t n, size_t block,
-                     size_t piece)
+                     size_t piece, int rows_apart)
 {
   tt__rtree_box *boxes = make_boxes(n, piece ? piece : 1000);
   const char *path = tmp_path(name);
@@ -419,13 +510,21 @@ static void one_case(const char *name, int page, size_t n, size_t block,
   if (s != TT_OK)
     printf("%s: %s\n", name, tt_context_errmsg(ctx));
   int depth = 0;
-  size_t nodes = expected_nodes(n, block, piece, sh.node_cap, &depth);
+  size_t nodes = expected_nodes(boxes, n, block, piece, sh.node_cap, &depth);
   printf("%s: %zu boxes, pages of %d (%zu cells a node), blocks of %zu, "
          "pieces of %zu: %lld nodes (expected %zu), depth %d, at most %zu "
          "bytes held\n", name, n, page, sh.node_cap, block, piece,
          node_count(path), nodes, root_depth(path), peak);
   CHECK_INT_EQ(node_count(path), (long long)nodes);
   CHECK_INT_EQ(root_depth(path), depth);
+  /* a piece a tile, blocks of fewer than a row of 8 tiles of 1,000
+   * units: a block ends where a row wraps, so no leaf holds both the end
+   * of a row and the start of the next (it would be some 6,000 wide) */
+  if (rows_apart) {
+    double most = widest_leaf(path);
+    printf("%s: the widest leaf spans %.0f units\n", name, most);
+    CHECK_DBL_LE(most, 2000.0);
+  }
   check_tree(path, boxes, n, 150);
   tt__rtree_shadow_free(&sh);
   free(boxes);
@@ -588,25 +687,29 @@ int main(void)
   ctx = tt_context_create();
 
   /* small counts: never a block (the whole-layer tree) */
-  one_case("empty.gpkg", 4096, 0, 100, 10);
-  one_case("one.gpkg", 4096, 1, 100, 10);
-  one_case("one_leaf.gpkg", 4096, 51, 100, 51);
+  one_case("empty.gpkg", 4096, 0, 100, 10, 0);
+  one_case("one.gpkg", 4096, 1, 100, 10, 0);
+  one_case("one_leaf.gpkg", 4096, 51, 100, 51, 0);
   /* one box more than a leaf, in one block of 52: two leaves under a root
    * in the %_node table's root page (the patch in the page kept for the
    * commit) */
-  one_case("two_leaves.gpkg", 4096, 52, 1, 52);
+  one_case("two_leaves.gpkg", 4096, 52, 1, 52, 0);
   /* blocks at the pieces' ends; exactly on the block size; a last block
    * of one box; no cuts at all */
-  one_case("pieces.gpkg", 4096, 20000, 2000, 777);
-  one_case("exact.gpkg", 4096, 3 * 2040, 2040, 2040);
-  one_case("last_one.gpkg", 4096, 3 * 2040 + 1, 2040, 2040);
-  one_case("no_cuts.gpkg", 4096, 40000, 1000, 0);
+  one_case("pieces.gpkg", 4096, 20000, 2000, 777, 0);
+  /* rows of 8 tiles of 1,000 boxes, blocks of 2,500 to 7,000: every block
+   * that fills after a row's end ends there */
+  one_case("rows.gpkg", 4096, 40000, 2500, 1000, 1);
+  one_case("rows_7.gpkg", 4096, 40000, 7000, 1000, 1);
+  one_case("exact.gpkg", 4096, 3 * 2040, 2040, 2040, 0);
+  one_case("last_one.gpkg", 4096, 3 * 2040 + 1, 2040, 2040, 0);
+  one_case("no_cuts.gpkg", 4096, 40000, 1000, 0, 0);
   /* node 1's page in the write queue, then written before the patch */
-  one_case("queued.gpkg", 4096, 5000, 1000, 500);
-  one_case("one_node_a_page.gpkg", 1024, 30000, 3000, 1500);
-  one_case("written.gpkg", 4096, 200000, 4096, 3000);
+  one_case("queued.gpkg", 4096, 5000, 1000, 500, 0);
+  one_case("one_node_a_page.gpkg", 1024, 30000, 3000, 1500, 0);
+  one_case("written.gpkg", 4096, 200000, 4096, 3000, 0);
   /* four levels with nodes of 18 cells */
-  one_case("deep.gpkg", 512, 25000, 500, 333);
+  one_case("deep.gpkg", 512, 25000, 500, 333, 0);
   test_one_block_same(5000);
   test_changes();
   test_refusals();
