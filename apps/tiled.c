@@ -291,9 +291,9 @@ static tt_status stream_piece(tiled *T, size_t k)
              tt_context_errmsg(r->ctx));
     return st;
   }
-  /* -max_memory: what grows with the TIN here, beside the tiles in
-   * flight: the boxes kept for the R-trees, the pending vertices (56 bytes
-   * each), 4 bytes a vertex for the components */
+  /* -max_memory: what grows with the TIN beside the tiles in flight: the
+   * writer's R-tree blocks, leaf boxes and style classes, the pending
+   * vertices (56 bytes each), 4 bytes a vertex for the components */
   size_t nv = b.vtx_first + (b.vtx ? tt_tin_vertex_count(b.vtx) : 0);
   size_t bytes = tt__gpkg_stream_bytes(sink->out) +
                  56 * tt__tin_stream_pending(T->stream) + 4 * nv;
