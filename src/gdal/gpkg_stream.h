@@ -3,7 +3,8 @@
  * (io_gpkg_stream.c), and what it needs of the page writer of
  * io_gpkg_rows.c: the two layers' tables filled row by row as database
  * pages, in fid order, with SQLite closed, then their R-trees, extents and
- * counts (tt__gpkg_pages_*).
+ * counts (tt__gpkg_pages_*); and the pieces both write their geometry
+ * blobs with, so that they write the same bytes.
  */
 #ifndef TERRATIN_GPKG_STREAM_H
 #define TERRATIN_GPKG_STREAM_H
@@ -99,5 +100,50 @@ TT_HIDDEN void tt__gpkg_stream_close(tt__gpkg_stream *g);
 /* The bytes the writer holds: the R-trees' blocks and leaves' boxes
  * (tt__gpkg_pages_bytes), the vertices' insertion errors for the style. */
 TT_HIDDEN size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g);
+
+/* --- GeoPackage geometry blobs, as io_gpkg_rows.c and io_gpkg_stream.c
+ * write them: the blob header ("GP", version 0, flags, srs_id; GeoPackage
+ * 1.4 section 2.1.3), then ISO WKB, little-endian whatever the host's
+ * order; and a layer's extent grown point by point. Static inline with
+ * short names, so that the blob code reads as the format does. */
+#include <string.h>
+
+/* Little-endian stores; each returns the byte after the value. */
+static inline unsigned char *put_u32(unsigned char *p, uint32_t v)
+{
+  for (int k = 0; k < 4; k++)
+    *p++ = (unsigned char)(v >> (8 * k));
+  return p;
+}
+
+static inline unsigned char *put_f64(unsigned char *p, double d)
+{
+  uint64_t v;
+  memcpy(&v, &d, sizeof v);
+  for (int k = 0; k < 8; k++)
+    *p++ = (unsigned char)(v >> (8 * k));
+  return p;
+}
+
+/* The blob header: magic, version 0 (version 1 of the format), flags
+ * (byte order, envelope kind, empty), srs_id. */
+static inline unsigned char *put_header(unsigned char *p, unsigned flags,
+                                        int32_t srs_id)
+{
+  *p++ = 'G';
+  *p++ = 'P';
+  *p++ = 0;
+  *p++ = (unsigned char)flags;
+  return put_u32(p, (uint32_t)srs_id);
+}
+
+/* ext (minx, miny, maxx, maxy) grown to (x, y). */
+static inline void extend(double *ext, double x, double y)
+{
+  if (x < ext[0]) ext[0] = x;
+  if (y < ext[1]) ext[1] = y;
+  if (x > ext[2]) ext[2] = x;
+  if (y > ext[3]) ext[3] = y;
+}
 
 #endif /* TERRATIN_GPKG_STREAM_H */

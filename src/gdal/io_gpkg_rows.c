@@ -70,6 +70,7 @@
  * vertex.
  */
 #include "gdal/gpkg_rtree.h"
+#include "gdal/gpkg_stream.h"
 #include "gdal/sqlite_pages.h"
 #include "gdal/tin_records.h"
 
@@ -136,42 +137,6 @@ static tt_status exec(rows_state *w, const char *sql, const char *what)
                           err ? err : sqlite3_errmsg(w->db));
   sqlite3_free(err);
   return s;
-}
-
-/* Little-endian stores, whatever the host's order. */
-static unsigned char *put_u32(unsigned char *p, uint32_t v)
-{
-  for (int k = 0; k < 4; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_f64(unsigned char *p, double d)
-{
-  uint64_t v;
-  memcpy(&v, &d, sizeof v);
-  for (int k = 0; k < 8; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_header(unsigned char *p, unsigned flags,
-                                 int32_t srs_id)
-{
-  *p++ = 'G';
-  *p++ = 'P';
-  *p++ = 0; /* version 1 of the blob format */
-  *p++ = (unsigned char)flags;
-  return put_u32(p, (uint32_t)srs_id);
-}
-
-/* ext (minx, miny, maxx, maxy) grown to (x, y). */
-static void extend(double *ext, double x, double y)
-{
-  if (x < ext[0]) ext[0] = x;
-  if (y < ext[1]) ext[1] = y;
-  if (x > ext[2]) ext[2] = x;
-  if (y > ext[3]) ext[3] = y;
 }
 
 static tt_status report(rows_state *w)
@@ -1716,7 +1681,6 @@ done:
  * nodes as the whole-layer STR tree's (within 1 %); a block a batch gave
  * up to 4 times as many for the vertices, whose batches split tiles.
  * 65,536 boxes cost about 5 MB a layer with their scratch. */
-#include "gdal/gpkg_stream.h"
 
 /* The boxes an R-tree block gathers at least before its leaves are
  * packed and written (RTREE_BLOCK; docs/scale.md has the measurements). */

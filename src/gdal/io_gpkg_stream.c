@@ -68,40 +68,6 @@ struct tt__gpkg_stream {
   unsigned layers;
 };
 
-static unsigned char *put_u32(unsigned char *p, uint32_t v)
-{
-  for (int k = 0; k < 4; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_f64(unsigned char *p, double d)
-{
-  uint64_t v;
-  memcpy(&v, &d, sizeof v);
-  for (int k = 0; k < 8; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_header(unsigned char *p, unsigned flags,
-                                 int32_t srs_id)
-{
-  *p++ = 'G';
-  *p++ = 'P';
-  *p++ = 0;
-  *p++ = (unsigned char)flags;
-  return put_u32(p, (uint32_t)srs_id);
-}
-
-static void extend(double *ext, double x, double y)
-{
-  if (x < ext[0]) ext[0] = x;
-  if (y < ext[1]) ext[1] = y;
-  if (x > ext[2]) ext[2] = x;
-  if (y > ext[3]) ext[3] = y;
-}
-
 static void set_int(tt__gpkg_value *v, int64_t i)
 {
   v->type = TT__GV_INT;
