@@ -33,6 +33,7 @@
 #include "gdal/sqlite_pages.h"
 #include "terratin/terratin.h"
 #include "tt_test.h"
+#include "tt_test_sqlite.h"
 
 #include <sqlite3.h>
 
@@ -60,70 +61,6 @@ static const char *tmp_path(const char *name)
   k = (k + 1) % 8;
   snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir, name);
   return buf[k];
-}
-
-static unsigned char *slurp(const char *path, size_t *out_len)
-{
-  FILE *fp = fopen(path, "rb");
-  *out_len = 0;
-  if (!fp)
-    return NULL;
-  fseek(fp, 0, SEEK_END);
-  long n = ftell(fp);
-  fseek(fp, 0, SEEK_SET);
-  unsigned char *p = malloc(n > 0 ? (size_t)n : 1);
-  if (p && fread(p, 1, (size_t)n, fp) != (size_t)n) {
-    free(p);
-    p = NULL;
-  }
-  fclose(fp);
-  *out_len = p ? (size_t)n : 0;
-  return p;
-}
-
-/* --- SQLite helpers ------------------------------------------------------ */
-
-static sqlite3 *db_open(const char *path)
-{
-  sqlite3 *db = NULL;
-  if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE, NULL) != SQLITE_OK) {
-    TT_FAIL_("cannot open %s: %s", path, db ? sqlite3_errmsg(db) : "?");
-    sqlite3_close(db);
-    return NULL;
-  }
-  return db;
-}
-
-static char *sql_text(sqlite3 *db, const char *sql)
-{
-  sqlite3_stmt *st = NULL;
-  char *out = NULL;
-  if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
-    TT_FAIL_("prepare %s: %s", sql, sqlite3_errmsg(db));
-    return NULL;
-  }
-  if (sqlite3_step(st) == SQLITE_ROW) {
-    const unsigned char *t = sqlite3_column_text(st, 0);
-    out = strdup(t ? (const char *)t : "(null)");
-  }
-  sqlite3_finalize(st);
-  return out;
-}
-
-static long long sql_int(sqlite3 *db, const char *sql)
-{
-  char *t = sql_text(db, sql);
-  long long v = t ? atoll(t) : -1;
-  free(t);
-  return v;
-}
-
-static void sql_exec(sqlite3 *db, const char *sql)
-{
-  char *err = NULL;
-  if (sqlite3_exec(db, sql, NULL, NULL, &err) != SQLITE_OK)
-    TT_FAIL_("%s: %s", sql, err ? err : "?");
-  sqlite3_free(err);
 }
 
 /* --- the boxes ----------------------------------------------------------- */
