@@ -52,7 +52,7 @@ static inline void tt__rtree_box_set(tt__rtree_box *b, int64_t id,
   b->box[3] = tt__rtree_up(maxy);
 }
 
-/* A tree packed beforehand (Sort-Tile-Recursive, see io_gpkg_rtree.c),
+/* A tree packed beforehand (Sort-Tile-Recursive, see rtree_pack.c),
  * without a database: the row writer packs on its second thread while
  * SQLite inserts rows. */
 typedef struct tt__rtree_packed tt__rtree_packed;
@@ -123,7 +123,7 @@ TT_HIDDEN tt_status tt__rtree_write_pages(
  * (the streamed tiled run, io_gpkg_stream.c): its leaves are packed and
  * written block by block as the boxes come, only the leaves' boxes are
  * kept, and the upper levels, the root (node 1, a placeholder patched at
- * the end) and %_parent are written by the finish (io_gpkg_rtree.c, "the
+ * the end) and %_parent are written by the finish (io_gpkg_rtree_pages.c, "the
  * index written as the rows stream in", has the design). A layer of at
  * most one block gets the tree tt__rtree_write_pages() writes.
  *

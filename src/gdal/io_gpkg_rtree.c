@@ -22,10 +22,7 @@
  * module rounds the values it is given, so a row written here equals the
  * row an INSERT or a trigger would write.
  *
- * Packing is Sort-Tile-Recursive, level by level: a level of k items makes
- * ceil(k / capacity) nodes whose sizes differ by at most one (so every node
- * but a lone root is at least half full), cut from ceil(sqrt(nodes))
- * vertical slices sorted by x centre, each slice sorted by y centre. Ties
+ * Packing is Sort-Tile-Recursive, level by level (rtree_pack.c); ties
  * break on the rowid: the same table gives the same file.
  *
  * tt_gpkg_build_rtree() does everything in one IMMEDIATE transaction: the
@@ -39,26 +36,23 @@
  * indexes of its own rows that way, and the tests run the check. The
  * packing needs no database (tt__rtree_pack()): the row writer packs on
  * its second thread while SQLite inserts rows, and hands the packed tree
- * over. The trees written as pages with SQLite closed (the page writer's)
- * come whole from their boxes (tt__rtree_write_pages) or, for rows that
- * stream in (a tiled run), leaves first, block by block, the upper levels
- * and the root at the end (tt__rtree_stream, the last section).
+ * over. The page writer's trees, written with SQLite closed, are made
+ * empty here (tt__gpkg_rtree_create_empty: the virtual table, triggers,
+ * gpkg_extensions row, and the shadow tables' root pages) and filled by
+ * io_gpkg_rtree_pages.c.
  *
  * Workload: one sequential scan of the table, an O(n log n) sort, one blob
  * per 51 features and one %_rowid row per feature; memory 24 bytes per
- * feature and as much again for the packing (streamed: the block and 24
- * bytes a leaf).
+ * feature and as much again for the packing.
  */
 #include "gdal/gpkg_rtree.h"
-#include "gdal/sqlite_pages.h"
+#include "gdal/rtree_pack.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define RT_CELL_BYTES 24 /* 8-byte id + 4 floats */
-#define RT_MAX_DEPTH 40  /* far beyond any table SQLite can hold */
 #define WKB_MAX_NESTING 32
 #define LINK_BATCH 128   /* %_rowid rows per INSERT statement */
 
@@ -486,53 +480,6 @@ done:
 
 /* --- packing -------------------------------------------------------------- */
 
-/* a before b along axis (0: x, 1: y): by the box's centre (the sum of its
- * two floats, exact in a double), ties by id. */
-static inline int item_before(const rt_item *a, const rt_item *b, int axis)
-{
-  double ca = (double)a->box[2 * axis] + (double)a->box[2 * axis + 1];
-  double cb = (double)b->box[2 * axis] + (double)b->box[2 * axis + 1];
-  return ca < cb || (ca == cb && a->id < b->id);
-}
-
-/* Sorts items along axis: a merge sort with the comparison inlined (qsort's
- * callback per comparison cost the loader more than its SQL), runs of 16
- * by insertion first. tmp holds n items. The order is total (ids are
- * unique), so any correct sort gives the same result. */
-static void sort_items(rt_item *items, size_t n, int axis, rt_item *tmp)
-{
-  enum { RUN = 16 };
-  for (size_t r0 = 0; r0 < n; r0 += RUN) {
-    size_t r1 = r0 + RUN < n ? r0 + RUN : n;
-    for (size_t i = r0 + 1; i < r1; i++) {
-      rt_item x = items[i];
-      size_t j = i;
-      for (; j > r0 && item_before(&x, &items[j - 1], axis); j--)
-        items[j] = items[j - 1];
-      items[j] = x;
-    }
-  }
-  rt_item *src = items, *dst = tmp;
-  for (size_t width = RUN; width < n; width *= 2) {
-    for (size_t lo = 0; lo < n; lo += 2 * width) {
-      size_t mid = lo + width < n ? lo + width : n;
-      size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
-      size_t i = lo, j = mid, k = lo;
-      while (i < mid && j < hi)
-        dst[k++] = item_before(&src[j], &src[i], axis) ? src[j++] : src[i++];
-      while (i < mid)
-        dst[k++] = src[i++];
-      while (j < hi)
-        dst[k++] = src[j++];
-    }
-    rt_item *t = src;
-    src = dst;
-    dst = t;
-  }
-  if (src != items)
-    memcpy(items, src, n * sizeof *items);
-}
-
 static int cmp_link(const void *pa, const void *pb)
 {
   const rt_link *a = pa, *b = pb;
@@ -564,74 +511,6 @@ static void sort_links(rt_link *links, size_t n)
   qsort(links, n, sizeof *links, cmp_link);
 }
 
-/* First item of group g when n items make ngroups groups of near-equal
- * size. */
-static size_t group_start(size_t g, size_t n, size_t ngroups)
-{
-  return (size_t)((uint64_t)g * n / ngroups);
-}
-
-/* Orders items for ngroups consecutive groups: STR slices by x, then y.
- * tmp holds n items. fit: slices in proportion to the extent of the
- * items' centres (a block of a streamed tree, a strip of a few tiles, gets
- * about square leaves), else ceil(sqrt(ngroups)) as STR has it (the whole
- * layer). */
-static void str_order(rt_item *items, size_t n, size_t ngroups, rt_item *tmp,
-                      int fit)
-{
-  double ratio = 1.0;
-  if (fit && n) {
-    double lo[2], hi[2];
-    for (int a = 0; a < 2; a++)
-      lo[a] = hi[a] = (double)items[0].box[2 * a] +
-                      (double)items[0].box[2 * a + 1];
-    for (size_t i = 1; i < n; i++)
-      for (int a = 0; a < 2; a++) {
-        double c = (double)items[i].box[2 * a] +
-                   (double)items[i].box[2 * a + 1];
-        if (c < lo[a]) lo[a] = c;
-        if (c > hi[a]) hi[a] = c;
-      }
-    double w = hi[0] - lo[0], h = hi[1] - lo[1];
-    if (w > 0 && h > 0)
-      ratio = w / h;
-    else if (w > 0)
-      ratio = (double)ngroups; /* a row: every group its own slice */
-    else if (h > 0)
-      ratio = 1.0 / (double)ngroups;
-  }
-  double want = ceil(sqrt((double)ngroups * ratio));
-  size_t nslices = want < 1 ? 1 : want > (double)ngroups ? ngroups
-                                                          : (size_t)want;
-  sort_items(items, n, 0, tmp);
-  for (size_t sl = 0; sl < nslices; sl++) {
-    size_t g0 = sl * ngroups / nslices, g1 = (sl + 1) * ngroups / nslices;
-    size_t e0 = group_start(g0, n, ngroups), e1 = group_start(g1, n, ngroups);
-    if (e1 > e0)
-      sort_items(items + e0, e1 - e0, 1, tmp);
-  }
-}
-
-static void put_be16(unsigned char *p, unsigned v)
-{
-  p[0] = (unsigned char)(v >> 8);
-  p[1] = (unsigned char)v;
-}
-
-static void put_be64(unsigned char *p, uint64_t v)
-{
-  for (int i = 0; i < 8; i++)
-    p[i] = (unsigned char)(v >> (56 - 8 * i));
-}
-
-static void put_bef32(unsigned char *p, float f)
-{
-  uint32_t u;
-  memcpy(&u, &f, sizeof u);
-  for (int i = 0; i < 4; i++)
-    p[i] = (unsigned char)(u >> (24 - 8 * i));
-}
-
 static tt_status step_reset(rt_build *b, sqlite3_stmt *st, const char *what)
 {
   int rc = sqlite3_step(st);
@@ -644,15 +523,8 @@ static tt_status step_reset(rt_build *b, sqlite3_stmt *st, const char *what)
 static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
                             size_t n, int leaf, int depth)
 {
-  memset(b->blob, 0, b->node_size);
-  put_be16(b->blob, nodeno == 1 ? (unsigned)depth : 0u);
-  put_be16(b->blob + 2, (unsigned)n);
-  for (size_t i = 0; i < n; i++) {
-    unsigned char *c = b->blob + 4 + i * RT_CELL_BYTES;
-    put_be64(c, (uint64_t)items[i].id);
-    for (int k = 0; k < 4; k++)
-      put_bef32(c + 8 + 4 * k, items[i].box[k]);
-  }
+  tt__rtree_node_blob(b->blob, b->node_size, items, n,
+                      nodeno == 1 ? (unsigned)depth : 0u);
   sqlite3_bind_int64(b->ins_node, 1, nodeno);
   sqlite3_bind_blob(b->ins_node, 2, b->blob, (int)b->node_size,
                     SQLITE_STATIC);
@@ -674,112 +546,6 @@ static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
   return s;
 }
 
-/* The packed tree: every level's items in node order, the leaves first
- * (b->items itself, reordered), each level's groups the items of the one
- * above; the last level fits in the root. Computing needs no database. */
-struct tt__rtree_packed {
-  rt_item *items;    /* the leaves' cells (level 0), owned */
-  size_t nitems;
-  size_t node_cap;
-  int nlevels;
-  rt_item *level[RT_MAX_DEPTH + 1]; /* level[0] == items; others owned */
-  size_t n[RT_MAX_DEPTH + 1];
-  int64_t base[RT_MAX_DEPTH + 1]; /* node of level d's group g: base[d] + g
-                                     (the upper levels get reordered) */
-  size_t nodes_total;
-};
-
-void tt__rtree_packed_free(tt__rtree_packed *pk)
-{
-  if (!pk)
-    return;
-  for (int d = 1; d < pk->nlevels; d++)
-    free(pk->level[d]);
-  free(pk->items);
-  free(pk);
-}
-
-/* Packs items (n) into nodes of node_cap cells, the nodes above items
- * numbered from next_nodeno on (the root is 1): on success items belong
- * to *out, on failure they stay the caller's. */
-static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
-                            size_t n, size_t node_cap, int64_t next_nodeno,
-                            tt__rtree_packed **out)
-{
-  *out = NULL;
-  tt__rtree_packed *pk = calloc(1, sizeof *pk);
-  rt_item *tmp = n > node_cap ? malloc(n * sizeof *tmp) : NULL;
-  if (!pk || (n > node_cap && !tmp)) {
-    free(pk);
-    free(tmp);
-    return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                     "index", what);
-  }
-  pk->items = items;
-  pk->nitems = n;
-  pk->node_cap = node_cap;
-  pk->level[0] = items;
-  pk->n[0] = n;
-  pk->nlevels = 1;
-  pk->nodes_total = 1;
-  tt_status s = TT_OK;
-  for (int depth = 0; n > node_cap; depth++) {
-    if (depth >= RT_MAX_DEPTH) {
-      s = tt__error(ctx, TT_ERR_INTERNAL, "%s: index deeper than %d "
-                    "levels", what, RT_MAX_DEPTH);
-      break;
-    }
-    rt_item *level = pk->level[depth];
-    size_t ngroups = (n + node_cap - 1) / node_cap;
-    str_order(level, n, ngroups, tmp, 0);
-    rt_item *next = malloc(ngroups * sizeof *next);
-    if (!next) {
-      s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                    "index", what);
-      break;
-    }
-    pk->base[depth] = next_nodeno;
-    for (size_t g = 0; g < ngroups; g++) {
-      size_t e0 = group_start(g, n, ngroups);
-      size_t e1 = group_start(g + 1, n, ngroups);
-      rt_item *up = &next[g];
-      up->id = next_nodeno++;
-      memcpy(up->box, level[e0].box, sizeof up->box);
-      for (size_t i = e0 + 1; i < e1; i++) {
-        const float *bx = level[i].box;
-        if (bx[0] < up->box[0]) up->box[0] = bx[0];
-        if (bx[1] > up->box[1]) up->box[1] = bx[1];
-        if (bx[2] < up->box[2]) up->box[2] = bx[2];
-        if (bx[3] > up->box[3]) up->box[3] = bx[3];
-      }
-    }
-    pk->nodes_total += ngroups;
-    pk->level[depth + 1] = next;
-    pk->n[depth + 1] = ngroups;
-    pk->nlevels = depth + 2;
-    n = ngroups;
-  }
-  free(tmp);
-  if (s != TT_OK) {
-    pk->items = NULL; /* the caller's again */
-    tt__rtree_packed_free(pk);
-    return s;
-  }
-  *out = pk;
-  return TT_OK;
-}
-
-tt_status tt__rtree_pack(tt_context *ctx, const char *what,
-                         tt__rtree_box *boxes, size_t n, size_t node_cap,
-                         tt__rtree_packed **out)
-{
-  *out = NULL;
-  if (node_cap < 2)
-    return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells",
-                     what, node_cap);
-  return pack_items(ctx, what, boxes, n, node_cap, 2, out);
-}
-
 size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
 {
   sqlite3_stmt *st = NULL;
@@ -791,10 +557,10 @@ size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
   sqlite3_finalize(st);
   /* SQLite's R*Tree: nodes of the page size less 64 bytes, at most 51
    * cells (RTREE_MAXCELLS) */
-  size_t size = page > 64 ? (size_t)page - 64 : 4 + 2 * RT_CELL_BYTES;
-  if (size > 4 + 51 * RT_CELL_BYTES)
-    size = 4 + 51 * RT_CELL_BYTES;
-  return (size - 4) / RT_CELL_BYTES;
+  size_t size = page > 64 ? (size_t)page - 64 : 4 + 2 * TT__RTREE_CELL_BYTES;
+  if (size > 4 + 51 * TT__RTREE_CELL_BYTES)
+    size = 4 + 51 * TT__RTREE_CELL_BYTES;
+  return (size - 4) / TT__RTREE_CELL_BYTES;
 }
 
 /* Writes the packed tree's nodes, parents and rowid map. */
@@ -816,8 +582,8 @@ static tt_status write_packed(rt_build *b, const tt__rtree_packed *pk)
     }
     size_t ngroups = pk->n[d + 1];
     for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
-      size_t e0 = group_start(g, n, ngroups);
-      size_t e1 = group_start(g + 1, n, ngroups);
+      size_t e0 = tt__rtree_group_start(g, n, ngroups);
+      size_t e1 = tt__rtree_group_start(g + 1, n, ngroups);
       s = write_node(b, pk->base[d] + (int64_t)g, level + e0, e1 - e0,
                      d == 0, d);
     }
@@ -1030,11 +796,11 @@ static tt_status create_schema(rt_build *b)
     return s;
   int size = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int(st, 0) : 0;
   sqlite3_finalize(st);
-  if (size < 4 + 2 * RT_CELL_BYTES || size > 65536)
+  if (size < 4 + 2 * TT__RTREE_CELL_BYTES || size > 65536)
     return tt__error(b->ctx, TT_ERR_INTERNAL, "%s: table %s: unexpected "
                      "R-tree node size %d", b->path, b->table, size);
   b->node_size = (size_t)size;
-  b->node_cap = (b->node_size - 4) / RT_CELL_BYTES;
+  b->node_cap = (b->node_size - 4) / TT__RTREE_CELL_BYTES;
   b->blob = malloc(b->node_size);
   if (!b->blob)
     return tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
@@ -1147,8 +913,8 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
     packed = NULL;
   }
   if (s == TT_OK && !packed) {
-    s = pack_items(b->ctx, b->path, b->items, b->nitems, b->node_cap, 2,
-                   &own);
+    s = tt__rtree_pack_items(b->ctx, b->path, b->items, b->nitems,
+                             b->node_cap, 2, &own);
     if (s == TT_OK)
       b->items = NULL; /* taken over */
     packed = own;
@@ -1279,7 +1045,7 @@ done:
   return s;
 }
 
-/* --- the index written as pages ------------------------------------------- */
+/* --- the empty index the page writer fills, and its removal -------------- */
 
 void tt__rtree_shadow_free(tt__rtree_shadow *sh)
 {
@@ -1407,545 +1173,5 @@ tt_status tt__gpkg_rtree_drop(tt_context *ctx, sqlite3 *db,
     sqlite3_free(sql);
   }
   sqlite3_free(r);
-  return s;
-}
-
-/* Appends the %_node row (nodeno, blob): the record of NULL (the INTEGER
- * PRIMARY KEY) and the blob, which is its body as it is (no copy). */
-static tt_status node_row(tt__sqlite_table *t, int64_t nodeno,
-                          const unsigned char *blob, size_t size, int format)
-{
-  unsigned char body[16];
-  tt__sqlite_rec r;
-  tt__sqlite_rec_begin(&r, body, format);
-  tt__sqlite_rec_null(&r);
-  tt__sqlite_rec_bytes_type(&r, size, 0);
-  const unsigned char *head;
-  size_t nh = tt__sqlite_rec_head(&r, &head);
-  return tt__sqlite_table_append2(t, nodeno, head, nh, blob, size);
-}
-
-/* The node blob of items[0..n) (depth: the root's) into blob. */
-static void node_blob(unsigned char *blob, size_t node_size,
-                      const rt_item *items, size_t n, unsigned depth)
-{
-  put_be16(blob, depth);
-  put_be16(blob + 2, (unsigned)n);
-  for (size_t i = 0; i < n; i++) {
-    unsigned char *c = blob + 4 + i * RT_CELL_BYTES;
-    uint64_t id = TT__BE64(items[i].id);
-    uint32_t f[4];
-    memcpy(f, items[i].box, sizeof f);
-    for (int k = 0; k < 4; k++)
-      f[k] = TT__BE32(f[k]);
-    memcpy(c, &id, 8);
-    memcpy(c + 8, f, 16);
-  }
-  size_t used = 4 + n * RT_CELL_BYTES;
-  memset(blob + used, 0, node_size - used);
-}
-
-tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
-                                const tt__rtree_box *boxes, size_t n,
-                                const tt__rtree_packed *packed,
-                                const tt__rtree_shadow *sh,
-                                tt__sqlite_file *f, tt_progress_fn progress,
-                                void *progress_arg)
-{
-  tt__rtree_packed *own = NULL;
-  tt_status s = TT_OK;
-  if (!packed || packed->node_cap != sh->node_cap) {
-    /* packed for nodes of another size (or not at all): again, from its
-     * leaves (the order is total: the same tree as from the boxes) */
-    size_t m = packed ? packed->nitems : n;
-    rt_item *items = malloc((m ? m : 1) * sizeof *items);
-    if (!items)
-      return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                       "spatial index", what);
-    memcpy(items, packed ? packed->items : boxes, m * sizeof *items);
-    s = pack_items(ctx, what, items, m, sh->node_cap, 2, &own);
-    if (s != TT_OK) {
-      free(items);
-      return s;
-    }
-    packed = own;
-  }
-  const tt__rtree_packed *pk = packed;
-  const int format = tt__sqlite_file_format(f);
-  unsigned char *blob = malloc(sh->node_size);
-  uint32_t *node_of = calloc(pk->nitems ? pk->nitems : 1, sizeof *node_of);
-  uint32_t *parent = malloc((pk->nodes_total + 1) * sizeof *parent);
-  tt__sqlite_table *t = NULL;
-  char *name = NULL;
-  if (!blob || !node_of || !parent) {
-    s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                  "index", what);
-    goto done;
-  }
-  const int top = pk->nlevels - 1;
-  const size_t total = pk->nodes_total * 2 + pk->nitems;
-  size_t done_rows = 0;
-
-  /* Where each node and each feature hangs: level e's groups are nodes
-   * base[e] + g (the top level's one group is the root, node 1), the items
-   * of level e + 1 are level e's nodes. */
-  for (size_t i = 0; i <= pk->nodes_total; i++)
-    parent[i] = 0;
-  for (int e = 0; e <= top; e++) {
-    size_t ngroups = e == top ? 1 : pk->n[e + 1];
-    for (size_t g = 0; g < ngroups; g++) {
-      size_t e0 = e == top ? 0 : group_start(g, pk->n[e], ngroups);
-      size_t e1 = e == top ? pk->n[e] : group_start(g + 1, pk->n[e], ngroups);
-      uint32_t node = e == top ? 1u : (uint32_t)(pk->base[e] + (int64_t)g);
-      for (size_t i = e0; i < e1; i++) {
-        int64_t id = pk->level[e][i].id;
-        if (e > 0) {
-          parent[id] = node;
-        } else if (id < 1 || (uint64_t)id > pk->nitems ||
-                   node_of[id - 1] != 0) {
-          s = tt__error(ctx, TT_ERR_INTERNAL, "%s: the features' ids are "
-                        "not 1..%zu", what, pk->nitems);
-          goto done;
-        } else {
-          node_of[id - 1] = node;
-        }
-      }
-    }
-  }
-
-  /* %_node: the root, then every level's nodes, in node number order */
-  name = sqlite3_mprintf("%s_node", sh->rtree);
-  s = name ? tt__sqlite_table_begin(f, name, sh->root[0], &t)
-           : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  if (s == TT_OK) {
-    node_blob(blob, sh->node_size, pk->level[top], pk->n[top],
-              (unsigned)top);
-    s = node_row(t, 1, blob, sh->node_size, format);
-  }
-  for (int d = 0; d < top && s == TT_OK; d++) {
-    size_t ngroups = pk->n[d + 1];
-    for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
-      size_t e0 = group_start(g, pk->n[d], ngroups);
-      size_t e1 = group_start(g + 1, pk->n[d], ngroups);
-      node_blob(blob, sh->node_size, pk->level[d] + e0, e1 - e0, 0);
-      s = node_row(t, pk->base[d] + (int64_t)g, blob, sh->node_size,
-                   format);
-    }
-  }
-  done_rows += pk->nodes_total;
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-  if (s == TT_OK && progress &&
-      !progress((double)done_rows / (double)total, "indexing", progress_arg))
-    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial index "
-                  "was interrupted", what);
-
-  /* %_parent: every node but the root */
-  sqlite3_free(name);
-  name = s == TT_OK ? sqlite3_mprintf("%s_parent", sh->rtree) : NULL;
-  if (s == TT_OK)
-    s = name ? tt__sqlite_table_begin(f, name, sh->root[1], &t)
-             : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  for (size_t m = 2; m <= pk->nodes_total && s == TT_OK; m++)
-    s = tt__sqlite_table_append_int(t, (int64_t)m, parent[m]);
-  done_rows += pk->nodes_total;
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-
-  /* %_rowid: every feature, by id */
-  sqlite3_free(name);
-  name = s == TT_OK ? sqlite3_mprintf("%s_rowid", sh->rtree) : NULL;
-  if (s == TT_OK)
-    s = name ? tt__sqlite_table_begin(f, name, sh->root[2], &t)
-             : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  for (size_t i = 0; i < pk->nitems && s == TT_OK; i++) {
-    s = tt__sqlite_table_append_int(t, (int64_t)i + 1, node_of[i]);
-    if (s == TT_OK && progress && (i & 0xffff) == 0xffff &&
-        !progress((double)(done_rows + i) / (double)total, "indexing",
-                  progress_arg))
-      s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
-                    "index was interrupted", what);
-  }
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-  if (s == TT_OK && progress &&
-      !progress(1.0, "indexing", progress_arg))
-    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial index "
-                  "was interrupted", what);
-done:
-  /* a table not finished (t) is freed with the file, never committed */
-  sqlite3_free(name);
-  free(blob);
-  free(node_of);
-  free(parent);
-  tt__rtree_packed_free(own);
-  return s;
-}
-
-/* --- the index written as the rows stream in ------------------------------
- * tt__rtree_stream (gpkg_rtree.h): the boxes of a layer whose rows are
- * appended in id order (1, 2, ...) are gathered into a block; at a cut
- * (the end of a batch of a tiled run) once the block holds at least
- * `block` boxes, it is STR-ordered into leaves (str_order with the slices
- * fitted to the block's extent: a block is a strip of a few tiles) whose
- * node blobs go to %_node and whose features' (rowid, leaf) pairs go to
- * %_rowid at once, both in rowid order; only each leaf's number and box
- * is kept. A block ends early, before the last batch, when that batch
- * lies apart from the rest (a row of tiles wrapped): a block of the end of
- * one row and the start of the next made a few leaves spanning the DEM's
- * width (tt__rtree_stream_cut). After the last row the leaves are packed
- * like any level (pack_items, STR over the whole layer) into the upper
- * levels, written after them, then %_parent.
- *
- * Node numbers: the root is node 1, which SQLite's module reads first (its
- * depth, and the node size as the length of its blob), and %_node rows
- * must go in rowid order; but the root is known last. So before the first
- * leaf, node 1 is appended with a placeholder blob of the node size (all
- * zero) and its place kept (tt__sqlite_table_append2_spot); at the end
- * the root's blob is written over it (tt__sqlite_file_patch, same length,
- * so the page's cells and pointers stand). Leaves are nodes 2..L+1 in the
- * order written, the upper levels L+2 on, level by level.
- *
- * A layer that never fills a block (up to `block` features) is packed at
- * the end from its boxes, all of them, by tt__rtree_write_pages(): the
- * same tree as the merged path's, byte for byte.
- *
- * Measured on the 8193² and 16385² fractals in tiles of 1,024 (2.0 M and
- * 8.0 M features, blocks of 65,536: docs/scale.md): as many nodes visited
- * by random windows as the whole-layer STR tree's, within 2 %. Tried and
- * not kept, on the 16385²'s vertices (the leaves' area over the extent,
- * and nodes visited by windows of 0.1 % of the side; the whole-layer tree
- * 0.94 and 5.0): no early end at a row's wrap (1.09, 6.2), and halving
- * the block's groups along the wider spread of their centres instead of
- * STR (1.69, 7.4).
- *
- * Memory: the block (24 bytes a box, and 24 + 4 of scratch for the
- * sorting and the rowid pairs), 24 bytes a leaf (about one per 50
- * features) until the end, then the upper levels' packing (24 + 4 bytes a
- * leaf). */
-
-/* Blocks bigger than this many times `block` are packed without waiting
- * for a cut: memory stays bounded for a caller that gives no cuts. */
-#define RT_STREAM_HARD 16
-
-struct tt__rtree_stream {
-  tt_context *ctx;
-  const char *what;
-  const tt__rtree_shadow *sh;
-  tt__sqlite_file *f;
-  int format;
-  size_t block;
-  rt_item *buf, *tmp; /* the block's boxes in id order; sorting scratch */
-  size_t nbuf, cap_buf, cap_tmp;
-  uint32_t *node_of; /* the block's features' leaves, in id order */
-  size_t cap_node_of;
-  int64_t first_id;  /* the id of buf[0] */
-  size_t mark;       /* buf[0..mark): the boxes before the last cut */
-  float so_far[4];   /* their bounds */
-  size_t split;      /* where the block may end short (0: nowhere) */
-  rt_item *leaves;   /* every leaf written: node number, box */
-  size_t nleaves, cap_leaves;
-  unsigned char *blob;
-  tt__sqlite_table *node_t, *rowid_t; /* open while streaming */
-  tt__sqlite_spot root_spot;          /* node 1's payload */
-  size_t root_head;                   /* its record header's bytes */
-  int streaming;                      /* a block was written */
-};
-
-tt_status tt__rtree_stream_create(tt_context *ctx, const char *what,
-                                  const tt__rtree_shadow *sh,
-                                  tt__sqlite_file *f, size_t block,
-                                  tt__rtree_stream **out)
-{
-  *out = NULL;
-  if (sh->node_cap < 2 || sh->node_size < 4 + sh->node_cap * RT_CELL_BYTES)
-    return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells "
-                     "in %zu bytes", what, sh->node_cap, sh->node_size);
-  tt__rtree_stream *rs = calloc(1, sizeof *rs);
-  unsigned char *blob = malloc(sh->node_size);
-  if (!rs || !blob) {
-    free(rs);
-    free(blob);
-    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  }
-  rs->ctx = ctx;
-  rs->what = what;
-  rs->sh = sh;
-  rs->f = f;
-  rs->format = tt__sqlite_file_format(f);
-  /* more than a node: a block packed makes two leaves at least, so the
-   * root (node 1) is never a leaf itself */
-  rs->block = block > sh->node_cap ? block : sh->node_cap + 1;
-  rs->first_id = 1;
-  rs->blob = blob;
-  *out = rs;
-  return TT_OK;
-}
-
-size_t tt__rtree_stream_bytes(const tt__rtree_stream *rs)
-{
-  if (!rs)
-    return 0;
-  return (rs->cap_buf + rs->cap_tmp + rs->cap_leaves) * sizeof(rt_item) +
-         rs->cap_node_of * sizeof(uint32_t) + rs->sh->node_size;
-}
-
-void tt__rtree_stream_free(tt__rtree_stream *rs)
-{
-  if (!rs)
-    return;
-  /* tables not finished belong to the file, which frees them */
-  free(rs->buf);
-  free(rs->tmp);
-  free(rs->node_of);
-  free(rs->leaves);
-  free(rs->blob);
-  free(rs);
-}
-
-/* %_node and %_rowid begun, node 1's placeholder appended. */
-static tt_status stream_begin(tt__rtree_stream *rs)
-{
-  const tt__rtree_shadow *sh = rs->sh;
-  char *name = sqlite3_mprintf("%s_node", sh->rtree);
-  tt_status s = name ? tt__sqlite_table_begin(rs->f, name, sh->root[0],
-                                              &rs->node_t)
-                     : tt__error(rs->ctx, TT_ERR_NOMEM, "out of memory");
-  sqlite3_free(name);
-  name = s == TT_OK ? sqlite3_mprintf("%s_rowid", sh->rtree) : NULL;
-  if (s == TT_OK)
-    s = name ? tt__sqlite_table_begin(rs->f, name, sh->root[2], &rs->rowid_t)
-             : tt__error(rs->ctx, TT_ERR_NOMEM, "out of memory");
-  sqlite3_free(name);
-  if (s != TT_OK)
-    return s;
-  /* the record of (NULL, blob of node_size bytes): its header, then the
-   * blob, zero until the root is known */
-  unsigned char body[16];
-  tt__sqlite_rec r;
-  tt__sqlite_rec_begin(&r, body, rs->format);
-  tt__sqlite_rec_null(&r);
-  tt__sqlite_rec_bytes_type(&r, sh->node_size, 0);
-  const unsigned char *head;
-  rs->root_head = tt__sqlite_rec_head(&r, &head);
-  memset(rs->blob, 0, sh->node_size);
-  s = tt__sqlite_table_append2_spot(rs->node_t, 1, head, rs->root_head,
-                                    rs->blob, sh->node_size, &rs->root_spot);
-  rs->streaming = 1;
-  return s;
-}
-
-/* The bounds of items[0..n), n > 0. */
-static void items_bounds(const rt_item *items, size_t n, float out[4])
-{
-  memcpy(out, items[0].box, 4 * sizeof *out);
-  for (size_t i = 1; i < n; i++) {
-    const float *bx = items[i].box;
-    if (bx[0] < out[0]) out[0] = bx[0];
-    if (bx[1] > out[1]) out[1] = bx[1];
-    if (bx[2] < out[2]) out[2] = bx[2];
-    if (bx[3] > out[3]) out[3] = bx[3];
-  }
-}
-
-/* The block's first n boxes, buf[0..n), as leaves: nodes, rowid pairs,
- * leaf boxes; the boxes after them move to the front. */
-static tt_status stream_pack(tt__rtree_stream *rs, size_t n)
-{
-  const size_t cap = rs->sh->node_cap;
-  if (n == 0)
-    return TT_OK;
-  tt_status s = rs->streaming ? TT_OK : stream_begin(rs);
-  if (s != TT_OK)
-    return s;
-  const size_t ngroups = (n + cap - 1) / cap;
-  if (!tt__grow((void **)&rs->tmp, &rs->cap_tmp, n, sizeof *rs->tmp) ||
-      !tt__grow((void **)&rs->node_of, &rs->cap_node_of, n,
-                sizeof *rs->node_of) ||
-      !tt__grow((void **)&rs->leaves, &rs->cap_leaves,
-                rs->nleaves + ngroups, sizeof *rs->leaves))
-    return tt__error(rs->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                     "spatial index", rs->what);
-  if ((uint64_t)rs->nleaves + ngroups + 1 > 0xffffffffu)
-    return tt__error(rs->ctx, TT_ERR_INTERNAL, "%s: more than 2^32 R-tree "
-                     "leaves", rs->what);
-  str_order(rs->buf, n, ngroups, rs->tmp, 1);
-  for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
-    size_t e0 = group_start(g, n, ngroups), e1 = group_start(g + 1, n,
-                                                              ngroups);
-    rt_item *leaf = &rs->leaves[rs->nleaves];
-    leaf->id = (int64_t)rs->nleaves + 2;
-    memcpy(leaf->box, rs->buf[e0].box, sizeof leaf->box);
-    for (size_t i = e0; i < e1; i++) {
-      const float *bx = rs->buf[i].box;
-      if (bx[0] < leaf->box[0]) leaf->box[0] = bx[0];
-      if (bx[1] > leaf->box[1]) leaf->box[1] = bx[1];
-      if (bx[2] < leaf->box[2]) leaf->box[2] = bx[2];
-      if (bx[3] > leaf->box[3]) leaf->box[3] = bx[3];
-      rs->node_of[rs->buf[i].id - rs->first_id] = (uint32_t)leaf->id;
-    }
-    node_blob(rs->blob, rs->sh->node_size, rs->buf + e0, e1 - e0, 0);
-    s = node_row(rs->node_t, leaf->id, rs->blob, rs->sh->node_size,
-                 rs->format);
-    rs->nleaves++;
-  }
-  for (size_t i = 0; i < n && s == TT_OK; i++)
-    s = tt__sqlite_table_append_int(rs->rowid_t, rs->first_id + (int64_t)i,
-                                    rs->node_of[i]);
-  rs->first_id += (int64_t)n;
-  rs->nbuf -= n;
-  memmove(rs->buf, rs->buf + n, rs->nbuf * sizeof *rs->buf);
-  rs->mark = rs->split = 0;
-  if (rs->nbuf) { /* what is left is before no cut, or after the last */
-    items_bounds(rs->buf, rs->nbuf, rs->so_far);
-    rs->mark = rs->nbuf;
-  }
-  return s;
-}
-
-tt_status tt__rtree_stream_add(tt__rtree_stream *rs, const tt__rtree_box *b)
-{
-  if (b->id != rs->first_id + (int64_t)rs->nbuf)
-    return tt__error(rs->ctx, TT_ERR_INTERNAL, "%s: R-tree box of id %lld "
-                     "where %lld was due", rs->what, (long long)b->id,
-                     (long long)(rs->first_id + (int64_t)rs->nbuf));
-  if (!tt__grow((void **)&rs->buf, &rs->cap_buf, rs->nbuf + 1,
-                sizeof *rs->buf))
-    return tt__error(rs->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                     "spatial index", rs->what);
-  rs->buf[rs->nbuf++] = *b;
-  if (rs->nbuf >= RT_STREAM_HARD * rs->block)
-    return stream_pack(rs, rs->nbuf);
-  return TT_OK;
-}
-
-/* A cut: the boxes since the last one (a batch) join the block. When they
- * lie apart from the block so far (no overlap, not even touching: the
- * pieces jumped, a row of tiles ended and the next began at the other
- * side), the block may end before them, so that a block does not hold two
- * far clusters (whose STR slices made leaves spanning the gap: on the
- * 16385² fractal a sixth more leaf area for the vertices). A full block
- * ends there if it can, else here. */
-tt_status tt__rtree_stream_cut(tt__rtree_stream *rs)
-{
-  const size_t n = rs->nbuf, m = rs->mark;
-  if (n == m)
-    return TT_OK;
-  float bb[4];
-  items_bounds(rs->buf + m, n - m, bb);
-  if (m == 0) {
-    memcpy(rs->so_far, bb, sizeof bb);
-  } else {
-    float *sf = rs->so_far;
-    if (bb[0] > sf[1] || bb[1] < sf[0] || bb[2] > sf[3] || bb[3] < sf[2])
-      rs->split = m;
-    if (bb[0] < sf[0]) sf[0] = bb[0];
-    if (bb[1] > sf[1]) sf[1] = bb[1];
-    if (bb[2] < sf[2]) sf[2] = bb[2];
-    if (bb[3] > sf[3]) sf[3] = bb[3];
-  }
-  rs->mark = n;
-  if (n < rs->block)
-    return TT_OK;
-  tt_status s = stream_pack(rs, rs->split ? rs->split : n);
-  if (s == TT_OK && rs->nbuf >= rs->block)
-    s = stream_pack(rs, rs->nbuf);
-  return s;
-}
-
-tt_status tt__rtree_stream_finish(tt__rtree_stream *rs,
-                                  tt_progress_fn progress,
-                                  void *progress_arg)
-{
-  if (!rs->streaming) /* one block at most: the whole layer's STR */
-    return tt__rtree_write_pages(rs->ctx, rs->what, rs->buf, rs->nbuf,
-                                 NULL, rs->sh, rs->f, progress,
-                                 progress_arg);
-  const tt__rtree_shadow *sh = rs->sh;
-  tt__rtree_packed *pk = NULL;
-  uint32_t *parent = NULL;
-  char *name = NULL;
-  tt__sqlite_table *t = NULL;
-  tt_status s = stream_pack(rs, rs->nbuf);
-  if (s == TT_OK && progress && !progress(0.5, "indexing", progress_arg))
-    s = tt__error(rs->ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
-                  "index was interrupted", rs->what);
-  /* the upper levels: the leaves packed as any level is, numbered on */
-  const size_t L = rs->nleaves;
-  if (s == TT_OK) {
-    s = pack_items(rs->ctx, rs->what, rs->leaves, L, sh->node_cap,
-                   (int64_t)L + 2, &pk);
-    if (s == TT_OK) { /* the leaves are pk's now */
-      rs->leaves = NULL;
-      rs->cap_leaves = 0;
-    }
-  }
-  const int top = pk ? pk->nlevels - 1 : 0;
-  for (int d = 0; d < top && s == TT_OK; d++) {
-    size_t ngroups = pk->n[d + 1];
-    for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
-      size_t e0 = group_start(g, pk->n[d], ngroups);
-      size_t e1 = group_start(g + 1, pk->n[d], ngroups);
-      node_blob(rs->blob, sh->node_size, pk->level[d] + e0, e1 - e0, 0);
-      s = node_row(rs->node_t, pk->base[d] + (int64_t)g, rs->blob,
-                   sh->node_size, rs->format);
-    }
-  }
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(rs->node_t);
-    rs->node_t = NULL;
-  }
-  if (s == TT_OK) { /* node 1: the root, a level above the top's cells */
-    node_blob(rs->blob, sh->node_size, pk->level[top], pk->n[top],
-              (unsigned)top + 1);
-    s = tt__sqlite_file_patch(rs->f, &rs->root_spot, rs->root_head,
-                              rs->blob, sh->node_size);
-  }
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(rs->rowid_t);
-    rs->rowid_t = NULL;
-  }
-  /* %_parent: every node but the root, leaves 2..L+1 then the levels
-   * above */
-  const size_t last = pk ? L + pk->nodes_total : 0;
-  if (s == TT_OK) {
-    parent = calloc(last + 1, sizeof *parent);
-    if (!parent)
-      s = tt__error(rs->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                    "spatial index", rs->what);
-  }
-  for (int e = 0; e <= top && s == TT_OK; e++) {
-    size_t ngroups = e == top ? 1 : pk->n[e + 1];
-    for (size_t g = 0; g < ngroups; g++) {
-      size_t e0 = e == top ? 0 : group_start(g, pk->n[e], ngroups);
-      size_t e1 = e == top ? pk->n[e] : group_start(g + 1, pk->n[e],
-                                                    ngroups);
-      uint32_t node = e == top ? 1u : (uint32_t)(pk->base[e] + (int64_t)g);
-      for (size_t i = e0; i < e1; i++)
-        parent[pk->level[e][i].id] = node;
-    }
-  }
-  name = s == TT_OK ? sqlite3_mprintf("%s_parent", sh->rtree) : NULL;
-  if (s == TT_OK)
-    s = name ? tt__sqlite_table_begin(rs->f, name, sh->root[1], &t)
-             : tt__error(rs->ctx, TT_ERR_NOMEM, "out of memory");
-  for (size_t m = 2; m <= last && s == TT_OK; m++)
-    s = tt__sqlite_table_append_int(t, (int64_t)m, parent[m]);
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-  if (s == TT_OK && progress && !progress(1.0, "indexing", progress_arg))
-    s = tt__error(rs->ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
-                  "index was interrupted", rs->what);
-  sqlite3_free(name);
-  free(parent);
-  tt__rtree_packed_free(pk);
   return s;
 }

@@ -16,10 +16,11 @@
  *
  * Each row's box (rounded outward to the floats the index stores) goes
  * with it to the page writer, whose R-trees pack their leaves block by
- * block as the rows come (tt__rtree_stream, io_gpkg_rtree.c): a block ends
- * after a batch, a piece's triangles or the vertices final after it
- * (tt__gpkg_pages_cut), once it holds 65,536 boxes, so a block is a strip
- * of whole pieces, a few tiles of 1,024 at 1 % of the samples. Only the
+ * block as the rows come (tt__rtree_stream, io_gpkg_rtree_pages.c): a
+ * block ends after a batch, a piece's triangles or the vertices final
+ * after it (tt__gpkg_pages_cut), once it holds 65,536 boxes (earlier where
+ * a row of tiles wrapped), so a block is a strip of whole pieces, a few
+ * tiles of 1,024 at 1 % of the samples. Only the
  * leaves' boxes (24 bytes a leaf of about 51 features) are kept until the
  * end, when the upper levels and the root are written: the trees hold the
  * same boxes as the merged-TIN path's but not the same nodes (their
