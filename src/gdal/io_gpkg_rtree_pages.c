@@ -60,7 +60,8 @@ tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
     if (!items)
       return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the "
                        "spatial index", what);
-    memcpy(items, packed ? packed->items : boxes, m * sizeof *items);
+    if (m) /* no boxes: boxes may be NULL */
+      memcpy(items, packed ? packed->items : boxes, m * sizeof *items);
     s = tt__rtree_pack_items(ctx, what, items, m, sh->node_cap, 2, &own);
     if (s != TT_OK) {
       free(items);
