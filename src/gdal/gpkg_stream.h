@@ -1,10 +1,10 @@
 /*
  * gpkg_stream.h -- a tiled run's GeoPackage written as its tiles finish
  * (io_gpkg_stream.c), and what it needs of the page writer of
- * io_gpkg_rows.c: the two layers' tables filled row by row as database
- * pages, in fid order, with SQLite closed, then their R-trees, extents and
- * counts (tt__gpkg_pages_*); and the pieces both write their geometry
- * blobs with, so that they write the same bytes.
+ * io_gpkg_rows_pages.c: the two layers' tables filled row by row as
+ * database pages, in fid order, with SQLite closed, then their R-trees,
+ * extents and counts (tt__gpkg_pages_*); and the pieces both write their
+ * geometry blobs with, so that they write the same bytes.
  */
 #ifndef TERRATIN_GPKG_STREAM_H
 #define TERRATIN_GPKG_STREAM_H
@@ -22,15 +22,15 @@ typedef struct tt__gpkg_value {
   double d;
 } tt__gpkg_value;
 
-/* --- io_gpkg_rows.c: the layers' pages appended row by row ---------------
+/* --- io_gpkg_rows_pages.c: the layers' pages appended row by row ---------
  * Opens the GeoPackage whose empty layers tt_ogr_write_tin(ROWS=DEFERRED)
  * made (closed by GDAL), with the write options it got (NLN_PREFIX,
  * LAYERS, LCO=SPATIAL_INDEX, RTREE_CHECK, JOURNAL; RTREE_BLOCK, the boxes
  * an R-tree block gathers before its leaves are written, default 65,536:
- * tt__rtree_stream in gpkg_rtree.h; the rest ignored), makes
- * the R-trees' schema (committed), and opens both tables for appending as
- * pages (io_gpkg_rows.c's PAGES=YES, steps 1 and 2). TT_ERR_FORMAT when the
- * file cannot take pages. nvfields: the vertices layer's fields. Only for
+ * tt__rtree_stream in gpkg_rtree.h; the rest ignored), makes the
+ * R-trees' schema (committed), and opens both tables for appending as
+ * pages (PAGES=YES's steps 1 and 2). TT_ERR_FORMAT when the file cannot
+ * take pages. nvfields: the vertices layer's fields. Only for
  * a file no one else opens and that is thrown away unless
  * tt__gpkg_pages_finish() succeeds. The caller frees *out with
  * tt__gpkg_pages_close(), which, unless finished, cuts the file back and
@@ -101,7 +101,7 @@ TT_HIDDEN void tt__gpkg_stream_close(tt__gpkg_stream *g);
  * (tt__gpkg_pages_bytes), the vertices' insertion errors for the style. */
 TT_HIDDEN size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g);
 
-/* --- GeoPackage geometry blobs, as io_gpkg_rows.c and io_gpkg_stream.c
+/* --- GeoPackage geometry blobs, as gpkg_rows_pipe.c and io_gpkg_stream.c
  * write them: the blob header ("GP", version 0, flags, srs_id; GeoPackage
  * 1.4 section 2.1.3), then ISO WKB, little-endian whatever the host's
  * order; and a layer's extent grown point by point. Static inline with
