@@ -193,16 +193,16 @@ done:
  * tt__rtree_stream (gpkg_rtree.h): the boxes of a layer whose rows are
  * appended in id order (1, 2, ...) are gathered into a block; at a cut
  * (the end of a batch of a tiled run) once the block holds at least
- * `block` boxes, it is STR-ordered into leaves (str_order with the slices
- * fitted to the block's extent: a block is a strip of a few tiles) whose
- * node blobs go to %_node and whose features' (rowid, leaf) pairs go to
- * %_rowid at once, both in rowid order; only each leaf's number and box
- * is kept. A block ends early, before the last batch, when that batch
- * lies apart from the rest (a row of tiles wrapped): a block of the end of
- * one row and the start of the next made a few leaves spanning the DEM's
- * width (tt__rtree_stream_cut). After the last row the leaves are packed
- * like any level (pack_items, STR over the whole layer) into the upper
- * levels, written after them, then %_parent.
+ * `block` boxes, it is STR-ordered into leaves (tt__rtree_str_order with
+ * the slices fitted to the block's extent: a block is a strip of a few
+ * tiles) whose node blobs go to %_node and whose features' (rowid, leaf)
+ * pairs go to %_rowid at once, both in rowid order; only each leaf's
+ * number and box is kept. A block ends early, before the last batch, when
+ * that batch lies apart from the rest (a row of tiles wrapped): a block of
+ * the end of one row and the start of the next made a few leaves spanning
+ * the DEM's width (tt__rtree_stream_cut). After the last row the leaves
+ * are packed like any level (tt__rtree_pack_items, STR over the whole
+ * layer) into the upper levels, written after them, then %_parent.
  *
  * Node numbers: the root is node 1, which SQLite's module reads first (its
  * depth, and the node size as the length of its blob), and %_node rows
