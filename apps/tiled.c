@@ -312,9 +312,9 @@ static tt_status stream_piece(tiled *T, size_t k)
     return st;
   }
   /* -max_memory: what grows with the TIN here, beside the tiles in
-   * flight: the writer's boxes kept for the R-trees and style values,
-   * the stream's pending vertices (64 bytes each), outline table,
-   * components (4 bytes a vertex) and batch */
+   * flight: the writer's R-tree blocks, leaf boxes and style values, the
+   * stream's pending vertices (64 bytes each), outline table, components
+   * (4 bytes a vertex) and batch */
   size_t bytes = tt__gpkg_stream_bytes(sink->out) +
                  tt__tin_stream_bytes(T->stream);
   if (T->max_memory && bytes + T->inflight_bytes > T->max_memory) {

@@ -7,7 +7,8 @@
  * styles are written. The rows are those the merged-TIN path writes for
  * the same run, byte for byte; memory is the tiles in flight, about one
  * row of tiles of vertices waiting for their last tile, and what the
- * writer keeps for the end (40 bytes a feature for the R-trees, 8 a
+ * writer keeps for the end (the R-trees' leaves' boxes, about half a
+ * byte a feature, their leaves being packed as the rows come; 8 bytes a
  * vertex for the style, 4 a vertex for the count of pieces).
  *
  * Every tiled run into a GeoPackage file streams: insertion and
@@ -101,9 +102,17 @@ static tt_status stream_open(tt_app_tile_sink *sink,
   if (st == TT_OK && r->msg.failures != failures)
     st = tt__error(r->ctx, TT_ERR_IO, "%s: error while closing: %s", temp,
                    r->msg.last);
+  /* TERRATIN_RTREE_BLOCK: the boxes an R-tree block gathers before its
+   * leaves are written (the page writer's RTREE_BLOCK; tests make it small
+   * to get many blocks from a small DEM) */
+  const char *block = CPLGetConfigOption("TERRATIN_RTREE_BLOCK", NULL);
+  char **o = CSLDuplicate(*so->wopts);
+  if (block && *block)
+    o = CSLSetNameValue(o, "RTREE_BLOCK", block);
   if (st == TT_OK)
-    st = tt__gpkg_stream_open(r->ctx, temp, *so->srs, *so->wopts,
-                              s->decimate, &sink->out);
+    st = tt__gpkg_stream_open(r->ctx, temp, *so->srs, o, s->decimate,
+                              &sink->out);
+  CSLDestroy(o);
   return st;
 }
 

@@ -15,8 +15,11 @@
 # Prints each run's wall seconds, user + system CPU seconds and peak memory
 # (GNU time's maximum resident set, KiB), the vertices and, for a budget,
 # the passes; then checks that the two files hold the same tables
-# (tests/apps/same_gpkg.py). The DEM and files go to a mktemp folder,
-# removed at the end.
+# (tests/apps/same_gpkg.py; the R-trees by content: the streamed one's
+# leaves are packed block by block) and compares their R-trees for
+# queries (bench/rtree_queries.py). TT_TERRATIN_BEFORE=<binary> adds a
+# streamed run of that binary to each round (a before/after comparison).
+# The DEM and files go to a mktemp folder, removed at the end.
 set -eu
 SIZE=${1:-8193}
 ERR=${2:-3.446}
@@ -42,11 +45,13 @@ case $KIND in
   *) echo "tile_stream.sh: unknown KIND $KIND" >&2; exit 2 ;;
 esac
 for i in $(seq 1 "$RUNS"); do
-  for mode in YES NO; do
+  for mode in ${TT_TERRATIN_BEFORE:+BEFORE} YES NO; do
     rm -f "$WORK/$mode.gpkg"
-    TERRATIN_TILE_STREAM=$mode /usr/bin/time -o "$WORK/time.txt" \
+    bin=$T
+    [ "$mode" = BEFORE ] && bin=$TT_TERRATIN_BEFORE
+    TERRATIN_TILE_STREAM=${mode/BEFORE/YES} /usr/bin/time -o "$WORK/time.txt" \
       -f "%e s wall, %U + %S s CPU, %M KiB" \
-      "$T" simplify -q -json -tile_size "$TILE" -threads 2 "${OPTS[@]}" \
+      "$bin" simplify -q -json -tile_size "$TILE" -threads 2 "${OPTS[@]}" \
       "$DEM" "$WORK/$mode.gpkg" >"$WORK/run.json"
     echo "$KIND stream=$mode run $i: $(cat "$WORK/time.txt"), $("$PY" -c '
 import json, sys
@@ -56,4 +61,5 @@ print("%d vertices, streamed %s, %d budget passes" % (d["vertices"],
       t["streamed"], t["budget_passes"]))' "$WORK/run.json")"
   done
 done
-"$PY" "$HERE/tests/apps/same_gpkg.py" "$WORK/YES.gpkg" "$WORK/NO.gpkg"
+"$PY" "$HERE/tests/apps/same_gpkg.py" --rtree-content "$WORK/YES.gpkg" "$WORK/NO.gpkg"
+"$PY" "$HERE/bench/rtree_queries.py" "$WORK/YES.gpkg" "$WORK/NO.gpkg"

@@ -52,7 +52,7 @@ static inline void tt__rtree_box_set(tt__rtree_box *b, int64_t id,
   b->box[3] = tt__rtree_up(maxy);
 }
 
-/* A tree packed beforehand (Sort-Tile-Recursive, see io_gpkg_rtree.c),
+/* A tree packed beforehand (Sort-Tile-Recursive, see rtree_pack.c),
  * without a database: the row writer packs on its second thread while
  * SQLite inserts rows. */
 typedef struct tt__rtree_packed tt__rtree_packed;
@@ -117,6 +117,42 @@ TT_HIDDEN tt_status tt__rtree_write_pages(
     tt_context *ctx, const char *what, const tt__rtree_box *boxes, size_t n,
     const tt__rtree_packed *packed, const tt__rtree_shadow *sh,
     tt__sqlite_file *f, tt_progress_fn progress, void *progress_arg);
+
+/* --- the index written as the rows stream in -------------------------------
+ * For a layer whose rows are appended as pages one by one, in id order
+ * (the streamed tiled run, io_gpkg_stream.c): its leaves are packed and
+ * written block by block as the boxes come, only the leaves' boxes are
+ * kept, and the upper levels, the root (node 1, a placeholder patched at
+ * the end) and %_parent are written by the finish (io_gpkg_rtree_pages.c, "the
+ * index written as the rows stream in", has the design). A layer of at
+ * most one block gets the tree tt__rtree_write_pages() writes.
+ *
+ * tt__rtree_stream_create() for the empty shadow tables of sh (kept by the
+ * caller until the finish), with pages appended to f; block: the boxes a
+ * block gathers at least before it is packed at a cut (raised to one more
+ * than a node holds). what names the index in messages (kept by the
+ * caller). The caller frees *out with tt__rtree_stream_free(); tables it
+ * left unfinished go with f, never committed. */
+typedef struct tt__rtree_stream tt__rtree_stream;
+TT_HIDDEN tt_status tt__rtree_stream_create(tt_context *ctx, const char *what,
+                                            const tt__rtree_shadow *sh,
+                                            tt__sqlite_file *f, size_t block,
+                                            tt__rtree_stream **out);
+/* The next feature's box: ids 1, 2, 3, ... in turn, each once. */
+TT_HIDDEN tt_status tt__rtree_stream_add(tt__rtree_stream *rs,
+                                         const tt__rtree_box *box);
+/* A place where a block may end (the boxes so far make whole pieces of
+ * the layer, close together): the block is packed when it holds at least
+ * `block` boxes. Without cuts a block is packed at 16 times that. */
+TT_HIDDEN tt_status tt__rtree_stream_cut(tt__rtree_stream *rs);
+/* After the last box: the last block, the upper levels, the root and
+ * %_parent, as pages of f (not committed). progress gets [0, 1]. */
+TT_HIDDEN tt_status tt__rtree_stream_finish(tt__rtree_stream *rs,
+                                            tt_progress_fn progress,
+                                            void *progress_arg);
+/* The bytes it holds: the block, its scratch, the leaves' boxes. */
+TT_HIDDEN size_t tt__rtree_stream_bytes(const tt__rtree_stream *rs);
+TT_HIDDEN void tt__rtree_stream_free(tt__rtree_stream *rs);
 
 /* Removes the gpkg_rtree_index of table.geom_column from db (in its
  * caller's write transaction): the virtual table and its shadow tables,

@@ -1,9 +1,10 @@
 /*
  * gpkg_stream.h -- a tiled run's GeoPackage written as its tiles finish
  * (io_gpkg_stream.c), and what it needs of the page writer of
- * io_gpkg_rows.c: the two layers' tables filled row by row as database
- * pages, in fid order, with SQLite closed, then their R-trees, extents and
- * counts (tt__gpkg_pages_*).
+ * io_gpkg_rows_pages.c: the two layers' tables filled row by row as
+ * database pages, in fid order, with SQLite closed, then their R-trees,
+ * extents and counts (tt__gpkg_pages_*); and the pieces both write their
+ * geometry blobs with, so that they write the same bytes.
  */
 #ifndef TERRATIN_GPKG_STREAM_H
 #define TERRATIN_GPKG_STREAM_H
@@ -21,13 +22,15 @@ typedef struct tt__gpkg_value {
   double d;
 } tt__gpkg_value;
 
-/* --- io_gpkg_rows.c: the layers' pages appended row by row ---------------
+/* --- io_gpkg_rows_pages.c: the layers' pages appended row by row ---------
  * Opens the GeoPackage whose empty layers tt_ogr_write_tin(ROWS=DEFERRED)
  * made (closed by GDAL), with the write options it got (NLN_PREFIX,
- * LAYERS, LCO=SPATIAL_INDEX, RTREE_CHECK, JOURNAL; the rest ignored), makes
- * the R-trees' schema (committed), and opens both tables for appending as
- * pages (io_gpkg_rows.c's PAGES=YES, steps 1 and 2). TT_ERR_FORMAT when the
- * file cannot take pages. nvfields: the vertices layer's fields. Only for
+ * LAYERS, LCO=SPATIAL_INDEX, RTREE_CHECK, JOURNAL; RTREE_BLOCK, the boxes
+ * an R-tree block gathers before its leaves are written, default 65,536:
+ * tt__rtree_stream in gpkg_rtree.h; the rest ignored), makes the
+ * R-trees' schema (committed), and opens both tables for appending as
+ * pages (PAGES=YES's steps 1 and 2). TT_ERR_FORMAT when the file cannot
+ * take pages. nvfields: the vertices layer's fields. Only for
  * a file no one else opens and that is thrown away unless
  * tt__gpkg_pages_finish() succeeds. The caller frees *out with
  * tt__gpkg_pages_close(), which, unless finished, cuts the file back and
@@ -42,20 +45,26 @@ TT_HIDDEN int tt__gpkg_pages_has(const tt__gpkg_pages *p, int layer);
 TT_HIDDEN int32_t tt__gpkg_pages_srs_id(const tt__gpkg_pages *p, int layer);
 TT_HIDDEN int tt__gpkg_pages_rtree(const tt__gpkg_pages *p);
 /* Appends a row: fid (1, 2, ... in order), the layer's fields in
- * tin_records.h's order, the geometry blob. */
+ * tin_records.h's order, the geometry blob, and its box for the R-tree
+ * (id the fid; needed when tt__gpkg_pages_rtree(), else NULL): the
+ * R-tree's leaves are packed and written block by block
+ * (tt__rtree_stream). */
 TT_HIDDEN tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer,
                                        int64_t fid,
                                        const tt__gpkg_value *fields,
                                        const unsigned char *blob,
-                                       size_t blob_len);
-/* Ends the tables (count[k] rows each), writes the R-trees of the boxes
- * (one per row, fid order, malloc'd; NULL without R-trees) as pages,
- * freeing each array once its index is written (boxes[k] set NULL),
- * commits them,
- * then sets sqlite_sequence, the extents ext[k] (min x, min y, max x,
- * max y) and counts, and runs rtreecheck() when RTREE_CHECK asked. */
+                                       size_t blob_len,
+                                       const tt__rtree_box *box);
+/* The layer's rows so far make whole pieces (a tiled run's batch): a
+ * block of the R-tree may end here (tt__rtree_stream_cut). */
+TT_HIDDEN tt_status tt__gpkg_pages_cut(tt__gpkg_pages *p, int layer);
+/* The bytes the R-trees hold: the blocks gathering, the leaves' boxes. */
+TT_HIDDEN size_t tt__gpkg_pages_bytes(const tt__gpkg_pages *p);
+/* Ends the tables (count[k] rows each), writes the R-trees' last blocks,
+ * upper levels and roots as pages, commits them, then sets
+ * sqlite_sequence, the extents ext[k] (min x, min y, max x, max y) and
+ * counts, and runs rtreecheck() when RTREE_CHECK asked. */
 TT_HIDDEN tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
-                                          tt__rtree_box *boxes[2],
                                           const size_t count[2],
                                           const double ext[2][4],
                                           tt_progress_fn progress,
@@ -68,9 +77,10 @@ TT_HIDDEN void tt__gpkg_pages_close(tt__gpkg_pages *p);
  * included); tt__gpkg_stream_batch() for each batch tt__tin_stream_add()
  * gave, in order; tt__gpkg_stream_finish() after the last tile. decimated:
  * the vertices layer has the importance field (the TIN is decimated,
- * tt__records_decimated). The rows,
- * blobs, boxes, extents and counts are those tt_gpkg_write_rows() writes
- * for the merged TIN, byte for byte. The caller frees *out with
+ * tt__records_decimated). The rows, blobs, extents and counts are those
+ * tt_gpkg_write_rows() writes for the merged TIN, byte for byte; the
+ * R-trees hold the same boxes (their nodes the same only for a layer of
+ * one block). The caller frees *out with
  * tt__gpkg_stream_close() (which undoes an unfinished write, as above). */
 typedef struct tt__gpkg_stream tt__gpkg_stream;
 TT_HIDDEN tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
@@ -89,8 +99,53 @@ TT_HIDDEN tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
                                            tt_progress_fn progress,
                                            void *progress_arg);
 TT_HIDDEN void tt__gpkg_stream_close(tt__gpkg_stream *g);
-/* The bytes the writer holds: the boxes kept for the R-trees, the
- * vertices' insertion errors for the style. */
+/* The bytes the writer holds: the R-trees' blocks and leaves' boxes
+ * (tt__gpkg_pages_bytes), the vertices' insertion errors for the style. */
 TT_HIDDEN size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g);
+
+/* --- GeoPackage geometry blobs, as gpkg_rows_pipe.c and io_gpkg_stream.c
+ * write them: the blob header ("GP", version 0, flags, srs_id; GeoPackage
+ * 1.4 section 2.1.3), then ISO WKB, little-endian whatever the host's
+ * order; and a layer's extent grown point by point. Static inline with
+ * short names, so that the blob code reads as the format does. */
+#include <string.h>
+
+/* Little-endian stores; each returns the byte after the value. */
+static inline unsigned char *put_u32(unsigned char *p, uint32_t v)
+{
+  for (int k = 0; k < 4; k++)
+    *p++ = (unsigned char)(v >> (8 * k));
+  return p;
+}
+
+static inline unsigned char *put_f64(unsigned char *p, double d)
+{
+  uint64_t v;
+  memcpy(&v, &d, sizeof v);
+  for (int k = 0; k < 8; k++)
+    *p++ = (unsigned char)(v >> (8 * k));
+  return p;
+}
+
+/* The blob header: magic, version 0 (version 1 of the format), flags
+ * (byte order, envelope kind, empty), srs_id. */
+static inline unsigned char *put_header(unsigned char *p, unsigned flags,
+                                        int32_t srs_id)
+{
+  *p++ = 'G';
+  *p++ = 'P';
+  *p++ = 0;
+  *p++ = (unsigned char)flags;
+  return put_u32(p, (uint32_t)srs_id);
+}
+
+/* ext (minx, miny, maxx, maxy) grown to (x, y). */
+static inline void extend(double *ext, double x, double y)
+{
+  if (x < ext[0]) ext[0] = x;
+  if (y < ext[1]) ext[1] = y;
+  if (x > ext[2]) ext[2] = x;
+  if (y > ext[3]) ext[3] = y;
+}
 
 #endif /* TERRATIN_GPKG_STREAM_H */

@@ -27,7 +27,12 @@
  * compares every row, blob and index table with the OGR writer's, both
  * ways.
  *
- * As pages (PAGES=YES; "the rows as database pages" below): the tables'
+ * The files: here tt_gpkg_write_rows(), the layers' tables found and
+ * finished, and the SQL path; gpkg_rows_pipe.c makes the rows (a second
+ * thread); io_gpkg_rows_pages.c writes them as pages, for a whole TIN and
+ * row by row for a streamed tiled run; gpkg_rows.h is what they share.
+ *
+ * As pages (PAGES=YES; io_gpkg_rows_pages.c): the tables'
  * B-trees are built bottom-up, in rowid order, and written into the file
  * with SQLite closed (sqlite_pages.c, from SQLite's documented file
  * format), SQLite only making the R-trees' schema before and setting
@@ -69,136 +74,18 @@
  * few pages per table (or SQLite's page cache); with T_SRS, 16 bytes a
  * vertex.
  */
-#include "gdal/gpkg_rtree.h"
-#include "gdal/sqlite_pages.h"
-#include "gdal/tin_records.h"
+#include "gdal/gpkg_rows.h"
 
 #include <cpl_conv.h>
 #include <cpl_string.h>
 
-#include <sqlite3.h>
-
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
-#define TRI_BLOB_BYTES (8 + 48 + 1 + 4 + 4 + 4 + 4 * 24) /* 165 */
-#define PT_BLOB_BYTES (8 + 1 + 4 + 24)                   /* 37 */
-#define MAX_TRIGGERS 16
-
-typedef struct rows_state {
-  tt_context *ctx;
-  sqlite3 *db;
-  const char *path;
-  tt_progress_fn progress;
-  void *progress_arg;
-  size_t done, total, next_report, step;
-  double lo, hi;    /* the share of progress the present phase takes */
-  struct rows_pipe *pipe; /* the rows tt__rows gives */
-  tt_status status;       /* why the rows stopped */
-} rows_state;
-
-/* One saved trigger, re-created after the inserts. */
-typedef struct saved_trigger {
-  char *sql;
-} saved_trigger;
-
-/* A layer's table as OGR made it. */
-typedef struct layer_table {
-  char *name;       /* as in gpkg_contents */
-  char *fid;        /* the INTEGER PRIMARY KEY column */
-  char *geom;       /* the geometry column */
-  int32_t srs_id;
-  saved_trigger triggers[MAX_TRIGGERS];
-  int ntriggers;
-  double ext[4];    /* minx, miny, maxx, maxy of what was written */
-  tt__rtree_box *boxes; /* one per row, for the R-tree (NULL: no index) */
-  sqlite3_int64 last_fid; /* the fid of the last row written */
-} layer_table;
-
-static tt_status db_error(rows_state *w, const char *what)
-{
-  return tt__error(w->ctx, TT_ERR_IO, "%s: %s: %s", w->path, what,
-                   sqlite3_errmsg(w->db));
-}
-
-static tt_status exec(rows_state *w, const char *sql, const char *what)
-{
-  char *err = NULL;
-  if (sqlite3_exec(w->db, sql, NULL, NULL, &err) == SQLITE_OK)
-    return TT_OK;
-  tt_status s = tt__error(w->ctx, TT_ERR_IO, "%s: %s: %s", w->path, what,
-                          err ? err : sqlite3_errmsg(w->db));
-  sqlite3_free(err);
-  return s;
-}
-
-/* Little-endian stores, whatever the host's order. */
-static unsigned char *put_u32(unsigned char *p, uint32_t v)
-{
-  for (int k = 0; k < 4; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_f64(unsigned char *p, double d)
-{
-  uint64_t v;
-  memcpy(&v, &d, sizeof v);
-  for (int k = 0; k < 8; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_header(unsigned char *p, unsigned flags,
-                                 int32_t srs_id)
-{
-  *p++ = 'G';
-  *p++ = 'P';
-  *p++ = 0; /* version 1 of the blob format */
-  *p++ = (unsigned char)flags;
-  return put_u32(p, (uint32_t)srs_id);
-}
-
-/* ext (minx, miny, maxx, maxy) grown to (x, y). */
-static void extend(double *ext, double x, double y)
-{
-  if (x < ext[0]) ext[0] = x;
-  if (y < ext[1]) ext[1] = y;
-  if (x > ext[2]) ext[2] = x;
-  if (y > ext[3]) ext[3] = y;
-}
-
-static tt_status report(rows_state *w)
-{
-  w->done++;
-  if (!w->progress || w->done < w->next_report)
-    return TT_OK;
-  w->next_report = w->done + w->step;
-  double f = (double)w->done / (double)w->total;
-  if (!w->progress(w->lo + (w->hi - w->lo) * f, "writing", w->progress_arg))
-    return tt__error(w->ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
-                     "interrupted after %zu of %zu features", w->done,
-                     w->total);
-  return TT_OK;
-}
-
-/* The R-tree loader's progress, mapped onto [lo, hi]. */
-static int rtree_progress(double complete, const char *message, void *arg)
-{
-  rows_state *w = arg;
-  if (!w->progress)
-    return 1;
-  return w->progress(w->lo + (w->hi - w->lo) * complete, message,
-                     w->progress_arg);
-}
-
-static void layer_free(layer_table *t)
+void tt__rows_layer_free(layer_table *t)
 {
   sqlite3_free(t->name);
   sqlite3_free(t->fid);
@@ -211,7 +98,7 @@ static void layer_free(layer_table *t)
 
 /* Finds the table OGR made for layer name: its geometry column and srs_id,
  * its primary key; checks that it is empty. */
-static tt_status layer_find(rows_state *w, const char *name, layer_table *t)
+tt_status tt__rows_layer_find(rows_state *w, const char *name, layer_table *t)
 {
   sqlite3_stmt *st = NULL;
   tt_status s = TT_OK;
@@ -342,6 +229,54 @@ static tt_status triggers_restore(rows_state *w, layer_table *t)
   return TT_OK;
 }
 
+/* gpkg_contents' extent and gpkg_ogr_contents' count, as GDAL sets them at
+ * close. */
+tt_status tt__rows_finish_layer(rows_state *w, const layer_table *t,
+                              size_t count)
+{
+  sqlite3_stmt *st = NULL;
+  tt_status s = TT_OK;
+  if (count && t->last_fid != (sqlite3_int64)count)
+    return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: table %s: the last of "
+                     "%zu features got fid %lld", w->path, t->name, count,
+                     (long long)t->last_fid);
+  if (sqlite3_prepare_v2(w->db,
+                         "UPDATE gpkg_contents SET min_x = ?, min_y = ?, "
+                         "max_x = ?, max_y = ?, last_change = "
+                         "strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE "
+                         "lower(table_name) = lower(?)",
+                         -1, &st, NULL) != SQLITE_OK)
+    return db_error(w, "cannot update gpkg_contents");
+  for (int k = 0; k < 4; k++)
+    if (count)
+      sqlite3_bind_double(st, k + 1, t->ext[k]);
+    else
+      sqlite3_bind_null(st, k + 1);
+  sqlite3_bind_text(st, 5, t->name, -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(st) != SQLITE_DONE)
+    s = db_error(w, "cannot update gpkg_contents");
+  sqlite3_finalize(st);
+  st = NULL;
+  if (s != TT_OK)
+    return s;
+  /* gpkg_ogr_contents is GDAL's own table: absent when the file was made
+   * with ADD_GPKG_OGR_CONTENTS=NO. */
+  int rc = sqlite3_prepare_v2(w->db,
+                              "UPDATE gpkg_ogr_contents SET feature_count = "
+                              "? WHERE lower(table_name) = lower(?)",
+                              -1, &st, NULL);
+  if (rc != SQLITE_OK) {
+    sqlite3_finalize(st);
+    return TT_OK;
+  }
+  sqlite3_bind_int64(st, 1, (sqlite3_int64)count);
+  sqlite3_bind_text(st, 2, t->name, -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(st) != SQLITE_DONE)
+    s = db_error(w, "cannot update gpkg_ogr_contents");
+  sqlite3_finalize(st);
+  return s;
+}
+
 /* --- the rows as a virtual table ------------------------------------------
  * One INSERT INTO t (geom, fields...) SELECT c0, c1... FROM tt__rows writes
  * a whole layer: tt__rows is an eponymous virtual table of this connection
@@ -350,449 +285,9 @@ static tt_status triggers_restore(rows_state *w, layer_table *t)
  * and updates sqlite_sequence once per layer. (Batches of 64 rows of bound
  * parameters, the earlier way, took 5,500 instructions a triangle in
  * SQLite's bind and VDBE code.)
- *
- * The rows are made (tt__records_*, the geometry blobs, the R-tree boxes,
- * the extents) by a second thread, a chunk of CHUNK_ROWS rows at a time,
- * through a ring of NCHUNKS chunks, while SQLite inserts the previous ones:
- * the triangles' rows, then the vertices'. With one thread (THREADS=1, or
- * no second CPU) the cursor makes each chunk itself when it needs it. Only
- * the SQLite thread reports progress; a failure on either side (an
- * interruption, a row the TIN cannot give) stops the other and ends the
- * statement with an error, kept in rows_pipe.status. */
+ * The rows come from gpkg_rows_pipe.c. */
 
-#define MAX_COLS (1 + TT__TF_COUNT) /* the geometry and the fields */
 #define ROWS_MODULE "tt__rows"
-#define CHUNK_ROWS 1024
-#define NCHUNKS 4
-
-enum { V_NULL, V_INT, V_REAL };
-
-typedef struct row_value {
-  int type;
-  sqlite3_int64 i;
-  double d;
-} row_value;
-
-static void set_int(row_value *v, sqlite3_int64 i)
-{
-  v->type = V_INT;
-  v->i = i;
-}
-
-static void set_real(row_value *v, double d)
-{
-  v->type = isfinite(d) ? V_REAL : V_NULL; /* NaN as NULL */
-  v->d = d;
-}
-
-enum { CH_EMPTY, CH_MAKING, CH_FULL };
-
-typedef struct chunk {
-  int layer;         /* 0: triangles, 1: vertices */
-  size_t first, n;   /* rows [first, first + n) of the layer */
-  int state;         /* CH_*: CH_FULL made, not yet written */
-  double ext[4];     /* the extent of its rows */
-  row_value v[CHUNK_ROWS][MAX_COLS];
-  unsigned char blob[CHUNK_ROWS][TRI_BLOB_BYTES];
-  int blob_len[CHUNK_ROWS];
-} chunk;
-
-typedef struct rows_pipe {
-  const tt__records *rec;
-  layer_table *layer[2];
-  size_t count[2];
-  int ncols[2];
-  int decimated;
-  chunk *ring;       /* NCHUNKS */
-  /* the rows not yet given to a chunk: from row m_first of layer m_layer;
-   * chunk number claim is the next to be given them (shared) */
-  int m_layer;
-  size_t m_first;
-  size_t claim;
-  size_t made[2];    /* rows made, of each layer (shared) */
-  tt_context *m_ctx; /* the maker thread's own messages */
-  /* the writing side */
-  int layer_now;     /* the layer being inserted */
-  size_t c_slot;     /* the chunk being read, when c_held */
-  int c_held;
-  size_t row;        /* the row being read */
-  const row_value *vals;
-  const unsigned char *blob;
-  int blob_len;
-  /* shared */
-  int threaded;
-  pthread_t thread;
-  pthread_mutex_t lock;
-  pthread_cond_t cond;
-  int stop;          /* the SQLite side gave up */
-  int failed;        /* the maker failed: message in m_ctx */
-  /* the R-trees, packed by the maker once the rows are made (0 cells: not
-   * here; the SQLite thread packs what is not packed) */
-  size_t node_cap;
-  tt__rtree_packed *packed[2];
-  int claimed[2];    /* the tree is (being) packed by one of the threads */
-} rows_pipe;
-
-static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
-                               size_t i, row_value *vals,
-                               unsigned char *blob, int *blob_len,
-                               double *ext)
-{
-  layer_table *t = p->layer[0];
-  tt_triangle_info tr;
-  double px[3], py[3], pz[3];
-  tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, px, py, pz);
-  if (s != TT_OK)
-    return s;
-  double lo[3] = {px[0], py[0], pz[0]}, hi[3] = {px[0], py[0], pz[0]};
-  for (int k = 1; k < 3; k++) {
-    double c[3] = {px[k], py[k], pz[k]};
-    for (int d = 0; d < 3; d++) {
-      if (c[d] < lo[d]) lo[d] = c[d];
-      if (c[d] > hi[d]) hi[d] = c[d];
-    }
-  }
-  unsigned char *q = put_header(blob, 0x05, t->srs_id);
-  for (int d = 0; d < 3; d++) {
-    q = put_f64(q, lo[d]);
-    q = put_f64(q, hi[d]);
-  }
-  *q++ = 1; /* WKB little endian */
-  q = put_u32(q, 1003);
-  q = put_u32(q, 1);
-  q = put_u32(q, 4);
-  for (int k = 0; k < 4; k++) {
-    q = put_f64(q, px[k % 3]);
-    q = put_f64(q, py[k % 3]);
-    q = put_f64(q, pz[k % 3]);
-  }
-  *blob_len = (int)(q - blob);
-  extend(ext, lo[0], lo[1]);
-  extend(ext, hi[0], hi[1]);
-  if (t->boxes)
-    tt__rtree_box_set(&t->boxes[i], (int64_t)i + 1, lo[0], hi[0], lo[1],
-                      hi[1]);
-  row_value *f = vals + 1;
-  set_int(&f[TT__TF_V0], tr.v[0]);
-  set_int(&f[TT__TF_V1], tr.v[1]);
-  set_int(&f[TT__TF_V2], tr.v[2]);
-  set_real(&f[TT__TF_MAX_ERR], tr.max_error);
-  set_real(&f[TT__TF_RMSE], tr.rmse);
-  set_int(&f[TT__TF_N_SAMPLES], (sqlite3_int64)tr.samples);
-  set_real(&f[TT__TF_AREA_2D], tr.area_2d);
-  set_real(&f[TT__TF_AREA_3D], tr.area_3d);
-  set_real(&f[TT__TF_SLOPE], tr.slope_deg);
-  set_real(&f[TT__TF_ASPECT], tr.aspect_deg);
-  set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
-  set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
-  return TT_OK;
-}
-
-static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
-                             row_value *vals, unsigned char *blob,
-                             int *blob_len, double *ext)
-{
-  layer_table *t = p->layer[1];
-  tt_vertex_info v;
-  double x, y;
-  tt_status s = tt__records_vertex(p->rec, ctx, i, &v, &x, &y);
-  if (s != TT_OK)
-    return s;
-  unsigned char *q = put_header(blob, 0x01, t->srs_id);
-  *q++ = 1;
-  q = put_u32(q, 1001);
-  q = put_f64(q, x);
-  q = put_f64(q, y);
-  q = put_f64(q, v.z);
-  *blob_len = (int)(q - blob);
-  extend(ext, x, y);
-  if (t->boxes)
-    tt__rtree_box_set(&t->boxes[i], (int64_t)i + 1, x, x, y, y);
-  row_value *f = vals + 1;
-  set_int(&f[TT__VF_ID], (sqlite3_int64)i);
-  set_int(&f[TT__VF_COL], v.col);
-  set_int(&f[TT__VF_ROW], v.row);
-  set_real(&f[TT__VF_INS_ERR], v.insert_error);
-  if (p->decimated)
-    f[TT__VF_INS_RANK].type = V_NULL;
-  else
-    set_int(&f[TT__VF_INS_RANK], (sqlite3_int64)v.rank);
-  set_real(&f[TT__VF_STAR_MAX], v.star_max_error);
-  set_real(&f[TT__VF_STAR_RMSE], v.star_rmse);
-  set_int(&f[TT__VF_STAR_N], (sqlite3_int64)v.star_samples);
-  if (p->decimated)
-    set_real(&f[TT__VF_IMPORTANCE], v.importance);
-  return TT_OK;
-}
-
-/* The rows of chunk number p->claim given to ch (p->claim then the next
- * one); 0 when every row has been given. Called with the lock held. */
-static int claim_rows(rows_pipe *p, chunk *ch)
-{
-  while (p->m_layer < 2 && p->m_first >= p->count[p->m_layer]) {
-    p->m_layer++;
-    p->m_first = 0;
-  }
-  if (p->m_layer >= 2)
-    return 0;
-  size_t left = p->count[p->m_layer] - p->m_first;
-  ch->layer = p->m_layer;
-  ch->first = p->m_first;
-  ch->n = left < CHUNK_ROWS ? left : CHUNK_ROWS;
-  ch->state = CH_MAKING;
-  p->m_first += ch->n;
-  p->claim++;
-  return 1;
-}
-
-/* Makes the rows given to ch (either thread, without the lock: the rows,
- * boxes and extent are the chunk's own). Errors go to ctx. */
-static tt_status fill_chunk(rows_pipe *p, chunk *ch, tt_context *ctx)
-{
-  tt_status s = TT_OK;
-  ch->ext[0] = ch->ext[1] = INFINITY;
-  ch->ext[2] = ch->ext[3] = -INFINITY;
-  for (size_t r = 0; r < ch->n && s == TT_OK; r++)
-    s = (ch->layer == 0 ? fill_triangle : fill_vertex)(
-        p, ctx, ch->first + r, ch->v[r], ch->blob[r], &ch->blob_len[r],
-        ch->ext);
-  return s;
-}
-
-static void pipe_lock(rows_pipe *p)
-{
-  if (p->threaded)
-    pthread_mutex_lock(&p->lock);
-}
-
-static void pipe_unlock(rows_pipe *p)
-{
-  if (p->threaded)
-    pthread_mutex_unlock(&p->lock);
-}
-
-/* ch made (lock held): its rows count, the other side may go on. */
-static void chunk_made(rows_pipe *p, chunk *ch)
-{
-  ch->state = CH_FULL;
-  p->made[ch->layer] += ch->n;
-  if (p->threaded)
-    pthread_cond_broadcast(&p->cond);
-}
-
-/* The maker: takes the next chunk of rows when its slot of the ring is
- * free and makes it, until every row is given (the writing side makes the
- * chunks it finds not yet taken: neither waits for the other but for a
- * chunk being made); then packs the R-trees. */
-static void *maker_main(void *arg)
-{
-  rows_pipe *p = arg;
-  for (;;) {
-    pthread_mutex_lock(&p->lock);
-    chunk *ch = &p->ring[p->claim % NCHUNKS];
-    while (!p->stop && ch->state != CH_EMPTY) {
-      pthread_cond_wait(&p->cond, &p->lock);
-      ch = &p->ring[p->claim % NCHUNKS];
-    }
-    int more = !p->stop && claim_rows(p, ch);
-    pthread_mutex_unlock(&p->lock);
-    if (!more)
-      break;
-    tt_status s = fill_chunk(p, ch, p->m_ctx);
-    pthread_mutex_lock(&p->lock);
-    if (s != TT_OK)
-      p->failed = 1;
-    else
-      chunk_made(p, ch);
-    pthread_cond_broadcast(&p->cond);
-    pthread_mutex_unlock(&p->lock);
-    if (s != TT_OK)
-      break;
-  }
-  /* Every row given: the R-trees' packing (sorts) goes on here while the
-   * writing side writes the last rows, each tree once all its rows are
-   * made (the writing side may make the last ones). The boxes become the
-   * packed trees' leaves. */
-  for (int k = 0; k < 2 && p->node_cap; k++) {
-    pthread_mutex_lock(&p->lock);
-    while (!p->stop && !p->failed && p->made[k] < p->count[k])
-      pthread_cond_wait(&p->cond, &p->lock);
-    int stop = p->stop || p->failed, claimed = p->claimed[k];
-    p->claimed[k] = 1;
-    pthread_mutex_unlock(&p->lock);
-    layer_table *t = p->layer[k];
-    if (stop)
-      break;
-    if (claimed)
-      continue; /* the other thread packs it */
-    if (!t->boxes || p->count[k] == 0)
-      continue; /* a layer left out by LAYERS */
-    if (tt__rtree_pack(p->m_ctx, t->name, t->boxes, p->count[k],
-                       p->node_cap, &p->packed[k]) != TT_OK)
-      break; /* the writing side packs from the boxes */
-    t->boxes = NULL; /* the packed tree's */
-  }
-  return NULL;
-}
-
-/* The writing side: points p at row i of layer p->layer_now, taking the
- * next chunk when row i is past the one held: made by the maker, or made
- * here when the maker has not taken it yet. */
-static tt_status pipe_row(rows_pipe *p, rows_state *w, size_t i)
-{
-  chunk *ch = p->c_held ? &p->ring[p->c_slot % NCHUNKS] : NULL;
-  if (!ch || ch->layer != p->layer_now || i < ch->first ||
-      i >= ch->first + ch->n) {
-    pipe_lock(p);
-    if (ch) { /* done with it */
-      ch->state = CH_EMPTY;
-      p->c_slot++;
-      p->c_held = 0;
-      if (p->threaded)
-        pthread_cond_broadcast(&p->cond);
-    }
-    ch = &p->ring[p->c_slot % NCHUNKS];
-    tt_status s = TT_OK;
-    while (ch->state != CH_FULL) {
-      if (ch->state == CH_EMPTY && p->claim == p->c_slot) {
-        /* not taken: made here */
-        if (!claim_rows(p, ch)) {
-          s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s: row %zu of layer %s "
-                        "asked for past its end", w->path, i,
-                        p->layer[p->layer_now]->name);
-          break;
-        }
-        pipe_unlock(p);
-        s = fill_chunk(p, ch, w->ctx);
-        pipe_lock(p);
-        if (s != TT_OK)
-          break;
-        chunk_made(p, ch);
-        break;
-      }
-      if (p->failed || !p->threaded) {
-        s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s", p->failed
-                      ? tt_context_errmsg(p->m_ctx) : "rows out of order");
-        break;
-      }
-      pthread_cond_wait(&p->cond, &p->lock); /* the maker's, being made */
-    }
-    pipe_unlock(p);
-    if (s != TT_OK)
-      return s;
-    p->c_held = 1;
-    if (ch->layer != p->layer_now || i != ch->first)
-      return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: rows of layer %s out "
-                       "of order (%zu)", w->path,
-                       p->layer[p->layer_now]->name, i);
-    /* the chunks' extents, merged in order on this side */
-    double *ext = p->layer[ch->layer]->ext;
-    extend(ext, ch->ext[0], ch->ext[1]);
-    extend(ext, ch->ext[2], ch->ext[3]);
-  }
-  size_t r = i - ch->first;
-  p->vals = ch->v[r];
-  p->blob = ch->blob[r];
-  p->blob_len = ch->blob_len[r];
-  p->row = i;
-  return report(w);
-}
-
-/* The writing thread, its rows all written, packs the R-trees the maker
- * has not begun (the vertices' first: the maker begins with the
- * triangles'), so that the two share the sorts. Returns the trees it
- * packed (bit k: layer k). */
-static unsigned pipe_pack_too(rows_pipe *p, size_t node_cap)
-{
-  unsigned mine = 0;
-  if (!p->threaded || !node_cap)
-    return 0;
-  for (int k = 1; k >= 0; k--) {
-    pthread_mutex_lock(&p->lock);
-    int claimed = p->claimed[k], failed = p->failed;
-    p->claimed[k] = 1;
-    pthread_mutex_unlock(&p->lock);
-    layer_table *t = p->layer[k];
-    if (claimed || failed || !t->boxes || p->count[k] == 0)
-      continue;
-    /* a failure (out of memory) leaves the boxes for the page writer */
-    if (tt__rtree_pack(NULL, t->name, t->boxes, p->count[k], node_cap,
-                       &p->packed[k]) == TT_OK)
-      t->boxes = NULL; /* the packed tree's */
-    mine |= 1u << k;
-  }
-  return mine;
-}
-
-/* Joins the maker: after its packing when the rows went in (ok), else
- * stopping it first. */
-static void pipe_join(rows_pipe *p, int ok)
-{
-  if (p->threaded) {
-    pthread_mutex_lock(&p->lock);
-    p->stop = !ok;
-    pthread_cond_broadcast(&p->cond);
-    pthread_mutex_unlock(&p->lock);
-    pthread_join(p->thread, NULL);
-    pthread_cond_destroy(&p->cond);
-    pthread_mutex_destroy(&p->lock);
-    p->threaded = 0;
-  }
-  free(p->ring);
-  p->ring = NULL;
-}
-
-static void pipe_free(rows_pipe *p)
-{
-  pipe_join(p, 0);
-  for (int k = 0; k < 2; k++)
-    tt__rtree_packed_free(p->packed[k]);
-  if (p->m_ctx)
-    tt_context_destroy(p->m_ctx);
-  memset(p, 0, sizeof *p);
-}
-
-/* Sets up the rows of both layers (nt triangles, nv vertices: 0 for a layer
- * left out by LAYERS); a maker thread when threads allow. */
-static tt_status pipe_begin(rows_pipe *p, rows_state *w,
-                            const tt__records *rec, layer_table *tri,
-                            layer_table *vtx, size_t nt, size_t nv,
-                            int threads, size_t node_cap)
-{
-  memset(p, 0, sizeof *p);
-  p->rec = rec;
-  p->layer[0] = tri;
-  p->layer[1] = vtx;
-  p->count[0] = nt;
-  p->count[1] = nv;
-  p->ncols[0] = 1 + TT__TF_COUNT;
-  p->ncols[1] = 1 + tt__records_vertex_fields(rec->tin);
-  p->decimated = tt__records_decimated(rec->tin);
-  p->ring = calloc(NCHUNKS, sizeof *p->ring);
-  if (!p->ring)
-    return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
-  if (threads == 1 || p->count[0] + p->count[1] <= CHUNK_ROWS ||
-      (threads <= 0 && sysconf(_SC_NPROCESSORS_ONLN) < 2))
-    return TT_OK;
-  p->m_ctx = tt_context_create();
-  if (!p->m_ctx)
-    return TT_OK;
-  if (pthread_mutex_init(&p->lock, NULL) != 0)
-    return TT_OK;
-  if (pthread_cond_init(&p->cond, NULL) != 0) {
-    pthread_mutex_destroy(&p->lock);
-    return TT_OK;
-  }
-  p->node_cap = node_cap; /* read by the maker */
-  if (pthread_create(&p->thread, NULL, maker_main, p) != 0) {
-    p->node_cap = 0;
-    pthread_cond_destroy(&p->cond);
-    pthread_mutex_destroy(&p->lock);
-    return TT_OK; /* the SQLite thread makes the rows itself */
-  }
-  p->threaded = 1;
-  return TT_OK;
-}
 
 typedef struct rows_vtab {
   sqlite3_vtab base;
@@ -870,7 +365,7 @@ static int vt_fill(rows_cursor *c)
   rows_state *w = vt->w;
   if (c->row >= vt_count(w))
     return SQLITE_OK;
-  w->status = pipe_row(w->pipe, w, c->row);
+  w->status = tt__rows_pipe_row(w->pipe, w, c->row);
   if (w->status == TT_OK)
     return SQLITE_OK;
   sqlite3_free(vt->base.zErrMsg);
@@ -987,510 +482,6 @@ static tt_status insert_rows(rows_state *w, int layer,
   return s;
 }
 
-/* gpkg_contents' extent and gpkg_ogr_contents' count, as GDAL sets them at
- * close. */
-static tt_status finish_layer(rows_state *w, const layer_table *t,
-                              size_t count)
-{
-  sqlite3_stmt *st = NULL;
-  tt_status s = TT_OK;
-  if (count && t->last_fid != (sqlite3_int64)count)
-    return tt__error(w->ctx, TT_ERR_INTERNAL, "%s: table %s: the last of "
-                     "%zu features got fid %lld", w->path, t->name, count,
-                     (long long)t->last_fid);
-  if (sqlite3_prepare_v2(w->db,
-                         "UPDATE gpkg_contents SET min_x = ?, min_y = ?, "
-                         "max_x = ?, max_y = ?, last_change = "
-                         "strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE "
-                         "lower(table_name) = lower(?)",
-                         -1, &st, NULL) != SQLITE_OK)
-    return db_error(w, "cannot update gpkg_contents");
-  for (int k = 0; k < 4; k++)
-    if (count)
-      sqlite3_bind_double(st, k + 1, t->ext[k]);
-    else
-      sqlite3_bind_null(st, k + 1);
-  sqlite3_bind_text(st, 5, t->name, -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(st) != SQLITE_DONE)
-    s = db_error(w, "cannot update gpkg_contents");
-  sqlite3_finalize(st);
-  st = NULL;
-  if (s != TT_OK)
-    return s;
-  /* gpkg_ogr_contents is GDAL's own table: absent when the file was made
-   * with ADD_GPKG_OGR_CONTENTS=NO. */
-  int rc = sqlite3_prepare_v2(w->db,
-                              "UPDATE gpkg_ogr_contents SET feature_count = "
-                              "? WHERE lower(table_name) = lower(?)",
-                              -1, &st, NULL);
-  if (rc != SQLITE_OK) {
-    sqlite3_finalize(st);
-    return TT_OK;
-  }
-  sqlite3_bind_int64(st, 1, (sqlite3_int64)count);
-  sqlite3_bind_text(st, 2, t->name, -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(st) != SQLITE_DONE)
-    s = db_error(w, "cannot update gpkg_ogr_contents");
-  sqlite3_finalize(st);
-  return s;
-}
-
-/* --- the rows as database pages -------------------------------------------
- * PAGES=YES: the tables' B-trees are written as pages (sqlite_pages.h)
- * instead of inserted. In three steps:
- *   1. in SQLite, in the one transaction that also checked the layers: the
- *      R-trees' virtual tables, triggers and gpkg_extensions rows, their
- *      shadow tables left empty; commit, close;
- *   2. with SQLite closed: the rows of both layers and the R-trees' shadow
- *      tables appended as pages to the file, then their root pages and the
- *      database header (sqlite_pages.c);
- *   3. in SQLite again: sqlite_sequence (the AUTOINCREMENT fids), the
- *      extents and feature counts, rtreecheck() on request; commit (which
- *      syncs the file).
- * A failure or an interruption in step 2 cuts the file back to its size
- * after step 1, then the R-trees of step 1 are dropped: the layers are left
- * empty and unindexed, as the SQL path leaves them. A crash, or a failure
- * in writing the last pages of step 2 (the roots and the header), can
- * leave the file unsound: hence PAGES=YES only for a file that is thrown
- * away unless the write completes (the command's temporary output), and
- * nothing else may have it open. Otherwise, and when the file does not
- * allow pages (WAL, auto-vacuum, an index on a table, a text or defaulted
- * column, rows too large for a page), the SQL path below runs. */
-
-enum { SRC_NULL = -2, SRC_GEOM = -1 };
-
-/* How a layer's rows map onto its table's columns. */
-typedef struct page_layout {
-  char *table;    /* the name in sqlite_schema */
-  uint32_t root;
-  int autoinc;    /* AUTOINCREMENT: sqlite_sequence gets the last fid */
-  int ncols;
-  int *src;       /* per column: SRC_NULL, SRC_GEOM or a field's index */
-  int *aff;       /* per column: tt__sqlite_affinity() */
-} page_layout;
-
-static void layout_free(page_layout *l)
-{
-  sqlite3_free(l->table);
-  free(l->src);
-  free(l->aff);
-  memset(l, 0, sizeof *l);
-}
-
-/* The columns of t for rows of the nfields fields and a geometry blob of at
- * most blob_bytes. TT_OK with *why NULL: pages can take them; *why set: a
- * reason they cannot (the SQL path writes them). */
-static tt_status layout_find(rows_state *w, const layer_table *t,
-                             const tt__field_spec *fields, int nfields,
-                             size_t blob_bytes, size_t max_payload,
-                             page_layout *out, const char **why)
-{
-  memset(out, 0, sizeof *out);
-  *why = NULL;
-  sqlite3_stmt *st = NULL;
-  tt_status s = TT_OK;
-  if (sqlite3_prepare_v2(w->db,
-                         "SELECT name, rootpage, sql FROM sqlite_master "
-                         "WHERE type = 'table' AND lower(name) = lower(?)",
-                         -1, &st, NULL) != SQLITE_OK)
-    return db_error(w, "cannot read the schema");
-  sqlite3_bind_text(st, 1, t->name, -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(st) == SQLITE_ROW) {
-    out->table = sqlite3_mprintf("%s", sqlite3_column_text(st, 0));
-    sqlite3_int64 root = sqlite3_column_int64(st, 1);
-    out->root = root > 1 && root < 0xffffffff ? (uint32_t)root : 0;
-    const char *sql = (const char *)sqlite3_column_text(st, 2);
-    out->autoinc = sql && sqlite3_strlike("%AUTOINCREMENT%", sql, 0) == 0;
-  }
-  sqlite3_finalize(st);
-  st = NULL;
-  if (!out->table || !out->root) {
-    *why = "its table is not in sqlite_schema";
-    return TT_OK;
-  }
-  if (sqlite3_prepare_v2(w->db,
-                         "SELECT count(*) FROM sqlite_master WHERE type = "
-                         "'index' AND lower(tbl_name) = lower(?)",
-                         -1, &st, NULL) != SQLITE_OK)
-    return db_error(w, "cannot read the schema");
-  sqlite3_bind_text(st, 1, out->table, -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_int(st, 0) > 0)
-    *why = "the table has an index";
-  sqlite3_finalize(st);
-  st = NULL;
-  if (*why)
-    return TT_OK;
-
-  char *sql = sqlite3_mprintf("PRAGMA table_info(\"%w\")", out->table);
-  int rc = sql ? sqlite3_prepare_v2(w->db, sql, -1, &st, NULL) : SQLITE_NOMEM;
-  sqlite3_free(sql);
-  if (rc != SQLITE_OK)
-    return db_error(w, "cannot read the table's columns");
-  int cap = 0, npk = 0, geom = 0, mapped = 0;
-  while (s == TT_OK && !*why && sqlite3_step(st) == SQLITE_ROW) {
-    if (out->ncols == cap) {
-      cap = cap ? 2 * cap : 32;
-      int *a = realloc(out->src, (size_t)cap * sizeof *a);
-      if (a)
-        out->src = a;
-      int *b = a ? realloc(out->aff, (size_t)cap * sizeof *b) : NULL;
-      if (b)
-        out->aff = b;
-      if (!a || !b) {
-        s = tt__error(w->ctx, TT_ERR_NOMEM, "out of memory");
-        break;
-      }
-    }
-    const char *name = (const char *)sqlite3_column_text(st, 1);
-    const char *type = (const char *)sqlite3_column_text(st, 2);
-    int has_default = sqlite3_column_type(st, 4) != SQLITE_NULL;
-    int pk = sqlite3_column_int(st, 5);
-    int src = SRC_NULL;
-    if (pk) {
-      npk++;
-      if (!type || sqlite3_stricmp(type, "INTEGER") != 0 ||
-          sqlite3_stricmp(name, t->fid) != 0)
-        *why = "the table's primary key is not its INTEGER fid";
-    } else if (name && sqlite3_stricmp(name, t->geom) == 0) {
-      src = SRC_GEOM;
-      geom++;
-    } else {
-      for (int k = 0; name && k < nfields; k++)
-        if (sqlite3_stricmp(name, fields[k].name) == 0)
-          src = k;
-      if (src >= 0)
-        mapped++;
-      else if (has_default)
-        *why = "a column the rows leave out has a default";
-    }
-    out->src[out->ncols] = src;
-    out->aff[out->ncols] = tt__sqlite_affinity(type);
-    if (src >= 0 && out->aff[out->ncols] == TT__AFF_TEXT)
-      *why = "a field's column has text affinity";
-    out->ncols++;
-  }
-  sqlite3_finalize(st);
-  if (s != TT_OK || *why)
-    return s;
-  if (npk != 1 || geom != 1 || mapped != nfields)
-    *why = "the table's columns are not the layer's";
-  /* header and body of the largest row: 9 bytes a serial type and 8 a
-   * value, the blob */
-  else if (9 + 17 * (size_t)out->ncols + blob_bytes > max_payload)
-    *why = "rows too large for a page";
-  return TT_OK;
-}
-
-/* Whether PAGES=YES can be followed for the layers made (lay[0]:
- * triangles, lay[1]: vertices, when written); why not in *why. */
-static tt_status pages_possible(rows_state *w, const layer_table *tri,
-                                const layer_table *vtx, int do_tri,
-                                int do_vtx, int rtree, int nvfields,
-                                page_layout lay[2], const char **why)
-{
-  *why = NULL;
-  sqlite3_stmt *st = NULL;
-  char mode[16] = "";
-  int autovac = 0, page = 0;
-  if (sqlite3_prepare_v2(w->db, "PRAGMA journal_mode", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
-    snprintf(mode, sizeof mode, "%s", sqlite3_column_text(st, 0));
-  sqlite3_finalize(st);
-  if (sqlite3_prepare_v2(w->db, "PRAGMA auto_vacuum", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW)
-    autovac = sqlite3_column_int(st, 0);
-  sqlite3_finalize(st);
-  if (sqlite3_prepare_v2(w->db, "PRAGMA page_size", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW)
-    page = sqlite3_column_int(st, 0);
-  sqlite3_finalize(st);
-  int reserve = -1; /* asks, changes nothing */
-  if (sqlite3_file_control(w->db, "main", SQLITE_FCNTL_RESERVE_BYTES,
-                           &reserve) != SQLITE_OK)
-    reserve = -1;
-  if (strcasecmp(mode, "wal") == 0)
-    *why = "the database is in WAL mode";
-  else if (autovac)
-    *why = "the database has auto-vacuum";
-  else if (page < 512 || reserve < 0 || page - reserve < 480)
-    *why = "unknown page size";
-  if (*why)
-    return TT_OK;
-  const size_t max_payload = tt__sqlite_max_payload((size_t)(page - reserve));
-  /* R-tree nodes: the page size less 64 (whatever the reserved bytes), at
-   * most 51 cells of 24 bytes (tt__gpkg_rtree_node_cap()), a blob in a
-   * record of a NULL and the blob: a header of 4 bytes */
-  size_t node = (size_t)page - 64 < 4 + 51 * 24 ? (size_t)page - 64
-                                                : 4 + 51 * 24;
-  if (rtree && node + 4 > max_payload) {
-    *why = "R-tree nodes too large for a page";
-    return TT_OK;
-  }
-  tt_status s = TT_OK;
-  if (do_tri)
-    s = layout_find(w, tri, tt__triangle_fields, TT__TF_COUNT,
-                    TRI_BLOB_BYTES, max_payload, &lay[0], why);
-  if (s == TT_OK && !*why && do_vtx)
-    s = layout_find(w, vtx, tt__vertex_fields, nvfields, PT_BLOB_BYTES,
-                    max_payload, &lay[1], why);
-  return s;
-}
-
-/* Appends the rows of layer (0: triangles, 1: vertices) to t: the values
- * the maker made, as records of the table's columns. */
-static tt_status append_layer(rows_state *w, rows_pipe *p, int layer,
-                              const page_layout *lay, tt__sqlite_table *t,
-                              int format)
-{
-  if (lay->ncols > TT__SQLITE_REC_COLS)
-    return tt__error(w->ctx, TT_ERR_FORMAT, "%s: table %s has more than %d "
-                     "columns", w->path, lay->table, TT__SQLITE_REC_COLS);
-  unsigned char body[8 * TT__SQLITE_REC_COLS + TRI_BLOB_BYTES + 8];
-  tt__sqlite_rec r;
-  tt_status s = TT_OK;
-  p->layer_now = layer;
-  for (size_t i = 0; i < p->count[layer] && s == TT_OK; i++) {
-    s = pipe_row(p, w, i);
-    if (s != TT_OK)
-      break;
-    tt__sqlite_rec_begin(&r, body, format);
-    for (int c = 0; c < lay->ncols; c++) {
-      int src = lay->src[c];
-      if (src == SRC_GEOM) {
-        tt__sqlite_rec_bytes(&r, p->blob, (size_t)p->blob_len, 0);
-        continue;
-      }
-      const row_value *rv = src >= 0 ? &p->vals[1 + src] : NULL;
-      if (!rv || rv->type == V_NULL) {
-        tt__sqlite_rec_null(&r);
-        continue;
-      }
-      tt__sqlite_value x;
-      x.type = rv->type == V_INT ? TT__SQV_INT : TT__SQV_REAL;
-      x.i = rv->i;
-      x.d = rv->d;
-      tt__sqlite_apply_affinity(&x, lay->aff[c]);
-      if (x.type == TT__SQV_INT)
-        tt__sqlite_rec_int(&r, x.i);
-      else
-        tt__sqlite_rec_real(&r, x.d);
-    }
-    const unsigned char *head;
-    size_t nh = tt__sqlite_rec_head(&r, &head);
-    s = tt__sqlite_table_append2(t, (int64_t)i + 1, head, nh, body, r.nb);
-  }
-  return s;
-}
-
-/* sqlite_sequence's row of an AUTOINCREMENT table: seq, the last fid, as
- * SQLite's inserts would have left it. */
-static tt_status set_sequence(rows_state *w, const page_layout *lay,
-                              size_t count)
-{
-  if (!count || !lay->autoinc)
-    return TT_OK;
-  sqlite3_stmt *st = NULL;
-  tt_status s = TT_OK;
-  if (sqlite3_prepare_v2(w->db,
-                         "UPDATE sqlite_sequence SET seq = ?1 WHERE name = "
-                         "?2",
-                         -1, &st, NULL) != SQLITE_OK)
-    return db_error(w, "cannot update sqlite_sequence");
-  sqlite3_bind_int64(st, 1, (sqlite3_int64)count);
-  sqlite3_bind_text(st, 2, lay->table, -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(st) != SQLITE_DONE)
-    s = db_error(w, "cannot update sqlite_sequence");
-  sqlite3_finalize(st);
-  if (s != TT_OK || sqlite3_changes(w->db) > 0)
-    return s;
-  if (sqlite3_prepare_v2(w->db,
-                         "INSERT INTO sqlite_sequence (name, seq) VALUES "
-                         "(?2, ?1)",
-                         -1, &st, NULL) != SQLITE_OK)
-    return db_error(w, "cannot update sqlite_sequence");
-  sqlite3_bind_int64(st, 1, (sqlite3_int64)count);
-  sqlite3_bind_text(st, 2, lay->table, -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(st) != SQLITE_DONE)
-    s = db_error(w, "cannot update sqlite_sequence");
-  sqlite3_finalize(st);
-  return s;
-}
-
-/* What the page path works with. */
-typedef struct pages_job {
-  rows_state *w;
-  rows_pipe *pipe;
-  const tt__records *rec;
-  layer_table *layer[2];
-  page_layout lay[2];
-  size_t count[2];
-  int todo[2];
-  int rtree, rtree_check, threads, journal_memory;
-  int had_extensions;    /* gpkg_extensions was there before step 1 */
-  tt__rtree_shadow sh[2];
-} pages_job;
-
-/* Step 2: the rows and the R-trees as pages. */
-static tt_status pages_write(pages_job *j)
-{
-  rows_state *w = j->w;
-  tt__sqlite_file *f = NULL;
-  tt__sqlite_table *t[2] = {NULL, NULL};
-  tt_status s = tt__sqlite_file_open(w->ctx, w->path, &f);
-  const int format = s == TT_OK ? tt__sqlite_file_format(f) : 4;
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k])
-      s = tt__sqlite_table_begin(f, j->lay[k].table, j->lay[k].root, &t[k]);
-  if (s == TT_OK)
-    s = pipe_begin(j->pipe, w, j->rec, j->layer[0], j->layer[1],
-                   j->count[0], j->count[1], j->threads,
-                   j->rtree ? j->sh[j->todo[0] ? 0 : 1].node_cap : 0);
-  w->pipe = j->pipe;
-  w->lo = 0.0;
-  w->hi = 0.9;
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k])
-      s = append_layer(w, j->pipe, k, &j->lay[k], t[k], format);
-  unsigned mine = 0;
-  if (s == TT_OK && j->rtree)
-    mine = pipe_pack_too(j->pipe, j->pipe->node_cap);
-  /* The tables, and the R-trees this thread packed, while the maker packs
-   * the others; then those. */
-  for (int k = 0; k < 2; k++)
-    if (t[k] && s == TT_OK) {
-      s = tt__sqlite_table_finish(t[k]);
-      t[k] = NULL;
-      j->layer[k]->last_fid = (sqlite3_int64)j->count[k];
-    }
-  int written = 0; /* trees written: progress 0.9 to 0.95 to 0.99 */
-  for (int pass = 0; pass < 2; pass++) {
-    if (pass == 1) {
-      pipe_join(j->pipe, s == TT_OK); /* the boxes, extents, trees done */
-      w->pipe = NULL;
-    }
-    for (int k = 1; k >= 0 && s == TT_OK; k--) {
-      if (!j->rtree || !j->todo[k] || ((mine >> k) & 1) != (pass == 0))
-        continue;
-      w->lo = written ? 0.95 : 0.9;
-      w->hi = written++ ? 0.99 : 0.95;
-      s = tt__rtree_write_pages(w->ctx, j->layer[k]->name,
-                                j->layer[k]->boxes, j->count[k],
-                                j->pipe->packed[k], &j->sh[k], f,
-                                rtree_progress, w);
-    }
-  }
-  if (s == TT_OK)
-    s = tt__sqlite_file_commit(f);
-  /* without the commit the file is cut back to its size after step 1 */
-  tt_status c = tt__sqlite_file_close(f);
-  return s != TT_OK ? s : c;
-}
-
-/* Undoes step 1 after a failure in step 2 (w->db idle). */
-static void pages_undo(pages_job *j)
-{
-  rows_state *w = j->w;
-  if (!j->rtree)
-    return;
-  tt_context *quiet = tt_context_create(); /* keeps the first message */
-  tt_context *ctx = quiet ? quiet : w->ctx;
-  if (sqlite3_exec(w->db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK)
-    goto done;
-  tt_status s = TT_OK;
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k])
-      s = tt__gpkg_rtree_drop(ctx, w->db, w->path, j->layer[k]->name,
-                              j->layer[k]->geom);
-  if (s == TT_OK && !j->had_extensions &&
-      sqlite3_exec(w->db, "DROP TABLE IF EXISTS gpkg_extensions", NULL,
-                   NULL, NULL) != SQLITE_OK)
-    s = TT_ERR_IO;
-  sqlite3_exec(w->db, s == TT_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL);
-done:
-  if (quiet)
-    tt_context_destroy(quiet);
-}
-
-/* Steps 1 (from the open transaction of w->db, which it ends) to 3. Between
- * steps 1 and 3 the connection stays open but idle: in rollback-journal
- * mode it then holds no lock (which the page writer's own descriptor,
- * closed after step 2, would cancel) and no page it trusts: the change
- * counter the page writer raises makes SQLite drop its cache at the next
- * transaction, and the schema is unchanged. */
-static tt_status pages_run(pages_job *j)
-{
-  rows_state *w = j->w;
-  tt_status s = TT_OK;
-  j->had_extensions =
-      sqlite3_table_column_metadata(w->db, NULL, "gpkg_extensions",
-                                    "extension_name", NULL, NULL, NULL, NULL,
-                                    NULL) == SQLITE_OK;
-  /* Step 1 needs no sync: a crash before step 3 ends loses the file. The
-   * transaction so far only read; the setting needs none open. */
-  int sync = 2;
-  sqlite3_stmt *st = NULL;
-  if (sqlite3_prepare_v2(w->db, "PRAGMA synchronous", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW)
-    sync = sqlite3_column_int(st, 0);
-  sqlite3_finalize(st);
-  s = exec(w, "COMMIT; PRAGMA synchronous = OFF; BEGIN IMMEDIATE",
-           "cannot start a transaction");
-  for (int k = 0; k < 2 && s == TT_OK && j->rtree; k++)
-    if (j->todo[k])
-      s = tt__gpkg_rtree_create_empty(w->ctx, w->db, w->path,
-                                      j->layer[k]->name, j->layer[k]->geom,
-                                      &j->sh[k]);
-  if (s == TT_OK)
-    s = exec(w, "COMMIT", "cannot commit the spatial indexes");
-  if (s != TT_OK) {
-    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
-    return s;
-  }
-  char pragma[48];
-  snprintf(pragma, sizeof pragma, "PRAGMA synchronous = %d", sync);
-  s = exec(w, pragma, "cannot set synchronous");
-
-  if (s == TT_OK)
-    s = pages_write(j);
-  if (s != TT_OK) {
-    pages_undo(j);
-    return s;
-  }
-
-  s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k]) {
-      s = set_sequence(w, &j->lay[k], j->count[k]);
-      if (s == TT_OK)
-        s = finish_layer(w, j->layer[k], j->count[k]);
-    }
-  for (int k = 0; k < 2 && s == TT_OK && j->rtree_check && j->rtree; k++) {
-    if (!j->todo[k])
-      continue;
-    char *sql = sqlite3_mprintf("SELECT rtreecheck(%Q)", j->sh[k].rtree);
-    int rc = sql ? sqlite3_prepare_v2(w->db, sql, -1, &st, NULL)
-                 : SQLITE_NOMEM;
-    sqlite3_free(sql);
-    const char *msg = rc == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW
-                          ? (const char *)sqlite3_column_text(st, 0) : NULL;
-    if (!msg || strcmp(msg, "ok") != 0)
-      s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s: the R-tree %s fails "
-                    "rtreecheck(): %.300s", w->path, j->sh[k].rtree,
-                    msg ? msg : sqlite3_errmsg(w->db));
-    sqlite3_finalize(st);
-    st = NULL;
-  }
-  if (s == TT_OK)
-    s = exec(w, "COMMIT", "cannot commit the TIN");
-  else
-    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
-  return s;
-}
-
 tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
                              const tt_tin *tin, OGRSpatialReferenceH srs,
                              char **options, tt_progress_fn progress,
@@ -1599,9 +590,9 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     goto done;
   in_transaction = 1;
   if (do_tri)
-    s = layer_find(&w, tri_name, &tri);
+    s = tt__rows_layer_find(&w, tri_name, &tri);
   if (s == TT_OK && do_vtx)
-    s = layer_find(&w, vtx_name, &vtx);
+    s = tt__rows_layer_find(&w, vtx_name, &vtx);
   if (s == TT_OK && rtree) {
     tri.boxes = malloc((nt ? nt : 1) * sizeof *tri.boxes);
     vtx.boxes = malloc((nv ? nv : 1) * sizeof *vtx.boxes);
@@ -1611,7 +602,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   }
   const char *why = NULL;
   if (s == TT_OK && pages)
-    s = pages_possible(&w, &tri, &vtx, do_tri, do_vtx, rtree,
+    s = tt__rows_pages_possible(&w, &tri, &vtx, do_tri, do_vtx, rtree,
                        tt__records_vertex_fields(tin), job.lay, &why);
   if (s == TT_OK && pages && why)
     CPLDebug("terratin", "%s: the rows go through SQLite, not as pages: %s",
@@ -1631,7 +622,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     job.threads = threads;
     job.journal_memory = journal_memory;
     in_transaction = 0; /* pages_run ends it */
-    s = pages_run(&job);
+    s = tt__rows_pages_run(&job);
     if (s == TT_OK && progress)
       progress(1.0, "writing", progress_arg); /* done: too late to stop */
     goto done;
@@ -1641,7 +632,7 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   if (s == TT_OK && do_vtx)
     s = triggers_drop(&w, &vtx);
   if (s == TT_OK) {
-    s = pipe_begin(&pipe, &w, &rec, &tri, &vtx, nt, nv, threads,
+    s = tt__rows_pipe_begin(&pipe, &w, &rec, &tri, &vtx, nt, nv, threads,
                    rtree ? tt__gpkg_rtree_node_cap(w.db) : 0);
     w.pipe = &pipe;
   }
@@ -1649,16 +640,16 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     s = insert_rows(&w, 0, tt__triangle_fields);
   if (s == TT_OK && do_vtx)
     s = insert_rows(&w, 1, tt__vertex_fields);
-  pipe_join(&pipe, s == TT_OK); /* the boxes and extents are complete */
+  tt__rows_pipe_join(&pipe, s == TT_OK); /* the boxes and extents done */
   w.pipe = NULL;
   if (s == TT_OK && do_tri)
     s = triggers_restore(&w, &tri);
   if (s == TT_OK && do_vtx)
     s = triggers_restore(&w, &vtx);
   if (s == TT_OK && do_tri)
-    s = finish_layer(&w, &tri, nt);
+    s = tt__rows_finish_layer(&w, &tri, nt);
   if (s == TT_OK && do_vtx)
-    s = finish_layer(&w, &vtx, nv);
+    s = tt__rows_finish_layer(&w, &vtx, nv);
   /* The R-trees from the boxes just written, in the same transaction. */
   w.lo = 0.7;
   w.hi = 0.93;
@@ -1682,9 +673,9 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   if (s == TT_OK && progress)
     progress(1.0, "writing", progress_arg); /* done: too late to stop */
 done:
-  pipe_free(&pipe); /* before the tables the maker fills */
+  tt__rows_pipe_free(&pipe); /* before the tables the maker fills */
   for (int k = 0; k < 2; k++) {
-    layout_free(&job.lay[k]);
+    tt__rows_layout_free(&job.lay[k]);
     tt__rtree_shadow_free(&job.sh[k]);
   }
   if (in_transaction)
@@ -1692,288 +683,10 @@ done:
   if (w.db && sqlite3_close(w.db) != SQLITE_OK && s == TT_OK)
     s = tt__error(ctx, TT_ERR_IO, "%s: cannot close the GeoPackage",
                   gpkg_path);
-  layer_free(&tri);
-  layer_free(&vtx);
+  tt__rows_layer_free(&tri);
+  tt__rows_layer_free(&vtx);
   CPLFree(tri_name);
   CPLFree(vtx_name);
   tt__records_free(&rec);
   return s;
-}
-
-/* --- the pages row by row, for a streamed write (gpkg_stream.h) -----------
- * pages_run()'s steps 1 to 3 split so that a tiled run
- * (io_gpkg_stream.c) can append rows as its tiles finish instead of from a
- * whole TIN: open makes step 1 and begins the tables, each row is
- * encoded as append_layer() encodes it, finish ends step 2 and makes step
- * 3. Nothing above changes. */
-#include "gdal/gpkg_stream.h"
-
-struct tt__gpkg_pages {
-  rows_state w;
-  layer_table layer[2];
-  pages_job job;
-  tt__sqlite_file *f;
-  tt__sqlite_table *t[2];
-  int format;
-  int finished;
-  char *names[2];
-};
-
-tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
-                              char **options, int nvfields,
-                              tt__gpkg_pages **out)
-{
-  *out = NULL;
-  tt__gpkg_pages *p = calloc(1, sizeof *p);
-  if (!p)
-    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  rows_state *w = &p->w;
-  pages_job *j = &p->job;
-  w->ctx = ctx;
-  w->path = path;
-  j->w = w;
-  j->layer[0] = &p->layer[0];
-  j->layer[1] = &p->layer[1];
-  j->rtree = 1;
-  const char *prefix = "";
-  unsigned layers = TT__LAYERS_ALL;
-  int journal_memory = 0;
-  tt_status s = TT_OK;
-  for (char **o = options; o && *o && s == TT_OK; o++) {
-    char *key = NULL;
-    const char *value = CPLParseNameValue(*o, &key);
-    if (!key || !value)
-      s = tt__error(ctx, TT_ERR_ARG, "write option \"%s\" is not "
-                    "NAME=VALUE", *o);
-    else if (strcasecmp(key, "NLN_PREFIX") == 0)
-      prefix = value;
-    else if (strcasecmp(key, "LCO") == 0) {
-      char *lkey = NULL;
-      const char *lvalue = CPLParseNameValue(value, &lkey);
-      if (lkey && lvalue && strcasecmp(lkey, "SPATIAL_INDEX") == 0)
-        j->rtree = CPLTestBool(lvalue);
-      CPLFree(lkey);
-    } else if (strcasecmp(key, "RTREE_CHECK") == 0)
-      j->rtree_check = CPLTestBool(value);
-    else if (strcasecmp(key, "LAYERS") == 0)
-      s = tt__records_parse_layers(ctx, value, &layers);
-    else if (strcasecmp(key, "JOURNAL") == 0)
-      journal_memory = strcasecmp(value, "MEMORY") == 0;
-    CPLFree(key);
-  }
-  j->todo[0] = (layers & TT__LAYER_TRIANGLES) != 0;
-  j->todo[1] = (layers & TT__LAYER_VERTICES) != 0;
-  p->names[0] = CPLStrdup(CPLSPrintf("%striangles", prefix));
-  p->names[1] = CPLStrdup(CPLSPrintf("%svertices", prefix));
-  *out = p;
-  if (s != TT_OK)
-    return s;
-  if (sqlite3_open_v2(path, &w->db,
-                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, NULL) !=
-      SQLITE_OK)
-    return tt__error(ctx, TT_ERR_IO, "%s: cannot open the GeoPackage: %s",
-                     path, w->db ? sqlite3_errmsg(w->db) : "out of memory");
-  sqlite3_extended_result_codes(w->db, 1);
-  if (journal_memory)
-    s = exec(w, "PRAGMA journal_mode = MEMORY", "cannot set the journal");
-  if (s == TT_OK)
-    s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k])
-      s = layer_find(w, p->names[k], &p->layer[k]);
-  const char *why = NULL;
-  if (s == TT_OK)
-    s = pages_possible(w, &p->layer[0], &p->layer[1], j->todo[0],
-                       j->todo[1], j->rtree, nvfields, j->lay, &why);
-  if (s == TT_OK && why)
-    s = tt__error(ctx, TT_ERR_FORMAT, "%s: the rows cannot be written as "
-                  "pages: %s", path, why);
-  if (s != TT_OK) {
-    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
-    return s;
-  }
-  /* step 1, as pages_run() makes it */
-  j->had_extensions =
-      sqlite3_table_column_metadata(w->db, NULL, "gpkg_extensions",
-                                    "extension_name", NULL, NULL, NULL, NULL,
-                                    NULL) == SQLITE_OK;
-  int sync = 2;
-  sqlite3_stmt *st = NULL;
-  if (sqlite3_prepare_v2(w->db, "PRAGMA synchronous", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW)
-    sync = sqlite3_column_int(st, 0);
-  sqlite3_finalize(st);
-  s = exec(w, "COMMIT; PRAGMA synchronous = OFF; BEGIN IMMEDIATE",
-           "cannot start a transaction");
-  for (int k = 0; k < 2 && s == TT_OK && j->rtree; k++)
-    if (j->todo[k])
-      s = tt__gpkg_rtree_create_empty(ctx, w->db, path, p->layer[k].name,
-                                      p->layer[k].geom, &j->sh[k]);
-  if (s == TT_OK)
-    s = exec(w, "COMMIT", "cannot commit the spatial indexes");
-  if (s != TT_OK) {
-    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
-    memset(j->sh, 0, sizeof j->sh); /* rolled back: nothing to undo */
-    j->rtree = 0;
-    return s;
-  }
-  char pragma[48];
-  snprintf(pragma, sizeof pragma, "PRAGMA synchronous = %d", sync);
-  s = exec(w, pragma, "cannot set synchronous");
-  /* step 2 begins */
-  if (s == TT_OK)
-    s = tt__sqlite_file_open(ctx, path, &p->f);
-  p->format = s == TT_OK ? tt__sqlite_file_format(p->f) : 4;
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k]) {
-      if (j->lay[k].ncols > TT__SQLITE_REC_COLS)
-        s = tt__error(ctx, TT_ERR_FORMAT, "%s: table %s has more than %d "
-                      "columns", path, j->lay[k].table, TT__SQLITE_REC_COLS);
-      else
-        s = tt__sqlite_table_begin(p->f, j->lay[k].table, j->lay[k].root,
-                                   &p->t[k]);
-    }
-  return s;
-}
-
-int tt__gpkg_pages_has(const tt__gpkg_pages *p, int layer)
-{
-  return p->job.todo[layer];
-}
-
-int32_t tt__gpkg_pages_srs_id(const tt__gpkg_pages *p, int layer)
-{
-  return p->layer[layer].srs_id;
-}
-
-int tt__gpkg_pages_rtree(const tt__gpkg_pages *p)
-{
-  return p->job.rtree;
-}
-
-tt_status tt__gpkg_pages_row(tt__gpkg_pages *p, int layer, int64_t fid,
-                             const tt__gpkg_value *fields,
-                             const unsigned char *blob, size_t blob_len)
-{
-  const page_layout *lay = &p->job.lay[layer];
-  unsigned char body[8 * TT__SQLITE_REC_COLS + TRI_BLOB_BYTES + 8];
-  tt__sqlite_rec r;
-  tt__sqlite_rec_begin(&r, body, p->format);
-  for (int c = 0; c < lay->ncols; c++) {
-    int src = lay->src[c];
-    if (src == SRC_GEOM) {
-      tt__sqlite_rec_bytes(&r, blob, blob_len, 0);
-      continue;
-    }
-    const tt__gpkg_value *v = src >= 0 ? &fields[src] : NULL;
-    if (!v || v->type == TT__GV_NULL) {
-      tt__sqlite_rec_null(&r);
-      continue;
-    }
-    tt__sqlite_value x;
-    x.type = v->type == TT__GV_INT ? TT__SQV_INT : TT__SQV_REAL;
-    x.i = v->i;
-    x.d = v->d;
-    tt__sqlite_apply_affinity(&x, lay->aff[c]);
-    if (x.type == TT__SQV_INT)
-      tt__sqlite_rec_int(&r, x.i);
-    else
-      tt__sqlite_rec_real(&r, x.d);
-  }
-  const unsigned char *head;
-  size_t nh = tt__sqlite_rec_head(&r, &head);
-  return tt__sqlite_table_append2(p->t[layer], fid, head, nh, body, r.nb);
-}
-
-tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p, tt__rtree_box *boxes[2],
-                                const size_t count[2],
-                                const double ext[2][4],
-                                tt_progress_fn progress, void *progress_arg)
-{
-  rows_state *w = &p->w;
-  pages_job *j = &p->job;
-  tt_status s = TT_OK;
-  w->progress = progress;
-  w->progress_arg = progress_arg;
-  for (int k = 0; k < 2; k++) {
-    j->count[k] = j->todo[k] ? count[k] : 0;
-    memcpy(p->layer[k].ext, ext[k], sizeof p->layer[k].ext);
-    if (p->t[k] && s == TT_OK) {
-      s = tt__sqlite_table_finish(p->t[k]);
-      p->t[k] = NULL;
-      p->layer[k].last_fid = (sqlite3_int64)j->count[k];
-    }
-  }
-  /* the vertices' index first: its boxes are freed before the
-   * triangles' (twice as many) are packed */
-  for (int k = 1; k >= 0 && s == TT_OK; k--) {
-    if (!j->rtree || !j->todo[k])
-      continue;
-    w->lo = k ? 0.0 : 0.3;
-    w->hi = k ? 0.3 : 0.9;
-    s = tt__rtree_write_pages(w->ctx, p->layer[k].name, boxes[k],
-                              j->count[k], NULL, &j->sh[k], p->f,
-                              rtree_progress, w);
-    free(boxes[k]);
-    boxes[k] = NULL;
-  }
-  if (s == TT_OK)
-    s = tt__sqlite_file_commit(p->f);
-  tt_status c = tt__sqlite_file_close(p->f);
-  p->f = NULL;
-  if (s == TT_OK)
-    s = c;
-  if (s != TT_OK)
-    return s; /* close() undoes step 1 */
-  p->finished = 1; /* the pages are in: step 3 */
-  s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
-  for (int k = 0; k < 2 && s == TT_OK; k++)
-    if (j->todo[k]) {
-      s = set_sequence(w, &j->lay[k], j->count[k]);
-      if (s == TT_OK)
-        s = finish_layer(w, &p->layer[k], j->count[k]);
-    }
-  for (int k = 0; k < 2 && s == TT_OK && j->rtree_check && j->rtree; k++) {
-    if (!j->todo[k])
-      continue;
-    sqlite3_stmt *st = NULL;
-    char *sql = sqlite3_mprintf("SELECT rtreecheck(%Q)", j->sh[k].rtree);
-    int rc = sql ? sqlite3_prepare_v2(w->db, sql, -1, &st, NULL)
-                 : SQLITE_NOMEM;
-    sqlite3_free(sql);
-    const char *msg = rc == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW
-                          ? (const char *)sqlite3_column_text(st, 0) : NULL;
-    if (!msg || strcmp(msg, "ok") != 0)
-      s = tt__error(w->ctx, TT_ERR_INTERNAL, "%s: the R-tree %s fails "
-                    "rtreecheck(): %.300s", w->path, j->sh[k].rtree,
-                    msg ? msg : sqlite3_errmsg(w->db));
-    sqlite3_finalize(st);
-  }
-  if (s == TT_OK)
-    s = exec(w, "COMMIT", "cannot commit the TIN");
-  else
-    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
-  if (s == TT_OK && progress)
-    progress(1.0, "writing", progress_arg);
-  return s;
-}
-
-void tt__gpkg_pages_close(tt__gpkg_pages *p)
-{
-  if (!p)
-    return;
-  if (p->f) /* not committed: the file is cut back to step 1's size */
-    tt__sqlite_file_close(p->f);
-  if (!p->finished && p->w.db && p->job.rtree)
-    pages_undo(&p->job);
-  if (p->w.db)
-    sqlite3_close(p->w.db);
-  for (int k = 0; k < 2; k++) {
-    layout_free(&p->job.lay[k]);
-    tt__rtree_shadow_free(&p->job.sh[k]);
-    layer_free(&p->layer[k]);
-    CPLFree(p->names[k]);
-  }
-  free(p);
 }

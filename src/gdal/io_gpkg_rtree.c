@@ -22,10 +22,7 @@
  * module rounds the values it is given, so a row written here equals the
  * row an INSERT or a trigger would write.
  *
- * Packing is Sort-Tile-Recursive, level by level: a level of k items makes
- * ceil(k / capacity) nodes whose sizes differ by at most one (so every node
- * but a lone root is at least half full), cut from ceil(sqrt(nodes))
- * vertical slices sorted by x centre, each slice sorted by y centre. Ties
+ * Packing is Sort-Tile-Recursive, level by level (rtree_pack.c); ties
  * break on the rowid: the same table gives the same file.
  *
  * tt_gpkg_build_rtree() does everything in one IMMEDIATE transaction: the
@@ -39,22 +36,23 @@
  * indexes of its own rows that way, and the tests run the check. The
  * packing needs no database (tt__rtree_pack()): the row writer packs on
  * its second thread while SQLite inserts rows, and hands the packed tree
- * over.
+ * over. The page writer's trees, written with SQLite closed, are made
+ * empty here (tt__gpkg_rtree_create_empty: the virtual table, triggers,
+ * gpkg_extensions row, and the shadow tables' root pages) and filled by
+ * io_gpkg_rtree_pages.c.
  *
  * Workload: one sequential scan of the table, an O(n log n) sort, one blob
- * per 51 features and one %_rowid row per feature; memory about 40 bytes per
- * feature.
+ * per 51 features and one %_rowid row per feature; memory 24 bytes per
+ * feature and as much again for the packing.
  */
 #include "gdal/gpkg_rtree.h"
-#include "gdal/sqlite_pages.h"
+#include "gdal/rtree_pack.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define RT_CELL_BYTES 24 /* 8-byte id + 4 floats */
-#define RT_MAX_DEPTH 40  /* far beyond any table SQLite can hold */
 #define WKB_MAX_NESTING 32
 #define LINK_BATCH 128   /* %_rowid rows per INSERT statement */
 
@@ -482,53 +480,6 @@ done:
 
 /* --- packing -------------------------------------------------------------- */
 
-/* a before b along axis (0: x, 1: y): by the box's centre (the sum of its
- * two floats, exact in a double), ties by id. */
-static inline int item_before(const rt_item *a, const rt_item *b, int axis)
-{
-  double ca = (double)a->box[2 * axis] + (double)a->box[2 * axis + 1];
-  double cb = (double)b->box[2 * axis] + (double)b->box[2 * axis + 1];
-  return ca < cb || (ca == cb && a->id < b->id);
-}
-
-/* Sorts items along axis: a merge sort with the comparison inlined (qsort's
- * callback per comparison cost the loader more than its SQL), runs of 16
- * by insertion first. tmp holds n items. The order is total (ids are
- * unique), so any correct sort gives the same result. */
-static void sort_items(rt_item *items, size_t n, int axis, rt_item *tmp)
-{
-  enum { RUN = 16 };
-  for (size_t r0 = 0; r0 < n; r0 += RUN) {
-    size_t r1 = r0 + RUN < n ? r0 + RUN : n;
-    for (size_t i = r0 + 1; i < r1; i++) {
-      rt_item x = items[i];
-      size_t j = i;
-      for (; j > r0 && item_before(&x, &items[j - 1], axis); j--)
-        items[j] = items[j - 1];
-      items[j] = x;
-    }
-  }
-  rt_item *src = items, *dst = tmp;
-  for (size_t width = RUN; width < n; width *= 2) {
-    for (size_t lo = 0; lo < n; lo += 2 * width) {
-      size_t mid = lo + width < n ? lo + width : n;
-      size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
-      size_t i = lo, j = mid, k = lo;
-      while (i < mid && j < hi)
-        dst[k++] = item_before(&src[j], &src[i], axis) ? src[j++] : src[i++];
-      while (i < mid)
-        dst[k++] = src[i++];
-      while (j < hi)
-        dst[k++] = src[j++];
-    }
-    rt_item *t = src;
-    src = dst;
-    dst = t;
-  }
-  if (src != items)
-    memcpy(items, src, n * sizeof *items);
-}
-
 static int cmp_link(const void *pa, const void *pb)
 {
   const rt_link *a = pa, *b = pb;
@@ -560,49 +511,6 @@ static void sort_links(rt_link *links, size_t n)
   qsort(links, n, sizeof *links, cmp_link);
 }
 
-/* First item of group g when n items make ngroups groups of near-equal
- * size. */
-static size_t group_start(size_t g, size_t n, size_t ngroups)
-{
-  return (size_t)((uint64_t)g * n / ngroups);
-}
-
-/* Orders items for ngroups consecutive groups: STR slices by x, then y.
- * tmp holds n items. */
-static void str_order(rt_item *items, size_t n, size_t ngroups, rt_item *tmp)
-{
-  size_t nslices = (size_t)ceil(sqrt((double)ngroups));
-  if (nslices < 1)
-    nslices = 1;
-  sort_items(items, n, 0, tmp);
-  for (size_t sl = 0; sl < nslices; sl++) {
-    size_t g0 = sl * ngroups / nslices, g1 = (sl + 1) * ngroups / nslices;
-    size_t e0 = group_start(g0, n, ngroups), e1 = group_start(g1, n, ngroups);
-    if (e1 > e0)
-      sort_items(items + e0, e1 - e0, 1, tmp);
-  }
-}
-
-static void put_be16(unsigned char *p, unsigned v)
-{
-  p[0] = (unsigned char)(v >> 8);
-  p[1] = (unsigned char)v;
-}
-
-static void put_be64(unsigned char *p, uint64_t v)
-{
-  for (int i = 0; i < 8; i++)
-    p[i] = (unsigned char)(v >> (56 - 8 * i));
-}
-
-static void put_bef32(unsigned char *p, float f)
-{
-  uint32_t u;
-  memcpy(&u, &f, sizeof u);
-  for (int i = 0; i < 4; i++)
-    p[i] = (unsigned char)(u >> (24 - 8 * i));
-}
-
 static tt_status step_reset(rt_build *b, sqlite3_stmt *st, const char *what)
 {
   int rc = sqlite3_step(st);
@@ -615,15 +523,8 @@ static tt_status step_reset(rt_build *b, sqlite3_stmt *st, const char *what)
 static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
                             size_t n, int leaf, int depth)
 {
-  memset(b->blob, 0, b->node_size);
-  put_be16(b->blob, nodeno == 1 ? (unsigned)depth : 0u);
-  put_be16(b->blob + 2, (unsigned)n);
-  for (size_t i = 0; i < n; i++) {
-    unsigned char *c = b->blob + 4 + i * RT_CELL_BYTES;
-    put_be64(c, (uint64_t)items[i].id);
-    for (int k = 0; k < 4; k++)
-      put_bef32(c + 8 + 4 * k, items[i].box[k]);
-  }
+  tt__rtree_node_blob(b->blob, b->node_size, items, n,
+                      nodeno == 1 ? (unsigned)depth : 0u);
   sqlite3_bind_int64(b->ins_node, 1, nodeno);
   sqlite3_bind_blob(b->ins_node, 2, b->blob, (int)b->node_size,
                     SQLITE_STATIC);
@@ -645,112 +546,6 @@ static tt_status write_node(rt_build *b, int64_t nodeno, const rt_item *items,
   return s;
 }
 
-/* The packed tree: every level's items in node order, the leaves first
- * (b->items itself, reordered), each level's groups the items of the one
- * above; the last level fits in the root. Computing needs no database. */
-struct tt__rtree_packed {
-  rt_item *items;    /* the leaves' cells (level 0), owned */
-  size_t nitems;
-  size_t node_cap;
-  int nlevels;
-  rt_item *level[RT_MAX_DEPTH + 1]; /* level[0] == items; others owned */
-  size_t n[RT_MAX_DEPTH + 1];
-  int64_t base[RT_MAX_DEPTH + 1]; /* node of level d's group g: base[d] + g
-                                     (the upper levels get reordered) */
-  size_t nodes_total;
-};
-
-void tt__rtree_packed_free(tt__rtree_packed *pk)
-{
-  if (!pk)
-    return;
-  for (int d = 1; d < pk->nlevels; d++)
-    free(pk->level[d]);
-  free(pk->items);
-  free(pk);
-}
-
-/* Packs items (n) into nodes of node_cap cells: on success items belong
- * to *out, on failure they stay the caller's. */
-static tt_status pack_items(tt_context *ctx, const char *what, rt_item *items,
-                            size_t n, size_t node_cap,
-                            tt__rtree_packed **out)
-{
-  *out = NULL;
-  tt__rtree_packed *pk = calloc(1, sizeof *pk);
-  rt_item *tmp = n > node_cap ? malloc(n * sizeof *tmp) : NULL;
-  if (!pk || (n > node_cap && !tmp)) {
-    free(pk);
-    free(tmp);
-    return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                     "index", what);
-  }
-  pk->items = items;
-  pk->nitems = n;
-  pk->node_cap = node_cap;
-  pk->level[0] = items;
-  pk->n[0] = n;
-  pk->nlevels = 1;
-  pk->nodes_total = 1;
-  int64_t next_nodeno = 2;
-  tt_status s = TT_OK;
-  for (int depth = 0; n > node_cap; depth++) {
-    if (depth >= RT_MAX_DEPTH) {
-      s = tt__error(ctx, TT_ERR_INTERNAL, "%s: index deeper than %d "
-                    "levels", what, RT_MAX_DEPTH);
-      break;
-    }
-    rt_item *level = pk->level[depth];
-    size_t ngroups = (n + node_cap - 1) / node_cap;
-    str_order(level, n, ngroups, tmp);
-    rt_item *next = malloc(ngroups * sizeof *next);
-    if (!next) {
-      s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                    "index", what);
-      break;
-    }
-    pk->base[depth] = next_nodeno;
-    for (size_t g = 0; g < ngroups; g++) {
-      size_t e0 = group_start(g, n, ngroups);
-      size_t e1 = group_start(g + 1, n, ngroups);
-      rt_item *up = &next[g];
-      up->id = next_nodeno++;
-      memcpy(up->box, level[e0].box, sizeof up->box);
-      for (size_t i = e0 + 1; i < e1; i++) {
-        const float *bx = level[i].box;
-        if (bx[0] < up->box[0]) up->box[0] = bx[0];
-        if (bx[1] > up->box[1]) up->box[1] = bx[1];
-        if (bx[2] < up->box[2]) up->box[2] = bx[2];
-        if (bx[3] > up->box[3]) up->box[3] = bx[3];
-      }
-    }
-    pk->nodes_total += ngroups;
-    pk->level[depth + 1] = next;
-    pk->n[depth + 1] = ngroups;
-    pk->nlevels = depth + 2;
-    n = ngroups;
-  }
-  free(tmp);
-  if (s != TT_OK) {
-    pk->items = NULL; /* the caller's again */
-    tt__rtree_packed_free(pk);
-    return s;
-  }
-  *out = pk;
-  return TT_OK;
-}
-
-tt_status tt__rtree_pack(tt_context *ctx, const char *what,
-                         tt__rtree_box *boxes, size_t n, size_t node_cap,
-                         tt__rtree_packed **out)
-{
-  *out = NULL;
-  if (node_cap < 2)
-    return tt__error(ctx, TT_ERR_INTERNAL, "%s: R-tree nodes of %zu cells",
-                     what, node_cap);
-  return pack_items(ctx, what, boxes, n, node_cap, out);
-}
-
 size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
 {
   sqlite3_stmt *st = NULL;
@@ -762,10 +557,10 @@ size_t tt__gpkg_rtree_node_cap(sqlite3 *db)
   sqlite3_finalize(st);
   /* SQLite's R*Tree: nodes of the page size less 64 bytes, at most 51
    * cells (RTREE_MAXCELLS) */
-  size_t size = page > 64 ? (size_t)page - 64 : 4 + 2 * RT_CELL_BYTES;
-  if (size > 4 + 51 * RT_CELL_BYTES)
-    size = 4 + 51 * RT_CELL_BYTES;
-  return (size - 4) / RT_CELL_BYTES;
+  size_t size = page > 64 ? (size_t)page - 64 : 4 + 2 * TT__RTREE_CELL_BYTES;
+  if (size > 4 + 51 * TT__RTREE_CELL_BYTES)
+    size = 4 + 51 * TT__RTREE_CELL_BYTES;
+  return (size - 4) / TT__RTREE_CELL_BYTES;
 }
 
 /* Writes the packed tree's nodes, parents and rowid map. */
@@ -787,8 +582,8 @@ static tt_status write_packed(rt_build *b, const tt__rtree_packed *pk)
     }
     size_t ngroups = pk->n[d + 1];
     for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
-      size_t e0 = group_start(g, n, ngroups);
-      size_t e1 = group_start(g + 1, n, ngroups);
+      size_t e0 = tt__rtree_group_start(g, n, ngroups);
+      size_t e1 = tt__rtree_group_start(g + 1, n, ngroups);
       s = write_node(b, pk->base[d] + (int64_t)g, level + e0, e1 - e0,
                      d == 0, d);
     }
@@ -1001,11 +796,11 @@ static tt_status create_schema(rt_build *b)
     return s;
   int size = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int(st, 0) : 0;
   sqlite3_finalize(st);
-  if (size < 4 + 2 * RT_CELL_BYTES || size > 65536)
+  if (size < 4 + 2 * TT__RTREE_CELL_BYTES || size > 65536)
     return tt__error(b->ctx, TT_ERR_INTERNAL, "%s: table %s: unexpected "
                      "R-tree node size %d", b->path, b->table, size);
   b->node_size = (size_t)size;
-  b->node_cap = (b->node_size - 4) / RT_CELL_BYTES;
+  b->node_cap = (b->node_size - 4) / TT__RTREE_CELL_BYTES;
   b->blob = malloc(b->node_size);
   if (!b->blob)
     return tt__error(b->ctx, TT_ERR_NOMEM, "%s: out of memory", b->path);
@@ -1118,7 +913,8 @@ static tt_status build_in_transaction(rt_build *b, const char *table,
     packed = NULL;
   }
   if (s == TT_OK && !packed) {
-    s = pack_items(b->ctx, b->path, b->items, b->nitems, b->node_cap, &own);
+    s = tt__rtree_pack_items(b->ctx, b->path, b->items, b->nitems,
+                             b->node_cap, 2, &own);
     if (s == TT_OK)
       b->items = NULL; /* taken over */
     packed = own;
@@ -1249,7 +1045,7 @@ done:
   return s;
 }
 
-/* --- the index written as pages ------------------------------------------- */
+/* --- the empty index the page writer fills, and its removal -------------- */
 
 void tt__rtree_shadow_free(tt__rtree_shadow *sh)
 {
@@ -1377,183 +1173,5 @@ tt_status tt__gpkg_rtree_drop(tt_context *ctx, sqlite3 *db,
     sqlite3_free(sql);
   }
   sqlite3_free(r);
-  return s;
-}
-
-/* Appends the %_node row (nodeno, blob): the record of NULL (the INTEGER
- * PRIMARY KEY) and the blob, which is its body as it is (no copy). */
-static tt_status node_row(tt__sqlite_table *t, int64_t nodeno,
-                          const unsigned char *blob, size_t size, int format)
-{
-  unsigned char body[16];
-  tt__sqlite_rec r;
-  tt__sqlite_rec_begin(&r, body, format);
-  tt__sqlite_rec_null(&r);
-  tt__sqlite_rec_bytes_type(&r, size, 0);
-  const unsigned char *head;
-  size_t nh = tt__sqlite_rec_head(&r, &head);
-  return tt__sqlite_table_append2(t, nodeno, head, nh, blob, size);
-}
-
-/* The node blob of items[0..n) (depth: the root's) into blob. */
-static void node_blob(unsigned char *blob, size_t node_size,
-                      const rt_item *items, size_t n, unsigned depth)
-{
-  put_be16(blob, depth);
-  put_be16(blob + 2, (unsigned)n);
-  for (size_t i = 0; i < n; i++) {
-    unsigned char *c = blob + 4 + i * RT_CELL_BYTES;
-    uint64_t id = TT__BE64(items[i].id);
-    uint32_t f[4];
-    memcpy(f, items[i].box, sizeof f);
-    for (int k = 0; k < 4; k++)
-      f[k] = TT__BE32(f[k]);
-    memcpy(c, &id, 8);
-    memcpy(c + 8, f, 16);
-  }
-  size_t used = 4 + n * RT_CELL_BYTES;
-  memset(blob + used, 0, node_size - used);
-}
-
-tt_status tt__rtree_write_pages(tt_context *ctx, const char *what,
-                                const tt__rtree_box *boxes, size_t n,
-                                const tt__rtree_packed *packed,
-                                const tt__rtree_shadow *sh,
-                                tt__sqlite_file *f, tt_progress_fn progress,
-                                void *progress_arg)
-{
-  tt__rtree_packed *own = NULL;
-  tt_status s = TT_OK;
-  if (!packed || packed->node_cap != sh->node_cap) {
-    /* packed for nodes of another size (or not at all): again, from its
-     * leaves (the order is total: the same tree as from the boxes) */
-    size_t m = packed ? packed->nitems : n;
-    rt_item *items = malloc((m ? m : 1) * sizeof *items);
-    if (!items)
-      return tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                       "spatial index", what);
-    memcpy(items, packed ? packed->items : boxes, m * sizeof *items);
-    s = pack_items(ctx, what, items, m, sh->node_cap, &own);
-    if (s != TT_OK) {
-      free(items);
-      return s;
-    }
-    packed = own;
-  }
-  const tt__rtree_packed *pk = packed;
-  const int format = tt__sqlite_file_format(f);
-  unsigned char *blob = malloc(sh->node_size);
-  uint32_t *node_of = calloc(pk->nitems ? pk->nitems : 1, sizeof *node_of);
-  uint32_t *parent = malloc((pk->nodes_total + 1) * sizeof *parent);
-  tt__sqlite_table *t = NULL;
-  char *name = NULL;
-  if (!blob || !node_of || !parent) {
-    s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                  "index", what);
-    goto done;
-  }
-  const int top = pk->nlevels - 1;
-  const size_t total = pk->nodes_total * 2 + pk->nitems;
-  size_t done_rows = 0;
-
-  /* Where each node and each feature hangs: level e's groups are nodes
-   * base[e] + g (the top level's one group is the root, node 1), the items
-   * of level e + 1 are level e's nodes. */
-  for (size_t i = 0; i <= pk->nodes_total; i++)
-    parent[i] = 0;
-  for (int e = 0; e <= top; e++) {
-    size_t ngroups = e == top ? 1 : pk->n[e + 1];
-    for (size_t g = 0; g < ngroups; g++) {
-      size_t e0 = e == top ? 0 : group_start(g, pk->n[e], ngroups);
-      size_t e1 = e == top ? pk->n[e] : group_start(g + 1, pk->n[e], ngroups);
-      uint32_t node = e == top ? 1u : (uint32_t)(pk->base[e] + (int64_t)g);
-      for (size_t i = e0; i < e1; i++) {
-        int64_t id = pk->level[e][i].id;
-        if (e > 0) {
-          parent[id] = node;
-        } else if (id < 1 || (uint64_t)id > pk->nitems ||
-                   node_of[id - 1] != 0) {
-          s = tt__error(ctx, TT_ERR_INTERNAL, "%s: the features' ids are "
-                        "not 1..%zu", what, pk->nitems);
-          goto done;
-        } else {
-          node_of[id - 1] = node;
-        }
-      }
-    }
-  }
-
-  /* %_node: the root, then every level's nodes, in node number order */
-  name = sqlite3_mprintf("%s_node", sh->rtree);
-  s = name ? tt__sqlite_table_begin(f, name, sh->root[0], &t)
-           : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  if (s == TT_OK) {
-    node_blob(blob, sh->node_size, pk->level[top], pk->n[top],
-              (unsigned)top);
-    s = node_row(t, 1, blob, sh->node_size, format);
-  }
-  for (int d = 0; d < top && s == TT_OK; d++) {
-    size_t ngroups = pk->n[d + 1];
-    for (size_t g = 0; g < ngroups && s == TT_OK; g++) {
-      size_t e0 = group_start(g, pk->n[d], ngroups);
-      size_t e1 = group_start(g + 1, pk->n[d], ngroups);
-      node_blob(blob, sh->node_size, pk->level[d] + e0, e1 - e0, 0);
-      s = node_row(t, pk->base[d] + (int64_t)g, blob, sh->node_size,
-                   format);
-    }
-  }
-  done_rows += pk->nodes_total;
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-  if (s == TT_OK && progress &&
-      !progress((double)done_rows / (double)total, "indexing", progress_arg))
-    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial index "
-                  "was interrupted", what);
-
-  /* %_parent: every node but the root */
-  sqlite3_free(name);
-  name = s == TT_OK ? sqlite3_mprintf("%s_parent", sh->rtree) : NULL;
-  if (s == TT_OK)
-    s = name ? tt__sqlite_table_begin(f, name, sh->root[1], &t)
-             : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  for (size_t m = 2; m <= pk->nodes_total && s == TT_OK; m++)
-    s = tt__sqlite_table_append_int(t, (int64_t)m, parent[m]);
-  done_rows += pk->nodes_total;
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-
-  /* %_rowid: every feature, by id */
-  sqlite3_free(name);
-  name = s == TT_OK ? sqlite3_mprintf("%s_rowid", sh->rtree) : NULL;
-  if (s == TT_OK)
-    s = name ? tt__sqlite_table_begin(f, name, sh->root[2], &t)
-             : tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  for (size_t i = 0; i < pk->nitems && s == TT_OK; i++) {
-    s = tt__sqlite_table_append_int(t, (int64_t)i + 1, node_of[i]);
-    if (s == TT_OK && progress && (i & 0xffff) == 0xffff &&
-        !progress((double)(done_rows + i) / (double)total, "indexing",
-                  progress_arg))
-      s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial "
-                    "index was interrupted", what);
-  }
-  if (s == TT_OK) {
-    s = tt__sqlite_table_finish(t);
-    t = NULL;
-  }
-  if (s == TT_OK && progress &&
-      !progress(1.0, "indexing", progress_arg))
-    s = tt__error(ctx, TT_ERR_INTERRUPTED, "%s: building the spatial index "
-                  "was interrupted", what);
-done:
-  /* a table not finished (t) is freed with the file, never committed */
-  sqlite3_free(name);
-  free(blob);
-  free(node_of);
-  free(parent);
-  tt__rtree_packed_free(own);
   return s;
 }

@@ -14,10 +14,18 @@
  * (tests/apps/test_tiles.sh compares them). The extents are min/max over
  * the rows, whatever the order.
  *
- * The R-trees need every box: they are kept (40 bytes a feature, about
- * 120 bytes a vertex with its two triangles) and packed at the end, as
- * the merged-TIN path does; that is the one store here that grows with
- * the TIN.
+ * Each row's box (rounded outward to the floats the index stores) goes
+ * with it to the page writer, whose R-trees pack their leaves block by
+ * block as the rows come (tt__rtree_stream, io_gpkg_rtree_pages.c): a
+ * block ends after a batch, a piece's triangles or the vertices final
+ * after it (tt__gpkg_pages_cut), once it holds 65,536 boxes (earlier where
+ * a row of tiles wrapped), so a block is a strip of whole pieces, a few
+ * tiles of 1,024 at 1 % of the samples. Only the
+ * leaves' boxes (24 bytes a leaf of about 51 features) are kept until the
+ * end, when the upper levels and the root are written: the trees hold the
+ * same boxes as the merged-TIN path's but not the same nodes (their
+ * queries visit as many: docs/scale.md). Left to grow with the TIN: 8
+ * bytes a vertex for the style's quantile classes.
  *
  * A geographic or Web Mercator DEM's triangles come with their piece's
  * ground points and the area function (src/tile/stream.c), so
@@ -56,8 +64,6 @@ struct tt__gpkg_stream {
   int32_t srs_id[2];
   size_t count[2];
   double ext[2][4];
-  tt__rtree_box *boxes[2];
-  size_t cap[2];
   /* the layers' default style (STYLE=YES), whose classes the whole TIN's
    * values make: the triangles' max_err range, every vertex's finite
    * ins_err (quantiles: 8 bytes a vertex) */
@@ -70,40 +76,6 @@ struct tt__gpkg_stream {
   int decimated; /* the importance field; ins_rank NULL */
 };
 
-static unsigned char *put_u32(unsigned char *p, uint32_t v)
-{
-  for (int k = 0; k < 4; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_f64(unsigned char *p, double d)
-{
-  uint64_t v;
-  memcpy(&v, &d, sizeof v);
-  for (int k = 0; k < 8; k++)
-    *p++ = (unsigned char)(v >> (8 * k));
-  return p;
-}
-
-static unsigned char *put_header(unsigned char *p, unsigned flags,
-                                 int32_t srs_id)
-{
-  *p++ = 'G';
-  *p++ = 'P';
-  *p++ = 0;
-  *p++ = (unsigned char)flags;
-  return put_u32(p, (uint32_t)srs_id);
-}
-
-static void extend(double *ext, double x, double y)
-{
-  if (x < ext[0]) ext[0] = x;
-  if (y < ext[1]) ext[1] = y;
-  if (x > ext[2]) ext[2] = x;
-  if (y > ext[3]) ext[3] = y;
-}
-
 static void set_int(tt__gpkg_value *v, int64_t i)
 {
   v->type = TT__GV_INT;
@@ -114,24 +86,6 @@ static void set_real(tt__gpkg_value *v, double d)
 {
   v->type = isfinite(d) ? TT__GV_REAL : TT__GV_NULL; /* NaN as NULL */
   v->d = d;
-}
-
-/* Room for n more boxes of layer k. */
-static tt_status box_room(tt__gpkg_stream *g, int k, size_t n)
-{
-  if (!g->rtree || g->count[k] + n <= g->cap[k])
-    return TT_OK;
-  size_t c = g->cap[k] + g->cap[k] / 2;
-  if (c < g->count[k] + n)
-    c = g->count[k] + n;
-  tt__rtree_box *b = realloc(g->boxes[k], c * sizeof *b);
-  if (!b)
-    return tt__error(g->ctx, TT_ERR_NOMEM, "%s: out of memory for the "
-                     "spatial index of %zu features", g->path,
-                     g->count[k] + n);
-  g->boxes[k] = b;
-  g->cap[k] = c;
-  return TT_OK;
 }
 
 tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
@@ -186,10 +140,7 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   const tt_tin *tin = b->tri;
   tt__records rec;
-  tt_status s = box_room(g, 0, tt_tin_triangle_count(tin));
-  if (s != TT_OK)
-    return s;
-  s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
+  tt_status s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
   unsigned char blob[TRI_BLOB];
   tt__gpkg_value f[TT__TF_COUNT];
   for (size_t i = 0; i < tt_tin_triangle_count(tin) && s == TT_OK; i++) {
@@ -223,9 +174,8 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     size_t fid = b->tri_first + i + 1;
     extend(g->ext[0], lo[0], lo[1]);
     extend(g->ext[0], hi[0], hi[1]);
-    if (g->rtree)
-      tt__rtree_box_set(&g->boxes[0][g->count[0]], (int64_t)fid, lo[0],
-                        hi[0], lo[1], hi[1]);
+    tt__rtree_box box;
+    tt__rtree_box_set(&box, (int64_t)fid, lo[0], hi[0], lo[1], hi[1]);
     set_int(&f[TT__TF_V0], b->map[tr.v[0]]);
     set_int(&f[TT__TF_V1], b->map[tr.v[1]]);
     set_int(&f[TT__TF_V2], b->map[tr.v[2]]);
@@ -243,7 +193,7 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
     set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
     s = tt__gpkg_pages_row(g->pages, 0, (int64_t)fid, f, blob,
-                           (size_t)(q - blob));
+                           (size_t)(q - blob), g->rtree ? &box : NULL);
     g->count[0]++;
   }
   tt__records_free(&rec);
@@ -256,10 +206,7 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   const tt_tin *tin = b->vtx;
   tt__records rec;
-  tt_status s = box_room(g, 1, tt_tin_vertex_count(tin));
-  if (s != TT_OK)
-    return s;
-  s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
+  tt_status s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
   unsigned char blob[PT_BLOB];
   tt__gpkg_value f[TT__VF_COUNT];
   for (size_t i = 0; i < tt_tin_vertex_count(tin) && s == TT_OK; i++) {
@@ -276,9 +223,8 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     q = put_f64(q, y);
     q = put_f64(q, v.z);
     extend(g->ext[1], x, y);
-    if (g->rtree)
-      tt__rtree_box_set(&g->boxes[1][g->count[1]], (int64_t)id + 1, x, x,
-                        y, y);
+    tt__rtree_box box;
+    tt__rtree_box_set(&box, (int64_t)id + 1, x, x, y, y);
     set_int(&f[TT__VF_ID], (int64_t)id);
     set_int(&f[TT__VF_COL], v.col);
     set_int(&f[TT__VF_ROW], v.row);
@@ -307,7 +253,7 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     if (g->decimated)
       set_real(&f[TT__VF_IMPORTANCE], v.importance);
     s = tt__gpkg_pages_row(g->pages, 1, (int64_t)id + 1, f, blob,
-                           (size_t)(q - blob));
+                           (size_t)(q - blob), g->rtree ? &box : NULL);
     g->count[1]++;
   }
   tt__records_free(&rec);
@@ -317,17 +263,25 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
 tt_status tt__gpkg_stream_batch(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   tt_status s = TT_OK;
+  /* a batch is a piece's triangles and the vertices final after it: an
+   * R-tree block may end after either (tt__gpkg_pages_cut) */
   if (b->tri && tt_tin_triangle_count(b->tri)) {
-    if (g->todo[0])
+    if (g->todo[0]) {
       s = triangles(g, b);
-    else
+      if (s == TT_OK)
+        s = tt__gpkg_pages_cut(g->pages, 0);
+    } else {
       g->count[0] += tt_tin_triangle_count(b->tri);
+    }
   }
   if (s == TT_OK && b->vtx && tt_tin_vertex_count(b->vtx)) {
-    if (g->todo[1])
+    if (g->todo[1]) {
       s = vertices(g, b);
-    else
+      if (s == TT_OK)
+        s = tt__gpkg_pages_cut(g->pages, 1);
+    } else {
       g->count[1] += tt_tin_vertex_count(b->vtx);
+    }
   }
   return s;
 }
@@ -427,7 +381,7 @@ tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
   size_t count[2];
   for (int k = 0; k < 2; k++)
     count[k] = g->todo[k] ? g->count[k] : 0;
-  tt_status s = tt__gpkg_pages_finish(g->pages, g->boxes, count,
+  tt_status s = tt__gpkg_pages_finish(g->pages, count,
                                       (const double(*)[4])g->ext, progress,
                                       progress_arg);
   tt__gpkg_pages_close(g->pages); /* SQLite's connection too */
@@ -439,8 +393,7 @@ tt_status tt__gpkg_stream_finish(tt__gpkg_stream *g,
 
 size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g)
 {
-  return g ? (g->cap[0] + g->cap[1]) * sizeof(tt__rtree_box) +
-                 g->inscap * sizeof(double)
+  return g ? tt__gpkg_pages_bytes(g->pages) + g->inscap * sizeof(double)
            : 0;
 }
 
@@ -449,8 +402,6 @@ void tt__gpkg_stream_close(tt__gpkg_stream *g)
   if (!g)
     return;
   tt__gpkg_pages_close(g->pages);
-  free(g->boxes[0]);
-  free(g->boxes[1]);
   free(g->ins);
   CPLFree(g->t_srs);
   CPLFree(g->prefix);

@@ -34,6 +34,15 @@
  * the library version (96). The freelist, the schema and its cookie are
  * untouched: no page is taken from the freelist and no table is made.
  *
+ * One exception to append-only: a row whose payload is known only at the
+ * end but must come first in rowid order (the R*Tree's root, node 1, of
+ * a tree whose leaves are written as they are packed) is appended with a
+ * placeholder of its final length, its place kept (a spot: page and
+ * offset), and its bytes overwritten before the commit
+ * (tt__sqlite_file_patch): in the root page kept for the commit, in the
+ * queue, or with a pwrite into a page appended here (never into a page of
+ * the file before the open, so cutting the file back still undoes all).
+ *
  * Refused: a database in WAL mode (the pages would have to go through the
  * WAL), auto-vacuum or incremental vacuum (every new page would need its
  * pointer-map entry), an in-header size that disagrees with the file's,
@@ -581,6 +590,8 @@ struct tt__sqlite_table {
   size_t nc, content; /* the leaf's cells, start of its content area */
   int64_t last;       /* the last rowid appended */
   uint64_t rows, leaves_out;
+  tt__sqlite_spot *spot; /* a row's place, set when its leaf is done */
+  uint32_t spot_offset;
   size_t max_payload, cap_children;
   level lv[MAX_LEVELS + 1]; /* 1..nlv; lv[0] unused (the leaves) */
   int nlv;
@@ -769,6 +780,12 @@ static tt_status emit_leaf(tt__sqlite_table *t)
   tt_status s = page_out(t->f, &t->leaf, &pgno);
   if (s != TT_OK)
     return s;
+  if (t->spot) {
+    t->spot->pgno = pgno;
+    t->spot->offset = t->spot_offset;
+    t->spot->known = 1;
+    t->spot = NULL;
+  }
   t->leaves_out++;
   t->nc = 0;
   t->content = t->f->usable;
@@ -828,6 +845,58 @@ tt_status tt__sqlite_table_append2(tt__sqlite_table *t, int64_t rowid,
   return TT_OK;
 }
 
+tt_status tt__sqlite_table_append2_spot(tt__sqlite_table *t, int64_t rowid,
+                                        const unsigned char *a, size_t na,
+                                        const unsigned char *b, size_t nb,
+                                        tt__sqlite_spot *spot)
+{
+  spot->known = 0;
+  if (t->spot)
+    return tt__error(t->f->ctx, TT_ERR_INTERNAL, "%s: table %s: a second "
+                     "row's place asked before the first's is known",
+                     t->f->path, t->name);
+  tt_status s = tt__sqlite_table_append2(t, rowid, a, na, b, nb);
+  if (s != TT_OK)
+    return s;
+  /* the cell just made is the leaf's lowest: its sizes, then the payload */
+  size_t n = na + nb;
+  t->spot = spot;
+  t->spot_offset = (uint32_t)(t->content + (size_t)varint_len(n) +
+                              (size_t)varint_len((uint64_t)rowid));
+  return TT_OK;
+}
+
+tt_status tt__sqlite_file_patch(tt__sqlite_file *f,
+                                const tt__sqlite_spot *spot, size_t at,
+                                const void *p, size_t n)
+{
+  if (f->failed || f->committed || !spot->known ||
+      spot->offset + at + n > f->usable)
+    return tt__error(f->ctx, TT_ERR_INTERNAL, "%s: cannot patch page %u "
+                     "at %zu (%s)", f->path, spot->pgno,
+                     (size_t)spot->offset + at,
+                     !spot->known ? "its place is not known yet"
+                                  : "after a failure, a commit or past the "
+                                    "page");
+  size_t off = spot->offset + at;
+  for (size_t k = 0; k < f->nroots; k++)
+    if (f->roots[k].pgno == spot->pgno) {
+      memcpy(f->roots[k].page + off, p, n);
+      return TT_OK;
+    }
+  if (f->buf_n && spot->pgno >= f->buf_first &&
+      spot->pgno - f->buf_first < f->buf_n) {
+    memcpy(f->buf[spot->pgno - f->buf_first] + off, p, n);
+    return TT_OK;
+  }
+  if (spot->pgno <= f->orig_pages || spot->pgno >= f->next)
+    return tt__error(f->ctx, TT_ERR_INTERNAL, "%s: page %u is not a page "
+                     "written here", f->path, spot->pgno);
+  if (!pwrite_all(f->fd, p, n, page_offset(f, spot->pgno) + (off_t)off))
+    return io_error(f, "cannot patch a page");
+  return TT_OK;
+}
+
 tt_status tt__sqlite_table_append_int(tt__sqlite_table *t, int64_t rowid,
                                       int64_t value)
 {
@@ -878,6 +947,12 @@ tt_status tt__sqlite_table_finish(tt__sqlite_table *t)
     if (t->nc) { /* every row in the root leaf */
       leaf_header(t);
       s = keep_root(f, t->root, t->leaf);
+      if (s == TT_OK && t->spot) {
+        t->spot->pgno = t->root;
+        t->spot->offset = t->spot_offset;
+        t->spot->known = 1;
+        t->spot = NULL;
+      }
     }
     table_free(t);
     return s;

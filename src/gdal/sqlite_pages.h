@@ -284,6 +284,34 @@ TT_HIDDEN tt_status tt__sqlite_table_append2(tt__sqlite_table *t,
 TT_HIDDEN tt_status tt__sqlite_table_append_int(tt__sqlite_table *t,
                                                 int64_t rowid,
                                                 int64_t value);
+/* Where a row's payload lies in the file once its page is done: page
+ * number and the payload's first byte in that page (known: 1). */
+typedef struct tt__sqlite_spot {
+  uint32_t pgno;
+  uint32_t offset;
+  int known;
+} tt__sqlite_spot;
+/* tt__sqlite_table_append2, and *spot set to the row's place when its
+ * page is done: by a later append that fills the page, or by
+ * tt__sqlite_table_finish (the caller keeps *spot until then; one spot a
+ * table at a time). For a row whose payload is patched in place before
+ * the commit (tt__sqlite_file_patch): the R*Tree's root, node 1, known
+ * last but stored first. */
+TT_HIDDEN tt_status tt__sqlite_table_append2_spot(tt__sqlite_table *t,
+                                                  int64_t rowid,
+                                                  const unsigned char *a,
+                                                  size_t na,
+                                                  const unsigned char *b,
+                                                  size_t nb,
+                                                  tt__sqlite_spot *spot);
+/* Overwrites n bytes of the payload at spot, from its byte at on, with p:
+ * wherever the page is now (a root kept for the commit, a page queued,
+ * or one written past the file's old end). Before the commit only; the
+ * payload's length is the caller's to respect. */
+TT_HIDDEN tt_status tt__sqlite_file_patch(tt__sqlite_file *f,
+                                          const tt__sqlite_spot *spot,
+                                          size_t at, const void *p,
+                                          size_t n);
 /* Ends the table: its last pages and its root (kept for the commit).
  * Frees t, also on failure. */
 TT_HIDDEN tt_status tt__sqlite_table_finish(tt__sqlite_table *t);

@@ -133,21 +133,28 @@ check "nodata: threads 1 vs 2, the same layers" [ "$(dump out/n1.gpkg)" = "$(dum
 
 # --- streamed (the default for a GeoPackage: rows written as the tiles
 # merge, tiled_stream.c) against the merged-TIN path
-# (TERRATIN_TILE_STREAM=NO): the same rows, byte for byte, the same
-# R-tree nodes, extents, counts, run_parameters (but times), styles ---
-streamed_vs_merged "fractal, tiles of 128, 2 threads" in/ds.tif -max_error 6 -tile_size 128 -threads 2
-streamed_vs_merged "fractal, tiles of 100, 1 thread" in/ds.tif -max_error 6 -tile_size 100 -threads 1
-streamed_vs_merged "fractal, tiles of 500, 2 threads" in/ds.tif -max_error 6 -tile_size 500 -threads 2
-streamed_vs_merged "fractal, default bound, tiles of 64" in/ds.tif -tile_size 64 -threads 2
+# (TERRATIN_TILE_STREAM=NO): the same rows, byte for byte, extents,
+# counts, run_parameters (but times), styles; the R-trees by content (the
+# same id and box for every feature, rtreecheck ok: the streamed writer
+# packs its leaves block by block, TERRATIN_RTREE_BLOCK=RB features a block
+# here so that a small DEM makes many blocks; RB unset: the default block,
+# more than these layers hold, gives the merged path's nodes byte for
+# byte, SAME_MODE= compares them so) ---
+RB=5000 streamed_vs_merged "fractal, tiles of 128, 2 threads, R-tree blocks of 5000" in/ds.tif -max_error 6 -tile_size 128 -threads 2
+RB=1 streamed_vs_merged "fractal, tiles of 100, 1 thread, an R-tree block a piece" in/ds.tif -max_error 6 -tile_size 100 -threads 1
+SAME_MODE= streamed_vs_merged "fractal, tiles of 500, 2 threads, one R-tree block: the same nodes" in/ds.tif -max_error 6 -tile_size 500 -threads 2
+RB=20000 streamed_vs_merged "fractal, default bound, tiles of 64, R-tree blocks of 20000" in/ds.tif -tile_size 64 -threads 2
 check "streamed: threads 1 vs 2, the same layers" [ "$(dump out/t1.gpkg)" = "$(dump out/t128.gpkg)" ]
-streamed_vs_merged "nodata, tiles of 50, 2 threads" in/n.tif -max_error 4 -tile_size 50 -threads 2
+RB=3000 streamed_vs_merged "nodata, tiles of 50, 2 threads, R-tree blocks of 3000" in/n.tif -max_error 4 -tile_size 50 -threads 2
 streamed_vs_merged "nodata, tiles of 128, 1 thread" in/n.tif -max_error 4 -tile_size 128 -threads 1
 streamed_vs_merged "fault, minmax_angle + lookahead" in/f.tif -max_error 0.5 -tile_size 64 -criterion minmax_angle -optimize lookahead
 JB="$(cd "$(dirname "$0")/../../testdata" && pwd)/jacksboro_fault_dem.tif"
-LAYERS_OF="x_triangles x_vertices" streamed_vs_merged "-t_srs, -nln, -layers" "$JB" -max_error 2 -tile_size 64 -t_srs EPSG:3857 -nln x_ -layers vertices,triangles
+RB=700 LAYERS_OF="x_triangles x_vertices" streamed_vs_merged "-t_srs, -nln, -layers" "$JB" -max_error 2 -tile_size 64 -t_srs EPSG:3857 -nln x_ -layers vertices,triangles
 streamed_vs_merged "-lco SPATIAL_INDEX=NO, -nostyle" in/ds.tif -max_error 6 -tile_size 128 -lco SPATIAL_INDEX=NO -nostyle
-# GDAL's spatial filter goes through the streamed R-tree
-"$T" simplify -q -max_error 6 -tile_size 100 in/ds.tif out/sf.gpkg 2>err.txt
+# GDAL's spatial filter goes through the streamed R-tree (in blocks of
+# 2000 features: packed leaves, upper levels and the root patched at the
+# end)
+TERRATIN_RTREE_BLOCK=2000 "$T" simplify -q -max_error 6 -tile_size 100 in/ds.tif out/sf.gpkg 2>err.txt
 # a window in the middle of the layer's extent
 win=$(python3 -c 'import sqlite3,sys
 x0,y0,x1,y1=sqlite3.connect(sys.argv[1]).execute("select min_x,min_y,max_x,max_y from gpkg_contents where table_name=\"triangles\"").fetchone()
@@ -161,6 +168,30 @@ check "streamed: the R-tree's answer ($n1) is the scan's ($n2)" [ "$n1" = "$n2" 
 check "streamed: rtreecheck ok" [ "$(python3 -c 'import sqlite3,sys
 db=sqlite3.connect(sys.argv[1])
 print(" ".join(db.execute("select rtreecheck(?)",(t,)).fetchone()[0] for t in ("rtree_triangles_geom","rtree_vertices_geom")))' out/sf.gpkg 2>&1)" = "ok ok" ]
+# ... and the GeoPackage's triggers keep it right when the file changes: an
+# append through OGR (new fids), an SQL UPDATE and a DELETE of geometries
+cp out/sf.gpkg out/sf_src.gpkg
+ogr2ogr -q -update -append out/sf.gpkg out/sf_src.gpkg triangles -where "fid <= 500" 2>err.txt
+rc=$?
+check "streamed R-tree: ogr2ogr -update -append exit 0 ($(cat err.txt))" [ $rc -eq 0 ]
+check "streamed R-tree: 500 features appended" \
+  [ "$(sqlite3 out/sf.gpkg 'select count(*) from triangles') " = "$(( $(sqlite3 out/sf_src.gpkg 'select count(*) from triangles') + 500 )) " ]
+ogrinfo -q out/sf.gpkg -sql "UPDATE triangles SET geom = (SELECT geom FROM triangles WHERE fid = 7) WHERE fid IN (3, 1000, 20000)" >/dev/null 2>err.txt
+ogrinfo -q out/sf.gpkg -sql "DELETE FROM triangles WHERE fid IN (5, 6000)" >/dev/null 2>>err.txt
+check "streamed R-tree: SQL UPDATE and DELETE ran ($(cat err.txt))" [ ! -s err.txt ]
+check "streamed R-tree after the changes: rtreecheck, one entry a feature, each holding its geometry's envelope, the updated ones at their new place" \
+  [ "$(python3 -c 'import sqlite3,struct,sys
+db=sqlite3.connect(sys.argv[1])
+ok=db.execute("select rtreecheck(?)",("rtree_triangles_geom",)).fetchone()[0]
+n=db.execute("select count(*) from triangles").fetchone()[0]
+r=db.execute("select count(*) from rtree_triangles_geom").fetchone()[0]
+bad=0
+for g,a,b,c,d in db.execute("select t.geom, r.minx, r.maxx, r.miny, r.maxy from triangles t join rtree_triangles_geom r on r.id = t.fid"):
+    if (g[3] >> 1) & 7: # the envelope: min x, max x, min y, max y
+        e=struct.unpack("<4d" if g[3] & 1 else ">4d", g[8:40])
+        bad+=not (a<=e[0] and b>=e[1] and c<=e[2] and d>=e[3])
+moved=db.execute("select count(distinct minx || maxx || miny || maxy) from rtree_triangles_geom where id in (3, 7, 1000, 20000)").fetchone()[0]
+print(ok, n == r, bad, moved)' out/sf.gpkg 2>&1)" = "ok True 0 1" ]
 
 # --- the memory limit chooses tiles ---
 run simplify -q -json -max_error 30 -max_memory 1500K in/ds.tif out/m.gpkg

@@ -25,6 +25,7 @@
  */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
+#include "tt_test_sqlite.h"
 
 #include <cpl_conv.h>
 #include <cpl_string.h>
@@ -62,24 +63,6 @@ static const char *tmp_path(const char *name)
 
 /* --- files -------------------------------------------------------------- */
 
-static unsigned char *slurp(const char *path, size_t *out_len)
-{
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  unsigned char *p = malloc((size_t)n + 1);
-  if (p && fread(p, 1, (size_t)n, f) != (size_t)n) {
-    free(p);
-    p = NULL;
-  }
-  fclose(f);
-  *out_len = (size_t)n;
-  return p;
-}
-
 static void copy_file(const char *src, const char *dst)
 {
   size_t n = 0;
@@ -101,53 +84,6 @@ static int same_file(const char *path, const unsigned char *p, size_t n)
   int same = q && m == n && memcmp(p, q, n) == 0;
   free(q);
   return same;
-}
-
-/* --- SQLite helpers ----------------------------------------------------- */
-
-static sqlite3 *db_open(const char *path)
-{
-  sqlite3 *db = NULL;
-  if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE, NULL) != SQLITE_OK) {
-    TT_FAIL_("cannot open %s: %s", path, db ? sqlite3_errmsg(db) : "?");
-    sqlite3_close(db);
-    return NULL;
-  }
-  return db;
-}
-
-/* First column of the first row as a malloc'ed string ("(null)" for NULL,
- * NULL on error). */
-static char *sql_text(sqlite3 *db, const char *sql)
-{
-  sqlite3_stmt *st = NULL;
-  char *out = NULL;
-  if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
-    TT_FAIL_("prepare %s: %s", sql, sqlite3_errmsg(db));
-    return NULL;
-  }
-  if (sqlite3_step(st) == SQLITE_ROW) {
-    const unsigned char *t = sqlite3_column_text(st, 0);
-    out = strdup(t ? (const char *)t : "(null)");
-  }
-  sqlite3_finalize(st);
-  return out;
-}
-
-static long long sql_int(sqlite3 *db, const char *sql)
-{
-  char *t = sql_text(db, sql);
-  long long v = t ? atoll(t) : -1;
-  free(t);
-  return v;
-}
-
-static void sql_exec(sqlite3 *db, const char *sql)
-{
-  char *err = NULL;
-  if (sqlite3_exec(db, sql, NULL, NULL, &err) != SQLITE_OK)
-    TT_FAIL_("%s: %s", sql, err ? err : "?");
-  sqlite3_free(err);
 }
 
 /* --- TINs --------------------------------------------------------------- */

@@ -15,6 +15,10 @@
  *    (SQLITE_TESTCTRL_PENDING_BYTE, for this process only), the pages
  *    written skip it;
  *  - closing without a commit leaves the file byte for byte as it was;
+ *  - a row appended first with a placeholder and patched in place before
+ *    the commit (the R*Tree's root) reads back patched, wherever its page
+ *    was at the patch: kept for the commit (the table's root), queued, or
+ *    written; a patch before its place is known is refused;
  *  - refused: a row larger than a page holds, rowids out of order, a root
  *    that is not an empty leaf, a WAL database, auto-vacuum.
  */
@@ -467,6 +471,79 @@ static char *read_all(const char *path, size_t *n)
   return b;
 }
 
+/* Row 1 of (id, data BLOB) appended as a placeholder of 1,000 zero bytes,
+ * rows 2..nrows after it, then row 1's blob patched: nrows 3 keeps it in
+ * the root page, 20 in the write queue (a few pages, before the lock-byte
+ * page this test moves to page 17, where the queue is flushed), 2,000
+ * written to the file before the patch. */
+static void patched(int nrows)
+{
+  char path[320];
+  snprintf(path, sizeof path, "%s/patch%d.db", dir, nrows);
+  unlink(path);
+  sqlite3 *db = open_db(path);
+  exec(db, "PRAGMA page_size = 4096; CREATE TABLE p (id INTEGER PRIMARY "
+           "KEY, data BLOB); CREATE TABLE other(x); INSERT INTO other "
+           "VALUES (zeroblob(3000))");
+  sqlite3_close(db);
+  uint32_t root = root_of(path, "p");
+  tt__sqlite_file *f = NULL;
+  tt__sqlite_table *t = NULL;
+  CHECK_OK(ctx, tt__sqlite_file_open(ctx, path, &f));
+  CHECK_OK(ctx, tt__sqlite_table_begin(f, "p", root, &t));
+  enum { N = 1000 };
+  unsigned char blob[N], body[16];
+  tt__sqlite_rec r;
+  tt__sqlite_rec_begin(&r, body, 4);
+  tt__sqlite_rec_null(&r);
+  tt__sqlite_rec_bytes_type(&r, N, 0);
+  const unsigned char *head;
+  size_t nh = tt__sqlite_rec_head(&r, &head);
+  memset(blob, 0, N);
+  tt__sqlite_spot spot;
+  CHECK_OK(ctx, tt__sqlite_table_append2_spot(t, 1, head, nh, blob, N,
+                                              &spot));
+  /* its page is not done yet */
+  CHECK_INT_EQ(tt__sqlite_file_patch(f, &spot, nh, blob, N),
+               TT_ERR_INTERNAL);
+  for (int k = 2; k <= nrows; k++) {
+    memset(blob, k & 0xff, N);
+    CHECK_OK(ctx, tt__sqlite_table_append2(t, k, head, nh, blob, N));
+  }
+  CHECK_OK(ctx, tt__sqlite_table_finish(t));
+  CHECK(spot.known);
+  for (int i = 0; i < N; i++)
+    blob[i] = (unsigned char)(i * 7 + 1);
+  CHECK_OK(ctx, tt__sqlite_file_patch(f, &spot, nh, blob, N));
+  /* past the page's usable bytes: refused */
+  CHECK_INT_EQ(tt__sqlite_file_patch(f, &spot, 4096, blob, 1),
+               TT_ERR_INTERNAL);
+  CHECK_OK(ctx, tt__sqlite_file_commit(f));
+  CHECK_OK(ctx, tt__sqlite_file_close(f));
+  db = open_db(path);
+  text_is(db, "PRAGMA integrity_check", "ok");
+  CHECK_INT_EQ(scalar(db, "SELECT count(*) FROM p"), nrows);
+  sqlite3_stmt *st = NULL;
+  sqlite3_prepare_v2(db, "SELECT id, data FROM p ORDER BY id", -1, &st,
+                     NULL);
+  int bad = 0;
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    int id = sqlite3_column_int(st, 0);
+    const unsigned char *d = sqlite3_column_blob(st, 1);
+    if (sqlite3_column_bytes(st, 1) != N) {
+      bad++;
+      continue;
+    }
+    for (int i = 0; i < N; i++)
+      bad += d[i] != (id == 1 ? (unsigned char)(i * 7 + 1)
+                              : (unsigned char)(id & 0xff));
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  if (bad)
+    TT_FAIL_("patched, %d rows: %d bytes differ", nrows, bad);
+}
+
 int main(void)
 {
   /* The lock-byte page at 64 KiB for every database of this process (set
@@ -502,6 +579,10 @@ int main(void)
   lone_child(169);
   lone_child(170);
   lone_child(7057);
+
+  patched(3);
+  patched(20);
+  patched(2000);
 
   /* the lock-byte page lies inside the pages just written */
   if (lock_moved) {
