@@ -153,7 +153,7 @@ bool tt__app_curves_bound(const app_curve *c, size_t n, size_t target,
 }
 
 /* At most this many passes at a bound. */
-#define BUDGET_PASSES 6
+#define BUDGET_PASSES 8
 
 tt_status tt__app_budget_passes(app_run *r, const char *path,
                                 const app_curve *curves, size_t ntiles,
@@ -177,6 +177,7 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
   double above = -1, below = INFINITY, e = 0, good = NAN;
   bool calibrated = false;
   size_t nv = 0, nt = 0;
+  int overs = 0; /* passes over the budget in a row */
   for (int pass = 1;; pass++) {
     size_t estimate;
     double next;
@@ -186,7 +187,22 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
                           "out of memory for the curves");
     if (isnan(next) && !isnan(good))
       next = good; /* nothing between: back to the fitting bound */
-    if (isnan(next) || pass > BUDGET_PASSES)
+    else if (isnan(next) && above > 0)
+      /* over the budget, and the curves see no larger bound that makes
+       * fewer vertices: their borders are only the corners, while a
+       * pass's are simplified to the bound and thin out as it grows, so
+       * try larger bounds, 2 %, 4 %, 8 % ... above */
+      next = above * (1.0 + 0.01 * (double)(1u << (overs < 16 ? overs : 16)));
+    if (!isnan(next) && pass > BUDGET_PASSES)
+      return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_LIMIT, path,
+                          "no bound found in %d passes over the tiles that "
+                          "keeps the TIN within the budget of %zu %s (the "
+                          "last pass, at the bound %g, made %zu vertices and "
+                          "%zu triangles); ask for a little more, or use "
+                          "a larger -tile_size",
+                          BUDGET_PASSES, nv > max_v ? max_v : max_t,
+                          nv > max_v ? "vertices" : "triangles", e, nv, nt);
+    if (isnan(next))
       return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_LIMIT, path,
                           "the budget of %zu %s is below what %zu tiles make "
                           "at the bound %g (%zu vertices, %zu triangles: "
@@ -216,10 +232,18 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
       below = e;
       above = -1;
       target = aim > target ? aim : target + 1;
+      overs = 0;
     } else {
-      /* over: a larger bound (below the fitting one, if any) */
+      /* over: a larger bound (below the fitting one, if any), aimed lower
+       * by the excess, and by twice as much more each time a pass is over
+       * again: the curves' counts (borders simplified to no bound) can
+       * stay a few vertices below a real pass's, whatever the bound */
       above = e;
-      target = aim < target ? aim : target - 1;
+      size_t excess = nv > max_v ? nv - max_v : (nt - max_t + 1) / 2;
+      size_t step = (excess ? excess : 1) << (overs < 16 ? overs : 16);
+      overs++;
+      size_t lower = target > step ? target - step : 1;
+      target = aim < lower ? aim : lower;
     }
   }
   *out_bound = e;
