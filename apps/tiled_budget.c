@@ -177,7 +177,9 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
   double above = -1, below = INFINITY, e = 0, good = NAN;
   bool calibrated = false;
   size_t nv = 0, nt = 0;
-  int overs = 0; /* passes over the budget in a row */
+  int overs = 0;      /* passes over the budget in a row */
+  bool stuck = false; /* the last of them made no fewer than the one before */
+  size_t over_nv = 0, over_nt = 0; /* the counts of the one before */
   for (int pass = 1;; pass++) {
     size_t estimate;
     double next;
@@ -187,11 +189,12 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
                           "out of memory for the curves");
     if (isnan(next) && !isnan(good))
       next = good; /* nothing between: back to the fitting bound */
-    else if (isnan(next) && above > 0)
+    else if (isnan(next) && above > 0 && !stuck)
       /* over the budget, and the curves see no larger bound that makes
        * fewer vertices: their borders are only the corners, while a
        * pass's are simplified to the bound and thin out as it grows, so
-       * try larger bounds, 2 %, 4 %, 8 % ... above */
+       * try larger bounds, 2 %, 4 %, 8 % ... above, while they make
+       * fewer */
       next = above * (1.0 + 0.01 * (double)(1u << (overs < 16 ? overs : 16)));
     if (!isnan(next) && pass > BUDGET_PASSES)
       return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_LIMIT, path,
@@ -239,6 +242,9 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
        * again: the curves' counts (borders simplified to no bound) can
        * stay a few vertices below a real pass's, whatever the bound */
       above = e;
+      stuck = overs > 0 && nv >= over_nv && nt >= over_nt;
+      over_nv = nv;
+      over_nt = nt;
       size_t excess = nv > max_v ? nv - max_v : (nt - max_t + 1) / 2;
       size_t step = (excess ? excess : 1) << (overs < 16 ? overs : 16);
       overs++;
