@@ -307,10 +307,11 @@ static tt_status set_sequence(rows_state *w, const page_layout *lay,
 
 /* The R-trees of the layers in which (bit k: layer k), the vertices'
  * first, as pages of f; *written counts the trees written (progress 0.9
- * to 0.95 to 0.99). (A loop over two passes with the pass in its test, as
- * this was, was compiled by GCC 12.2 at -O2 and -O3 into one that wrote
- * every tree in both passes, once tt__rows_pipe_pack_too() was in another
- * file: a bit test of the packed trees that ignored the pass.) */
+ * to 0.95 to 0.99). pages_write() calls it for the trees this thread
+ * packed before the row maker is joined, and for the maker's after the
+ * join: a tree's packed nodes are read only once its packer is known to
+ * be done, and `which` is this thread's own value, never read from what
+ * the maker writes. */
 static tt_status write_trees(pages_job *j, tt__sqlite_file *f,
                              unsigned which, int *written)
 {
