@@ -21,8 +21,8 @@
 #include <pthread.h>
 #include <stdint.h>
 
-#define TRI_BLOB_BYTES (8 + 48 + 1 + 4 + 4 + 4 + 4 * 24) /* 165 */
-#define PT_BLOB_BYTES (8 + 1 + 4 + 24)                   /* 37 */
+#define TRI_BLOB_BYTES TT__TRI_BLOB_BYTES
+#define PT_BLOB_BYTES TT__PT_BLOB_BYTES
 #define MAX_TRIGGERS 16
 
 typedef struct rows_state {

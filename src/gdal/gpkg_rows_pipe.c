@@ -46,29 +46,8 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
   tt_status s = tt__records_triangle(p->rec, ctx, i, &tr, px, py, pz);
   if (s != TT_OK)
     return s;
-  double lo[3] = {px[0], py[0], pz[0]}, hi[3] = {px[0], py[0], pz[0]};
-  for (int k = 1; k < 3; k++) {
-    double c[3] = {px[k], py[k], pz[k]};
-    for (int d = 0; d < 3; d++) {
-      if (c[d] < lo[d]) lo[d] = c[d];
-      if (c[d] > hi[d]) hi[d] = c[d];
-    }
-  }
-  unsigned char *q = put_header(blob, 0x05, t->srs_id);
-  for (int d = 0; d < 3; d++) {
-    q = put_f64(q, lo[d]);
-    q = put_f64(q, hi[d]);
-  }
-  *q++ = 1; /* WKB little endian */
-  q = put_u32(q, 1003);
-  q = put_u32(q, 1);
-  q = put_u32(q, 4);
-  for (int k = 0; k < 4; k++) {
-    q = put_f64(q, px[k % 3]);
-    q = put_f64(q, py[k % 3]);
-    q = put_f64(q, pz[k % 3]);
-  }
-  *blob_len = (int)(q - blob);
+  double lo[3], hi[3];
+  *blob_len = (int)put_triangle_blob(blob, t->srs_id, px, py, pz, lo, hi);
   extend(ext, lo[0], lo[1]);
   extend(ext, hi[0], hi[1]);
   if (t->boxes)
@@ -100,13 +79,7 @@ static tt_status fill_vertex(const rows_pipe *p, tt_context *ctx, size_t i,
   tt_status s = tt__records_vertex(p->rec, ctx, i, &v, &x, &y);
   if (s != TT_OK)
     return s;
-  unsigned char *q = put_header(blob, 0x01, t->srs_id);
-  *q++ = 1;
-  q = put_u32(q, 1001);
-  q = put_f64(q, x);
-  q = put_f64(q, y);
-  q = put_f64(q, v.z);
-  *blob_len = (int)(q - blob);
+  *blob_len = (int)put_point_blob(blob, t->srs_id, x, y, v.z);
   extend(ext, x, y);
   if (t->boxes)
     tt__rtree_box_set(&t->boxes[i], (int64_t)i + 1, x, x, y, y);

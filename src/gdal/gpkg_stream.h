@@ -106,7 +106,8 @@ TT_HIDDEN size_t tt__gpkg_stream_bytes(const tt__gpkg_stream *g);
 /* --- GeoPackage geometry blobs, as gpkg_rows_pipe.c and io_gpkg_stream.c
  * write them: the blob header ("GP", version 0, flags, srs_id; GeoPackage
  * 1.4 section 2.1.3), then ISO WKB, little-endian whatever the host's
- * order; and a layer's extent grown point by point. Static inline with
+ * order, for a triangle and for a vertex; and a layer's extent grown
+ * point by point. Static inline with
  * short names, so that the blob code reads as the format does. */
 #include <string.h>
 
@@ -146,6 +147,58 @@ static inline void extend(double *ext, double x, double y)
   if (y < ext[1]) ext[1] = y;
   if (x > ext[2]) ext[2] = x;
   if (y > ext[3]) ext[3] = y;
+}
+
+/* A triangle's blob: the XYZ envelope (flags 0x05), then a WKB
+ * PolygonZ of one closed ring of 4 points. lo and hi get the envelope's
+ * (x, y, z) corners. Returns the blob's length, TT__TRI_BLOB_BYTES. */
+#define TT__TRI_BLOB_BYTES (8 + 48 + 1 + 4 + 4 + 4 + 4 * 24) /* 165 */
+static inline size_t put_triangle_blob(unsigned char *blob, int32_t srs_id,
+                                       const double px[3],
+                                       const double py[3],
+                                       const double pz[3], double lo[3],
+                                       double hi[3])
+{
+  lo[0] = hi[0] = px[0];
+  lo[1] = hi[1] = py[0];
+  lo[2] = hi[2] = pz[0];
+  for (int k = 1; k < 3; k++) {
+    double c[3] = {px[k], py[k], pz[k]};
+    for (int d = 0; d < 3; d++) {
+      if (c[d] < lo[d]) lo[d] = c[d];
+      if (c[d] > hi[d]) hi[d] = c[d];
+    }
+  }
+  unsigned char *q = put_header(blob, 0x05, srs_id);
+  for (int d = 0; d < 3; d++) {
+    q = put_f64(q, lo[d]);
+    q = put_f64(q, hi[d]);
+  }
+  *q++ = 1; /* WKB little endian */
+  q = put_u32(q, 1003);
+  q = put_u32(q, 1);
+  q = put_u32(q, 4);
+  for (int k = 0; k < 4; k++) {
+    q = put_f64(q, px[k % 3]);
+    q = put_f64(q, py[k % 3]);
+    q = put_f64(q, pz[k % 3]);
+  }
+  return (size_t)(q - blob);
+}
+
+/* A vertex's blob: no envelope (flags 0x01), a WKB PointZ. Returns the
+ * blob's length, TT__PT_BLOB_BYTES. */
+#define TT__PT_BLOB_BYTES (8 + 1 + 4 + 24) /* 37 */
+static inline size_t put_point_blob(unsigned char *blob, int32_t srs_id,
+                                    double x, double y, double z)
+{
+  unsigned char *q = put_header(blob, 0x01, srs_id);
+  *q++ = 1; /* WKB little endian */
+  q = put_u32(q, 1001);
+  q = put_f64(q, x);
+  q = put_f64(q, y);
+  q = put_f64(q, z);
+  return (size_t)(q - blob);
 }
 
 #endif /* TERRATIN_GPKG_STREAM_H */

@@ -6,10 +6,11 @@
  * The merge in tile order (src/tile/stream.c) hands out, after each
  * piece, its triangles (with the global vertex ids) and the vertices that
  * became final, in id order; here they become rows appended as database
- * pages (tt__gpkg_pages_*, io_gpkg_rows.c's page writer, opened once for
- * the whole run): the same values, the same geometry blobs (the GeoPackage
- * header and ISO WKB of io_gpkg_rows.c's fill_triangle and fill_vertex,
- * built the same way from tin_records.h), the same fids and ids, so the
+ * pages (tt__gpkg_pages_*, io_gpkg_rows_pages.c's page writer, opened
+ * once for the whole run): the same values, the same geometry blobs
+ * (gpkg_stream.h's put_triangle_blob and put_point_blob, which
+ * gpkg_rows_pipe.c's fill_triangle and fill_vertex use, from
+ * tin_records.h's records), the same fids and ids, so the
  * file's rows are those the merged-TIN path writes, byte for byte
  * (tests/apps/test_tiles.sh compares them). The extents are min/max over
  * the rows, whatever the order.
@@ -51,8 +52,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define TRI_BLOB (8 + 48 + 1 + 4 + 4 + 4 + 4 * 24) /* 165 */
-#define PT_BLOB (8 + 1 + 4 + 24)                   /* 37 */
 
 struct tt__gpkg_stream {
   tt_context *ctx;
@@ -134,14 +133,14 @@ tt_status tt__gpkg_stream_open(tt_context *ctx, const char *path,
   return TT_OK;
 }
 
-/* The triangles of batch b: fill_triangle() of io_gpkg_rows.c, the
+/* The triangles of batch b: fill_triangle() of gpkg_rows_pipe.c, the
  * vertex ids mapped to the global ones. */
 static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   const tt_tin *tin = b->tri;
   tt__records rec;
   tt_status s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
-  unsigned char blob[TRI_BLOB];
+  unsigned char blob[TT__TRI_BLOB_BYTES];
   tt__gpkg_value f[TT__TF_COUNT];
   for (size_t i = 0; i < tt_tin_triangle_count(tin) && s == TT_OK; i++) {
     tt_triangle_info tr;
@@ -149,28 +148,8 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     s = tt__records_triangle(&rec, g->ctx, i, &tr, px, py, pz);
     if (s != TT_OK)
       break;
-    double lo[3] = {px[0], py[0], pz[0]}, hi[3] = {px[0], py[0], pz[0]};
-    for (int k = 1; k < 3; k++) {
-      double c[3] = {px[k], py[k], pz[k]};
-      for (int d = 0; d < 3; d++) {
-        if (c[d] < lo[d]) lo[d] = c[d];
-        if (c[d] > hi[d]) hi[d] = c[d];
-      }
-    }
-    unsigned char *q = put_header(blob, 0x05, g->srs_id[0]);
-    for (int d = 0; d < 3; d++) {
-      q = put_f64(q, lo[d]);
-      q = put_f64(q, hi[d]);
-    }
-    *q++ = 1; /* WKB little endian */
-    q = put_u32(q, 1003);
-    q = put_u32(q, 1);
-    q = put_u32(q, 4);
-    for (int k = 0; k < 4; k++) {
-      q = put_f64(q, px[k % 3]);
-      q = put_f64(q, py[k % 3]);
-      q = put_f64(q, pz[k % 3]);
-    }
+    double lo[3], hi[3];
+    size_t len = put_triangle_blob(blob, g->srs_id[0], px, py, pz, lo, hi);
     size_t fid = b->tri_first + i + 1;
     extend(g->ext[0], lo[0], lo[1]);
     extend(g->ext[0], hi[0], hi[1]);
@@ -192,22 +171,22 @@ static tt_status triangles(tt__gpkg_stream *g, const tt__stream_batch *b)
     set_real(&f[TT__TF_ASPECT], tr.aspect_deg);
     set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
     set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
-    s = tt__gpkg_pages_row(g->pages, 0, (int64_t)fid, f, blob,
-                           (size_t)(q - blob), g->rtree ? &box : NULL);
+    s = tt__gpkg_pages_row(g->pages, 0, (int64_t)fid, f, blob, len,
+                           g->rtree ? &box : NULL);
     g->count[0]++;
   }
   tt__records_free(&rec);
   return s;
 }
 
-/* The final vertices of batch b: fill_vertex() of io_gpkg_rows.c, ids and
+/* The final vertices of batch b: fill_vertex() of gpkg_rows_pipe.c, ids and
  * ranks counted from b->vtx_first. */
 static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
 {
   const tt_tin *tin = b->vtx;
   tt__records rec;
   tt_status s = tt__records_init(&rec, g->ctx, tin, g->srs, g->t_srs);
-  unsigned char blob[PT_BLOB];
+  unsigned char blob[TT__PT_BLOB_BYTES];
   tt__gpkg_value f[TT__VF_COUNT];
   for (size_t i = 0; i < tt_tin_vertex_count(tin) && s == TT_OK; i++) {
     tt_vertex_info v;
@@ -216,12 +195,7 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     if (s != TT_OK)
       break;
     size_t id = b->vtx_first + i;
-    unsigned char *q = put_header(blob, 0x01, g->srs_id[1]);
-    *q++ = 1;
-    q = put_u32(q, 1001);
-    q = put_f64(q, x);
-    q = put_f64(q, y);
-    q = put_f64(q, v.z);
+    size_t len = put_point_blob(blob, g->srs_id[1], x, y, v.z);
     extend(g->ext[1], x, y);
     tt__rtree_box box;
     tt__rtree_box_set(&box, (int64_t)id + 1, x, x, y, y);
@@ -252,8 +226,8 @@ static tt_status vertices(tt__gpkg_stream *g, const tt__stream_batch *b)
     set_int(&f[TT__VF_STAR_N], (int64_t)v.star_samples);
     if (g->decimated)
       set_real(&f[TT__VF_IMPORTANCE], v.importance);
-    s = tt__gpkg_pages_row(g->pages, 1, (int64_t)id + 1, f, blob,
-                           (size_t)(q - blob), g->rtree ? &box : NULL);
+    s = tt__gpkg_pages_row(g->pages, 1, (int64_t)id + 1, f, blob, len,
+                           g->rtree ? &box : NULL);
     g->count[1]++;
   }
   tt__records_free(&rec);
