@@ -68,7 +68,7 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * feet), gives the grid a local metric ground frame chosen with PROJ: the
  * Jacobian at the grid's centre of pixel -> UTM zone of the centre (or
  * WORK_SRS) coordinates; metric projected CRSs keep the geotransform's
- * frame unless WORK_SRS is given (src/gdal/georef_proj.c; info->frame_name says
+ * frame unless WORK_SRS is given (src/gdal/georef/georef_proj.c; info->frame_name says
  * which frame). Heights are never changed by the frame. Unless the user set
  * GDAL_CACHEMAX, GDAL's block cache limit (process-wide) is lowered to a
  * few MiB during the read and restored after.
@@ -126,7 +126,7 @@ typedef struct tt_run_field {
  * (traditional GIS axis order), triangles unchanged. When the layers' CRS
  * is geographic, area_2d is the geodesic area on its ellipsoid
  * (GeographicLib's geod_polygonarea) and area_3d = area_2d / cos(slope);
- * otherwise both are ground-frame areas (see io_ogr_write.c).
+ * otherwise both are ground-frame areas (see ogr_write.c).
  * Options: NLN_PREFIX=<p>, LCO=<NAME=VALUE> (repeat for each layer creation
  * option), RTREE=NOW|DEFERRED, T_SRS=<CRS> (any OSRSetFromUserInput form). GPKG gets its R-trees built once after the
  * inserts (LCO=SPATIAL_INDEX=NO: none): with RTREE=NOW (the default) by

@@ -14,7 +14,7 @@ and the two must give the same ids with the same boxes (SELECT * from the
 virtual table, by id); their shadow tables (_node, _parent, _rowid) are
 not compared row by row. Two valid trees of the same boxes packed
 differently (the streamed writer packs its leaves block by block,
-io_gpkg_rtree_pages.c) then compare equal; everything else is still byte for
+gpkg_rtree_pages.c) then compare equal; everything else is still byte for
 byte.
 
 tests/apps/test_tiles.sh compares a tiled run's GeoPackage written as the

@@ -1,6 +1,6 @@
 /*
  * test_cli_options.c -- unit tests of the terratin command's option parser
- * (apps/options.c): defaults, every option of every command, every
+ * (apps/core/options.c): defaults, every option of every command, every
  * usage error (exit code 2, one line, no object), --help/--version winning
  * over the rest of the line, the help texts documenting defaults and exit
  * codes, and the text progress bar; then the library shape: commands run

@@ -420,7 +420,7 @@ static void test_geographic_frame(tt_context *ctx)
       double a[4];
       tt_grid_get_ground_frame(g, a);
       CHECK_INT_EQ(info->crs_is_geographic, 1);
-      /* The frame is UTM zone 32's Jacobian (src/gdal/georef_proj.c): rotated
+      /* The frame is UTM zone 32's Jacobian (src/gdal/georef/georef_proj.c): rotated
        * by the meridian convergence and scaled by UTM's k (0.9996 to
        * 1.0000 here), so the step lengths match the ellipsoid's to 1e-3;
        * tests/gdal/test_georef.c checks it against PROJ's coordinates. */

@@ -1,5 +1,5 @@
 /* test_geoframe.c -- geographic DEMs measured on the ground through ground
- * points in a conformal frame (src/gdal/georef_conformal.c, issue 18),
+ * points in a conformal frame (src/gdal/georef/georef_conformal.c, issue 18),
  * checked against PROJ and GeographicLib themselves:
  *  - an SRTM-like crop at 57 N (350 x 400 samples of 1 arc-second, heights
  *    generated here): every interior edge of the Delaunay TIN is Delaunay
@@ -22,7 +22,7 @@
  *    slopes; with heights in feet too (band unit us-ft, Z_UNIT=m), the
  *    same slopes.
  * Figures go to stdout (ctest -V). */
-#include "gdal/tin_records.h"
+#include "gdal/ogr/tin_records.h"
 #include "terratin/terratin_gdal.h"
 #include "terratin_lib.h"
 #include "tt_test.h"

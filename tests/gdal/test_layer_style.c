@@ -1,11 +1,11 @@
 /*
  * test_layer_style.c -- the class breaks of the default QGIS style
- * (tt__style_graduated_qml, src/gdal/layer_style.c), found by selection,
+ * (tt__style_graduated_qml, src/gdal/ogr/layer_style.c), found by selection,
  * against the same breaks from a full sort: quantiles and equal intervals
  * over values with NaNs, long runs of one value (an integer DEM's errors
  * of 0), few values, one value, none.
  */
-#include "gdal/layer_style.h"
+#include "gdal/ogr/layer_style.h"
 #include "tt_test.h"
 
 #include <cpl_conv.h>

@@ -1,5 +1,5 @@
 /*
- * test_mesh_write.c -- tt_mesh_write() (io_mesh_write.c): a small TIN in
+ * test_mesh_write.c -- tt_mesh_write() (mesh_write.c): a small TIN in
  * UTM 33N written as 2DM, PLY, OBJ (map and local coordinates) and LandXML
  * and parsed back: the vertex and face counts, every coordinate equal to
  * the double the OGR layers get (tin_records.h), every face the same three
@@ -13,7 +13,7 @@
  * -t_srs's transformed coordinates, the format names and extensions, and
  * an interruption through progress, which leaves no file (nor dataset).
  */
-#include "gdal/tin_records.h"
+#include "gdal/ogr/tin_records.h"
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
 

@@ -1,6 +1,6 @@
 /*
  * test_rtree_stream.c -- the R-tree written as the rows stream in
- * (tt__rtree_stream, io_gpkg_rtree_pages.c) against SQLite's R*Tree module, no
+ * (tt__rtree_stream, gpkg_rtree_pages.c) against SQLite's R*Tree module, no
  * mocks. Boxes are made in the order a tiled run gives them (pieces of
  * nearby features, tile after tile; large, fractional map coordinates so
  * the float rounding matters), fed with a cut after each piece into the
@@ -29,8 +29,8 @@
  *   - the memory held is the block and the leaves' boxes, not the
  *     features'.
  */
-#include "gdal/gpkg_rtree.h"
-#include "gdal/sqlite_pages.h"
+#include "gdal/gpkg/gpkg_rtree.h"
+#include "gdal/gpkg/sqlite_pages.h"
 #include "terratin/terratin.h"
 #include "tt_test.h"
 #include "tt_test_sqlite.h"
@@ -158,7 +158,7 @@ static tt_status stream_boxes(const char *path, const tt__rtree_shadow *sh,
   return s != TT_OK ? s : c;
 }
 
-/* The stream's blocks replayed (io_gpkg_rtree_pages.c, tt__rtree_stream_cut):
+/* The stream's blocks replayed (gpkg_rtree_pages.c, tt__rtree_stream_cut):
  * at a cut the boxes since the last one join the block, and when they lie
  * apart from it (a row of tiles wrapped) the block may end before them; a
  * full block ends there if it can, else at the cut; 16 times the block

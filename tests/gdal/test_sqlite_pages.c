@@ -1,5 +1,5 @@
 /*
- * test_sqlite_pages.c -- the table B-tree page writer (src/gdal/sqlite_pages.c)
+ * test_sqlite_pages.c -- the table B-tree page writer (src/gdal/gpkg/sqlite_pages.c)
  * against SQLite itself. The same rows go into two databases, one by
  * INSERTs, one as pages; then:
  *  - every value of every row is the same, of the same type (affinities:
@@ -22,7 +22,7 @@
  *  - refused: a row larger than a page holds, rowids out of order, a root
  *    that is not an empty leaf, a WAL database, auto-vacuum.
  */
-#include "gdal/sqlite_pages.h"
+#include "gdal/gpkg/sqlite_pages.h"
 #include "terratin/terratin.h"
 #include "tt_test.h"
 

@@ -1,0 +1,302 @@
+/*
+ * app.h -- the command's core (apps/core/), what every command's folder
+ * shares (internal; the public face is terratin_lib.h): the options
+ * object, a run's state, the one-line failure helpers, the phase-scaled
+ * progress, the JSON writer, the inputs and outputs several commands
+ * read and write, and one entry point per command.
+ *
+ *   terratin.c      main(): the words to an options object, run, exit
+ *   options.c       the parser; option_table.c the table it reads
+ *   settings.c      the options object's lists and accessors
+ *   values.c        numbers, sizes, booleans and grid sizes of words
+ *   help.c          the help texts
+ *   run.c           tt_app_run (the dispatch), GDAL messages, failures,
+ *                   the output driver
+ *   dem.c           opening the DEM and reading it into a grid
+ *   tin_input.c     opening a TIN and picking its triangle layer
+ *   raster_output.c the raster writer (rasterize, eval -error_raster)
+ *   progress.c      the text progress bar and the phase scaling
+ *   report.c        the JSON writer and simplify's summary and JSON
+ *
+ * The commands, a folder each over this core (none includes another's
+ * headers): simplify/ (with the tiled path and the output choice; its
+ * own simplify.h), tiles/, study/, eval/, rasterize/, optimize/,
+ * generate/.
+ *
+ * Invariants: a run reports at most one failure (the first), as one line;
+ * every run either commits its output or leaves nothing behind; GDAL never
+ * prints by itself while a run is active.
+ */
+#ifndef TERRATIN_APP_H
+#define TERRATIN_APP_H
+
+/* GDAL's VSIStatBufL is a struct stat64 on glibc: declare it. */
+#define _LARGEFILE64_SOURCE 1
+
+#include "terratin_lib.h"
+
+#include "terratin/terratin_gdal.h"
+
+#include <cpl_error.h>
+#include <gdal.h>
+
+#include <stdint.h>
+#include <stdio.h>
+
+#if defined(__GNUC__)
+#define TT_APP_PRINTF_(a, b) __attribute__((format(printf, a, b)))
+#else
+#define TT_APP_PRINTF_(a, b)
+#endif
+
+/* --- the options object (options.c) -------------------------------------- */
+
+/* A NULL-terminated list of owned strings. */
+typedef struct app_strlist {
+  char **v;
+  size_t n, cap;
+} app_strlist;
+
+struct tt_app_options {
+  tt_app_settings s;     /* the public view; strings point into the lists */
+  app_strlist strings;   /* every single string (input, output, -of, ...) */
+  app_strlist config, lco, dsco, terrains;
+  app_strlist co;        /* -co (rasterize, eval -error_raster) */
+  tt_progress_fn progress;
+  void *progress_arg;
+  FILE *out, *err;
+};
+
+/* --- the values of words (values.c) ------------------------------------- */
+
+/* A list of owned strings kept NULL-terminated; 0 when out of memory. */
+int tt__app_strlist_add(app_strlist *l, const char *s);
+void tt__app_strlist_free(app_strlist *l);
+
+/* What the integer and size parsers found. */
+enum { NUM_BAD = 0, NUM_OK = 1, NUM_TOO_LARGE = 2 };
+
+/* A finite decimal number, the whole word ([+-]digits[.digits][e...]):
+ * 1 and *out, else 0. */
+int tt__app_parse_double(const char *w, double *out);
+/* An unsigned decimal integer, the whole word: NUM_OK, NUM_BAD, or
+ * NUM_TOO_LARGE beyond 2^64 - 1 (resp. SIZE_MAX). */
+int tt__app_parse_u64(const char *w, uint64_t *out);
+int tt__app_parse_size(const char *w, size_t *out);
+/* -tile_size: a whole number of cells from 16 to 65536; 0 otherwise. */
+int tt__app_parse_tile_size(const char *w, size_t *out);
+/* Bytes, or a number with K, M, G or T (powers of 1024, then B or iB). */
+int tt__app_parse_mem_size(const char *w, size_t *out);
+/* One of the words GDAL's CPLTestBool reads as a boolean. */
+int tt__app_is_gdal_bool(const char *w);
+/* "N" or "NXxNY". */
+int tt__app_parse_grid_size(const char *w, size_t *nx, size_t *ny);
+int tt__app_is_pow2_plus1(size_t n);
+/* The TT_APP_LAYER_* bit of the layer named by the n bytes at w
+ * (triangles, vertices, run_parameters; case-insensitive), else 0. */
+unsigned tt__app_layer_bit(const char *w, size_t n);
+/* The names of the layers of mask, comma-separated, in the writer's order
+ * ("triangles,run_parameters"), into buf. */
+const char *tt__app_layer_list(unsigned mask, char *buf, size_t size);
+
+/* "simplify", "generate", "eval" or "" (help.c). */
+const char *tt__app_command_name(tt_app_command c);
+
+/* --- results and messages (run.c) ---------------------------------------- */
+
+/* Seconds of a monotonic clock (the app's own; the engine keeps its own). */
+double tt__app_now(void);
+/* Fills a result, keeping the first failure: later ones are consequences. */
+void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
+                        const char *fmt, ...) TT_APP_PRINTF_(4, 5);
+void tt__app_result_ok(tt_app_result *res);
+int tt__app_str_ieq(const char *a, const char *b);
+
+/* GDAL's failures and warnings while a run is active (run.c). */
+typedef struct app_messages {
+  FILE *err;
+  size_t warnings;           /* printed or dropped (repeats not counted) */
+  uint64_t seen[32];         /* hashes of the warnings printed */
+  size_t nseen;
+  tt_app_term_progress *bar; /* the text bar, if the run draws one */
+  unsigned failures;         /* GDAL failures seen */
+  char last[TT_APP_MESSAGE_MAX];
+} app_messages;
+
+/* Prints "terratin: warning: ..." (at most a fixed number per run). */
+void tt__app_warn(app_messages *m, const char *fmt, ...) TT_APP_PRINTF_(2, 3);
+
+/* --- progress (progress.c) ----------------------------------------------- */
+
+/* Maps a phase's [0,1] onto [lo,hi] of the whole run and passes it on. */
+typedef struct app_phase {
+  tt_progress_fn fn;
+  void *arg;
+  double lo, hi;
+} app_phase;
+
+/* A tt_progress_fn; arg is an app_phase. */
+int tt__app_phase_fn(double complete, const char *message, void *arg);
+void tt__app_phase_set(app_phase *p, double lo, double hi);
+
+/* --- a run: what every subcommand shares (run.c) ------------------------- */
+
+typedef struct app_run {
+  const tt_app_options *o;
+  const tt_app_settings *s;
+  tt_app_result *res;
+  FILE *out, *err;
+  tt_context *ctx;
+  app_messages msg;
+  app_phase prog;
+  double t0;
+  struct tt_app_tile_sink *sink; /* a tiled run's streamed GeoPackage, or
+                                    NULL (tiled_stream.c) */
+} app_run;
+
+/* Records the run's failure "<file>: <problem>" (or "<problem>" when file
+ * is NULL) and returns st. */
+tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
+                       const char *file, const char *fmt, ...)
+    TT_APP_PRINTF_(5, 6);
+/* The best one-line explanation of a failed engine or glue call about file
+ * (the context's message, GDAL's last failure, or the status's). */
+const char *tt__app_why(app_run *r, tt_status st, const char *file);
+/* Fails with the glue's or engine's message about file. */
+tt_status tt__app_fail_tt(app_run *r, tt_status st, const char *file);
+/* Fails a write of output (the file being written: written) with the
+ * device's cause when there is one (the file system full, ulimit -f
+ * reached; the driver's message follows in parentheses), else with the
+ * driver's or engine's message. what ("error while closing") names a
+ * failure of GDAL's own, whose last message is then the detail; NULL: the
+ * failure of an engine or glue call (its message). */
+tt_status tt__app_fail_write(app_run *r, tt_status st, const char *output,
+                             const char *written, const char *what);
+/* An output refused because something exists in its way. */
+tt_status tt__app_fail_exists(app_run *r, const char *output);
+/* Polls the progress callback between phases: 0 means stop. */
+int tt__app_continue(app_run *r, double at);
+
+/* Opens a raster for reading and checks the band; on failure explains in
+ * one line why and returns NULL. */
+GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
+                                 GDALRasterBandH *out_band);
+/* Reads the band into a grid (with -srcnodata, -z_factor, -z_unit,
+ * -work_srs) and checks it has valid samples. The caller owns *out_grid and
+ * *out_info. */
+tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
+                           tt_progress_fn progress, void *progress_arg,
+                           tt_grid **out_grid, tt_raster_info **out_info,
+                           size_t *out_valid);
+/* optimize's and rasterize's inputs: the DEM (s->input) read into a grid
+ * with the progress phase set, then the TIN (s->tin) opened with its
+ * triangles layer; both inputs protected from outp. On failure (recorded)
+ * the caller still owns and frees whatever was set. */
+tt_status tt__app_read_dem_and_tin(app_run *r, tt_output *outp,
+                                   tt_grid **out_grid,
+                                   tt_raster_info **out_info,
+                                   size_t *out_valid, GDALDatasetH *out_tds,
+                                   OGRLayerH *out_layer);
+void tt__app_height_range(const tt_grid *grid, double *out_min,
+                          double *out_max);
+const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
+const char *tt__app_nonempty_or_null(const char *s);
+/* "2026-11-22T10:38:55Z" */
+void tt__app_iso8601_utc(char *buf, size_t size);
+/* The engine's thread count (tt_refine_options.threads): -threads, else
+ * GDAL_NUM_THREADS (a number or ALL_CPUS, from the environment or
+ * --config), else 0 (automatic). A GDAL_NUM_THREADS that is neither is
+ * warned about and ignored. */
+int tt__app_threads(app_run *r);
+/* The output driver of simplify: -of, else OUTPUT's extension, else GPKG. */
+GDALDriverH tt__app_output_driver(app_run *r);
+/* name with the value of every password= replaced by *** (run.c). */
+void tt__app_mask_password(const char *name, char *buf, size_t size);
+/* Whether two paths name the same existing file. */
+int tt__app_same_file(const char *a, const char *b);
+
+/* --- JSON (report.c) ----------------------------------------------------- */
+
+/* One object, strings escaped, non-finite numbers as null, bytes that are
+ * not UTF-8 replaced by U+FFFD so the output always parses. */
+typedef struct app_json {
+  FILE *fp;
+  int depth;
+  int first[8];
+} app_json;
+
+/* The shortest "%.Ng" text of d (N = 6..17) that reads back as d. */
+void tt__app_format_double(char *buf, size_t size, double d);
+void tt__json_begin(app_json *j, FILE *fp);
+void tt__json_open(app_json *j, const char *key);
+void tt__json_close(app_json *j);
+void tt__json_str(app_json *j, const char *key, const char *v);
+void tt__json_num(app_json *j, const char *key, double v);
+void tt__json_size(app_json *j, const char *key, size_t v);
+void tt__json_i64(app_json *j, const char *key, int64_t v);
+void tt__json_bool(app_json *j, const char *key, int v);
+void tt__json_null(app_json *j, const char *key);
+
+/* What simplify reports, as text or JSON (report.c). */
+typedef struct app_simplify_report {
+  const tt_raster_info *info;
+  const char *driver;
+  size_t cells, valid;
+  double zmin, zmax;
+  const tt_refine_options *ropt;  /* the limits, for either method */
+  const tt_decimate_options *dopt; /* -method decimate; else NULL */
+  int default_error;            /* max_error came from the 0.5% rule */
+  tt_tin_summary sum;
+  double t_read, t_simplify, t_write, t_total;
+  /* tiled runs (tiled.c): the tiles, their size, the threads, whether
+   * the memory limit chose tiling, the bytes the tiles in flight hold */
+  size_t tiles, tile_size, tile_bytes;
+  int tile_threads, auto_tiled;
+  int budget_passes;  /* tiled runs to a budget: the runs at a bound */
+  int streamed;       /* the GeoPackage written as the tiles merged */
+} app_simplify_report;
+
+/* --- the subcommands ----------------------------------------------------- */
+
+tt_status tt__app_simplify(app_run *r);  /* simplify.c */
+tt_status tt__app_generate(app_run *r);  /* generate.c */
+tt_status tt__app_eval(app_run *r);      /* eval.c */
+tt_status tt__app_optimize(app_run *r);  /* optimize.c */
+tt_status tt__app_study(app_run *r);     /* study.c */
+tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+/* raster_output.c, for rasterize and eval -error_raster: the raster
+ * driver of -of, else
+ * the one path's extension names (NULL path: GTiff), that can write a
+ * Float32 or Float64 band; NULL with the failure recorded. */
+GDALDriverH tt__app_raster_driver(app_run *r, const char *of,
+                                  const char *path);
+/* Writes values (the DEM's grid, NaN: nodata) to out's temporary name with
+ * drv (GTiff: tiled, DEFLATE, unless -co says otherwise; -co), Float64
+ * when the grid holds doubles, else Float32, in the DEM's geotransform and
+ * CRS, and commits it; the failure recorded otherwise. */
+tt_status tt__app_write_raster(app_run *r, tt_output *out, GDALDriverH drv,
+                               const tt_grid *grid,
+                               const tt_raster_info *info,
+                               const double *values);
+/* `terratin tiles run` and `tiles merge` (tiles_*.c) run simplify's tiled
+ * path with this set: save, the one tile given is computed and handed to
+ * it (nothing else written); load, every tile's piece is read by it
+ * instead of computed (then merged and written as simplify does). */
+typedef struct tt_app_tiles_hook {
+  size_t tile;
+  tt_status (*save)(void *arg, app_run *r, size_t k, const tt_tin *piece);
+  tt_status (*load)(void *arg, tt_context *ctx, size_t k, tt_tin **piece,
+                    char *msg, size_t msgsize);
+  void *arg;
+} tt_app_tiles_hook;
+extern tt_app_tiles_hook tt__app_tiles_hook;
+/* tin_input.c, for eval, optimize and rasterize: opens r->s->tin's kind of dataset (a vector
+ * dataset, explaining in one line why not), and picks its triangle layer
+ * (-layer, else "triangles" or "*_triangles", else the first polygon
+ * layer); NULL with the failure recorded. */
+GDALDatasetH tt__app_open_vector(app_run *r, const char *path);
+OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds);
+/* Whether the layer declares a CRS that is not the DEM's (tin_input.c). */
+int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info);
+
+#endif /* TERRATIN_APP_H */

@@ -1,0 +1,395 @@
+/*
+ * ogr_output.c -- what simplify checks about an OGR output before any work,
+ * and the outputs that are no file.
+ *
+ *  - The dry run: tt_ogr_write_tin() itself, with the same driver, layers
+ *    (-layers), -dsco, -lco and -t_srs, writes a TIN of two triangles into
+ *    a dataset under /vsimem/ right after the DEM is opened and before it
+ *    is read. A driver that cannot hold the layers asked for (GeoJSON and
+ *    FlatGeobuf files hold one, DXF one of entities, GPX no polygons and no
+ *    table without geometry, MapInfo's .tab one) is thus refused in a
+ *    fraction of a second instead of after the whole run, with the way out:
+ *    the -layers that the driver takes (each layer is then tried alone) or,
+ *    for a format that writes a folder of files when OUTPUT has no
+ *    extension, that form. What the drivers' metadata says is not enough:
+ *    DXF and GPX claim several layers. A driver that cannot even create a
+ *    dataset in memory is not judged (the real write will say).
+ *  - Databases (PostgreSQL through "PG:..."; any driver that writes no file
+ *    and holds transactions): the datasource is opened before the work,
+ *    its layers of our names refused without -overwrite, and the TIN is
+ *    written in one transaction with the tables made inside it, so that a
+ *    failure, an interruption or the end of the process leaves no table and
+ *    -overwrite replaces the old tables only at the commit. A connection
+ *    string's password never appears in a message.
+ */
+#include "simplify.h"
+
+#include <cpl_conv.h>
+#include <cpl_string.h>
+#include <cpl_vsi.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* The representative run_parameters of the dry run: one field of each
+ * type. */
+static const tt_run_field probe_fields[] = {
+    {"input", TT_FIELD_STRING, "dem.tif", 0, 0},
+    {"band", TT_FIELD_INTEGER, NULL, 1, 0},
+    {"max_error", TT_FIELD_REAL, NULL, 0, 1.5},
+};
+
+/* A two-triangle TIN on the DEM's first 2 x 2 samples (its geotransform),
+ * for the dry run. NULL when the engine cannot make it. */
+static tt_tin *probe_tin(tt_context *ctx, const double gt[6])
+{
+  static const float z[4] = {1, 2, 3, 5};
+  tt_grid *grid = NULL;
+  tt_tin *tin = NULL;
+  tt_refine_options ro;
+  tt_refine_options_init(&ro);
+  ro.max_error = 0;
+  if (tt_grid_create_from_floats(ctx, 2, 2, z, &grid) == TT_OK &&
+      tt_grid_set_geotransform(ctx, grid, gt) == TT_OK)
+    tt_refine_run(ctx, grid, &ro, &tin);
+  tt_grid_destroy(grid);
+  return tin;
+}
+
+typedef struct probe {
+  GDALDriverH drv;
+  const char *ext;        /* OUTPUT's extension with its dot, or "" */
+  char **dsco, **wopts;   /* wopts without LAYERS */
+  tt_tin *tin;
+  OGRSpatialReferenceH srs;
+  char why[TT_APP_MESSAGE_MAX];
+  unsigned seq;
+} probe;
+
+/* 1: the driver wrote the layers of mask; 0: it refused (p->why says
+ * why); -1: no dataset could be made in memory, nothing is known. */
+static int probe_run(probe *p, unsigned mask, const char *ext)
+{
+  char list[64];
+  char *dir = CPLStrdup(CPLSPrintf("/vsimem/terratin_probe_%p_%u", (void *)p,
+                                   p->seq++));
+  char *name = CPLStrdup(CPLSPrintf("%s/out%s", dir, ext));
+  char **opts = CSLDuplicate(p->wopts);
+  opts = CSLSetNameValue(opts, "LAYERS",
+                         tt__app_layer_list(mask, list, sizeof list));
+  opts = CSLSetNameValue(opts, "ROWS", "NOW");
+  tt_context *ctx = tt_context_create(); /* silent: no warnings printed */
+  int result = -1;
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  VSIMkdir(dir, 0755);
+  CPLErrorReset();
+  GDALDatasetH ds = ctx ? GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
+                                     (CSLConstList)p->dsco)
+                        : NULL;
+  if (ds) {
+    tt_status st = tt_ogr_write_tin(ctx, ds, p->tin, p->srs, probe_fields,
+                                    sizeof probe_fields /
+                                        sizeof probe_fields[0],
+                                    opts, NULL, NULL);
+    if (st != TT_OK)
+      snprintf(p->why, sizeof p->why, "%s", tt_context_errmsg(ctx));
+    CPLErrorReset();
+    GDALClose(ds);
+    if (st == TT_OK && CPLGetLastErrorType() >= CE_Failure) {
+      snprintf(p->why, sizeof p->why, "%s", CPLGetLastErrorMsg());
+      st = TT_ERR_IO;
+    }
+    result = st == TT_OK;
+    /* A folder where OUTPUT names a file (FlatGeobuf and MapInfo put
+     * each layer in a file of its own there): one layer a file. */
+    VSIStatBufL sb;
+    if (result == 1 && *ext && VSIStatL(name, &sb) == 0 &&
+        VSI_ISDIR(sb.st_mode)) {
+      snprintf(p->why, sizeof p->why, "the driver writes a folder of one "
+               "file a layer for them");
+      result = 0;
+    }
+  }
+  VSIRmdirRecursive(dir);
+  CPLPopErrorHandler();
+  CPLErrorReset();
+  tt_context_destroy(ctx);
+  CSLDestroy(opts);
+  CPLFree(name);
+  CPLFree(dir);
+  return result;
+}
+
+/* "-layers triangles, -layers vertices or -layers run_parameters" */
+static void layer_choices(unsigned mask, char *buf, size_t size)
+{
+  static const char *const names[] = {"triangles", "vertices",
+                                      "run_parameters"};
+  int n = 0, total = 0;
+  for (int i = 0; i < 3; i++)
+    total += (mask >> i) & 1;
+  buf[0] = '\0';
+  for (int i = 0; i < 3; i++)
+    if (mask & (1u << i)) {
+      size_t len = strlen(buf);
+      snprintf(buf + len, size - len, "%s-layers %s",
+               n == 0 ? "" : n == total - 1 ? " or " : ", ", names[i]);
+      n++;
+    }
+}
+
+char **tt__app_output_dsco(const char *drvname, const char *const *dsco)
+{
+  char **out = CSLDuplicate((CSLConstList)dsco);
+  /* GPX keeps attributes only in <extensions>: without them, none. */
+  if (tt__app_str_ieq(drvname, "GPX") &&
+      !CSLFetchNameValue(out, "GPX_USE_EXTENSIONS"))
+    out = CSLSetNameValue(out, "GPX_USE_EXTENSIONS", "YES");
+  return out;
+}
+
+int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
+                             char **dsco, char **wopts)
+{
+  const tt_app_settings *s = r->s;
+  const char *dname = GDALGetDriverShortName(drv);
+  probe p;
+  memset(&p, 0, sizeof p);
+  p.drv = drv;
+  p.dsco = dsco;
+  const char *base = strrchr(s->output, '/');
+  base = base ? base + 1 : s->output;
+  const char *dot = strrchr(base, '.');
+  p.ext = dot && dot != base ? dot : "";
+  for (char **o = wopts; o && *o; o++)
+    if (strncasecmp(*o, "LAYERS=", 7) != 0)
+      p.wopts = CSLAddString(p.wopts, *o);
+  double gt[6] = {0, 1, 0, 0, 0, -1};
+  GDALGetGeoTransform(src, gt);
+  const char *wkt = GDALGetProjectionRef(src);
+  if (wkt && *wkt) {
+    p.srs = OSRNewSpatialReference(wkt);
+    if (p.srs)
+      OSRSetAxisMappingStrategy(p.srs, OAMS_TRADITIONAL_GIS_ORDER);
+  }
+  tt_context *ctx = tt_context_create();
+  p.tin = ctx ? probe_tin(ctx, gt) : NULL;
+  int ok = 1;
+  if (!p.tin)
+    goto done; /* nothing to judge with */
+
+  const unsigned want = s->layers;
+  int all = probe_run(&p, want, p.ext);
+  if (all != 0)
+    goto done; /* it holds them, or it cannot be judged */
+  char why_all[TT_APP_MESSAGE_MAX];
+  snprintf(why_all, sizeof why_all, "%s", p.why);
+  {
+    /* The same into a GeoPackage, which holds everything: when that fails
+     * too, the fault is not the driver's (a -t_srs the DEM's CRS cannot
+     * reach): said now, as the write would say it after the work. */
+    probe g = p;
+    static const char *const none[] = {NULL};
+    GDALDriverH gpkg = GDALGetDriverByName("GPKG");
+    g.drv = gpkg;
+    g.wopts = NULL;
+    for (char **o = p.wopts; o && *o; o++)
+      if (strncasecmp(*o, "LCO=", 4) != 0 && strncasecmp(*o, "STYLE=", 6))
+        g.wopts = CSLAddString(g.wopts, *o);
+    g.dsco = (char **)none;
+    int control = gpkg ? probe_run(&g, want, ".gpkg") : -1;
+    CSLDestroy(g.wopts);
+    if (control == 0) {
+      ok = 0;
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->output, "%s",
+                   g.why);
+      goto done;
+    }
+  }
+  if ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0])) {
+    /* Without the user's -lco and -dsco? Then those are at fault. */
+    probe q = p;
+    static const char *const none[] = {NULL};
+    q.wopts = NULL;
+    for (char **o = p.wopts; o && *o; o++)
+      if (strncasecmp(*o, "LCO=", 4) != 0)
+        q.wopts = CSLAddString(q.wopts, *o);
+    q.dsco = tt__app_output_dsco(dname, none);
+    int plain = probe_run(&q, want, p.ext);
+    CSLDestroy(q.wopts);
+    CSLDestroy(q.dsco);
+    if (plain == 1) {
+      ok = 0;
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                   "simplify: -of %s cannot write the TIN with the -lco and "
+                   "-dsco given: %s", dname, why_all);
+      goto done;
+    }
+  }
+  /* Which layers it takes alone; the first one it refuses names why. */
+  unsigned alone = 0, refused = 0;
+  char why_one[TT_APP_MESSAGE_MAX] = "";
+  for (unsigned bit = 1; bit <= 4; bit <<= 1) {
+    int k = probe_run(&p, bit, p.ext);
+    if (k != 0)
+      alone |= bit;
+    else if (want & bit) {
+      if (!refused)
+        snprintf(why_one, sizeof why_one, "%s", p.why);
+      refused |= bit;
+    }
+  }
+  char list[64], choices[160];
+  ok = 0;
+  /* A folder of files may hold what one file cannot (FlatGeobuf,
+   * MapInfo): OUTPUT without its extension. */
+  if (p.ext[0] && probe_run(&p, want, "") == 1) {
+    tt__app_layer_list(want, list, sizeof list);
+    layer_choices(alone, choices, sizeof choices);
+    tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                 "simplify: -of %s cannot write %s into one '%s' file "
+                 "(%s): name OUTPUT without '%s' to write a folder of "
+                 "files%s%s", dname, list, p.ext,
+                 refused ? why_one : why_all, p.ext,
+                 alone && (alone & (alone - 1)) == 0 ? ", or write "
+                 : alone ? ", or write one with " : "",
+                 alone ? choices : "");
+    goto done;
+  }
+  if (refused) {
+    tt__app_layer_list(refused, list, sizeof list);
+    if (alone) {
+      /* the layers it takes, together when it holds them together */
+      if ((alone & (alone - 1)) && probe_run(&p, alone, p.ext) == 1) {
+        char together[64];
+        snprintf(choices, sizeof choices, "-layers %s",
+                 tt__app_layer_list(alone, together, sizeof together));
+      } else {
+        layer_choices(alone, choices, sizeof choices);
+      }
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                   "simplify: -of %s cannot hold the %s layer%s (%s); it "
+                   "takes %s", dname, list, strchr(list, ',') ? "s" : "",
+                   why_one, choices);
+    } else {
+      tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                   "simplify: -of %s cannot hold the %s layer%s (%s); use "
+                   "-of GPKG", dname, list, strchr(list, ',') ? "s" : "",
+                   why_one);
+    }
+    goto done;
+  }
+  /* Each alone, not together: one layer a file. */
+  layer_choices(want, choices, sizeof choices);
+  tt__app_layer_list(want, list, sizeof list);
+  tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+               "simplify: -of %s holds one layer, not %s (%s): write one "
+               "with %s", dname, list, why_all, choices);
+
+done:
+  tt_tin_destroy(p.tin);
+  tt_context_destroy(ctx);
+  if (p.srs)
+    OSRDestroySpatialReference(p.srs);
+  CSLDestroy(p.wopts);
+  return ok;
+}
+
+/* ===========================================================================
+ * Databases
+ * ========================================================================= */
+
+static int has_file_extension(GDALDriverH drv)
+{
+  return GDALGetMetadataItem(drv, GDAL_DMD_EXTENSIONS, NULL) ||
+         GDALGetMetadataItem(drv, GDAL_DMD_EXTENSION, NULL);
+}
+
+GDALDriverH tt__app_database_driver(app_run *r)
+{
+  const char *of = r->s->format, *out = r->s->output;
+  if (of) {
+    GDALDriverH drv = GDALGetDriverByName(of);
+    if (!drv || has_file_extension(drv) ||
+        !GDALGetMetadataItem(drv, GDAL_DCAP_VECTOR, NULL))
+      return NULL; /* tt__app_output_driver says what is wrong */
+    /* Memory and the like write nothing that lasts: refused there */
+    const char *prefix =
+        GDALGetMetadataItem(drv, GDAL_DMD_CONNECTION_PREFIX, NULL);
+    if (prefix || tt__app_str_ieq(of, "PostgreSQL"))
+      return drv;
+    return NULL;
+  }
+  /* No -of: a connection string names its driver (GDAL 3.6 does not
+   * declare PostgreSQL's "PG:" prefix). */
+  if (strncasecmp(out, "PG:", 3) == 0)
+    return GDALGetDriverByName("PostgreSQL");
+  for (int i = 0; i < GDALGetDriverCount(); i++) {
+    GDALDriverH drv = GDALGetDriver(i);
+    const char *prefix =
+        GDALGetMetadataItem(drv, GDAL_DMD_CONNECTION_PREFIX, NULL);
+    if (prefix && *prefix && strncasecmp(out, prefix, strlen(prefix)) == 0 &&
+        GDALGetMetadataItem(drv, GDAL_DCAP_VECTOR, NULL) &&
+        GDALGetMetadataItem(drv, GDAL_DCAP_CREATE, NULL))
+      return drv;
+  }
+  return NULL;
+}
+
+GDALDatasetH tt__app_database_open(app_run *r, GDALDriverH drv,
+                                   const char *shown)
+{
+  const tt_app_settings *s = r->s;
+  const char *dname = GDALGetDriverShortName(drv);
+  const char *allowed[] = {dname, NULL};
+  r->msg.last[0] = '\0';
+  GDALDatasetH ds = GDALOpenEx(s->output, GDAL_OF_VECTOR | GDAL_OF_UPDATE,
+                               allowed, NULL, NULL);
+  if (!ds) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, shown,
+                 "cannot open the %s datasource for writing: %s", dname,
+                 r->msg.last[0] ? r->msg.last : "no details from GDAL");
+    return NULL;
+  }
+  if (!GDALDatasetTestCapability(ds, ODsCTransactions) ||
+      !GDALDatasetTestCapability(ds, ODsCCreateLayer)) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, shown,
+                 "the %s datasource %s; a TIN is written in one "
+                 "transaction or not at all", dname,
+                 GDALDatasetTestCapability(ds, ODsCCreateLayer)
+                     ? "has no transactions"
+                     : "cannot create layers");
+    GDALClose(ds);
+    return NULL;
+  }
+  /* Our tables must not be there already, unless -overwrite. */
+  const char *schema = NULL;
+  for (size_t i = 0; s->lco[i]; i++)
+    if (strncasecmp(s->lco[i], "SCHEMA=", 7) == 0)
+      schema = s->lco[i] + 7;
+  static const char *const names[] = {"triangles", "vertices",
+                                      "run_parameters"};
+  for (unsigned i = 0; i < 3 && !s->overwrite; i++) {
+    if (!(s->layers & (1u << i)))
+      continue;
+    char *name = CPLStrdup(CPLSPrintf("%s%s%s%s", schema ? schema : "",
+                                      schema ? "." : "", s->nln, names[i]));
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRLayerH l = GDALDatasetGetLayerByName(ds, name);
+    CPLPopErrorHandler();
+    CPLErrorReset();
+    if (l) {
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, shown,
+                   "layer %s exists; use -overwrite to replace it", name);
+      CPLFree(name);
+      GDALClose(ds);
+      return NULL;
+    }
+    CPLFree(name);
+  }
+  return ds;
+}
