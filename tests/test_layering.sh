@@ -13,7 +13,8 @@
 #     folder includes a header of another command's folder, and the core
 #     includes none of theirs (it reaches a command only through the entry
 #     point app.h declares);
-#  5. files a reader can hold: no file of apps/ over 800 lines, no function
+#  5. every file opens with a comment that names its folder's role;
+#  6. files a reader can hold: no file of apps/ over 800 lines, no function
 #     of apps/ or src/gdal/ over 150 lines.
 set -u
 root=${1:?usage: test_layering.sh SOURCE_DIR}
@@ -65,7 +66,17 @@ done > /tmp/tt_layering_$$.txt
 bad=$(cat /tmp/tt_layering_$$.txt); rm -f /tmp/tt_layering_$$.txt
 [ -z "$bad" ] || broken "includes across the command's folders (a command uses apps/core/ and the libraries only):" "$bad"
 
-# 5. sizes
+# 5. every file opens with a paragraph that names its folder's role
+# ("Part of src/mesh/, the mesh stage: ...", "apps/eval/: the eval command")
+# (apps/ and src/gdal/ are being named in issue 25's branches)
+unnamed=$(for f in $(find src include apps -path src/gdal -prune -o -path apps -prune -o -type f \( -name '*.c' -o -name '*.h' \) -print | sort); do
+  dir=$(dirname "$f")/
+  awk 'NR == 1 && !/^\/\*/ { exit 1 } { print } /\*\// { exit }' "$f" |
+    grep -qF "$dir" || echo "$f"
+done)
+[ -z "$unnamed" ] || broken "files whose opening comment does not name their folder (its role):" "$unnamed"
+
+# 6. sizes
 long=$(find apps -type f \( -name '*.c' -o -name '*.h' \) -print0 | xargs -0 wc -l |
        awk '$2 != "total" && $1 > 800 {print}')
 [ -z "$long" ] || broken "files of apps/ over 800 lines (split them by concept):" "$long"

@@ -26,6 +26,8 @@
  *  - No global mutable state: everything lives in the context.
  *
  * The header compiles alone, in C11 and in C++.
+ *
+ * Part of include/terratin/, the public C API.
  */
 #ifndef TERRATIN_H
 #define TERRATIN_H

@@ -8,6 +8,8 @@
  *
  * Ownership sentences are fixed: "The caller owns *out_X and frees it with
  * tt_X_destroy()."
+ *
+ * Part of include/terratin/, the public C API.
  */
 #ifndef TERRATIN_GDAL_H
 #define TERRATIN_GDAL_H

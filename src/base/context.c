@@ -3,6 +3,9 @@
  * and the small helpers every module uses: error formatting, array growth,
  * the clock. The context holds all mutable state a
  * run needs besides its own objects: there is no global mutable state.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #include "base/internal.h"
 

@@ -6,6 +6,9 @@
  * written once by its producer (reader, generator, caller) and then only
  * read: the engine never modifies heights. Memory: 4 bytes per sample, 8
  * for a grid of doubles.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 /* madvise() and MADV_HUGEPAGE are outside ISO C and POSIX. */
 #define _DEFAULT_SOURCE 1

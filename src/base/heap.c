@@ -2,6 +2,9 @@
  * heap.c -- the indexed 4-ary max-heap of heap.h. Workload: in greedy
  * refinement one pop and a handful of updates per inserted vertex, so every
  * operation is O(log n) with no allocation but amortised growth.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #include "base/heap.h"
 

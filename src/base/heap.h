@@ -6,6 +6,9 @@
  * removed in O(log n). Order: larger key first; equal keys break on the
  * smaller item id, so the same pushes give the same pops on every machine
  * (the TIN is reproducible byte for byte). Keys must not be NaN.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #ifndef TT_HEAP_H
 #define TT_HEAP_H

@@ -2,6 +2,9 @@
  * internal.h -- what the engine's files share and the public API hides: the
  * context and grid structures, the error helpers, hidden-visibility
  * declarations. Internal cross-file symbols are named tt__<module>_<verb>.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #ifndef TT_INTERNAL_H
 #define TT_INTERNAL_H

@@ -13,6 +13,9 @@
  *
  * Linux files are read when present; elsewhere only sysconf and getrlimit
  * answer. Nothing is cached: callers ask once per run.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #include "base/internal.h"
 

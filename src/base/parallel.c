@@ -13,6 +13,9 @@
  * Idle workers spin, then sleep on a condition variable; the caller wakes
  * them when it sees the `sleeping` flag, which both sides access with
  * sequentially consistent order, so no wake-up is lost.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #include "base/parallel.h"
 

@@ -10,6 +10,9 @@
  * scheduling. Batches in refinement are small (a handful of triangles), so
  * idle workers spin briefly before sleeping on a condition variable.
  * A pool of 1 thread runs everything in the caller.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #ifndef TT_PARALLEL_H
 #define TT_PARALLEL_H

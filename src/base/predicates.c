@@ -27,6 +27,9 @@
  * Workload: tt__incircle_metric runs for every flip test of Delaunay
  * refinement; its square-pixel case is a handful of integer multiplications.
  * Nothing here allocates or keeps state; all functions are reentrant.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #include "base/predicates.h"
 

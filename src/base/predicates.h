@@ -19,6 +19,9 @@
  *    internal.h), evaluated exactly from integer determinants and the three
  *    double coefficients.
  * All return -1, 0 or +1. Compile without -ffast-math or FMA contraction.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #ifndef TT_PREDICATES_H
 #define TT_PREDICATES_H

@@ -4,6 +4,9 @@
  * here from their description). Its state lives with its user (synthetic
  * terrains, simulated annealing): no global state, and the same seed gives
  * the same sequence on every machine, so runs repeat byte for byte.
+ *
+ * Part of src/base/, the base stage: the context and its errors, grids, exact
+ * predicates, the heap, threads, memory limits.
  */
 #ifndef TT_RANDOM_H
 #define TT_RANDOM_H

@@ -20,6 +20,9 @@
  * across them). Quads that are not strictly convex score 0 (geometry.h).
  * The quad is read in geometry.h's canonical form, so a swap and the swap
  * back have exactly opposite values. Cost: 8 cross products and 10 atan2.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/geometry.h"
 

@@ -6,6 +6,9 @@
  * (a, b, c). The test is exact (predicates.c): grid cells are co-circular,
  * so ties are the normal case, and a tie is legal: the edge stays. Flipping
  * illegal edges reaches the global Delaunay triangulation.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/criterion.h"
 

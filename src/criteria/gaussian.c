@@ -72,6 +72,9 @@
  * (they only come back when the swap is taken). Those four stars are the
  * bulk of the criterion's cost; docs/criteria.md gives the measurements and
  * what a cheaper design would need.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/geometry.h"
 

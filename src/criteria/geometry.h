@@ -20,6 +20,9 @@
  *
  * All static inline: each criterion's hot path compiles to straight-line
  * arithmetic with no call and no allocation.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #ifndef TT_CRITERIA_GEOMETRY_H
 #define TT_CRITERIA_GEOMETRY_H

@@ -41,6 +41,9 @@
  * not strictly convex score 0 (geometry.h), so the scans never meet a
  * degenerate triangle. Cost: a scan of the quad's samples twice -- the
  * price of a data-dependent criterion, linear in the quad's area.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/geometry.h"
 #include "mesh/raster_scan.h"

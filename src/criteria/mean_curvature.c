@@ -18,6 +18,9 @@
  * The quad is read in geometry.h's canonical form, so a swap and the swap
  * back have exactly opposite values. Cost: 8 cross products and 5 + 5
  * atan2.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/geometry.h"
 

@@ -12,6 +12,9 @@
  * quad is read in geometry.h's canonical form, so a swap and the swap back
  * have exactly opposite values.
  * Cost: four cross products and four square roots.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/geometry.h"
 

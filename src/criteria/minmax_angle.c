@@ -19,6 +19,9 @@
  * atan2: one call per value (usually one for the lexicographic form too).
  * The quad is read in geometry.h's canonical form, so a swap and the swap
  * back have exactly opposite values.
+ *
+ * Part of src/criteria/, the criteria: one file per triangulation criterion
+ * behind one vtable.
  */
 #include "criteria/geometry.h"
 

@@ -38,6 +38,8 @@
  * order (ties on vertex indices), so the TIN does not depend on threads.
  * Memory: the mesh, 9 bytes per vertex, 4 per vertex of candidates, the
  * scans' tile bounds (0.25 bytes per sample).
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #include "decimate/decimate.h"
 

@@ -7,6 +7,8 @@
  * Vertices keep their mesh index for the whole run (removal frees
  * triangle slots, never vertex records), so per-vertex arrays are indexed
  * by it. A vertex is alive while m.v[v].edge >= 0.
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #ifndef TT_DECIMATE_H
 #define TT_DECIMATE_H

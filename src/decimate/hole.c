@@ -18,6 +18,8 @@
  * vertices.
  *
  * DP: the polygon goes to tt__polygon_dp with the criterion's measure.
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #include "decimate/hole.h"
 

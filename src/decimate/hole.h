@@ -12,6 +12,8 @@
  * fill never fails for want of one: ear cutting with exact orientation
  * tests finds an ear at every step (docs/decimation.md gives the
  * argument), collinear runs and slivers included.
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #ifndef TT_DECIMATE_HOLE_H
 #define TT_DECIMATE_HOLE_H

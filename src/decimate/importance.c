@@ -26,6 +26,8 @@
  * never. Workload: one call per vertex and round (independent sets) or
  * per changed star (sequential); error dominates, a scan of the star's
  * samples.
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #include "decimate/decimate.h"
 

@@ -3,6 +3,8 @@
  * the names of the importance measures, selections, hole rules and
  * starts and their parsing, the options' defaults, and the check of a
  * whole option set that every entry of decimate.c makes first.
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #include "decimate/decimate.h"
 

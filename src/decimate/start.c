@@ -22,6 +22,8 @@
  *
  * Memory of `all`: the mesh itself, about 16 bytes per vertex and 27 per
  * triangle slot (two per sample), plus the link table while linking.
+ *
+ * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #include "decimate/decimate.h"
 

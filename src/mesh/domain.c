@@ -20,6 +20,9 @@
  * valid sample stays uncovered exactly when no valid cell part holds it.
  *
  * Memory: one byte per sample (outline directions) while building.
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #include "mesh/domain.h"
 

@@ -1,6 +1,9 @@
 /*
  * domain.h -- the valid domain of a grid with nodata as the constrained
  * outline of the starting triangulation (see domain.c).
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #ifndef TT_DOMAIN_H
 #define TT_DOMAIN_H

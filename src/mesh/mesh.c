@@ -7,6 +7,9 @@
  * does one split and a few flips per inserted vertex, so operations are
  * O(1) with amortised array growth; validate() is O(V + T) and meant for
  * tests.
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #include "mesh/mesh.h"
 

@@ -19,6 +19,9 @@
  * candidates); a logged slot may have been freed since, or logged twice.
  *
  * Limits: at most TT_MAX_VERTICES vertices and INT32_MAX/3 triangle slots.
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #ifndef TT_MESH_H
 #define TT_MESH_H

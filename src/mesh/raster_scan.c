@@ -21,6 +21,9 @@
  * per-triangle set-up costs as much as the samples on small triangles, and
  * the rows' cache misses (one a row, on a grid larger than the caches) as
  * much as both on large grids.
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #include "mesh/raster_scan.h"
 

@@ -13,6 +13,9 @@
  * z0 + gx (x - x0) + gy (y - y0) in pixel space; every caller (candidate
  * search, statistics) uses the same expression, so they agree bit for bit.
  * This is the hot loop of refinement: keep it branch-free per sample.
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #ifndef TT_RASTER_SCAN_H
 #define TT_RASTER_SCAN_H

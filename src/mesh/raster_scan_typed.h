@@ -21,6 +21,9 @@
  * and this file defines and undefines in turn:
  *   TT_ZARR(g)    the grid's array of TT_Z, TT_ZTILES(t) the tiles' array,
  *   TT_ZLINE      samples per 64-byte line, TT_ZNEXTUP(x) the next TT_Z up.
+ *
+ * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
+ * triangle owns, the nodata domain.
  */
 #if TT_Z_IS_F64
 #define TT_ZARR(g) ((g)->zd)

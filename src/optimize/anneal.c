@@ -13,6 +13,9 @@
  * the defaults 500 per swappable edge), each swap two slots' worth of heap
  * updates for the max-type criteria. Memory: the log, at most LOG_MAX
  * records of about 110 bytes, and one snapshot (13 bytes per slot).
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "optimize/anneal.h"
 

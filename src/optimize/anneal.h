@@ -34,6 +34,9 @@
  * Constrained and boundary edges are never swapped, non-convex quads
  * neither. The accept callback (optimize.h), when given, may refuse a
  * swap after it was made; it is then taken back.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #ifndef TT_ANNEAL_H
 #define TT_ANNEAL_H

@@ -21,6 +21,9 @@
  * Workload: the heap holds every live triangle once; a search visits a few
  * windows when the first candidate improves, at most the windows within
  * TT__EI_MAX_DEPTH crossed edges when none does (once per run, at the end).
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "optimize/edge_insert.h"
 

@@ -32,6 +32,9 @@
  * edges (the depth bound keeps a failed search local on a mesh of 100k
  * vertices; the optimum is exact when every improving edge crosses fewer,
  * as on every test set). The touched log is emptied along the way.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #ifndef TT_EDGE_INSERT_H
 #define TT_EDGE_INSERT_H

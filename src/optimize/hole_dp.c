@@ -41,6 +41,9 @@
  * far skip theirs, and start spokes of the fan path stop as soon as their
  * value cannot beat the current area or the best start. About 1.5 us per
  * call plus the mesh update (tt__mesh_replace_region).
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "optimize/hole_dp.h"
 

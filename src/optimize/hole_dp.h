@@ -15,6 +15,9 @@
  * (pockets as in polygon_dp.c, the fan as a shortest path around v), so
  * its minimum is exact. Constrained spokes at v (v inserted on a
  * constrained edge) and the outline are never crossed.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #ifndef TT_HOLE_DP_H
 #define TT_HOLE_DP_H

@@ -13,6 +13,9 @@
  * of allocations per call); a whole-mesh pass is O(E log E) for the heap
  * plus one criterion evaluation per edge and per re-scored edge, and the
  * look-ahead phase one trial flip and four evaluations per edge.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "optimize/optimize.h"
 

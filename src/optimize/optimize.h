@@ -40,6 +40,9 @@
  *
  * Constrained and boundary edges are never swapped; non-convex quads
  * neither (tt__mesh_flippable).
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #ifndef TT_OPTIMIZE_H
 #define TT_OPTIMIZE_H

@@ -19,6 +19,9 @@
  * swap for TT_OPTIMIZE_AUTO), refusing moves that lift a triangle above
  * max_error, and the TIN is built with the statistics of every sample.
  * Workload: O(T log T) to rebuild, then the optimiser's own cost.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "base/internal.h"
 #include "criteria/criterion.h"

@@ -3,6 +3,9 @@
  * polygon_dp.h for the rules and the recurrence). Workload: holes of a few
  * to a few dozen vertices (the star of a vertex), so the n^2 diagonal
  * tests, each O(n), cost about as much as the recurrence itself.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "optimize/polygon_dp.h"
 

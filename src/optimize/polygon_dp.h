@@ -19,6 +19,9 @@
  * v_i..v_j closed by the diagonal (i, j); Q(i, j) = best over apexes k of
  * G(Q(i, k), Q(k, j), measure(i, k, j)); ties go to the smallest k, so the
  * result is reproducible. O(n^3) time, O(n^2) space.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #ifndef TT_POLYGON_DP_H
 #define TT_POLYGON_DP_H

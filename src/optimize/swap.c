@@ -3,6 +3,9 @@
  * after one insertion examines O(degree) edges; tt__swap_all is O(E) flips
  * for Delaunay in practice. Iterative with a growable stack, never
  * recursive.
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #include "optimize/swap.h"
 

@@ -8,6 +8,9 @@
  * classic outward legalisation and yields the Delaunay triangulation.
  * tt__swap_all runs Lawson's flip loop over every edge (used to make a
  * starting triangulation satisfy the criterion).
+ *
+ * Part of src/optimize/, the optimisers: swaps under a criterion, look-ahead,
+ * annealing, edge insertion, the dynamic programs.
  */
 #ifndef TT_SWAP_H
 #define TT_SWAP_H

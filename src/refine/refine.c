@@ -40,6 +40,8 @@
  * (+ 16 per triangle above max_error; + 24 for the sums when recording);
  * per sample, while inserting: the scans' tile bounds, 0.25 bytes.
  * Cost: O((m + n) log n) for m samples and n inserted vertices in practice.
+ *
+ * Part of src/refine/, the greedy insertion method (tt_refine_run).
  */
 #include "criteria/criterion.h"
 #include "mesh/domain.h"

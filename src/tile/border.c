@@ -23,6 +23,9 @@
  * Cost: O(n log n) for a line of n samples in practice (O(n^2) when every
  * sample must be kept, 4096^2 steps for a tile of 4096); memory: a stack of
  * pairs of indices, at most n.
+ *
+ * Part of src/tile/, tiled runs: the tiles, their shared borders, one tile's
+ * run, the merge.
  */
 #include "tile/tile.h"
 #include "mesh/mesh.h"

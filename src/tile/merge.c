@@ -27,6 +27,9 @@
  * points, 24 bytes a vertex more), plus 8 bytes per triangle (its squared
  * errors) and 16 per vertex on a tile outline (the table) until the end;
  * no sample.
+ *
+ * Part of src/tile/, tiled runs: the tiles, their shared borders, one tile's
+ * run, the merge.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"

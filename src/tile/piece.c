@@ -13,6 +13,9 @@
  * factors and convergences among the arrays; its area function is code,
  * not data: the merge takes it from a window of the DEM
  * (tt_tin_merger_set_ground).
+ *
+ * Part of src/tile/, tiled runs: the tiles, their shared borders, one tile's
+ * run, the merge.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"

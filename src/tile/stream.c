@@ -44,6 +44,9 @@
  * bytes each, a row of tile borders), 4 bytes a vertex for the
  * components, and per piece, while its batch is out, 16 bytes a triangle
  * and 20 a vertex (tt__tin_stream_bytes counts them all).
+ *
+ * Part of src/tile/, tiled runs: the tiles, their shared borders, one tile's
+ * run, the merge.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"

@@ -32,6 +32,9 @@
  * Memory: the window's heights, a copy of the tile's (4 or 8 bytes a
  * sample), with ground points 16 bytes a sample more in each, and
  * refinement's state for the tile.
+ *
+ * Part of src/tile/, tiled runs: the tiles, their shared borders, one tile's
+ * run, the merge.
  */
 #include "tile/tile.h"
 #include "tin/tin.h"

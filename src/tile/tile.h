@@ -7,6 +7,9 @@
  * A tile's sides are numbered 0 left (column 0 of the tile), 1 top (row
  * 0), 2 right (last column), 3 bottom (last row). A side is shared when a
  * neighbouring tile lies beyond it (not at the DEM's edge).
+ *
+ * Part of src/tile/, tiled runs: the tiles, their shared borders, one tile's
+ * run, the merge.
  */
 #ifndef TT_TILE_H
 #define TT_TILE_H

@@ -9,6 +9,9 @@
  * final pass, O(slots) for the copy and the comparison plus the pass
  * itself and the scans of the triangles it changed; tt__curve_measure
  * once per decimation round, O(samples).
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #include "tin/curve.h"
 

@@ -17,6 +17,9 @@
  * triangle's samples in the order the scan visits them, as metrics.c
  * adds them), so a step's measures agree with a full pass to about 1e-15
  * relative, not bit for bit.
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #ifndef TT_CURVE_H
 #define TT_CURVE_H

@@ -33,6 +33,9 @@
  * `terratin rasterize` and `eval -error_raster` write as rasters. Workload:
  * O(triangles + rows of the clipped bounding boxes + covered samples)
  * time; memory 2 bits per sample.
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #include "base/internal.h"
 

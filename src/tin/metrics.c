@@ -11,6 +11,9 @@
  * corner of a triangle (vertex indices keep their insertion order). Cost: O(samples + triangles); memory: the compact tin arrays
  * plus 12 bytes per vertex and 4 per triangle slot while building.
  * Every RMS is clamped to its max (rounding could lift it by an ulp).
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #include "mesh/raster_scan.h"
 #include "tin/tin.h"

@@ -25,6 +25,9 @@
  * 3 doubles per line of scratch. Diamond-square: O(samples), no scratch (it
  * works in the grid's floats). The functions: O(samples). Only the grid is
  * allocated beyond that.
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #include "base/internal.h"
 #include "base/random.h"

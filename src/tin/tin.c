@@ -3,6 +3,9 @@
  * and per-triangle records. Geometry attributes (areas, slope, aspect,
  * angles) are derived on demand in the ground frame from the stored
  * corners, so the TIN holds only what cannot be recomputed cheaply.
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #include "tin/tin.h"
 

@@ -5,6 +5,9 @@
  * among the vertices kept (those in some triangle).
  * Triangles are counter-clockwise in map space (the ground frame keeps the
  * geotransform's orientation, grid.c).
+ *
+ * Part of src/tin/, the finished TIN: its records and error statistics, eval,
+ * synthetic terrains.
  */
 #ifndef TT_TIN_H
 #define TT_TIN_H
