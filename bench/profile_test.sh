@@ -27,10 +27,11 @@ export TT_TERRATIN="$build/terratin" TT_TESTDATA="$src/testdata" \
   TT_SHARED_TESTDATA="${TT_SHARED_TESTDATA:-$src/../shared/testdata}" \
   TT_SOURCE_DIR="$src" TT_BUILD_DIR="$build" TT_CORPUS="$src/tests/corpus"
 start=$EPOCHREALTIME
-# the trace on fd 9 (BASH_XTRACEFD is read at start), the test's own
-# output as usual
-PS4='+${EPOCHREALTIME}|${BASH_SOURCE[0]##*/}:${LINENO}|' BASH_XTRACEFD=9 \
-  bash -x "$test" 9>"$trace"
+# the trace on fd 9, the test's own output as usual; PS4 is set inside
+# (bash run as root does not take it from the environment) and the test
+# sourced with $0 its own path
+bash -c 'PS4='\''+${EPOCHREALTIME}|${BASH_SOURCE[0]##*/}:${LINENO}|'\''
+BASH_XTRACEFD=9; set -x; . "$0"' "$test" 9>"$trace"
 rc=$?
 end=$EPOCHREALTIME
 python3 - "$trace" "$(basename "$test")" "$top" "$start" "$end" "$rc" <<'PY'
