@@ -2,8 +2,11 @@
 #
 # Both targets install the Debian packages the build needs when they are
 # missing (apt-get, as root or through sudo), configure with CMake and build.
-# `make check` then runs the whole suite through ctest twice: an optimised
-# build with -Werror, and a build under AddressSanitizer + UBSan.
+# `make check` then runs the suite through ctest twice, all but the `long`
+# label: an optimised build with -Werror, and a build under AddressSanitizer
+# + UBSan; it ends with the tests each build skipped and why
+# (tests/skipped.py). `make check-long` runs the `long` label (full-size
+# scenarios, README "Tests"); `cd build && ctest -L unit` is the inner loop.
 
 BUILD      ?= build
 BUILD_SAN  ?= build-asan
@@ -15,7 +18,7 @@ DEB_PKGS   := cmake make gcc g++ pkg-config libgdal-dev libproj-dev gdal-bin lib
 DEMO_IN    ?= testdata/jacksboro_fault_dem.tif
 DEMO_OUT   ?= demo-out/jacksboro_tin.gpkg
 
-.PHONY: all deps build build-san demo check test test-san bench clean study
+.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study
 
 all: build
 
@@ -47,14 +50,30 @@ demo: build
 	$(BUILD)/terratin simplify -overwrite -max_error 20 $(DEMO_IN) $(DEMO_OUT)
 	@echo "demo: wrote $(DEMO_OUT) (layers triangles, vertices, run_parameters); open it in QGIS or run: ogrinfo -so $(DEMO_OUT) triangles"
 
-test: build
-	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+# ctest's results also go to BUILD/Testing/ctest-junit.xml, where
+# tests/skipped.py finds the skipped tests and the reasons they printed.
+CTEST       = ctest --output-on-failure -j $(JOBS) --output-junit Testing/ctest-junit.xml
+SAN_ENV     = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
 
-test-san: build-san
-	cd $(BUILD_SAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-	  ctest --output-on-failure -j $(JOBS)
+ctest: build
+	cd $(BUILD) && $(CTEST) -LE long
 
-check: test test-san
+ctest-san: build-san
+	cd $(BUILD_SAN) && $(SAN_ENV) $(CTEST) -LE long
+
+test: ctest
+	@python3 tests/skipped.py $(BUILD)
+
+test-san: ctest-san
+	@python3 tests/skipped.py $(BUILD_SAN)
+
+check: ctest ctest-san
+	@python3 tests/skipped.py $(BUILD) $(BUILD_SAN)
+
+# The long tier (ctest label `long`, tests/long/): full-size runs, in the
+# optimised build only, one at a time; README "Tests" says how long.
+check-long: build
+	cd $(BUILD) && ctest --output-on-failure -L long --output-junit Testing/ctest-long-junit.xml
 
 bench: build
 	bench/run.sh

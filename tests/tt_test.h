@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static int tt_test_failures = 0;
 
@@ -102,6 +103,25 @@ static int tt_test_failures = 0;
       return 1;                                                              \
     }                                                                        \
     return 0;                                                                \
+  } while (0)
+
+/* TT_RUN(test_x(args)): runs one test function of main(); with
+ * TT_TEST_TIMES set in the environment it prints the seconds it took
+ * ("time: test_x(args) 1.234 s" on stderr), to see what makes a test slow
+ * (STYLE.md: each property on the smallest input that shows it). */
+static inline double tt_test_now(void)
+{
+  struct timespec t;
+  timespec_get(&t, TIME_UTC);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+#define TT_RUN(...)                                                          \
+  do {                                                                       \
+    double t0_ = tt_test_now();                                              \
+    __VA_ARGS__;                                                             \
+    if (getenv("TT_TEST_TIMES"))                                             \
+      fprintf(stderr, "time: %s %.3f s\n", #__VA_ARGS__,                     \
+              tt_test_now() - t0_);                                          \
   } while (0)
 
 /* A seeded generator for property tests (splitmix64); print the seed on

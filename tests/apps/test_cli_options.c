@@ -818,17 +818,17 @@ static void test_library_runs(void)
 
 int main(void)
 {
-  test_simplify_defaults();
-  test_simplify_all_options();
-  test_simplify_usage_errors();
-  test_layers();
-  test_issue11_parsing();
-  test_help_and_version();
-  test_generate();
-  test_eval();
-  test_optimize();
-  test_progress_bar();
-  test_no_argv();
-  test_library_runs();
+  TT_RUN(test_simplify_defaults());
+  TT_RUN(test_simplify_all_options());
+  TT_RUN(test_simplify_usage_errors());
+  TT_RUN(test_layers());
+  TT_RUN(test_issue11_parsing());
+  TT_RUN(test_help_and_version());
+  TT_RUN(test_generate());
+  TT_RUN(test_eval());
+  TT_RUN(test_optimize());
+  TT_RUN(test_progress_bar());
+  TT_RUN(test_no_argv());
+  TT_RUN(test_library_runs());
   TT_TEST_DONE();
 }

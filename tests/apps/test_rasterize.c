@@ -525,10 +525,10 @@ int main(void)
     perror("mkdtemp");
     return 1;
   }
-  test_plane();
-  test_error_raster(1);
-  test_error_raster(2);
-  test_refusals();
+  TT_RUN(test_plane());
+  TT_RUN(test_error_raster(1));
+  TT_RUN(test_error_raster(2));
+  TT_RUN(test_refusals());
   const char *shared = getenv("TT_SHARED_TESTDATA");
   if (shared && *shared)
     test_real_dem(shared);

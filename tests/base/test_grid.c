@@ -100,8 +100,8 @@ static void test_doubles(tt_context *ctx)
 int main(void)
 {
   tt_context *ctx = tt_context_create();
-  test_floats(ctx);
-  test_doubles(ctx);
+  TT_RUN(test_floats(ctx));
+  TT_RUN(test_doubles(ctx));
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

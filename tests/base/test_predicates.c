@@ -898,12 +898,12 @@ int main(void)
   if (s && *s)
     g_seed = strtoull(s, NULL, 10);
   init_perm4();
-  test_known_signs();
-  test_grid_degenerate();
-  test_ulp_perturbations();
-  test_random_doubles();
-  test_metric_vs_ground();
-  test_metric_vs_oracle();
-  test_orient_i_big();
+  TT_RUN(test_known_signs());
+  TT_RUN(test_grid_degenerate());
+  TT_RUN(test_ulp_perturbations());
+  TT_RUN(test_random_doubles());
+  TT_RUN(test_metric_vs_ground());
+  TT_RUN(test_metric_vs_oracle());
+  TT_RUN(test_orient_i_big());
   TT_TEST_DONE();
 }

@@ -441,14 +441,14 @@ static void test_options(void)
 int main(void)
 {
   ctx = tt_context_create();
-  test_options();
-  test_stops();
-  test_random_runs();
-  test_exact_bound();
-  test_final_importance();
-  test_determinism();
-  test_double_heights();
-  test_interrupt();
+  TT_RUN(test_options());
+  TT_RUN(test_stops());
+  TT_RUN(test_random_runs());
+  TT_RUN(test_exact_bound());
+  TT_RUN(test_final_importance());
+  TT_RUN(test_determinism());
+  TT_RUN(test_double_heights());
+  TT_RUN(test_interrupt());
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

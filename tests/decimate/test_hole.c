@@ -510,8 +510,8 @@ int main(void)
   uint64_t rng = 5;
   for (size_t i = 0; i < (size_t)SIDE * SIDE; i++)
     z[i] = (float)(100 * tt_test_uniform(&rng));
-  test_hard_stars();
-  test_dp_optimal();
+  TT_RUN(test_hard_stars());
+  TT_RUN(test_dp_optimal());
   /* again on ground points: (c - MID, MID - r) through p + alpha p^2
    * (complex), 0.6 % of bend over a star's 65 pixels */
   CHECK_OK(ctx, tt_grid_alloc_ground_points(ctx, grid));
@@ -525,8 +525,8 @@ int main(void)
   if (xy)
     test_dp_optimal();
   tt_grid_drop_ground_points(grid);
-  test_boundary();
-  test_importances();
+  TT_RUN(test_boundary());
+  TT_RUN(test_importances());
   tt_grid_destroy(grid);
   tt_context_destroy(ctx);
   TT_TEST_DONE();

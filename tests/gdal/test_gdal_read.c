@@ -1110,15 +1110,15 @@ int main(void)
     return 1;
   }
   tt_context *ctx = tt_context_create();
-  test_int16_nodata_tiled_and_striped(ctx);
-  test_float32_nan_nodata(ctx);
-  test_scale_offset_z_factor(ctx);
-  test_other_formats(ctx);
-  test_geographic_frame(ctx);
-  test_refusals(ctx);
-  test_band_types(ctx);
-  test_cache_and_progress(ctx);
-  test_write_grid(ctx);
+  TT_RUN(test_int16_nodata_tiled_and_striped(ctx));
+  TT_RUN(test_float32_nan_nodata(ctx));
+  TT_RUN(test_scale_offset_z_factor(ctx));
+  TT_RUN(test_other_formats(ctx));
+  TT_RUN(test_geographic_frame(ctx));
+  TT_RUN(test_refusals(ctx));
+  TT_RUN(test_band_types(ctx));
+  TT_RUN(test_cache_and_progress(ctx));
+  TT_RUN(test_write_grid(ctx));
   int shared = test_shared_data(ctx);
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);

@@ -796,13 +796,13 @@ int main(void)
   GDALAllRegister();
   ctx = tt_context_create();
   geod_init(&wgs84, 6378137.0, 1 / 298.257223563);
-  test_srtm_57n();
-  test_ten_degrees();
-  test_sixty_degrees();
-  test_web_mercator();
-  test_feet();
-  test_frame_choice();
-  test_memory_limit();
+  TT_RUN(test_srtm_57n());
+  TT_RUN(test_ten_degrees());
+  TT_RUN(test_sixty_degrees());
+  TT_RUN(test_web_mercator());
+  TT_RUN(test_feet());
+  TT_RUN(test_frame_choice());
+  TT_RUN(test_memory_limit());
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

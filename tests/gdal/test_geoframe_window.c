@@ -244,7 +244,7 @@ int main(void)
   const double webmerc[6] = {1000000, 2500, 0, 8600000, 0, -5000};
   check_dem("Web Mercator at 58-61 N", 120, 120, webmerc, 3857,
             "per vertex");
-  test_nodata_corners();
+  TT_RUN(test_nodata_corners());
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

@@ -679,9 +679,9 @@ int main(void)
                           &predicted, &inner);
   CHECK_DBL_LE(e, 1.05 * predicted + 3e-4);
   CHECK_DBL_LE(inner, 1e-3);
-  test_jacksboro_tin(p);
-  test_warped(p);
-  test_vertical_crs(p);
+  TT_RUN(test_jacksboro_tin(p));
+  TT_RUN(test_warped(p));
+  TT_RUN(test_vertical_crs(p));
 
   /* Twenty degrees: ground points in an oblique stereographic, named. */
   GDALDatasetH jd = GDALOpen(p, GA_ReadOnly);

@@ -820,12 +820,12 @@ int main(void)
   CHECK(depth >= 2);
   printf("big TIN index depth %d\n", depth);
 
-  test_counts(ctx, big_plain, cap);
-  test_null_and_empty(ctx, small_plain);
+  TT_RUN(test_counts(ctx, big_plain, cap));
+  TT_RUN(test_null_and_empty(ctx, small_plain));
   test_triggers(ctx, small_plain, 10200); /* what GDAL 3.6 writes */
   test_triggers(ctx, small_plain, 10400); /* GeoPackage 1.4 */
-  test_refusals(ctx, small_plain);
-  test_cli();
+  TT_RUN(test_refusals(ctx, small_plain));
+  TT_RUN(test_cli());
 
   tt_tin_destroy(small);
   tt_tin_destroy(big);

@@ -238,10 +238,10 @@ int main(void)
   tt_context *ctx = tt_context_create();
   const double north_up[6] = {1000, 10, 0, 2000, 0, -10};
   const double rotated[6] = {500, 2, 0.5, 800, 0.3, -2};
-  test_geometry_types(ctx, north_up);
-  test_geometry_types(ctx, rotated);
-  test_round_trip(ctx, "GPKG");
-  test_round_trip(ctx, "ESRI Shapefile");
+  TT_RUN(test_geometry_types(ctx, north_up));
+  TT_RUN(test_geometry_types(ctx, rotated));
+  TT_RUN(test_round_trip(ctx, "GPKG"));
+  TT_RUN(test_round_trip(ctx, "ESRI Shapefile"));
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);
   TT_TEST_DONE();

@@ -699,16 +699,16 @@ int main(void)
   }
   tt_context *ctx = tt_context_create();
   CPLPushErrorHandler(CPLQuietErrorHandler);
-  test_gpkg(ctx);
-  test_unwritable(ctx);
-  test_shapefile(ctx);
-  test_not_regular(ctx);
-  test_long_name(ctx);
-  test_folder_output(ctx);
-  test_protect(ctx);
-  test_sqlite_sidecars(ctx);
-  test_abandon(ctx);
-  test_mesh_sidecars(ctx);
+  TT_RUN(test_gpkg(ctx));
+  TT_RUN(test_unwritable(ctx));
+  TT_RUN(test_shapefile(ctx));
+  TT_RUN(test_not_regular(ctx));
+  TT_RUN(test_long_name(ctx));
+  TT_RUN(test_folder_output(ctx));
+  TT_RUN(test_protect(ctx));
+  TT_RUN(test_sqlite_sidecars(ctx));
+  TT_RUN(test_abandon(ctx));
+  TT_RUN(test_mesh_sidecars(ctx));
   CPLPopErrorHandler();
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);

@@ -266,7 +266,7 @@ int main(void)
   GDALAllRegister();
   CPLSetConfigOption("CPL_LOG", "/dev/null");
   ctx = tt_context_create();
-  test_jacksboro();
+  TT_RUN(test_jacksboro());
   const char *shared = getenv("TT_SHARED_TESTDATA");
   char probe[4096];
   snprintf(probe, sizeof probe, "%s/CATALOG.md", shared ? shared : "");

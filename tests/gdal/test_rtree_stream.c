@@ -647,9 +647,9 @@ int main(void)
   one_case("written.gpkg", 4096, 200000, 4096, 3000, 0);
   /* four levels with nodes of 18 cells */
   one_case("deep.gpkg", 512, 25000, 500, 333, 0);
-  test_one_block_same(5000);
-  test_changes();
-  test_refusals();
+  TT_RUN(test_one_block_same(5000));
+  TT_RUN(test_changes());
+  TT_RUN(test_refusals());
 
   /* memory: the block and the leaves, not the features */
   {

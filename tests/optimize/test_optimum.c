@@ -985,9 +985,9 @@ int main(void)
     seed = strtoull(env, NULL, 10);
   printf("seed %" PRIu64 "\n", seed);
   ctx = tt_context_create();
-  test_point_sets(seed);
-  test_medium(seed);
-  test_convex_dp(seed);
+  TT_RUN(test_point_sets(seed));
+  TT_RUN(test_medium(seed));
+  TT_RUN(test_convex_dp(seed));
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

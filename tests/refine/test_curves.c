@@ -467,12 +467,12 @@ int main(void)
   ctx = tt_context_create();
   if (!ctx)
     return 1;
-  test_curves();
-  test_synth();
-  test_no_drift();
-  test_stop_and_at();
-  test_threads();
-  test_decimate();
+  TT_RUN(test_curves());
+  TT_RUN(test_synth());
+  TT_RUN(test_no_drift());
+  TT_RUN(test_stop_and_at());
+  TT_RUN(test_threads());
+  TT_RUN(test_decimate());
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

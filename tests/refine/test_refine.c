@@ -639,15 +639,15 @@ static void test_doubles_exact(void)
 int main(void)
 {
   ctx = tt_context_create();
-  test_doubles_same_tin();
-  test_doubles_exact();
-  test_threads();
-  test_bounds_and_frames();
-  test_stop_conditions();
-  test_flat_and_plane();
-  test_nodata();
-  test_errors();
-  test_budgets_and_memory();
+  TT_RUN(test_doubles_same_tin());
+  TT_RUN(test_doubles_exact());
+  TT_RUN(test_threads());
+  TT_RUN(test_bounds_and_frames());
+  TT_RUN(test_stop_conditions());
+  TT_RUN(test_flat_and_plane());
+  TT_RUN(test_nodata());
+  TT_RUN(test_errors());
+  TT_RUN(test_budgets_and_memory());
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

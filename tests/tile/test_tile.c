@@ -775,14 +775,14 @@ static void test_refusals(void)
 int main(void)
 {
   ctx = tt_context_create();
-  test_fractal();
-  test_criteria();
-  test_nodata();
-  test_decimate();
-  test_optimizers();
-  test_curve();
-  test_stream_ground();
-  test_refusals();
+  TT_RUN(test_fractal());
+  TT_RUN(test_criteria());
+  TT_RUN(test_nodata());
+  TT_RUN(test_decimate());
+  TT_RUN(test_optimizers());
+  TT_RUN(test_curve());
+  TT_RUN(test_stream_ground());
+  TT_RUN(test_refusals());
   tt_context_destroy(ctx);
   return tt_test_failures ? 1 : 0;
 }

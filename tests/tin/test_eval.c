@@ -614,17 +614,17 @@ int main(void)
   CHECK(ctx != NULL);
   if (!ctx)
     return 1;
-  test_plane(ctx);
-  test_spike(ctx);
-  test_bump(ctx);
-  test_coverage(ctx);
-  test_tolerance(ctx);
-  test_degenerate(ctx);
-  test_nodata(ctx);
-  test_refusals(ctx);
-  test_doubles(ctx);
-  test_random(ctx);
-  test_large(ctx);
+  TT_RUN(test_plane(ctx));
+  TT_RUN(test_spike(ctx));
+  TT_RUN(test_bump(ctx));
+  TT_RUN(test_coverage(ctx));
+  TT_RUN(test_tolerance(ctx));
+  TT_RUN(test_degenerate(ctx));
+  TT_RUN(test_nodata(ctx));
+  TT_RUN(test_refusals(ctx));
+  TT_RUN(test_doubles(ctx));
+  TT_RUN(test_random(ctx));
+  TT_RUN(test_large(ctx));
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

@@ -529,14 +529,14 @@ int main(void)
   CHECK(ctx != NULL);
   if (!ctx)
     return 1;
-  test_names(ctx);
-  test_defaults(ctx);
-  test_reproducible(ctx);
-  test_sphere_cylinder(ctx);
-  test_bump(ctx);
-  test_fault(ctx);
-  test_diamond_square(ctx);
-  test_refusals(ctx);
+  TT_RUN(test_names(ctx));
+  TT_RUN(test_defaults(ctx));
+  TT_RUN(test_reproducible(ctx));
+  TT_RUN(test_sphere_cylinder(ctx));
+  TT_RUN(test_bump(ctx));
+  TT_RUN(test_fault(ctx));
+  TT_RUN(test_diamond_square(ctx));
+  TT_RUN(test_refusals(ctx));
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }

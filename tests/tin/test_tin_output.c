@@ -176,10 +176,10 @@ static void test_rmse_le_max(tt_context *ctx)
 int main(void)
 {
   tt_context *ctx = tt_context_create();
-  test_rmse_le_max(ctx);
-  test_orientation(ctx);
-  test_speckled_corners(ctx);
-  test_checkerboard(ctx);
+  TT_RUN(test_rmse_le_max(ctx));
+  TT_RUN(test_orientation(ctx));
+  TT_RUN(test_speckled_corners(ctx));
+  TT_RUN(test_checkerboard(ctx));
   tt_context_destroy(ctx);
   TT_TEST_DONE();
 }
