@@ -87,7 +87,6 @@ apps/simplify/simplify.c tt__app_simplify
 apps/simplify/tiled.c tt__app_simplify_tiled
 apps/study/study.c tt__app_study
 apps/tiles/tiles_plan.c plan_cmd
-src/gdal/gpkg/gpkg_rows.c tt_gpkg_write_rows
 "
 new_long=$(echo "$long" | while read -r at name rest; do
   [ -n "$at" ] || continue
