@@ -1,4 +1,8 @@
 /*
+ * src/gdal/georef/ -- the georeferencing: where a grid's samples stand on
+ * the ground, with PROJ (the affine ground frame, and the conformal ground
+ * points of a geographic or Web Mercator grid).
+ *
  * georef_conformal.c -- the ground points of a longitude/latitude grid, or
  * of a Web Mercator one: every sample projected once into a conformal
  * working projection, with the projection's scale factor and meridian

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rows.c -- the rows of a TIN's triangles and vertices layers
  * written straight into a closed GeoPackage: as SQLite database pages
  * (PAGES=YES, the command's way) or through the sqlite3 C API.

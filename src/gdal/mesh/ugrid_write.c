@@ -1,4 +1,7 @@
 /*
+ * src/gdal/mesh/ -- the mesh formats: a TIN as SMS 2DM, PLY, OBJ, LandXML
+ * or UGRID netCDF, without OGR.
+ *
  * ugrid_write.c -- a TIN as a UGRID 1.0 mesh in a netCDF file (-of
  * UGRID), through libnetcdf, laid out as QGIS's MDAL reads it. The file is
  * netCDF classic with 64-bit offsets (CDF-2), which every netCDF reader

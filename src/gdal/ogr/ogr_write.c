@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * ogr_write.c -- writing a TIN into an open OGR dataset.
  *
  * Three layers, named with an optional prefix (NLN_PREFIX, which the

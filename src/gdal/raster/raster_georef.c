@@ -1,6 +1,6 @@
 /*
- * src/gdal/raster/ -- the rasters: a band read into a grid, a grid
- * written as a GeoTIFF.
+ * src/gdal/raster/ -- the rasters: a band read into a grid, a grid written
+ * as a GeoTIFF.
  *
  * raster_georef.c -- where the band read by tt_gdal_read_grid stands
  * (raster_read.h): its geotransform (the default (0,1,0,0,0,1) when there

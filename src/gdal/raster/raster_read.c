@@ -1,6 +1,6 @@
 /*
- * src/gdal/raster/ -- the rasters: a band read into a grid, a grid
- * written as a GeoTIFF.
+ * src/gdal/raster/ -- the rasters: a band read into a grid, a grid written
+ * as a GeoTIFF.
  *
  * raster_read.c -- reading one raster band into a tt_grid. Here the read's
  * recipe (tt_gdal_read_grid: options, the band's type and size checked,

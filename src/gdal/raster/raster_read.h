@@ -1,13 +1,15 @@
 /*
- * raster_read.h -- src/gdal/raster/: reading a band into a grid and writing
- * GeoTIFFs. What the files of the band reader share, private to them: the
- * read's options and its state (one struct a read, filled stage by stage),
- * and the stages each file holds: raster_read.c (tt_gdal_read_grid, the
- * options, the band's type and size checked, the grid made, the info
- * filled), raster_georef.c (the geotransform, the CRS and the height unit;
- * the ground frame) and raster_scan.c (the blocks read, mask, nodata and
- * the heights converted). raster_read.c's opening comment describes the
- * read.
+ * src/gdal/raster/ -- the rasters: a band read into a grid, a grid written
+ * as a GeoTIFF.
+ *
+ * raster_read.h -- what the files of the band reader share, private to
+ * them: the read's options and its state (one struct a read, filled stage
+ * by stage), and the stages each file holds: raster_read.c
+ * (tt_gdal_read_grid, the options, the band's type and size checked, the
+ * grid made, the info filled), raster_georef.c (the geotransform, the CRS
+ * and the height unit; the ground frame) and raster_scan.c (the blocks
+ * read, mask, nodata and the heights converted). raster_read.c's opening
+ * comment describes the read.
  */
 #ifndef TT_RASTER_READ_H
 #define TT_RASTER_READ_H

@@ -1,6 +1,6 @@
 /*
- * src/gdal/raster/ -- the rasters: a band read into a grid, a grid
- * written as a GeoTIFF.
+ * src/gdal/raster/ -- the rasters: a band read into a grid, a grid written
+ * as a GeoTIFF.
  *
  * raster_scan.c -- the scan of tt_gdal_read_grid (raster_read.h): the
  * band read a band of rows at a time, a block wide, by RasterIO into the
