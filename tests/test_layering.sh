@@ -98,11 +98,6 @@ apps/simplify/simplify.c tt__app_simplify
 apps/simplify/tiled.c tt__app_simplify_tiled
 apps/study/study.c tt__app_study
 apps/tiles/tiles_plan.c plan_cmd
-src/gdal/georef/georef_conformal.c tt__georef_ground_points
-src/gdal/gpkg/gpkg_rows.c tt_gpkg_write_rows
-src/gdal/mesh/ugrid_write.c tt__ugrid_write
-src/gdal/ogr/ogr_write.c tt_ogr_write_tin
-src/gdal/raster/raster_read.c tt_gdal_read_grid
 "
 new_long=$(echo "$long" | while read -r at name rest; do
   [ -n "$at" ] || continue

@@ -1,7 +1,13 @@
 /*
- * georef.h -- the glue's private interface to georef_proj.c: the ground
- * frame of a georeferenced grid, chosen with PROJ (see georef_proj.c).
- * Glue only: it includes GDAL's OGR SRS API.
+ * src/gdal/georef/ -- the georeferencing: where a grid's samples stand on
+ * the ground, with PROJ (the affine ground frame, and the conformal ground
+ * points of a geographic or Web Mercator grid).
+ *
+ * georef.h -- the glue's private interface to georef_proj.c (the ground
+ * frame of a georeferenced grid, chosen with PROJ) and georef_conformal.c
+ * (the ground points of a geographic or Web Mercator grid), used by the
+ * band reader (raster_georef.c). Glue only: it includes GDAL's OGR SRS
+ * API.
  */
 #ifndef TT_GEOREF_H
 #define TT_GEOREF_H

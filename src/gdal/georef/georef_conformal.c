@@ -1,4 +1,8 @@
 /*
+ * src/gdal/georef/ -- the georeferencing: where a grid's samples stand on
+ * the ground, with PROJ (the affine ground frame, and the conformal ground
+ * points of a geographic or Web Mercator grid).
+ *
  * georef_conformal.c -- the ground points of a longitude/latitude grid, or
  * of a Web Mercator one: every sample projected once into a conformal
  * working projection, with the projection's scale factor and meridian
@@ -457,45 +461,58 @@ static tt_status raster_scale_range(tt_context *ctx,
   return TT_OK;
 }
 
-tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
-                                   const char *work_srs,
-                                   const double raster_gt[6],
-                                   size_t raster_nx, size_t raster_ny,
-                                   size_t col0, size_t row0, tt_grid *grid,
-                                   char *out_name, size_t name_size,
-                                   double *out_scale_error)
-{
-  tt_status s = TT_OK;
-  OGRSpatialReferenceH work = NULL, src = NULL;
-  OGRCoordinateTransformationH ct = NULL;
-  double *lx = NULL, *ly = NULL;
-  int *ok = NULL;
-  char work_name[384] = "";
-  frame_kind kind = FRAME_USER;
-  const size_t nx = grid->nx, ny = grid->ny;
-  const size_t rnx = raster_nx, rny = raster_ny;
-  const double *gt = raster_gt;
+/* A ground-point job: where the map coordinates stand on the ellipsoid,
+ * the raster's extent, the working projection and PROJ's transformation
+ * into it. */
+typedef struct conformal {
+  tt_context *ctx;
+  source sk;
+  double a, f, e2;    /* the ellipsoid: semi-major axis, flattening, e^2 */
+  double u, deg;      /* radians and degrees per unit (1: Web Mercator) */
+  double lon_min, lon_max, lat_min, lat_max; /* the raster's, degrees */
+  double lon0, lat0;  /* its centre */
+  OGRSpatialReferenceH work, src; /* src: srs in GIS axis order */
+  OGRCoordinateTransformationH ct;
+  char work_name[384];
+  frame_kind kind;
+} conformal;
 
+/* The ellipsoid and angular unit of srs (geographic or Web Mercator), and
+ * whether the window (nx x ny at col0, row0) lies in the raster's rnx x rny
+ * samples. */
+static tt_status read_source(conformal *cf, OGRSpatialReferenceH srs,
+                             size_t rnx, size_t rny, size_t col0,
+                             size_t row0, size_t nx, size_t ny)
+{
   OGRErr err = OGRERR_NONE;
-  source sk = {0, 0, 0, 0};
-  if (!OSRIsGeographic(srs) && !web_mercator_of(srs, &sk))
-    return tt__error(ctx, TT_ERR_DATA, "ground points need a geographic "
-                     "or Web Mercator CRS");
+  source *sk = &cf->sk;
+  if (!OSRIsGeographic(srs) && !web_mercator_of(srs, sk))
+    return tt__error(cf->ctx, TT_ERR_DATA, "ground points need a "
+                     "geographic or Web Mercator CRS");
   double a = OSRGetSemiMajor(srs, &err);
   double invf = err == OGRERR_NONE ? OSRGetInvFlattening(srs, &err) : 0;
-  double u = sk.webmerc ? 1.0 : OSRGetAngularUnits(srs, NULL); /* radians
+  double u = sk->webmerc ? 1.0 : OSRGetAngularUnits(srs, NULL); /* radians
                                                                    per unit */
-  sk.u = u;
+  sk->u = u;
   if (err != OGRERR_NONE || !(a > 0) || !isfinite(invf) || invf < 0 ||
       !(u > 0) || rnx < 2 || rny < 2 || col0 + nx > rnx || row0 + ny > rny)
-    return tt__error(ctx, TT_ERR_DATA, "no ellipsoid or angular unit for "
-                     "ground points");
-  double f = invf > 0 ? 1.0 / invf : 0.0, e2 = f * (2.0 - f);
-  double deg = u * 180.0 / TT_PI;
+    return tt__error(cf->ctx, TT_ERR_DATA, "no ellipsoid or angular unit "
+                     "for ground points");
+  cf->a = a;
+  cf->u = u;
+  cf->f = invf > 0 ? 1.0 / invf : 0.0;
+  cf->e2 = cf->f * (2.0 - cf->f);
+  cf->deg = u * 180.0 / TT_PI;
+  return TT_OK;
+}
 
-  /* Extent of the whole raster's sample centres (a geotransform is
-   * affine, longitude and latitude monotonic in x and y: the corners): a
-   * window gets the frame of the raster it is cut from. */
+/* Extent of the whole raster's sample centres (a geotransform is affine,
+ * longitude and latitude monotonic in x and y: the corners): a window gets
+ * the frame of the raster it is cut from. */
+static tt_status raster_extent(conformal *cf, const double gt[6],
+                               size_t rnx, size_t rny)
+{
+  const double deg = cf->deg;
   double lon_min = HUGE_VAL, lon_max = -HUGE_VAL, lat_min = HUGE_VAL,
          lat_max = -HUGE_VAL;
   for (int k = 0; k < 4; k++) {
@@ -503,8 +520,8 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     double py = (k & 2) ? (double)rny - 0.5 : 0.5;
     double lon = (gt[0] + px * gt[1] + py * gt[2]) * deg;
     double lat = (gt[3] + px * gt[4] + py * gt[5]) * deg;
-    if (sk.webmerc) {
-      to_lonlat(&sk, gt[0] + px * gt[1] + py * gt[2],
+    if (cf->sk.webmerc) {
+      to_lonlat(&cf->sk, gt[0] + px * gt[1] + py * gt[2],
                 gt[3] + px * gt[4] + py * gt[5], &lon, &lat);
       lon *= 180 / TT_PI;
       lat *= 180 / TT_PI;
@@ -515,78 +532,93 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
     lat_max = fmax(lat_max, lat);
   }
   if (!(lat_min >= -90.0 && lat_max <= 90.0 && lon_max - lon_min <= 360.0))
-    return tt__error(ctx, TT_ERR_DATA, "the grid's extent is not "
+    return tt__error(cf->ctx, TT_ERR_DATA, "the grid's extent is not "
                      "geographic");
-  double lon0 = 0.5 * (lon_min + lon_max), lat0 = 0.5 * (lat_min + lat_max);
+  cf->lon_min = lon_min;
+  cf->lon_max = lon_max;
+  cf->lat_min = lat_min;
+  cf->lat_max = lat_max;
+  cf->lon0 = 0.5 * (lon_min + lon_max);
+  cf->lat0 = 0.5 * (lat_min + lat_max);
+  return TT_OK;
+}
 
+/* The working projection: work_srs when given (projected, else
+ * TT_ERR_ARG), else the one chosen for the extent (choose()). */
+static tt_status working_crs(conformal *cf, OGRSpatialReferenceH srs,
+                             const char *work_srs)
+{
   if (work_srs && *work_srs) {
-    work = OSRNewSpatialReference(NULL);
+    cf->work = OSRNewSpatialReference(NULL);
     CPLPushErrorHandler(CPLQuietErrorHandler);
-    if (!work || OSRSetFromUserInput(work, work_srs) != OGRERR_NONE ||
-        !OSRIsProjected(work)) {
+    if (!cf->work || OSRSetFromUserInput(cf->work, work_srs) != OGRERR_NONE ||
+        !OSRIsProjected(cf->work)) {
       CPLPopErrorHandler();
-      s = tt__error(ctx, TT_ERR_ARG, "-work_srs '%s' is not a projected "
-                    "CRS GDAL understands", work_srs);
-      goto done;
+      return tt__error(cf->ctx, TT_ERR_ARG, "-work_srs '%s' is not a "
+                       "projected CRS GDAL understands", work_srs);
     }
     CPLPopErrorHandler();
-    const char *nm = OSRGetName(work);
-    snprintf(work_name, sizeof work_name, "%s (%s)",
+    const char *nm = OSRGetName(cf->work);
+    snprintf(cf->work_name, sizeof cf->work_name, "%s (%s)",
              nm ? nm : "unnamed", work_srs);
-  } else {
-    work = choose(srs, lon0, lat0, lon_min, lon_max, lat_min, lat_max,
-                  &kind, work_name, sizeof work_name);
-    if (!work) {
-      s = tt__error(ctx, TT_ERR_DATA, "GDAL cannot build a conformal "
-                    "working projection on this CRS's datum");
-      goto done;
-    }
+    return TT_OK;
   }
-  src = OSRClone(srs);
-  if (src)
-    OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
-  if (sk.webmerc) {
-    s = check_web_mercator(ctx, src, &sk, gt, rnx, rny);
+  cf->work = choose(srs, cf->lon0, cf->lat0, cf->lon_min, cf->lon_max,
+                    cf->lat_min, cf->lat_max, &cf->kind, cf->work_name,
+                    sizeof cf->work_name);
+  if (!cf->work)
+    return tt__error(cf->ctx, TT_ERR_DATA, "GDAL cannot build a conformal "
+                     "working projection on this CRS's datum");
+  return TT_OK;
+}
+
+/* PROJ's transformation from srs (GIS axis order) to the working
+ * projection, Web Mercator's inverse checked against PROJ first. */
+static tt_status open_transform(conformal *cf, OGRSpatialReferenceH srs,
+                                const char *work_srs, const double gt[6],
+                                size_t rnx, size_t rny)
+{
+  cf->src = OSRClone(srs);
+  if (cf->src)
+    OSRSetAxisMappingStrategy(cf->src, OAMS_TRADITIONAL_GIS_ORDER);
+  if (cf->sk.webmerc) {
+    tt_status s = check_web_mercator(cf->ctx, cf->src, &cf->sk, gt, rnx, rny);
     if (s != TT_OK)
-      goto done;
+      return s;
   }
-  OSRSetAxisMappingStrategy(work, OAMS_TRADITIONAL_GIS_ORDER);
+  OSRSetAxisMappingStrategy(cf->work, OAMS_TRADITIONAL_GIS_ORDER);
   CPLPushErrorHandler(CPLQuietErrorHandler);
-  ct = src ? OCTNewCoordinateTransformation(src, work) : NULL;
+  cf->ct = cf->src ? OCTNewCoordinateTransformation(cf->src, cf->work) : NULL;
   CPLPopErrorHandler();
-  if (!ct) {
-    s = tt__error(ctx, work_srs && *work_srs ? TT_ERR_ARG : TT_ERR_DATA,
-                  "PROJ cannot transform the raster's CRS to %s",
-                  work_name);
-    goto done;
-  }
+  if (!cf->ct)
+    return tt__error(cf->ctx,
+                     work_srs && *work_srs ? TT_ERR_ARG : TT_ERR_DATA,
+                     "PROJ cannot transform the raster's CRS to %s",
+                     cf->work_name);
+  return TT_OK;
+}
 
-  /* The range of k and the frame at the centre, of the whole raster. */
-  const double metric_par[4] = {a, e2, sk.webmerc ? -sk.R : u, 0};
-  double kmin, kmax, centre_frame[4];
-  s = raster_scale_range(ctx, ct, gt, rnx, rny, metric_par, &kmin, &kmax,
-                         centre_frame);
-  if (s != TT_OK)
-    goto done;
-  double scale = 1.0;
-  if (kind == FRAME_POLAR || kind == FRAME_MERCATOR || kind == FRAME_STEREO)
-    scale = 2.0 / (kmin + kmax);
-
-  lx = malloc(nx * sizeof *lx);
-  ly = malloc(nx * sizeof *ly);
-  ok = malloc(nx * sizeof *ok);
+/* Every sample of the grid projected, times scale, into its ground points
+ * (allocated here), a row at a time: from the raster's own column and row
+ * (not the window's geotransform), so that two tiles sharing a sample
+ * compute the same bits for it, and an untiled run too. */
+static tt_status project_samples(conformal *cf, tt_grid *grid,
+                                 const double gt[6], size_t col0,
+                                 size_t row0, double scale)
+{
+  const size_t nx = grid->nx, ny = grid->ny;
+  double *lx = malloc(nx * sizeof *lx);
+  double *ly = malloc(nx * sizeof *ly);
+  int *ok = malloc(nx * sizeof *ok);
+  tt_status s = TT_OK;
   if (!lx || !ly || !ok) {
-    s = tt__error(ctx, TT_ERR_NOMEM, "out of memory for ground points");
+    s = tt__error(cf->ctx, TT_ERR_NOMEM, "out of memory for ground points");
     goto done;
   }
-  s = tt_grid_alloc_ground_points(ctx, grid);
+  s = tt_grid_alloc_ground_points(cf->ctx, grid);
   if (s != TT_OK)
     goto done;
   double *xy = tt_grid_ground_xy(grid);
-
-  /* Every sample from the raster's own column and row (not the window's
-   * geotransform), so that two tiles sharing a sample compute the same
-   * bits for it, and an untiled run too. */
   for (size_t r = 0; r < ny; r++) {
     for (size_t c = 0; c < nx; c++) {
       double px = (double)(col0 + c) + 0.5, py = (double)(row0 + r) + 0.5;
@@ -594,19 +626,69 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
       ly[c] = gt[3] + px * gt[4] + py * gt[5];
     }
     CPLPushErrorHandler(CPLQuietErrorHandler);
-    int all = OCTTransformEx(ct, (int)nx, lx, ly, NULL, ok);
+    int all = OCTTransformEx(cf->ct, (int)nx, lx, ly, NULL, ok);
     CPLPopErrorHandler();
     for (size_t c = 0; c < nx; c++) {
       if (!all || !ok[c] || !isfinite(lx[c]) || !isfinite(ly[c])) {
-        s = tt__error(ctx, TT_ERR_DATA, "PROJ cannot project sample (col "
-                      "%zu, row %zu) into %s", col0 + c, row0 + r,
-                      work_name);
+        s = tt__error(cf->ctx, TT_ERR_DATA, "PROJ cannot project sample "
+                      "(col %zu, row %zu) into %s", col0 + c, row0 + r,
+                      cf->work_name);
         goto done;
       }
       xy[2 * (r * nx + c)] = lx[c] * scale;
       xy[2 * (r * nx + c) + 1] = ly[c] * scale;
     }
   }
+done:
+  free(lx);
+  free(ly);
+  free(ok);
+  return s;
+}
+
+tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
+                                   const char *work_srs,
+                                   const double raster_gt[6],
+                                   size_t raster_nx, size_t raster_ny,
+                                   size_t col0, size_t row0, tt_grid *grid,
+                                   char *out_name, size_t name_size,
+                                   double *out_scale_error)
+{
+  const size_t rnx = raster_nx, rny = raster_ny;
+  const double *gt = raster_gt;
+  conformal cf;
+  memset(&cf, 0, sizeof cf);
+  cf.ctx = ctx;
+  cf.kind = FRAME_USER;
+  tt_status s = read_source(&cf, srs, rnx, rny, col0, row0, grid->nx,
+                            grid->ny);
+  if (s == TT_OK)
+    s = raster_extent(&cf, gt, rnx, rny);
+  if (s != TT_OK)
+    return s; /* nothing made yet */
+  s = working_crs(&cf, srs, work_srs);
+  if (s != TT_OK)
+    goto done;
+  s = open_transform(&cf, srs, work_srs, gt, rnx, rny);
+  if (s != TT_OK)
+    goto done;
+
+  /* The range of k and the frame at the centre, of the whole raster. */
+  const source *sk = &cf.sk;
+  const double metric_par[4] = {cf.a, cf.e2, sk->webmerc ? -sk->R : cf.u, 0};
+  double kmin, kmax, centre_frame[4];
+  s = raster_scale_range(ctx, cf.ct, gt, rnx, rny, metric_par, &kmin, &kmax,
+                         centre_frame);
+  if (s != TT_OK)
+    goto done;
+  double scale = 1.0;
+  if (cf.kind == FRAME_POLAR || cf.kind == FRAME_MERCATOR ||
+      cf.kind == FRAME_STEREO)
+    scale = 2.0 / (kmin + kmax);
+  s = project_samples(&cf, grid, gt, col0, row0, scale);
+  if (s != TT_OK)
+    goto done;
+
   /* k and the convergence at the TIN's vertices (tt_grid_ground_scale_at,
    * against the ellipsoid's metric, at the raster's map coordinates) */
   tt_grid_set_ground_metric_fn(grid, ellipsoid_metric, metric_par);
@@ -616,20 +698,20 @@ tt_status tt__georef_ground_points(tt_context *ctx, OGRSpatialReferenceH srs,
       centre_frame[k] *= scale;
     kmin *= scale;
     kmax *= scale;
-    size_t len = strlen(work_name);
-    snprintf(work_name + len, sizeof work_name - len, ", scaled by %.9f",
-             scale);
+    size_t len = strlen(cf.work_name);
+    snprintf(cf.work_name + len, sizeof cf.work_name - len,
+             ", scaled by %.9f", scale);
   }
   s = tt_grid_set_ground_frame(ctx, grid, centre_frame);
   if (s != TT_OK)
     goto done;
-  const double area_par[4] = {a, f, sk.webmerc ? -1.0 / sk.R : deg,
-                              sk.lon0 * 180 / TT_PI};
+  const double area_par[4] = {cf.a, cf.f, sk->webmerc ? -1.0 / sk->R : cf.deg,
+                              sk->lon0 * 180 / TT_PI};
   tt_grid_set_area_fn(grid, geodesic_area, area_par);
   double err_max = fmax(fabs(kmax - 1.0), fabs(kmin - 1.0));
   *out_scale_error = err_max;
   snprintf(out_name, name_size, "%s, per vertex; scale %.6f to %.6f "
-           "(%.2g%% off over the whole DEM)", work_name, kmin, kmax,
+           "(%.2g%% off over the whole DEM)", cf.work_name, kmin, kmax,
            100 * err_max);
 done:
   if (s != TT_OK) {
@@ -637,12 +719,9 @@ done:
     tt_grid_set_area_fn(grid, NULL, NULL);
     tt_grid_set_ground_metric_fn(grid, NULL, NULL);
   }
-  free(lx);
-  free(ly);
-  free(ok);
-  if (ct)
-    OCTDestroyCoordinateTransformation(ct);
-  OSRDestroySpatialReference(src);
-  OSRDestroySpatialReference(work);
+  if (cf.ct)
+    OCTDestroyCoordinateTransformation(cf.ct);
+  OSRDestroySpatialReference(cf.src);
+  OSRDestroySpatialReference(cf.work);
   return s;
 }

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/georef/ -- the georeferencing: where a grid's samples stand on
+ * the ground, with PROJ (the affine ground frame, and the conformal ground
+ * points of a geographic or Web Mercator grid).
+ *
  * georef_proj.c -- where a grid's pixels stand on the ground.
  *
  * The engine measures angles, areas and the Delaunay test in a *ground

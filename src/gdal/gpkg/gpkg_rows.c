@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rows.c -- the rows of a TIN's triangles and vertices layers
  * written straight into a closed GeoPackage: as SQLite database pages
  * (PAGES=YES, the command's way) or through the sqlite3 C API.
@@ -482,61 +486,67 @@ static tt_status insert_rows(rows_state *w, int layer,
   return s;
 }
 
-tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
-                             const tt_tin *tin, OGRSpatialReferenceH srs,
-                             char **options, tt_progress_fn progress,
-                             void *progress_arg)
-{
-  if (!gpkg_path || !tin)
-    return tt__error(ctx, TT_ERR_ARG, "path and TIN must not be NULL");
-  rows_state w;
+/* The write options (those of tt_ogr_write_tin that concern only it are
+ * accepted and ignored). */
+typedef struct rows_options {
+  const char *prefix, *t_srs;   /* NLN_PREFIX, T_SRS: point into options */
+  int rtree, rtree_check;       /* LCO=SPATIAL_INDEX, RTREE_CHECK */
+  int threads, journal_memory, pages; /* THREADS, JOURNAL=MEMORY, PAGES */
+  unsigned layers;              /* LAYERS: TT__LAYER_* bits */
+} rows_options;
+
+/* One write of the rows, from the open to the close. */
+typedef struct rows_write {
+  rows_state w;        /* the connection (the row source's aux: stays put) */
+  rows_options o;
   tt__records rec;
   layer_table tri, vtx;
-  memset(&w, 0, sizeof w);
-  memset(&rec, 0, sizeof rec);
-  memset(&tri, 0, sizeof tri);
-  memset(&vtx, 0, sizeof vtx);
-  w.ctx = ctx;
-  w.path = gpkg_path;
-  w.progress = progress;
-  w.progress_arg = progress_arg;
-  const char *prefix = "", *t_srs = NULL;
-  int in_transaction = 0, rtree = 1, rtree_check = 0, threads = 0;
-  int journal_memory = 0, pages = 0;
-  unsigned layers = TT__LAYERS_ALL;
   rows_pipe pipe;
-  memset(&pipe, 0, sizeof pipe);
-  pages_job job; /* PAGES=YES */
-  memset(&job, 0, sizeof job);
-  char *tri_name = NULL, *vtx_name = NULL;
-  tt_status s = TT_OK;
+  pages_job job;       /* PAGES=YES */
+  int do_tri, do_vtx;  /* the layers LAYERS made; the others count as empty */
+  size_t nt, nv;
+  int in_transaction;
+  char *tri_name, *vtx_name;
+} rows_write;
 
-  for (char **o = options; o && *o; o++) {
+static tt_status parse_rows_options(tt_context *ctx, char **options,
+                                    rows_options *o)
+{
+  o->prefix = "";
+  o->t_srs = NULL;
+  o->rtree = 1;
+  o->rtree_check = 0;
+  o->threads = 0;
+  o->journal_memory = 0;
+  o->pages = 0;
+  o->layers = TT__LAYERS_ALL;
+  tt_status s = TT_OK;
+  for (char **opt = options; opt && *opt; opt++) {
     char *key = NULL;
-    const char *value = CPLParseNameValue(*o, &key);
+    const char *value = CPLParseNameValue(*opt, &key);
     if (!key || !value)
       s = tt__error(ctx, TT_ERR_ARG, "write option \"%s\" is not "
-                    "NAME=VALUE", *o);
+                    "NAME=VALUE", *opt);
     else if (strcasecmp(key, "NLN_PREFIX") == 0)
-      prefix = value;
+      o->prefix = value;
     else if (strcasecmp(key, "T_SRS") == 0)
-      t_srs = value;
+      o->t_srs = value;
     else if (strcasecmp(key, "LCO") == 0) {
       char *lkey = NULL;
       const char *lvalue = CPLParseNameValue(value, &lkey);
       if (lkey && lvalue && strcasecmp(lkey, "SPATIAL_INDEX") == 0)
-        rtree = CPLTestBool(lvalue);
+        o->rtree = CPLTestBool(lvalue);
       CPLFree(lkey);
     } else if (strcasecmp(key, "RTREE_CHECK") == 0)
-      rtree_check = CPLTestBool(value);
+      o->rtree_check = CPLTestBool(value);
     else if (strcasecmp(key, "LAYERS") == 0)
-      s = tt__records_parse_layers(ctx, value, &layers);
+      s = tt__records_parse_layers(ctx, value, &o->layers);
     else if (strcasecmp(key, "THREADS") == 0)
-      threads = atoi(value);
+      o->threads = atoi(value);
     else if (strcasecmp(key, "JOURNAL") == 0)
-      journal_memory = strcasecmp(value, "MEMORY") == 0;
+      o->journal_memory = strcasecmp(value, "MEMORY") == 0;
     else if (strcasecmp(key, "PAGES") == 0)
-      pages = CPLTestBool(value);
+      o->pages = CPLTestBool(value);
     else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0 &&
              strcasecmp(key, "STYLE") != 0 &&
              strcasecmp(key, "OVERWRITE") != 0)
@@ -547,146 +557,216 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
     if (s != TT_OK)
       return s;
   }
+  return TT_OK;
+}
+
+/* The GeoPackage opened, the row source registered, the journal set, and
+ * the one IMMEDIATE transaction begun. */
+static tt_status open_gpkg(rows_write *rw)
+{
+  rows_state *w = &rw->w;
+  if (sqlite3_open_v2(w->path, &w->db,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, NULL) !=
+      SQLITE_OK)
+    return tt__error(w->ctx, TT_ERR_IO, "%s: cannot open the GeoPackage: %s",
+                     w->path,
+                     w->db ? sqlite3_errmsg(w->db) : "out of memory");
+  sqlite3_extended_result_codes(w->db, 1);
+  if (sqlite3_create_module_v2(w->db, ROWS_MODULE, &rows_module, w, NULL) !=
+      SQLITE_OK)
+    return db_error(w, "cannot register the row source");
+  if (rw->o.journal_memory) {
+    tt_status s = exec(w, "PRAGMA journal_mode = MEMORY",
+                       "cannot set the journal");
+    if (s != TT_OK)
+      return s;
+  }
+  tt_status s = exec(w, "BEGIN IMMEDIATE", "cannot start a transaction");
+  if (s != TT_OK)
+    return s;
+  rw->in_transaction = 1;
+  return TT_OK;
+}
+
+/* The layers' tables found, and the boxes of their R-trees allocated. */
+static tt_status find_layers(rows_write *rw)
+{
+  tt_status s = TT_OK;
+  if (rw->do_tri)
+    s = tt__rows_layer_find(&rw->w, rw->tri_name, &rw->tri);
+  if (s == TT_OK && rw->do_vtx)
+    s = tt__rows_layer_find(&rw->w, rw->vtx_name, &rw->vtx);
+  if (s == TT_OK && rw->o.rtree) {
+    rw->tri.boxes = malloc((rw->nt ? rw->nt : 1) * sizeof *rw->tri.boxes);
+    rw->vtx.boxes = malloc((rw->nv ? rw->nv : 1) * sizeof *rw->vtx.boxes);
+    if (!rw->tri.boxes || !rw->vtx.boxes)
+      s = tt__error(rw->w.ctx, TT_ERR_NOMEM, "%s: out of memory for the "
+                    "spatial index of %zu features", rw->w.path,
+                    rw->nt + rw->nv);
+  }
+  return s;
+}
+
+/* PAGES=YES, the file allowing it: the page path (gpkg_rows_pages.c),
+ * which ends the transaction. */
+static tt_status write_as_pages(rows_write *rw)
+{
+  pages_job *job = &rw->job;
+  job->w = &rw->w;
+  job->pipe = &rw->pipe;
+  job->rec = &rw->rec;
+  job->layer[0] = &rw->tri;
+  job->layer[1] = &rw->vtx;
+  job->count[0] = rw->nt;
+  job->count[1] = rw->nv;
+  job->todo[0] = rw->do_tri;
+  job->todo[1] = rw->do_vtx;
+  job->rtree = rw->o.rtree;
+  job->rtree_check = rw->o.rtree_check;
+  job->threads = rw->o.threads;
+  job->journal_memory = rw->o.journal_memory;
+  rw->in_transaction = 0; /* pages_run ends it */
+  tt_status s = tt__rows_pages_run(job);
+  if (s == TT_OK && rw->w.progress)
+    rw->w.progress(1.0, "writing", rw->w.progress_arg); /* done: too late
+                                                          to stop */
+  return s;
+}
+
+/* The SQL path: the feature-count triggers dropped, each layer inserted
+ * from the row source (the rows made on the pipe), the triggers back, the
+ * extents and counts, the R-trees from the boxes just written, all in the
+ * one transaction, then the commit. */
+static tt_status write_through_sql(rows_write *rw)
+{
+  rows_state *w = &rw->w;
+  layer_table *tri = &rw->tri, *vtx = &rw->vtx;
+  const int do_tri = rw->do_tri, do_vtx = rw->do_vtx;
+  tt_status s = TT_OK;
+  if (do_tri)
+    s = triggers_drop(w, tri);
+  if (s == TT_OK && do_vtx)
+    s = triggers_drop(w, vtx);
+  if (s == TT_OK) {
+    s = tt__rows_pipe_begin(&rw->pipe, w, &rw->rec, tri, vtx, rw->nt, rw->nv,
+                            rw->o.threads,
+                            rw->o.rtree ? tt__gpkg_rtree_node_cap(w->db) : 0);
+    w->pipe = &rw->pipe;
+  }
+  if (s == TT_OK && do_tri)
+    s = insert_rows(w, 0, tt__triangle_fields);
+  if (s == TT_OK && do_vtx)
+    s = insert_rows(w, 1, tt__vertex_fields);
+  tt__rows_pipe_join(&rw->pipe, s == TT_OK); /* the boxes and extents done */
+  w->pipe = NULL;
+  if (s == TT_OK && do_tri)
+    s = triggers_restore(w, tri);
+  if (s == TT_OK && do_vtx)
+    s = triggers_restore(w, vtx);
+  if (s == TT_OK && do_tri)
+    s = tt__rows_finish_layer(w, tri, rw->nt);
+  if (s == TT_OK && do_vtx)
+    s = tt__rows_finish_layer(w, vtx, rw->nv);
+  /* The R-trees from the boxes just written, in the same transaction. */
+  w->lo = 0.7;
+  w->hi = 0.93;
+  if (s == TT_OK && rw->o.rtree && do_tri)
+    s = tt__gpkg_rtree_from_boxes(w->ctx, w->db, w->path, tri->name,
+                                  tri->geom, tri->boxes, rw->nt,
+                                  rw->pipe.packed[0], rw->o.rtree_check,
+                                  rtree_progress, w);
+  w->lo = 0.93;
+  w->hi = 0.99;
+  if (s == TT_OK && rw->o.rtree && do_vtx)
+    s = tt__gpkg_rtree_from_boxes(w->ctx, w->db, w->path, vtx->name,
+                                  vtx->geom, vtx->boxes, rw->nv,
+                                  rw->pipe.packed[1], rw->o.rtree_check,
+                                  rtree_progress, w);
+  if (s == TT_OK) {
+    s = exec(w, "COMMIT", "cannot commit the TIN");
+    if (s == TT_OK)
+      rw->in_transaction = 0;
+  }
+  if (s == TT_OK && w->progress)
+    w->progress(1.0, "writing", w->progress_arg); /* done: too late to stop */
+  return s;
+}
+
+/* Everything freed, a transaction still open rolled back, the file
+ * closed; s, or the close's failure. */
+static tt_status end_rows_write(rows_write *rw, tt_status s)
+{
+  rows_state *w = &rw->w;
+  tt__rows_pipe_free(&rw->pipe); /* before the tables the maker fills */
+  for (int k = 0; k < 2; k++) {
+    tt__rows_layout_free(&rw->job.lay[k]);
+    tt__rtree_shadow_free(&rw->job.sh[k]);
+  }
+  if (rw->in_transaction)
+    sqlite3_exec(w->db, "ROLLBACK", NULL, NULL, NULL);
+  if (w->db && sqlite3_close(w->db) != SQLITE_OK && s == TT_OK)
+    s = tt__error(w->ctx, TT_ERR_IO, "%s: cannot close the GeoPackage",
+                  w->path);
+  tt__rows_layer_free(&rw->tri);
+  tt__rows_layer_free(&rw->vtx);
+  CPLFree(rw->tri_name);
+  CPLFree(rw->vtx_name);
+  tt__records_free(&rw->rec);
+  return s;
+}
+
+tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
+                             const tt_tin *tin, OGRSpatialReferenceH srs,
+                             char **options, tt_progress_fn progress,
+                             void *progress_arg)
+{
+  if (!gpkg_path || !tin)
+    return tt__error(ctx, TT_ERR_ARG, "path and TIN must not be NULL");
+  rows_write rw;
+  memset(&rw, 0, sizeof rw);
+  rows_state *w = &rw.w;
+  w->ctx = ctx;
+  w->path = gpkg_path;
+  w->progress = progress;
+  w->progress_arg = progress_arg;
+  tt_status s = parse_rows_options(ctx, options, &rw.o);
+  if (s != TT_OK)
+    return s;
   /* Only the layers asked for (LAYERS) were made: the others count as
    * empty here. */
-  const int do_tri = (layers & TT__LAYER_TRIANGLES) != 0;
-  const int do_vtx = (layers & TT__LAYER_VERTICES) != 0;
-  const size_t nv = do_vtx ? tt_tin_vertex_count(tin) : 0;
-  const size_t nt = do_tri ? tt_tin_triangle_count(tin) : 0;
-  w.total = nv + nt;
-  w.step = (w.total + 99) / 100;
-  w.next_report = w.step;
-  w.lo = 0.0;
-  w.hi = 0.7; /* the rows; the R-trees take the rest */
+  rw.do_tri = (rw.o.layers & TT__LAYER_TRIANGLES) != 0;
+  rw.do_vtx = (rw.o.layers & TT__LAYER_VERTICES) != 0;
+  rw.nv = rw.do_vtx ? tt_tin_vertex_count(tin) : 0;
+  rw.nt = rw.do_tri ? tt_tin_triangle_count(tin) : 0;
+  w->total = rw.nv + rw.nt;
+  w->step = (w->total + 99) / 100;
+  w->next_report = w->step;
+  w->lo = 0.0;
+  w->hi = 0.7; /* the rows; the R-trees take the rest */
   if (progress && !progress(0.0, "writing", progress_arg))
     return tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
                      "interrupted before the first feature");
-  s = tt__records_init(&rec, ctx, tin, srs, t_srs);
+  s = tt__records_init(&rw.rec, ctx, tin, srs, rw.o.t_srs);
   if (s != TT_OK)
     goto done;
-  tri_name = CPLStrdup(CPLSPrintf("%striangles", prefix));
-  vtx_name = CPLStrdup(CPLSPrintf("%svertices", prefix));
+  rw.tri_name = CPLStrdup(CPLSPrintf("%striangles", rw.o.prefix));
+  rw.vtx_name = CPLStrdup(CPLSPrintf("%svertices", rw.o.prefix));
 
-  if (sqlite3_open_v2(gpkg_path, &w.db,
-                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, NULL) !=
-      SQLITE_OK) {
-    s = tt__error(ctx, TT_ERR_IO, "%s: cannot open the GeoPackage: %s",
-                  gpkg_path, w.db ? sqlite3_errmsg(w.db) : "out of memory");
-    goto done;
-  }
-  sqlite3_extended_result_codes(w.db, 1);
-  if (sqlite3_create_module_v2(w.db, ROWS_MODULE, &rows_module, &w, NULL) !=
-      SQLITE_OK) {
-    s = db_error(&w, "cannot register the row source");
-    goto done;
-  }
-  if (journal_memory) {
-    s = exec(&w, "PRAGMA journal_mode = MEMORY", "cannot set the journal");
-    if (s != TT_OK)
-      goto done;
-  }
-  s = exec(&w, "BEGIN IMMEDIATE", "cannot start a transaction");
-  if (s != TT_OK)
-    goto done;
-  in_transaction = 1;
-  if (do_tri)
-    s = tt__rows_layer_find(&w, tri_name, &tri);
-  if (s == TT_OK && do_vtx)
-    s = tt__rows_layer_find(&w, vtx_name, &vtx);
-  if (s == TT_OK && rtree) {
-    tri.boxes = malloc((nt ? nt : 1) * sizeof *tri.boxes);
-    vtx.boxes = malloc((nv ? nv : 1) * sizeof *vtx.boxes);
-    if (!tri.boxes || !vtx.boxes)
-      s = tt__error(ctx, TT_ERR_NOMEM, "%s: out of memory for the spatial "
-                    "index of %zu features", gpkg_path, nt + nv);
-  }
+  s = open_gpkg(&rw);
+  if (s == TT_OK)
+    s = find_layers(&rw);
   const char *why = NULL;
-  if (s == TT_OK && pages)
-    s = tt__rows_pages_possible(&w, &tri, &vtx, do_tri, do_vtx, rtree,
-                       tt__records_vertex_fields(tin), job.lay, &why);
-  if (s == TT_OK && pages && why)
+  if (s == TT_OK && rw.o.pages)
+    s = tt__rows_pages_possible(w, &rw.tri, &rw.vtx, rw.do_tri, rw.do_vtx,
+                                rw.o.rtree, tt__records_vertex_fields(tin),
+                                rw.job.lay, &why);
+  if (s == TT_OK && rw.o.pages && why)
     CPLDebug("terratin", "%s: the rows go through SQLite, not as pages: %s",
              gpkg_path, why);
-  if (s == TT_OK && pages && !why) {
-    job.w = &w;
-    job.pipe = &pipe;
-    job.rec = &rec;
-    job.layer[0] = &tri;
-    job.layer[1] = &vtx;
-    job.count[0] = nt;
-    job.count[1] = nv;
-    job.todo[0] = do_tri;
-    job.todo[1] = do_vtx;
-    job.rtree = rtree;
-    job.rtree_check = rtree_check;
-    job.threads = threads;
-    job.journal_memory = journal_memory;
-    in_transaction = 0; /* pages_run ends it */
-    s = tt__rows_pages_run(&job);
-    if (s == TT_OK && progress)
-      progress(1.0, "writing", progress_arg); /* done: too late to stop */
-    goto done;
-  }
-  if (s == TT_OK && do_tri)
-    s = triggers_drop(&w, &tri);
-  if (s == TT_OK && do_vtx)
-    s = triggers_drop(&w, &vtx);
-  if (s == TT_OK) {
-    s = tt__rows_pipe_begin(&pipe, &w, &rec, &tri, &vtx, nt, nv, threads,
-                   rtree ? tt__gpkg_rtree_node_cap(w.db) : 0);
-    w.pipe = &pipe;
-  }
-  if (s == TT_OK && do_tri)
-    s = insert_rows(&w, 0, tt__triangle_fields);
-  if (s == TT_OK && do_vtx)
-    s = insert_rows(&w, 1, tt__vertex_fields);
-  tt__rows_pipe_join(&pipe, s == TT_OK); /* the boxes and extents done */
-  w.pipe = NULL;
-  if (s == TT_OK && do_tri)
-    s = triggers_restore(&w, &tri);
-  if (s == TT_OK && do_vtx)
-    s = triggers_restore(&w, &vtx);
-  if (s == TT_OK && do_tri)
-    s = tt__rows_finish_layer(&w, &tri, nt);
-  if (s == TT_OK && do_vtx)
-    s = tt__rows_finish_layer(&w, &vtx, nv);
-  /* The R-trees from the boxes just written, in the same transaction. */
-  w.lo = 0.7;
-  w.hi = 0.93;
-  if (s == TT_OK && rtree && do_tri)
-    s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, tri.name, tri.geom,
-                                  tri.boxes, nt, pipe.packed[0], rtree_check,
-                                  rtree_progress,
-                                  &w);
-  w.lo = 0.93;
-  w.hi = 0.99;
-  if (s == TT_OK && rtree && do_vtx)
-    s = tt__gpkg_rtree_from_boxes(ctx, w.db, gpkg_path, vtx.name, vtx.geom,
-                                  vtx.boxes, nv, pipe.packed[1], rtree_check,
-                                  rtree_progress,
-                                  &w);
-  if (s == TT_OK) {
-    s = exec(&w, "COMMIT", "cannot commit the TIN");
-    if (s == TT_OK)
-      in_transaction = 0;
-  }
-  if (s == TT_OK && progress)
-    progress(1.0, "writing", progress_arg); /* done: too late to stop */
+  if (s == TT_OK && rw.o.pages && !why)
+    s = write_as_pages(&rw);
+  else if (s == TT_OK)
+    s = write_through_sql(&rw);
 done:
-  tt__rows_pipe_free(&pipe); /* before the tables the maker fills */
-  for (int k = 0; k < 2; k++) {
-    tt__rows_layout_free(&job.lay[k]);
-    tt__rtree_shadow_free(&job.sh[k]);
-  }
-  if (in_transaction)
-    sqlite3_exec(w.db, "ROLLBACK", NULL, NULL, NULL);
-  if (w.db && sqlite3_close(w.db) != SQLITE_OK && s == TT_OK)
-    s = tt__error(ctx, TT_ERR_IO, "%s: cannot close the GeoPackage",
-                  gpkg_path);
-  tt__rows_layer_free(&tri);
-  tt__rows_layer_free(&vtx);
-  CPLFree(tri_name);
-  CPLFree(vtx_name);
-  tt__records_free(&rec);
-  return s;
+  return end_rows_write(&rw, s);
 }

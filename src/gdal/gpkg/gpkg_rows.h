@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rows.h -- what the files of the GeoPackage row writer share, private
  * to them: gpkg_rows.c (tt_gpkg_write_rows; the layers' tables found and
  * finished; the SQL path, a virtual table SQLite inserts from),

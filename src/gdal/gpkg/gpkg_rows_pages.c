@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rows_pages.c -- the GeoPackage row writer's page path
  * (gpkg_rows.h): PAGES=YES for a whole TIN (tt_gpkg_write_rows), and the
  * same pages row by row for a streamed tiled run (tt__gpkg_pages_*,

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rows_pipe.c -- the rows of the GeoPackage row writer (gpkg_rows.h)
  * made: each feature's values (tin_records.h), geometry blob, R-tree box
  * and extent, a chunk of rows at a time.

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rtree.c -- bulk-loading the R-tree spatial index of a GeoPackage
  * feature table, on the closed file, with the sqlite3 C API.
  *

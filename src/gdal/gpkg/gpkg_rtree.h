@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rtree.h -- the R-tree bulk loader of gpkg_rtree.c as the row
  * writer (gpkg_rows.c) uses it: inside the writer's own transaction,
  * fed with the boxes it has just written, so nothing is read back.

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_rtree_pages.c -- a GeoPackage R-tree's shadow tables written as
  * database pages while SQLite is closed (gpkg_rtree.h), for the page
  * writer of gpkg_rows.c: into the empty tables

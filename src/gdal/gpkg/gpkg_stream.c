@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_stream.c -- the triangles and vertices rows of a tiled run
  * written into its GeoPackage as the tiles are merged (tt__gpkg_stream),
  * instead of from the whole merged TIN after the last tile.

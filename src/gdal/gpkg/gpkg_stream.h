@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * gpkg_stream.h -- a tiled run's GeoPackage written as its tiles finish
  * (gpkg_stream.c), and what it needs of the page writer of
  * gpkg_rows_pages.c: the two layers' tables filled row by row as

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * rtree_pack.c -- the R-tree packing of the GeoPackage index writers
  * (rtree_pack.h): no database, only boxes.
  *

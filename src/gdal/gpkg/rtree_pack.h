@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * rtree_pack.h -- the R-tree packing shared by the GeoPackage index writers
  * (rtree_pack.c): Sort-Tile-Recursive order, the packed tree level by
  * level, and a node's blob as SQLite's R*Tree module stores it. Used by

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * sqlite_pages.c -- a table B-tree appended in rowid order: SQLite database
  * pages built here and written straight into the file, SQLite closed
  * (sqlite_pages.h). The format is SQLite's documented file format

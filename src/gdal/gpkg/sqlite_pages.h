@@ -1,4 +1,8 @@
 /*
+ * src/gdal/gpkg/ -- the GeoPackage fast path: a TIN's rows, SQLite database
+ * pages, R-trees and a tiled run's streamed write, straight into the file
+ * rather than through OGR.
+ *
  * sqlite_pages.h -- a table B-tree appended in rowid order, written as
  * pages straight into an SQLite database file while SQLite is closed.
  *

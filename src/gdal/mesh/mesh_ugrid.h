@@ -1,4 +1,7 @@
 /*
+ * src/gdal/mesh/ -- the mesh formats: a TIN as SMS 2DM, PLY, OBJ, LandXML
+ * or UGRID netCDF, without OGR.
+ *
  * mesh_ugrid.h -- the UGRID netCDF writer (ugrid_write.c), called by
  * tt_mesh_write() for -of UGRID with the records it set up.
  */

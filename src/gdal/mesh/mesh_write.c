@@ -1,4 +1,7 @@
 /*
+ * src/gdal/mesh/ -- the mesh formats: a TIN as SMS 2DM, PLY, OBJ, LandXML
+ * or UGRID netCDF, without OGR.
+ *
  * mesh_write.c -- a TIN written as one mesh or survey file, without
  * OGR: SMS 2DM (QGIS's MDAL reads it as a mesh layer), binary PLY (vertex
  * and face properties), Wavefront OBJ (3-D and game tools) and a LandXML

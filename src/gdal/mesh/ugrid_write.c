@@ -1,4 +1,7 @@
 /*
+ * src/gdal/mesh/ -- the mesh formats: a TIN as SMS 2DM, PLY, OBJ, LandXML
+ * or UGRID netCDF, without OGR.
+ *
  * ugrid_write.c -- a TIN as a UGRID 1.0 mesh in a netCDF file (-of
  * UGRID), through libnetcdf, laid out as QGIS's MDAL reads it. The file is
  * netCDF classic with 64-bit offsets (CDF-2), which every netCDF reader
@@ -68,6 +71,9 @@ typedef struct ugrid {
   const char *path;
   int nc;
   int st;          /* the first netCDF error */
+  /* the file's dimensions and variables */
+  int d_node, d_face, d_three;
+  int v_mesh, v_crs, v_node[N_NODE_VARS], v_fn, v_face[N_FACE_DOUBLES + 1];
 } ugrid;
 
 /* Records the first netCDF failure; 1 while there is none. */
@@ -124,133 +130,129 @@ static int keep_going(tt_progress_fn progress, void *arg, size_t done,
          progress(total ? (double)done / (double)total : 1.0, NULL, arg);
 }
 
-tt_status tt__ugrid_write(tt_context *ctx, const char *path,
-                          const char *name, const tt__records *rec,
-                          tt_progress_fn progress, void *progress_arg)
+
+/* The dimensions: nv nodes, nt faces, 3 nodes a face. */
+static void define_dims(ugrid *u, size_t nv, size_t nt)
 {
-  ugrid u = {ctx, path, -1, NC_NOERR};
-  tt_status st = TT_OK;
-  double *dbuf = NULL;
-  int *ibuf = NULL;
-  const tt_tin *tin = rec->tin;
-  const size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
-  const size_t total = nv + nt;
-  const OGRSpatialReferenceH srs = rec->out_srs;
-  const int geographic = srs && OSRIsGeographic(srs);
+  ok(u, nc_def_dim(u->nc, "nmesh_node", nv, &u->d_node));
+  ok(u, nc_def_dim(u->nc, "nmesh_face", nt, &u->d_face));
+  ok(u, nc_def_dim(u->nc, "max_nmesh_face_nodes", 3, &u->d_three));
+}
 
-  /* netCDF dimensions may not be 0: an empty TIN has nothing to map. */
-  if (nv == 0 || nt == 0)
-    return tt__error(ctx, TT_ERR_DATA, "%s: UGRID: the TIN has no "
-                     "triangles", path);
-  if (!ok(&u, nc_create(path, NC_CLOBBER | NC_64BIT_OFFSET, &u.nc)))
-    goto done;
-  int d_node, d_face, d_three;
-  int v_mesh, v_crs = -1, v_node[N_NODE_VARS], v_fn, v_face[N_FACE_DOUBLES + 1];
-  ok(&u, nc_def_dim(u.nc, "nmesh_node", nv, &d_node));
-  ok(&u, nc_def_dim(u.nc, "nmesh_face", nt, &d_face));
-  ok(&u, nc_def_dim(u.nc, "max_nmesh_face_nodes", 3, &d_three));
-  if (!ok(&u, NC_NOERR))
-    goto done;
-
-  put_text(&u, NC_GLOBAL, "Conventions", "CF-1.8 UGRID-1.0");
-  put_text(&u, NC_GLOBAL, "title", name);
+/* The global attributes and the mesh topology variable (and the crs
+ * variable when there is a CRS). */
+static void define_mesh(ugrid *u, const char *name, OGRSpatialReferenceH srs)
+{
+  put_text(u, NC_GLOBAL, "Conventions", "CF-1.8 UGRID-1.0");
+  put_text(u, NC_GLOBAL, "title", name);
   char source[96];
   snprintf(source, sizeof source, "terratin %s", tt_version());
-  put_text(&u, NC_GLOBAL, "source", source);
+  put_text(u, NC_GLOBAL, "source", source);
 
-  ok(&u, nc_def_var(u.nc, "mesh", NC_INT, 0, NULL, &v_mesh));
-  put_text(&u, v_mesh, "cf_role", "mesh_topology");
-  put_text(&u, v_mesh, "long_name", name);
-  put_int(&u, v_mesh, "topology_dimension", 2);
-  put_text(&u, v_mesh, "node_coordinates", "mesh_node_x mesh_node_y");
-  put_text(&u, v_mesh, "face_node_connectivity", "mesh_face_nodes");
-  put_text(&u, v_mesh, "face_dimension", "nmesh_face");
+  ok(u, nc_def_var(u->nc, "mesh", NC_INT, 0, NULL, &u->v_mesh));
+  put_text(u, u->v_mesh, "cf_role", "mesh_topology");
+  put_text(u, u->v_mesh, "long_name", name);
+  put_int(u, u->v_mesh, "topology_dimension", 2);
+  put_text(u, u->v_mesh, "node_coordinates", "mesh_node_x mesh_node_y");
+  put_text(u, u->v_mesh, "face_node_connectivity", "mesh_face_nodes");
+  put_text(u, u->v_mesh, "face_dimension", "nmesh_face");
   if (srs) {
-    ok(&u, nc_def_var(u.nc, "crs", NC_INT, 0, NULL, &v_crs));
-    put_crs(&u, v_crs, srs);
+    ok(u, nc_def_var(u->nc, "crs", NC_INT, 0, NULL, &u->v_crs));
+    put_crs(u, u->v_crs, srs);
   }
+}
 
+/* The node variables: coordinates (named for the CRS), height and the
+ * vertices' attributes. */
+static void define_node_vars(ugrid *u, OGRSpatialReferenceH srs)
+{
   static const char *const node_var_names[N_NODE_VARS] = {
       "mesh_node_x", "mesh_node_y", "mesh_node_z",
       "ins_err",     "star_max",    "star_rmse"};
+  const int geographic = srs && OSRIsGeographic(srs);
   for (int k = 0; k < N_NODE_VARS; k++) {
     int v;
-    ok(&u, nc_def_var(u.nc, node_var_names[k], NC_DOUBLE, 1, &d_node, &v));
-    v_node[k] = v;
+    ok(u, nc_def_var(u->nc, node_var_names[k], NC_DOUBLE, 1, &u->d_node, &v));
+    u->v_node[k] = v;
     if (k != NV_X && k != NV_Y) {
-      put_text(&u, v, "mesh", "mesh");
-      put_text(&u, v, "location", "node");
+      put_text(u, v, "mesh", "mesh");
+      put_text(u, v, "location", "node");
     }
     if (k == NV_X || k == NV_Y) {
-      put_text(&u, v, "standard_name",
+      put_text(u, v, "standard_name",
                geographic ? (k == NV_X ? "longitude" : "latitude")
                           : (k == NV_X ? "projection_x_coordinate"
                                        : "projection_y_coordinate"));
-      put_text(&u, v, "long_name", k == NV_X ? "x of the mesh nodes"
-                                             : "y of the mesh nodes");
+      put_text(u, v, "long_name", k == NV_X ? "x of the mesh nodes"
+                                            : "y of the mesh nodes");
       if (geographic)
-        put_text(&u, v, "units", k == NV_X ? "degrees_east"
-                                           : "degrees_north");
+        put_text(u, v, "units", k == NV_X ? "degrees_east"
+                                          : "degrees_north");
       else if (srs) {
         /* UDUNITS names of the common linear units; none for others */
         double m = OSRGetLinearUnits(srs, NULL);
-        put_text(&u, v, "units", m == 1.0            ? "m"
-                                 : m == 0.3048        ? "ft"
-                                 : fabs(m - 1200.0 / 3937.0) < 1e-12
-                                     ? "US_survey_foot"
-                                     : NULL);
+        put_text(u, v, "units", m == 1.0            ? "m"
+                                : m == 0.3048        ? "ft"
+                                : fabs(m - 1200.0 / 3937.0) < 1e-12
+                                    ? "US_survey_foot"
+                                    : NULL);
       }
     } else {
-      put_text(&u, v, "coordinates", "mesh_node_x mesh_node_y");
+      put_text(u, v, "coordinates", "mesh_node_x mesh_node_y");
       if (k == NV_Z) {
-        put_text(&u, v, "standard_name", "altitude");
-        put_text(&u, v, "long_name", "height of the mesh nodes (the DEM's "
-                                     "samples)");
+        put_text(u, v, "standard_name", "altitude");
+        put_text(u, v, "long_name", "height of the mesh nodes (the DEM's "
+                                    "samples)");
       } else {
-        put_text(&u, v, "long_name", node_attr_names[k]);
-        put_text(&u, v, "comment", node_attr_desc[k]);
+        put_text(u, v, "long_name", node_attr_names[k]);
+        put_text(u, v, "comment", node_attr_desc[k]);
       }
     }
     if (srs)
-      put_text(&u, v, "grid_mapping", "crs");
+      put_text(u, v, "grid_mapping", "crs");
   }
-  int fdims[2] = {d_face, d_three};
-  ok(&u, nc_def_var(u.nc, "mesh_face_nodes", NC_INT, 2, fdims, &v_fn));
-  put_text(&u, v_fn, "cf_role", "face_node_connectivity");
-  put_text(&u, v_fn, "long_name", "the vertices of each triangle, "
-                                  "counter-clockwise");
-  put_int(&u, v_fn, "start_index", 0);
+}
+
+/* The face variables: the connectivity and the triangles' attributes. */
+static void define_face_vars(ugrid *u, OGRSpatialReferenceH srs)
+{
+  int fdims[2] = {u->d_face, u->d_three};
+  ok(u, nc_def_var(u->nc, "mesh_face_nodes", NC_INT, 2, fdims, &u->v_fn));
+  put_text(u, u->v_fn, "cf_role", "face_node_connectivity");
+  put_text(u, u->v_fn, "long_name", "the vertices of each triangle, "
+                                    "counter-clockwise");
+  put_int(u, u->v_fn, "start_index", 0);
   for (int k = 0; k <= N_FACE_DOUBLES; k++) {
     int v;
-    ok(&u, nc_def_var(u.nc, face_names[k],
-                      k < N_FACE_DOUBLES ? NC_DOUBLE : NC_INT, 1, &d_face,
-                      &v));
-    v_face[k] = v;
-    put_text(&u, v, "mesh", "mesh");
-    put_text(&u, v, "location", "face");
-    put_text(&u, v, "long_name", face_names[k]);
-    put_text(&u, v, "comment", face_desc[k]);
+    ok(u, nc_def_var(u->nc, face_names[k],
+                     k < N_FACE_DOUBLES ? NC_DOUBLE : NC_INT, 1, &u->d_face,
+                     &v));
+    u->v_face[k] = v;
+    put_text(u, v, "mesh", "mesh");
+    put_text(u, v, "location", "face");
+    put_text(u, v, "long_name", face_names[k]);
+    put_text(u, v, "comment", face_desc[k]);
     if (srs)
-      put_text(&u, v, "grid_mapping", "crs");
+      put_text(u, v, "grid_mapping", "crs");
   }
-  if (!ok(&u, nc_enddef(u.nc)))
-    goto done;
+}
 
-  dbuf = malloc((size_t)BLOCK * N_NODE_VARS * sizeof *dbuf);
-  ibuf = malloc((size_t)BLOCK * 4 * sizeof *ibuf);
-  if (!dbuf || !ibuf) {
-    st = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-    goto done;
-  }
-  /* Nodes, a block at a time: column k of the block at dbuf + k * BLOCK. */
+/* The nodes' values, a block at a time: column k of the block at
+ * dbuf + k * BLOCK (BLOCK x N_NODE_VARS doubles). Stops at the first
+ * netCDF failure (in u->st) or interruption. */
+static tt_status write_nodes(ugrid *u, const tt__records *rec, double *dbuf,
+                             tt_progress_fn progress, void *progress_arg,
+                             size_t total)
+{
+  const size_t nv = tt_tin_vertex_count(rec->tin);
   for (size_t i0 = 0; i0 < nv; i0 += BLOCK) {
     size_t n = nv - i0 < BLOCK ? nv - i0 : BLOCK;
     for (size_t j = 0; j < n; j++) {
       tt_vertex_info v;
       double x, y;
-      st = tt__records_vertex(rec, ctx, i0 + j, &v, &x, &y);
+      tt_status st = tt__records_vertex(rec, u->ctx, i0 + j, &v, &x, &y);
       if (st != TT_OK)
-        goto done;
+        return st;
       const double d[N_NODE_VARS] = {x,
                                      y,
                                      v.z,
@@ -261,24 +263,33 @@ tt_status tt__ugrid_write(tt_context *ctx, const char *path,
         dbuf[(size_t)k * BLOCK + j] = d[k];
     }
     for (int k = 0; k < N_NODE_VARS; k++)
-      ok(&u, nc_put_vara_double(u.nc, v_node[k], &i0, &n,
-                                dbuf + (size_t)k * BLOCK));
-    if (!ok(&u, NC_NOERR))
-      goto done;
-    if (!keep_going(progress, progress_arg, i0 + n, total)) {
-      st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
-      goto done;
-    }
+      ok(u, nc_put_vara_double(u->nc, u->v_node[k], &i0, &n,
+                               dbuf + (size_t)k * BLOCK));
+    if (!ok(u, NC_NOERR))
+      return TT_OK;
+    if (!keep_going(progress, progress_arg, i0 + n, total))
+      return tt__error(u->ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
-  /* Faces: connectivity (3 ints), the doubles, the sample counts. */
+  return TT_OK;
+}
+
+/* The faces' values, a block at a time: connectivity (3 ints), the
+ * doubles, the sample counts (ibuf: BLOCK x 4 ints, dbuf: BLOCK x 2
+ * doubles). Stops as write_nodes does; progress goes on from nv. */
+static tt_status write_faces(ugrid *u, const tt__records *rec, double *dbuf,
+                             int *ibuf, tt_progress_fn progress,
+                             void *progress_arg, size_t total)
+{
+  const size_t nv = tt_tin_vertex_count(rec->tin);
+  const size_t nt = tt_tin_triangle_count(rec->tin);
   for (size_t i0 = 0; i0 < nt; i0 += BLOCK) {
     size_t n = nt - i0 < BLOCK ? nt - i0 : BLOCK;
     int *conn = ibuf, *count = ibuf + 3 * (size_t)BLOCK;
     for (size_t j = 0; j < n; j++) {
       tt_triangle_info t;
-      st = tt__records_face(rec, ctx, i0 + j, &t);
+      tt_status st = tt__records_face(rec, u->ctx, i0 + j, &t);
       if (st != TT_OK)
-        goto done;
+        return st;
       for (int k = 0; k < 3; k++)
         conn[3 * j + (size_t)k] = t.v[k];
       dbuf[j] = t.max_error;
@@ -286,18 +297,65 @@ tt_status tt__ugrid_write(tt_context *ctx, const char *path,
       count[j] = t.samples > INT32_MAX ? INT32_MAX : (int)t.samples;
     }
     const size_t start[2] = {i0, 0}, cnt[2] = {n, 3};
-    ok(&u, nc_put_vara_int(u.nc, v_fn, start, cnt, conn));
-    ok(&u, nc_put_vara_double(u.nc, v_face[FV_MAX_ERR], &i0, &n, dbuf));
-    ok(&u, nc_put_vara_double(u.nc, v_face[FV_RMSE], &i0, &n,
-                              dbuf + BLOCK));
-    ok(&u, nc_put_vara_int(u.nc, v_face[N_FACE_DOUBLES], &i0, &n, count));
-    if (!ok(&u, NC_NOERR))
-      goto done;
-    if (!keep_going(progress, progress_arg, nv + i0 + n, total)) {
-      st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
-      goto done;
-    }
+    ok(u, nc_put_vara_int(u->nc, u->v_fn, start, cnt, conn));
+    ok(u, nc_put_vara_double(u->nc, u->v_face[FV_MAX_ERR], &i0, &n, dbuf));
+    ok(u, nc_put_vara_double(u->nc, u->v_face[FV_RMSE], &i0, &n,
+                             dbuf + BLOCK));
+    ok(u, nc_put_vara_int(u->nc, u->v_face[N_FACE_DOUBLES], &i0, &n, count));
+    if (!ok(u, NC_NOERR))
+      return TT_OK;
+    if (!keep_going(progress, progress_arg, nv + i0 + n, total))
+      return tt__error(u->ctx, TT_ERR_INTERRUPTED, "interrupted");
   }
+  return TT_OK;
+}
+
+tt_status tt__ugrid_write(tt_context *ctx, const char *path,
+                          const char *name, const tt__records *rec,
+                          tt_progress_fn progress, void *progress_arg)
+{
+  ugrid u;
+  memset(&u, 0, sizeof u);
+  u.ctx = ctx;
+  u.path = path;
+  u.nc = -1;
+  u.st = NC_NOERR;
+  u.v_crs = -1;
+  tt_status st = TT_OK;
+  double *dbuf = NULL;
+  int *ibuf = NULL;
+  const tt_tin *tin = rec->tin;
+  const size_t nv = tt_tin_vertex_count(tin), nt = tt_tin_triangle_count(tin);
+  const size_t total = nv + nt;
+  const OGRSpatialReferenceH srs = rec->out_srs;
+
+  /* netCDF dimensions may not be 0: an empty TIN has nothing to map. */
+  if (nv == 0 || nt == 0)
+    return tt__error(ctx, TT_ERR_DATA, "%s: UGRID: the TIN has no "
+                     "triangles", path);
+  if (!ok(&u, nc_create(path, NC_CLOBBER | NC_64BIT_OFFSET, &u.nc)))
+    goto done;
+  define_dims(&u, nv, nt);
+  if (!ok(&u, NC_NOERR))
+    goto done;
+  define_mesh(&u, name, srs);
+  define_node_vars(&u, srs);
+  define_face_vars(&u, srs);
+  if (!ok(&u, nc_enddef(u.nc)))
+    goto done;
+
+  dbuf = malloc((size_t)BLOCK * N_NODE_VARS * sizeof *dbuf);
+  ibuf = malloc((size_t)BLOCK * 4 * sizeof *ibuf);
+  if (!dbuf || !ibuf) {
+    st = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+    goto done;
+  }
+  st = write_nodes(&u, rec, dbuf, progress, progress_arg, total);
+  if (st != TT_OK || !ok(&u, NC_NOERR))
+    goto done;
+  st = write_faces(&u, rec, dbuf, ibuf, progress, progress_arg, total);
+  if (st != TT_OK || !ok(&u, NC_NOERR))
+    goto done;
   int nc = u.nc;
   u.nc = -1;
   ok(&u, nc_close(nc));

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * input_files.c -- the local files a raster read depends on, registered
  * with tt_output_protect() so that no output can replace or remove the
  * input, whatever spelling names it.

@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * layer_style.c -- the default QGIS style saved with a GeoPackage, so that
  * its layers open styled: the `layer_styles` table of QGIS's convention
  * (the schema QGIS's OGR provider creates when a user saves a style into a

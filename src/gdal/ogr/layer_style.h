@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * layer_style.h -- the default QGIS style of a GeoPackage's layers: the
  * `layer_styles` table of QGIS's own convention (written by QGIS's OGR
  * provider when a user saves a style into the file, read when the layer is

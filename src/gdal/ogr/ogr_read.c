@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * ogr_read.c -- reading another tool's (or our own) triangles from an OGR
  * layer for tt_eval_triangles().
  *

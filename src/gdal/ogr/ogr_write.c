@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * ogr_write.c -- writing a TIN into an open OGR dataset.
  *
  * Three layers, named with an optional prefix (NLN_PREFIX, which the
@@ -108,6 +112,11 @@ typedef struct write_state {
   tt__records rec;         /* the layers' CRS, transformed vertices */
   size_t done, total;
   double scale;            /* share of the progress range the rows take */
+  const char *drv_name;    /* the driver's short name, "" */
+  int database;            /* transactions that hold the tables too
+                              (PostgreSQL): see write_in_transaction() */
+  int in_transaction;      /* a transaction to roll back on failure */
+  int rolled_back;         /* the layers made went with a rollback */
 } write_state;
 
 /* The driver's last message, or a generic one. */
@@ -649,6 +658,188 @@ static tt_status start_transaction(write_state *w)
   return TT_OK;
 }
 
+/* The order the layers are made and filled in. */
+static const unsigned layer_order[3] = {TT__LAYER_TRIANGLES,
+                                        TT__LAYER_VERTICES,
+                                        TT__LAYER_RUN_PARAMETERS};
+
+/* The state of a write into dst: the driver's name and what it takes. */
+static void begin_write(write_state *w, tt_context *ctx, GDALDatasetH dst,
+                        tt_progress_fn progress, void *progress_arg)
+{
+  memset(w, 0, sizeof *w);
+  w->ctx = ctx;
+  w->dst = dst;
+  w->layers = TT__LAYERS_ALL;
+  GDALDriverH drv = GDALGetDatasetDriver(dst);
+  w->drv_name = drv ? GDALGetDriverShortName(drv) : "";
+  w->shapefile = strcasecmp(w->drv_name, "ESRI Shapefile") == 0;
+  w->gpkg = strcasecmp(w->drv_name, "GPKG") == 0;
+  const char *types =
+      drv ? GDALGetMetadataItem(drv, GDAL_DMD_CREATIONFIELDDATATYPES, NULL)
+          : NULL;
+  w->no_int64 = types && !strstr(types, "Integer64");
+  w->progress = progress;
+  w->progress_arg = progress_arg;
+}
+
+/* The TIN's size for 32-bit fields, the records of the output CRS, the
+ * features to report progress over; progress starts. */
+static tt_status prepare_rows(write_state *w, const tt_tin *tin,
+                              OGRSpatialReferenceH srs)
+{
+  const size_t nv = tt_tin_vertex_count(tin);
+  const size_t nt = tt_tin_triangle_count(tin);
+  if (nv > (size_t)INT32_MAX || nt > (size_t)INT32_MAX)
+    return tt__error(w->ctx, TT_ERR_LIMIT, "TIN of %zu vertices and %zu "
+                     "triangles is too large for 32-bit feature fields", nv,
+                     nt);
+  tt_status s = tt__records_init(&w->rec, w->ctx, tin, srs, w->t_srs);
+  if (s != TT_OK)
+    return s;
+  w->total = (w->layers & TT__LAYER_RUN_PARAMETERS) ? 1 : 0;
+  if (!w->rows_deferred)
+    w->total += ((w->layers & TT__LAYER_TRIANGLES) ? nt : 0) +
+                ((w->layers & TT__LAYER_VERTICES) ? nv : 0);
+  if (w->total == 0)
+    w->total = 1;
+  w->scale = w->build_rtree ? 0.75 : 1.0; /* the R-trees take about a
+                                              quarter */
+  if (w->progress && !w->progress(0.0, "writing", w->progress_arg))
+    return tt__error(w->ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
+                     "interrupted before the first feature");
+  return TT_OK;
+}
+
+/* Drivers without transactions: one layer after the other, each complete
+ * before the next is made: KML takes features only into its last layer. */
+static tt_status write_layer_by_layer(write_state *w, const tt_tin *tin,
+                                      const tt_run_field *fields,
+                                      size_t nfields)
+{
+  tt_status s = TT_OK;
+  for (int k = 0; k < 3 && s == TT_OK; k++)
+    if (w->layers & layer_order[k]) {
+      s = make_layer(w, tin, layer_order[k], fields, nfields);
+      if (s == TT_OK)
+        s = fill_layer(w, tin, layer_order[k], fields, nfields);
+    }
+  return s;
+}
+
+/* With transactions: the layers, their fields and QGIS's style table
+ * made, inside the transaction for a database, before it (then started
+ * here) otherwise. */
+static tt_status make_layers(write_state *w, const tt_tin *tin,
+                             const tt_run_field *fields, size_t nfields)
+{
+  tt_status s = TT_OK;
+  if (w->database) {
+    s = start_transaction(w);
+    if (s != TT_OK)
+      return s;
+    w->in_transaction = 1;
+  }
+  for (int k = 0; k < 3 && s == TT_OK; k++)
+    if (w->layers & layer_order[k])
+      s = make_layer(w, tin, layer_order[k], fields, nfields);
+  if (s == TT_OK && w->style && w->gpkg &&
+      (w->layers & (TT__LAYER_TRIANGLES | TT__LAYER_VERTICES))) {
+    /* as QGIS makes it: the FID column is "id" */
+    char **style_lco = CSLSetNameValue(NULL, "FID", "id");
+    s = create_named_layer(w, TT__STYLE_TABLE, NULL, wkbNone, style_lco,
+                           &w->style_layer);
+    CSLDestroy(style_lco);
+    if (s == TT_OK)
+      s = tt__style_create_fields(w->ctx, w->style_layer);
+  }
+  if (s != TT_OK || w->database)
+    return s;
+  /* Drivers that create tables lazily (GPKG) make them now, so that the
+   * transaction holds only rows (and the R-trees). */
+  CPLErrorReset();
+  GDALFlushCache(w->dst);
+  if (CPLGetLastErrorType() >= CE_Failure)
+    return tt__error(w->ctx, TT_ERR_IO, "cannot create the layers: %s",
+                     ogr_msg());
+  s = start_transaction(w);
+  if (s != TT_OK)
+    return s;
+  w->in_transaction = 1;
+  return TT_OK;
+}
+
+/* With transactions, the layers made: their rows, the style rows, the
+ * R-trees, then the commit. */
+static tt_status fill_and_commit(write_state *w, const tt_tin *tin,
+                                 const tt_run_field *fields, size_t nfields)
+{
+  tt_status s = TT_OK;
+  for (int k = 0; k < 3 && s == TT_OK; k++)
+    if (w->layers & layer_order[k])
+      s = fill_layer(w, tin, layer_order[k], fields, nfields);
+  if (s == TT_OK && w->style_layer)
+    s = tt__style_insert(w->ctx, w->style_layer, tin, w->prefix, w->layers,
+                         w->tri_layer ? OGR_L_GetGeometryColumn(w->tri_layer)
+                                      : NULL,
+                         w->vtx_layer ? OGR_L_GetGeometryColumn(w->vtx_layer)
+                                      : NULL);
+  if (s == TT_OK && w->build_rtree && w->tri_layer)
+    s = build_rtree(w, w->tri_layer);
+  if (s == TT_OK && w->build_rtree && w->progress &&
+      !w->progress(0.95, "indexing", w->progress_arg))
+    s = tt__error(w->ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
+                  "interrupted while indexing");
+  if (s == TT_OK && w->build_rtree && w->vtx_layer)
+    s = build_rtree(w, w->vtx_layer);
+  if (s != TT_OK)
+    return s;
+  CPLErrorReset();
+  w->in_transaction = 0; /* a failed commit leaves nothing to roll back */
+  if (GDALDatasetCommitTransaction(w->dst) != OGRERR_NONE) {
+    w->rolled_back = w->database; /* the tables went with the rows */
+    return tt__error(w->ctx, TT_ERR_IO, "cannot commit the TIN: %s",
+                     ogr_msg());
+  }
+  return TT_OK;
+}
+
+/* Flushes now so that write errors (disk full) surface here rather than
+ * unreported at close; progress ends. */
+static tt_status flush_output(write_state *w)
+{
+  CPLErrorReset();
+  GDALFlushCache(w->dst);
+  if (CPLGetLastErrorType() >= CE_Failure)
+    return tt__error(w->ctx, TT_ERR_IO, "cannot write the TIN: %s",
+                     ogr_msg());
+  if (w->progress)
+    w->progress(1.0, "writing", w->progress_arg); /* done: too late to stop */
+  return TT_OK;
+}
+
+/* After a failure: the transaction rolled back (a database's tables went
+ * with it; its layers that OVERWRITE dropped came back), else the layers
+ * made deleted. Then the state freed. */
+static void end_write(write_state *w, tt_status s)
+{
+  if (s != TT_OK) {
+    if (w->in_transaction) {
+      GDALDatasetRollbackTransaction(w->dst);
+      w->rolled_back = w->database;
+    }
+    if (!w->rolled_back)
+      delete_created_layers(w);
+  }
+  for (int k = 0; k < w->ncreated; k++)
+    CPLFree(w->created[k]);
+  free(w->run_idx);
+  tt__records_free(&w->rec);
+  CPLFree(w->t_srs);
+  CPLFree(w->prefix);
+  CSLDestroy(w->lco);
+}
+
 tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
                            const tt_tin *tin, OGRSpatialReferenceH srs,
                            const tt_run_field *fields, size_t nfields,
@@ -661,52 +852,14 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
     return tt__error(ctx, TT_ERR_ARG, "run parameters must not be NULL");
 
   write_state w;
-  memset(&w, 0, sizeof w);
-  w.ctx = ctx;
-  w.dst = dst;
-  w.layers = TT__LAYERS_ALL;
-  GDALDriverH drv = GDALGetDatasetDriver(dst);
-  const char *drv_name = drv ? GDALGetDriverShortName(drv) : "";
-  w.shapefile = strcasecmp(drv_name, "ESRI Shapefile") == 0;
-  w.gpkg = strcasecmp(drv_name, "GPKG") == 0;
-  const char *types =
-      drv ? GDALGetMetadataItem(drv, GDAL_DMD_CREATIONFIELDDATATYPES, NULL)
-          : NULL;
-  w.no_int64 = types && !strstr(types, "Integer64");
-  w.progress = progress;
-  w.progress_arg = progress_arg;
-  int in_transaction = 0, rolled_back = 0;
-  static const unsigned order[3] = {TT__LAYER_TRIANGLES, TT__LAYER_VERTICES,
-                                    TT__LAYER_RUN_PARAMETERS};
-
+  begin_write(&w, ctx, dst, progress, progress_arg);
   tt_status s = parse_options(&w, options);
   if (s == TT_OK)
     s = check_run_fields(&w, fields, nfields);
+  if (s == TT_OK)
+    s = prepare_rows(&w, tin, srs);
   if (s != TT_OK)
     goto done;
-
-  const size_t nv = tt_tin_vertex_count(tin);
-  const size_t nt = tt_tin_triangle_count(tin);
-  if (nv > (size_t)INT32_MAX || nt > (size_t)INT32_MAX) {
-    s = tt__error(ctx, TT_ERR_LIMIT, "TIN of %zu vertices and %zu triangles "
-                  "is too large for 32-bit feature fields", nv, nt);
-    goto done;
-  }
-  s = tt__records_init(&w.rec, ctx, tin, srs, w.t_srs);
-  if (s != TT_OK)
-    goto done;
-  w.total = (w.layers & TT__LAYER_RUN_PARAMETERS) ? 1 : 0;
-  if (!w.rows_deferred)
-    w.total += ((w.layers & TT__LAYER_TRIANGLES) ? nt : 0) +
-               ((w.layers & TT__LAYER_VERTICES) ? nv : 0);
-  if (w.total == 0)
-    w.total = 1;
-  w.scale = w.build_rtree ? 0.75 : 1.0; /* the R-trees take about a quarter */
-  if (progress && !progress(0.0, "writing", progress_arg)) {
-    s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
-                  "interrupted before the first feature");
-    goto done;
-  }
 
   const int transactions = GDALDatasetTestCapability(dst, ODsCTransactions);
   /* A database (PostgreSQL): its tables are made inside the transaction
@@ -715,110 +868,19 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
    * it: GDAL 3.6's GPKG driver keeps the layer objects of a rolled-back
    * CREATE TABLE and then breaks the file at close; on failure they are
    * deleted instead (the temporary name guards the file either way). */
-  const int database = transactions && !w.gpkg &&
-                       strcasecmp(drv_name, "SQLite") != 0;
-
+  w.database = transactions && !w.gpkg &&
+               strcasecmp(w.drv_name, "SQLite") != 0;
   if (!transactions) {
-    /* One layer after the other, each complete before the next is made:
-     * KML takes features only into its last layer. */
-    for (int k = 0; k < 3 && s == TT_OK; k++)
-      if (w.layers & order[k]) {
-        s = make_layer(&w, tin, order[k], fields, nfields);
-        if (s == TT_OK)
-          s = fill_layer(&w, tin, order[k], fields, nfields);
-      }
-    if (s != TT_OK)
-      goto done;
+    s = write_layer_by_layer(&w, tin, fields, nfields);
   } else {
-    if (database) {
-      s = start_transaction(&w);
-      if (s != TT_OK)
-        goto done;
-      in_transaction = 1;
-    }
-    for (int k = 0; k < 3 && s == TT_OK; k++)
-      if (w.layers & order[k])
-        s = make_layer(&w, tin, order[k], fields, nfields);
-    if (s == TT_OK && w.style && w.gpkg &&
-        (w.layers & (TT__LAYER_TRIANGLES | TT__LAYER_VERTICES))) {
-      /* as QGIS makes it: the FID column is "id" */
-      char **style_lco = CSLSetNameValue(NULL, "FID", "id");
-      s = create_named_layer(&w, TT__STYLE_TABLE, NULL, wkbNone, style_lco,
-                             &w.style_layer);
-      CSLDestroy(style_lco);
-      if (s == TT_OK)
-        s = tt__style_create_fields(ctx, w.style_layer);
-    }
-    if (s != TT_OK)
-      goto done;
-    if (!database) {
-      /* Drivers that create tables lazily (GPKG) make them now, so that
-       * the transaction holds only rows (and the R-trees). */
-      CPLErrorReset();
-      GDALFlushCache(dst);
-      if (CPLGetLastErrorType() >= CE_Failure) {
-        s = tt__error(ctx, TT_ERR_IO, "cannot create the layers: %s",
-                      ogr_msg());
-        goto done;
-      }
-      s = start_transaction(&w);
-      if (s != TT_OK)
-        goto done;
-      in_transaction = 1;
-    }
-    for (int k = 0; k < 3 && s == TT_OK; k++)
-      if (w.layers & order[k])
-        s = fill_layer(&w, tin, order[k], fields, nfields);
-    if (s == TT_OK && w.style_layer)
-      s = tt__style_insert(ctx, w.style_layer, tin, w.prefix, w.layers,
-                           w.tri_layer ? OGR_L_GetGeometryColumn(w.tri_layer)
-                                       : NULL,
-                           w.vtx_layer ? OGR_L_GetGeometryColumn(w.vtx_layer)
-                                       : NULL);
-    if (s == TT_OK && w.build_rtree && w.tri_layer)
-      s = build_rtree(&w, w.tri_layer);
-    if (s == TT_OK && w.build_rtree && progress &&
-        !progress(0.95, "indexing", progress_arg))
-      s = tt__error(ctx, TT_ERR_INTERRUPTED, "writing the TIN was "
-                    "interrupted while indexing");
-    if (s == TT_OK && w.build_rtree && w.vtx_layer)
-      s = build_rtree(&w, w.vtx_layer);
-    if (s != TT_OK)
-      goto done;
-    CPLErrorReset();
-    in_transaction = 0; /* a failed commit leaves nothing to roll back */
-    if (GDALDatasetCommitTransaction(dst) != OGRERR_NONE) {
-      s = tt__error(ctx, TT_ERR_IO, "cannot commit the TIN: %s", ogr_msg());
-      rolled_back = database; /* the tables went with the rows */
-      goto done;
-    }
+    s = make_layers(&w, tin, fields, nfields);
+    if (s == TT_OK)
+      s = fill_and_commit(&w, tin, fields, nfields);
   }
-  /* Flush now so that write errors (disk full) surface here rather than
-   * unreported at close. */
-  CPLErrorReset();
-  GDALFlushCache(dst);
-  if (CPLGetLastErrorType() >= CE_Failure)
-    s = tt__error(ctx, TT_ERR_IO, "cannot write the TIN: %s", ogr_msg());
-  if (s == TT_OK && progress)
-    progress(1.0, "writing", progress_arg); /* done: too late to stop */
+  if (s == TT_OK)
+    s = flush_output(&w);
 
 done:
-  if (s != TT_OK) {
-    if (in_transaction) {
-      GDALDatasetRollbackTransaction(dst);
-      /* a database's tables went with the rollback; its layers that
-       * OVERWRITE dropped came back */
-      rolled_back = database;
-    }
-    if (!rolled_back)
-      delete_created_layers(&w);
-  }
-  for (int k = 0; k < w.ncreated; k++)
-    CPLFree(w.created[k]);
-  free(w.run_idx);
-  tt__records_free(&w.rec);
-  CPLFree(w.t_srs);
-  CPLFree(w.prefix);
-  CSLDestroy(w.lco);
+  end_write(&w, s);
   return s;
 }

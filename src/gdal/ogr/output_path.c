@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * output_path.c -- safe output: never overwrite without permission, never
  * leave a half-written file under a final name, never replace what the run
  * reads or what another program has open.

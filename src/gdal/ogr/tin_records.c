@@ -1,4 +1,8 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * tin_records.c -- the fields of the TIN layers and the values of each
  * feature in the layers' CRS (see tin_records.h).
  *

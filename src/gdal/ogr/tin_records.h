@@ -1,13 +1,18 @@
 /*
+ * src/gdal/ogr/ -- the OGR layers: a TIN written into an OGR dataset and
+ * triangles read from one, the features' records, QGIS's default style,
+ * safe output paths and the protection of the input's files.
+ *
  * tin_records.h -- what a TIN's features hold, shared by the writers: the
  * fields of the triangles and vertices layers, and the output coordinates
  * and areas of each feature in the layers' CRS (the input CRS, or T_SRS
  * with every vertex transformed once, up front; geodesic triangle areas
  * when that CRS is geographic).
  *
- * The OGR writer (ogr_write.c) and the direct GeoPackage row writer
- * (gpkg_rows.c) both take their values from here, so the two write the
- * same content.
+ * The OGR writer (ogr_write.c), the GeoPackage row writers (gpkg_rows.c
+ * and its files, the streamed gpkg_stream.c) and the mesh writers
+ * (mesh_write.c, ugrid_write.c) all take their values from here, so they
+ * write the same content.
  */
 #ifndef TERRATIN_TIN_RECORDS_H
 #define TERRATIN_TIN_RECORDS_H

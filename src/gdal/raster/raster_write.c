@@ -1,4 +1,7 @@
 /*
+ * src/gdal/raster/ -- the rasters: a band read into a grid, a grid written
+ * as a GeoTIFF.
+ *
  * raster_write.c -- writing a grid as a GeoTIFF (synthetic terrains,
  * residual or reconstructed grids).
  *
