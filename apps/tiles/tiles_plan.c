@@ -119,7 +119,7 @@ static void plan_cmd(char **argv, tt_app_result *res)
         return;
       }
       words = CSLAddString(words, w);
-      if (d && d->takes_value && argv[i + 1])
+      if (d && tt__app_opt_takes_value(d) && argv[i + 1])
         words = CSLAddString(words, argv[++i]);
       continue;
     }
