@@ -82,7 +82,6 @@ long=$(find apps src/gdal -type f -name '*.c' -print0 | sort -z | xargs -0 awk '
 known_long="
 apps/simplify/simplify.c tt__app_simplify
 apps/simplify/tiled.c tt__app_simplify_tiled
-apps/study/study.c tt__app_study
 src/gdal/georef/georef_conformal.c tt__georef_ground_points
 src/gdal/gpkg/gpkg_rows.c tt_gpkg_write_rows
 src/gdal/mesh/ugrid_write.c tt__ugrid_write

@@ -302,7 +302,7 @@ const char *tt__app_opt_keep(tt_app_options *o, const char *w)
   return o->strings.v[o->strings.n - 1];
 }
 
-/* --- the readers, one per kind --------------------------------------------- */
+/* --- the readers, one per kind ------------------------------------------ */
 
 static tt_status refuse(tt__app_opt_parse *p, const tt__app_opt_def *d,
                         const char *v)
@@ -409,8 +409,10 @@ static tt_status read_name(tt__app_opt_parse *p, const tt__app_opt_def *d,
     return TT_OK;
   if (d->bad)
     return refuse(p, d, v);
+  if (!d->known)
+    known_criteria(known, sizeof known);
   return OPT_USAGE(p, "%s: unknown %s '%s'; known: %s", p->cmdname, label(d),
-                   v, d->known ? d->known : known_criteria(known, sizeof known));
+                   v, d->known ? d->known : known);
 }
 
 /* The band's own mask is used unless -srcnodata names a number or nan. */
