@@ -1,9 +1,10 @@
 /*
- * dem.c -- the DEM as every subcommand opens it: the raster opened with a
+ * dem.c -- apps/core/: the command's core, what every command's folder shares.
+ * This file: the DEM as every subcommand opens it: the raster opened with a
  * one-line reason when it cannot be (missing, a folder, empty, a vector
- * dataset, a missing member of an archive), the band read into a grid at
- * its own precision with -srcnodata, -z_factor, -z_unit, -work_srs and the
- * memory limit, undeclared fill values warned about, the height range.
+ * dataset, a missing member of an archive), the band read into a grid at its
+ * own precision with -srcnodata, -z_factor, -z_unit, -work_srs and the memory
+ * limit, undeclared fill values warned about, the height range.
  */
 #include "app.h"
 

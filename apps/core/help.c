@@ -1,7 +1,8 @@
 /*
- * help.c -- the help texts of terratin: the top level and one page per
- * subcommand, as `terratin [COMMAND] --help` prints them. docs/cli.md says
- * the same at more length; the two are kept in step by hand.
+ * help.c -- apps/core/: the command's core, what every command's folder shares.
+ * This file: the help texts of terratin: the top level and one page per
+ * subcommand, as `terratin [COMMAND] --help` prints them. docs/cli.md says the
+ * same at more length; the two are kept in step by hand.
  */
 #include "app.h"
 

@@ -1,8 +1,9 @@
 /*
- * progress.c -- the text progress bar of `terratin simplify` (GDAL's
+ * progress.c -- apps/core/: the command's core, what every command's folder
+ * shares. This file: the text progress bar of `terratin simplify` (GDAL's
  * "0...10...20..." bar, with its state in a struct rather than in statics as
- * GDALTermProgress keeps it, and a stop flag a signal handler can set), and
- * the scaling of each phase's progress onto the whole run.
+ * GDALTermProgress keeps it, and a stop flag a signal handler can set), and the
+ * scaling of each phase's progress onto the whole run.
  */
 #include "app.h"
 

@@ -1,10 +1,11 @@
 /*
- * raster_output.c -- the raster writer of rasterize and of eval
- * -error_raster: the driver (-of, else the path's extension, else GTiff)
- * that can write a float band, the band type (Float64 for a grid of
- * doubles, else Float32), the creation options (GTiff: tiled, DEFLATE,
- * unless -co says otherwise), the DEM's geotransform and CRS, and the
- * commit of the temporary name.
+ * raster_output.c -- apps/core/: the command's core, what every command's
+ * folder shares. This file: the raster writer of rasterize and of eval
+ * -error_raster: the driver (-of, else the path's extension, else GTiff) that
+ * can write a float band, the band type (Float64 for a grid of doubles, else
+ * Float32), the creation options (GTiff: tiled, DEFLATE, unless -co says
+ * otherwise), the DEM's geotransform and CRS, and the commit of the temporary
+ * name.
  */
 #include "app.h"
 

@@ -1,5 +1,6 @@
 /*
- * report.c -- what the command prints: a small JSON writer (one object;
+ * report.c -- apps/core/: the command's core, what every command's folder
+ * shares. This file: what the command prints: a small JSON writer (one object;
  * strings escaped, invalid UTF-8 replaced by U+FFFD, non-finite numbers as
  * null, so the output always parses) and simplify's summary line and JSON
  * object. eval builds its JSON with the same writer.

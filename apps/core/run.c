@@ -1,9 +1,10 @@
 /*
- * run.c -- tt_app_run() and what every subcommand shares: the result and
- * its one-line failure, GDAL's messages while a run is active (failures
- * stored, warnings printed as "terratin: warning: ..."), the causes of a
- * failed write, choosing the output driver and the thread count (the DEM
- * itself is opened and read in dem.c).
+ * run.c -- apps/core/: the command's core, what every command's folder shares.
+ * This file: tt_app_run() and what every subcommand shares: the result and its
+ * one-line failure, GDAL's messages while a run is active (failures stored,
+ * warnings printed as "terratin: warning: ..."), the causes of a failed write,
+ * choosing the output driver and the thread count (the DEM itself is opened and
+ * read in dem.c).
  *
  * Invariants: a run reports at most one failure (the first; later ones are
  * consequences); GDAL never prints by itself while a run is active (a pushed

@@ -1,7 +1,8 @@
 /*
- * settings.c -- the options object outside the parser: the owned string
- * lists it keeps (every word it returns points into them), its accessors,
- * the progress callback and streams a caller sets, and its destruction.
+ * settings.c -- apps/core/: the command's core, what every command's folder
+ * shares. This file: the options object outside the parser: the owned string
+ * lists it keeps (every word it returns points into them), its accessors, the
+ * progress callback and streams a caller sets, and its destruction.
  */
 #include "app.h"
 

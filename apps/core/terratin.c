@@ -1,8 +1,9 @@
 /*
- * terratin.c -- main() of the terratin command: parse, run with a progress
+ * terratin.c -- apps/core/: the command's core, what every command's folder
+ * shares. This file: main() of the terratin command: parse, run with a progress
  * bar, print the one-line failure, map the outcome to the exit code. All the
- * work is in the app library (options.c parses, run.c runs), so tests and
- * other programs can run it too.
+ * work is in the app library (options.c parses, run.c runs), so tests and other
+ * programs can run it too.
  *
  * Signals: SIGINT, SIGTERM and SIGHUP set a flag that the progress callback
  * turns into a stop; the run then removes its temporary files, and main

@@ -1,9 +1,10 @@
 /*
- * terratin_lib.h -- the terratin command as a library, in the shape of GDAL's
- * apps/gdal_utils.h: tt_app_options_new() parses the words of a command line
- * into an options object, tt_app_run() runs it, and apps/core/terratin.c is a thin
- * main() around the two. Tests and other programs can drive every subcommand
- * (simplify, generate, eval) without a shell.
+ * terratin_lib.h -- apps/core/: the command's core, what every command's folder
+ * shares. This header: the terratin command as a library, in the shape of
+ * GDAL's apps/gdal_utils.h: tt_app_options_new() parses the words of a command
+ * line into an options object, tt_app_run() runs it, and apps/core/terratin.c
+ * is a thin main() around the two. Tests and other programs can drive every
+ * subcommand (simplify, generate, eval) without a shell.
  *
  * Parsing has no side effects: it only reads the words and checks their
  * values (numbers, ranges, names known to the engine). Everything that needs

@@ -1,5 +1,6 @@
 /*
- * tin_input.c -- a TIN to read: the vector dataset opened (explaining in
+ * tin_input.c -- apps/core/: the command's core, what every command's folder
+ * shares. This file: a TIN to read: the vector dataset opened (explaining in
  * one line why not) and its triangle layer picked, as eval, optimize and
  * rasterize read it (tt__app_read_dem_and_tin in dem.c, and eval).
  *

@@ -1,8 +1,9 @@
 /*
- * values.c -- the values the command line's words stand for: finite
- * decimal numbers (no hex, inf or nan), unsigned integers that say when
- * they are too large, GDAL-style memory sizes, GDAL's booleans, grid sizes
- * (N or NXxNY).
+ * values.c -- apps/core/: the command's core, what every command's folder
+ * shares. This file: the values the command line's words stand for: finite
+ * decimal numbers (no hex, inf or nan), unsigned integers that say when they
+ * are too large, GDAL-style memory sizes, GDAL's booleans, grid sizes (N or
+ * NXxNY).
  */
 #include "app.h"
 

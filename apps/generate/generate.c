@@ -1,5 +1,6 @@
 /*
- * generate.c -- `terratin generate KIND OUTPUT`: one of the synthetic test
+ * generate.c -- apps/generate/: the generate command, a folder over the core
+ * (apps/core/). `terratin generate KIND OUTPUT`: one of the synthetic test
  * terrains of the engine (tt_synth_generate) written as a GeoTIFF, with an
  * optional CRS.
  */

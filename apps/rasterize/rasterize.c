@@ -1,9 +1,10 @@
 /*
- * rasterize.c -- `terratin rasterize TIN DEM OUTPUT`: a layer of triangles
- * (read as eval reads it) drawn on the DEM's grid, each sample centre in a
- * triangle given the triangle's linear interpolation of its corners'
- * heights, NaN (the band's nodata) outside the TIN, written by the raster
- * writer it shares with `eval -error_raster` (core/raster_output.c).
+ * rasterize.c -- apps/rasterize/: the rasterize command, a folder over the core
+ * (apps/core/). `terratin rasterize TIN DEM OUTPUT`: a layer of triangles (read
+ * as eval reads it) drawn on the DEM's grid, each sample centre in a triangle
+ * given the triangle's linear interpolation of its corners' heights, NaN (the
+ * band's nodata) outside the TIN, written by the raster writer it shares with
+ * `eval -error_raster` (core/raster_output.c).
  *
  * The heights come from tt_eval_triangles_raster, the same pass eval
  * measures with, so a sample's value is the height of the triangle its

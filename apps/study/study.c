@@ -1,15 +1,20 @@
 /*
- * study.c -- `terratin study [options] OUTDIR`: the comparison of the
- * triangulation criteria (issue 15) as one command. For every terrain
- * (-terrain: a DEM file, or one of the study's generated terrains by name
- * with its published parameters), method (-methods insert,decimate),
- * criterion (-criteria), final optimiser (-optimizers) and checkpoint
- * (-percent P,P,...) it runs the engine as `terratin simplify -percent P`
- * would, and records the TIN summary's error measures and the seconds the
- * mesh took. It writes OUTDIR/curves.csv (a row per run), OUTDIR/tables.md
- * (the study's tables: mean absolute error, one table per terrain, method
- * and optimiser, best per row in bold) and OUTDIR/runs.json (every
- * parameter and the version).
+ * study.c -- apps/study/: the study command, a folder over the core
+ * (apps/core/). This file: `terratin study [options] OUTDIR`, the
+ * comparison of the triangulation criteria (issue 15) as one command. For
+ * every terrain (-terrain: a DEM file, or one of the study's generated
+ * terrains by name with its published parameters), method (-methods
+ * insert,decimate), criterion (-criteria), final optimiser (-optimizers)
+ * and checkpoint (-percent P,P,...) it runs the engine as `terratin
+ * simplify -percent P` would, and records the TIN summary's error
+ * measures and the seconds the mesh took. study_files.c writes
+ * OUTDIR/curves.csv (a row per run), OUTDIR/tables.md (the study's
+ * tables: mean absolute error, one table per terrain, method and
+ * optimiser, best per row in bold) and OUTDIR/runs.json (every parameter
+ * and the version). A study is a pipeline over one study_job: prepare
+ * (every check), load the terrains, the -percent runs, the -points runs,
+ * the -tin_points runs, then finish (the files, the TINs, the plots, the
+ * summary).
  *
  * Each checkpoint is its own run from the start, so its numbers are those
  * of a single simplify run at that percentage (the final optimisation
@@ -348,25 +353,9 @@ static tt_status run_one(app_run *r, const study_terrain *t,
   return st;
 }
 
-/* A CSV field: quoted when it holds a comma, a quote or a line break. */
-static void csv_field(FILE *fp, const char *v)
-{
-  if (!strpbrk(v, ",\"\r\n")) {
-    fputs(v, fp);
-    return;
-  }
-  fputc('"', fp);
-  for (; *v; v++) {
-    if (*v == '"')
-      fputc('"', fp);
-    fputc(*v, fp);
-  }
-  fputc('"', fp);
-}
-
 /* The final pass a run made: auto resolved as the engine resolves it
  * (with the study's repair for insertion, study_curves.c). */
-static const char *optimizer_used(const study_plan *p, const study_row *w)
+const char *tt__study_optimizer_used(const study_plan *p, const study_row *w)
 {
   tt_criterion c = p->crit[w->criterion];
   tt_repair rep = p->decimate[w->method] ? TT_REPAIR_AUTO
@@ -375,410 +364,205 @@ static const char *optimizer_used(const study_plan *p, const study_row *w)
       p->opt[w->optimizer], c, tt_repair_resolve(rep, c)));
 }
 
-/* Whether a -points row repeats a -percent row (the same run at the same
- * count: the -percent run, a TIN of its own, is kept). */
-static int repeats(const study_row *w, const study_row *rows, size_t nrows)
-{
-  for (size_t i = 0; i < nrows; i++)
-    if (rows[i].points == w->points && rows[i].terrain == w->terrain &&
-        rows[i].method == w->method && rows[i].optimizer == w->optimizer &&
-        rows[i].criterion == w->criterion)
-      return 1;
-  return 0;
-}
-
-/* The -percent rows, then the -points rows (in run order, each run's
- * steps in the order the run took them). */
-static size_t write_curves(FILE *fp, const study_terrain *ts,
-                           const study_plan *p, const study_row *rows,
-                           size_t nrows, const study_rows *steps)
-{
-  char b[6][40];
-  size_t written = 0;
-  fputs("terrain,method,criterion,optimizer,points,max_error,l2,rmse,"
-        "mean_abs_error,total_abs_error,seconds\n", fp);
-  for (size_t i = 0; i < nrows + steps->n; i++) {
-    const study_row *w = i < nrows ? &rows[i] : &steps->w[i - nrows];
-    if (i >= nrows && repeats(w, rows, nrows))
-      continue;
-    csv_field(fp, ts[w->terrain].label);
-    tt__app_format_double(b[0], sizeof b[0], w->e.max_error);
-    tt__app_format_double(b[1], sizeof b[1], w->e.l2);
-    tt__app_format_double(b[2], sizeof b[2], w->e.rmse);
-    tt__app_format_double(b[3], sizeof b[3], w->e.mean_abs);
-    tt__app_format_double(b[4], sizeof b[4], w->e.total_abs);
-    tt__app_format_double(b[5], sizeof b[5], w->seconds);
-    fprintf(fp, ",%s,%s,%s,%zu,%s,%s,%s,%s,%s,%s\n",
-            p->decimate[w->method] ? "decimate" : "insert",
-            tt_criterion_name(p->crit[w->criterion]),
-            optimizer_used(p, w), w->points, b[0], b[1],
-            b[2], b[3], b[4], b[5]);
-    written++;
-  }
-  return written;
-}
-
-/* The study's tables: rows are laid out terrain, method, optimiser,
- * percent, criterion (the loop order of the runs), so a table is a block
- * of npct x ncrit consecutive rows. */
-static void write_tables(FILE *fp, const study_terrain *ts, size_t nterr,
-                         const study_plan *p, const study_row *rows)
-{
-  size_t block = p->npct * p->ncrit, at = 0;
-  fputs("# terratin study: mean absolute error\n\n"
-        "Mean absolute error (z units) of the TIN at each percentage of "
-        "the valid samples; the best criterion of each row in bold.\n",
-        fp);
-  if (!p->npct) {
-    fputs("\nNo -percent checkpoints were asked for: the curves are in "
-          "curves.csv.\n", fp);
-    return;
-  }
-  for (size_t t = 0; t < nterr; t++)
-    for (size_t m = 0; m < p->nmeth; m++)
-      for (size_t o = 0; o < p->nopt; o++, at += block) {
-        const study_row *b = rows + at;
-        fprintf(fp, "\n## %s, %s, optimizer %s\n\n| %% | points |",
-                ts[t].label, p->decimate[m] ? "decimate" : "insert",
-                tt_optimize_name(p->opt[o]));
-        for (size_t c = 0; c < p->ncrit; c++)
-          fprintf(fp, " %s |", tt_criterion_name(p->crit[c]));
-        fputs("\n|---|---|", fp);
-        for (size_t c = 0; c < p->ncrit; c++)
-          fputs("---|", fp);
-        fputc('\n', fp);
-        for (size_t k = 0; k < p->npct; k++) {
-          const study_row *line = b + k * p->ncrit;
-          double best = line[0].e.mean_abs;
-          for (size_t c = 1; c < p->ncrit; c++)
-            if (line[c].e.mean_abs < best)
-              best = line[c].e.mean_abs;
-          fprintf(fp, "| %s | %zu |", p->pct_text[k], line[0].points);
-          for (size_t c = 0; c < p->ncrit; c++) {
-            const char *bold = line[c].e.mean_abs == best ? "**" : "";
-            fprintf(fp, " %s%.6g%s |", bold, line[c].e.mean_abs, bold);
-          }
-          fputc('\n', fp);
-        }
-      }
-}
-
-static const char *seeding_name(tt_synth_seeding s)
-{
-  switch (s) {
-  case TT_SEED_PEAK: return "peak";
-  case TT_SEED_VALLEY: return "valley";
-  case TT_SEED_HYBRID: return "hybrid";
-  default: return "none";
-  }
-}
-
-static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
-                       size_t nterr, size_t nrows, size_t nruns)
-{
-  const tt_app_settings *s = r->s;
-  app_json j;
-  char created[32], key[24];
-  tt__app_iso8601_utc(created, sizeof created);
-  tt__json_begin(&j, fp);
-  tt__json_str(&j, "command", "study");
-  tt__json_str(&j, "version", tt_version());
-  tt__json_str(&j, "created", created);
-  tt__json_str(&j, "outdir", s->output);
-  tt__json_open(&j, "terrains");
-  for (size_t t = 0; t < nterr; t++) {
-    const study_terrain *x = &ts[t];
-    snprintf(key, sizeof key, "%zu", t + 1);
-    tt__json_open(&j, key);
-    tt__json_str(&j, "terrain", x->arg);
-    tt__json_str(&j, "label", x->label);
-    tt__json_size(&j, "width", tt_grid_width(x->grid));
-    tt__json_size(&j, "height", tt_grid_height(x->grid));
-    tt__json_size(&j, "valid_samples", x->valid);
-    if (x->named) {
-      const tt_synth_options *o = &x->synth;
-      tt__json_str(&j, "generator", tt_synth_kind_name(o->kind));
-      tt__json_i64(&j, "seed", (int64_t)o->seed);
-      if (o->kind == TT_SYNTH_FAULT) {
-        tt__json_size(&j, "iterations", o->iterations);
-        tt__json_num(&j, "displacement", o->displacement);
-        tt__json_num(&j, "wave_size", o->wave_size);
-      } else if (o->kind == TT_SYNTH_DIAMOND_SQUARE) {
-        tt__json_num(&j, "roughness", o->roughness);
-        tt__json_num(&j, "amplitude", o->amplitude);
-        tt__json_str(&j, "seeding", seeding_name(o->seeding));
-      }
-    } else {
-      tt__json_null(&j, "generator");
-      if (x->path)
-        tt__json_str(&j, "path", x->path);
-      tt__json_i64(&j, "band", s->band);
-      tt__json_str(&j, "srcnodata", s->srcnodata);
-      tt__json_num(&j, "z_factor", s->z_factor);
-      tt__json_str(&j, "z_unit", s->z_unit);
-    }
-    tt__json_close(&j);
-  }
-  tt__json_close(&j);
-  tt__json_str(&j, "criteria", s->criteria ? s->criteria : "all");
-  tt__json_str(&j, "methods", s->methods ? s->methods : "insert");
-  tt__json_str(&j, "optimizers", s->optimizers ? s->optimizers : "auto");
-  tt__json_str(&j, "percent", s->percents   ? s->percents
-                              : s->points ? ""
-                                          : "1,10,25,50");
-  if (s->points)
-    tt__json_size(&j, "points", s->points);
-  else
-    tt__json_null(&j, "points");
-  if (s->seed_set)
-    tt__json_i64(&j, "seed", (int64_t)s->seed);
-  else
-    tt__json_null(&j, "seed");
-  tt__json_open(&j, "decimation");
-  if (s->start == TT_DSTART_GREEDY_N) {
-    snprintf(key, sizeof key, "greedy:%zu", s->start_points);
-    tt__json_str(&j, "start", key);
-  } else {
-    tt__json_str(&j, "start", tt_decimate_start_name(s->start));
-  }
-  tt__json_str(&j, "importance", tt_importance_name(s->importance));
-  tt__json_close(&j);
-  tt__json_open(&j, "anneal");
-  tt__json_num(&j, "t0", s->anneal.t0);
-  tt__json_i64(&j, "stages", s->anneal.stages);
-  tt__json_num(&j, "swaps", s->anneal.swaps);
-  tt__json_num(&j, "good", s->anneal.good);
-  tt__json_num(&j, "r", s->anneal.r);
-  tt__json_i64(&j, "seed", (int64_t)s->anneal.seed);
-  tt__json_close(&j);
-  tt__json_size(&j, "tin_points", s->tin_points);
-  tt__json_bool(&j, "plot", s->plot);
-  tt__json_size(&j, "runs", nruns);
-  tt__json_size(&j, "rows", nrows);
-  tt__json_str(&j, "seconds", "mesh: tt_tin_summary.seconds_mesh");
-  tt__json_close(&j);
-}
-
-enum { F_CURVES, F_TABLES, F_RUNS, F_COUNT };
-static const char *const out_names[F_COUNT] = {"curves.csv", "tables.md",
-                                               "runs.json"};
-
-/* Writes the three files under temporary names, then renames them. */
-static tt_status write_outputs(app_run *r, int exists, const study_terrain *ts,
-                               size_t nterr, const study_plan *p,
-                               const study_row *rows, size_t nrows,
-                               const study_rows *steps, size_t nruns)
-{
-  const char *dir = r->s->output;
-  tt_status st = TT_OK;
-  char *tmp[F_COUNT] = {NULL, NULL, NULL}, *fin[F_COUNT] = {NULL, NULL, NULL};
-  int created = 0, renamed = 0;
-  size_t written = 0;
-  if (!exists) {
-    if (mkdir(dir, 0777) != 0) {
-      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, dir,
-                        "cannot create the directory: %s", strerror(errno));
-      goto done;
-    }
-    created = 1;
-  }
-  for (int f = 0; f < F_COUNT; f++) {
-    tmp[f] = CPLStrdup(CPLSPrintf("%s/.%s.tmp%ld", dir, out_names[f],
-                                  (long)getpid()));
-    fin[f] = CPLStrdup(CPLSPrintf("%s/%s", dir, out_names[f]));
-    FILE *fp = fopen(tmp[f], "w");
-    if (!fp) {
-      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, tmp[f], "%s",
-                        strerror(errno));
-      goto done;
-    }
-    if (f == F_CURVES)
-      written = write_curves(fp, ts, p, rows, nrows, steps);
-    else if (f == F_TABLES)
-      write_tables(fp, ts, nterr, p, rows);
-    else
-      write_runs(r, fp, ts, nterr, written, nruns);
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad) {
-      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, tmp[f],
-                        "write failed: %s", strerror(errno));
-      goto done;
-    }
-  }
-  for (; renamed < F_COUNT; renamed++)
-    if (rename(tmp[renamed], fin[renamed]) != 0) {
-      st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_IO, fin[renamed],
-                        "%s", strerror(errno));
-      goto done;
-    }
-done:
-  for (int f = 0; f < F_COUNT; f++) {
-    if (st != TT_OK && tmp[f]) {
-      unlink(tmp[f]);
-      if (f < renamed)
-        unlink(fin[f]);
-    }
-    CPLFree(tmp[f]);
-    CPLFree(fin[f]);
-  }
-  if (st != TT_OK && created)
-    rmdir(dir);
-  return st;
-}
-
-tt_status tt__app_study(app_run *r)
-{
-  const tt_app_settings *s = r->s;
-  tt_status st = TT_OK;
+/* One study: the plan, the terrains, the rows made, the files' helpers. */
+typedef struct study_job {
+  app_run *r;
+  const tt_app_settings *s;
   study_plan plan;
-  study_terrain *ts = NULL;
-  study_row *rows = NULL;
-  study_rows steps = {NULL, 0, 0};
-  size_t nterr = 0, nrows = 0, nruns = 0;
-  char *python = NULL, *script = NULL;
-  app_study_tins *tins = NULL;
-  while (s->terrains[nterr])
-    nterr++;
+  study_terrain *ts;       /* nterr terrains */
+  size_t nterr;
+  study_row *rows;         /* the -percent runs, in the tables' order */
+  size_t nrows;
+  study_rows steps;        /* the -points runs' rows */
+  size_t nruns;            /* -points runs, then every run but the TINs' */
+  size_t ntin;             /* the -tin_points runs */
+  size_t total;            /* every run, for the progress */
+  int exists;              /* OUTDIR exists */
+  char *python, *script;   /* -plot */
+  app_study_tins *tins;    /* -tin_points */
+} study_job;
 
-  if (!make_plan(r, &plan)) {
-    st = r->res->status;
-    goto done;
-  }
-  int exists = tt__app_study_check_outdir(r, s->output);
-  if (exists < 0 || (s->plot && !tt__app_study_plot_check(r, &python,
-                                                           &script))) {
-    st = r->res->status;
-    goto done;
-  }
-  size_t per_terrain = plan.nmeth * plan.nopt * plan.npct * plan.ncrit;
-  ts = calloc(nterr, sizeof *ts);
-  rows = calloc(per_terrain ? nterr * per_terrain : 1, sizeof *rows);
-  if (!ts || !rows) {
-    st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
-                      "out of memory");
-    goto done;
-  }
+/* The plan, OUTDIR, the plotting: every check before the first run. */
+static tt_status prepare(study_job *j)
+{
+  app_run *r = j->r;
+  const tt_app_settings *s = j->s;
+  while (s->terrains[j->nterr])
+    j->nterr++;
+  if (!make_plan(r, &j->plan))
+    return r->res->status;
+  j->exists = tt__app_study_check_outdir(r, s->output);
+  if (j->exists < 0 ||
+      (s->plot && !tt__app_study_plot_check(r, &j->python, &j->script)))
+    return r->res->status;
+  const study_plan *p = &j->plan;
+  size_t per_terrain = p->nmeth * p->nopt * p->npct * p->ncrit;
+  size_t per_run = j->nterr * p->nmeth * p->nopt * p->ncrit;
+  j->ts = calloc(j->nterr, sizeof *j->ts);
+  j->rows = calloc(per_terrain ? j->nterr * per_terrain : 1, sizeof *j->rows);
+  if (!j->ts || !j->rows)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
+                        "out of memory");
+  /* the -percent runs, then one -points run and one -tin_points run per
+   * terrain, method, optimiser and criterion */
+  j->total = j->nterr * per_terrain + (p->points ? per_run : 0) +
+             (s->tin_points ? per_run : 0);
+  return TT_OK;
+}
 
-  /* Every terrain first (0 - 5%): a bad one costs no run. */
-  for (size_t t = 0; t < nterr; t++) {
-    ts[t].arg = s->terrains[t];
-    if (!tt__app_continue(r, 0.05 * (double)t / (double)nterr)) {
-      st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
-      goto done;
-    }
-    if (!load_terrain(r, &ts[t])) {
-      st = r->res->status;
-      goto done;
-    }
+/* Every terrain first (0 - 5%): a bad one costs no run. */
+static tt_status load_terrains(study_job *j)
+{
+  app_run *r = j->r;
+  for (size_t t = 0; t < j->nterr; t++) {
+    j->ts[t].arg = j->s->terrains[t];
+    if (!tt__app_continue(r, 0.05 * (double)t / (double)j->nterr))
+      return tt__app_fail_tt(r, TT_ERR_INTERRUPTED, j->s->output);
+    if (!load_terrain(r, &j->ts[t]))
+      return r->res->status;
   }
+  return TT_OK;
+}
 
-  /* The runs (5 - 99%), in the order the tables read them; then the
-   * -points runs (study_curves.c), one per terrain, method, optimiser and
-   * criterion; then the runs of -tin_points, as many (the percentages
-   * aside). */
-  size_t ncurves = plan.points ? nterr * plan.nmeth * plan.nopt * plan.ncrit
-                               : 0;
-  size_t total = nterr * per_terrain + ncurves, ntin = 0;
-  if (s->tin_points)
-    total += nterr * plan.nmeth * plan.nopt * plan.ncrit;
-  for (size_t t = 0; t < nterr; t++)
-    for (size_t m = 0; m < plan.nmeth; m++)
-      for (size_t o = 0; o < plan.nopt; o++)
-        for (size_t k = 0; k < plan.npct; k++)
-          for (size_t c = 0; c < plan.ncrit; c++) {
-            study_row *w = &rows[nrows];
-            double lo = 0.05 + 0.94 * (double)nrows / (double)total;
+/* The runs take 5 - 99%, an equal share each: the share of the run after
+ * `done` runs, unless a stop was asked. */
+static tt_status next_run(study_job *j, size_t done)
+{
+  app_run *r = j->r;
+  double lo = 0.05 + 0.94 * (double)done / (double)j->total;
+  tt__app_phase_set(&r->prog, lo, lo + 0.94 / (double)j->total);
+  if (!tt__app_continue(r, lo))
+    return tt__app_fail_tt(r, TT_ERR_INTERRUPTED, j->s->output);
+  return TT_OK;
+}
+
+/* The -percent runs, in the order the tables read them. */
+static tt_status run_checkpoints(study_job *j)
+{
+  const study_plan *p = &j->plan;
+  tt_status st = TT_OK;
+  for (size_t t = 0; t < j->nterr; t++)
+    for (size_t m = 0; m < p->nmeth; m++)
+      for (size_t o = 0; o < p->nopt; o++)
+        for (size_t k = 0; k < p->npct; k++)
+          for (size_t c = 0; c < p->ncrit; c++) {
+            study_row *w = &j->rows[j->nrows];
             w->terrain = t;
             w->method = m;
             w->optimizer = o;
             w->percent = k;
             w->criterion = c;
-            tt__app_phase_set(&r->prog, lo, lo + 0.94 / (double)total);
-            if (!tt__app_continue(r, lo)) {
-              st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
-              goto done;
-            }
-            st = run_one(r, &ts[t], &plan, w, 0, NULL);
-            if (st != TT_OK)
-              goto done;
-            nrows++;
+            if ((st = next_run(j, j->nrows)) != TT_OK ||
+                (st = run_one(j->r, &j->ts[t], p, w, 0, NULL)) != TT_OK)
+              return st;
+            j->nrows++;
           }
-  for (size_t t = 0; t < nterr && plan.points; t++)
-    for (size_t m = 0; m < plan.nmeth; m++)
-      for (size_t o = 0; o < plan.nopt; o++)
-        for (size_t c = 0; c < plan.ncrit; c++) {
+  return st;
+}
+
+/* The -points runs (study_curves.c), one per terrain, method, optimiser
+ * and criterion. */
+static tt_status run_curves(study_job *j)
+{
+  const study_plan *p = &j->plan;
+  tt_status st = TT_OK;
+  for (size_t t = 0; t < j->nterr && p->points; t++)
+    for (size_t m = 0; m < p->nmeth; m++)
+      for (size_t o = 0; o < p->nopt; o++)
+        for (size_t c = 0; c < p->ncrit; c++) {
           study_row key = {t, m, c, o, SIZE_MAX, 0, {0}, 0};
-          double lo = 0.05 + 0.94 * (double)(nrows + nruns) / (double)total;
-          tt__app_phase_set(&r->prog, lo, lo + 0.94 / (double)total);
-          if (!tt__app_continue(r, lo)) {
-            st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
-            goto done;
-          }
-          st = tt__study_curve_run(r, &ts[t], &plan, &key, &steps);
-          if (st != TT_OK)
-            goto done;
-          nruns++;
+          if ((st = next_run(j, j->nrows + j->nruns)) != TT_OK ||
+              (st = tt__study_curve_run(j->r, &j->ts[t], p, &key,
+                                        &j->steps)) != TT_OK)
+            return st;
+          j->nruns++;
         }
-  if (s->tin_points &&
-      (st = tt__app_study_tins_begin(r, s->output, &tins)) != TT_OK)
-    goto done;
-  for (size_t t = 0; s->tin_points && t < nterr; t++)
-    for (size_t m = 0; m < plan.nmeth; m++)
-      for (size_t o = 0; o < plan.nopt; o++)
-        for (size_t c = 0; c < plan.ncrit; c++, ntin++) {
+  return st;
+}
+
+/* The -tin_points runs, as many (the percentages aside), each TIN handed
+ * to study_files.c. */
+static tt_status run_tins(study_job *j)
+{
+  app_run *r = j->r;
+  const study_plan *p = &j->plan;
+  tt_status st = tt__app_study_tins_begin(r, j->s->output, &j->tins);
+  for (size_t t = 0; st == TT_OK && t < j->nterr; t++)
+    for (size_t m = 0; st == TT_OK && m < p->nmeth; m++)
+      for (size_t o = 0; st == TT_OK && o < p->nopt; o++)
+        for (size_t c = 0; st == TT_OK && c < p->ncrit; c++, j->ntin++) {
           study_row w = {t, m, c, o, 0, 0, {0}, 0};
           tt_tin *tin = NULL;
-          double lo =
-              0.05 + 0.94 * (double)(nrows + nruns + ntin) / (double)total;
-          tt__app_phase_set(&r->prog, lo, lo + 0.94 / (double)total);
-          if (!tt__app_continue(r, lo)) {
-            st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, s->output);
-            goto done;
-          }
-          st = run_one(r, &ts[t], &plan, &w, s->tin_points, &tin);
+          if ((st = next_run(j, j->nrows + j->nruns + j->ntin)) != TT_OK)
+            break;
+          st = run_one(r, &j->ts[t], p, &w, j->s->tin_points, &tin);
           if (st == TT_OK)
             st = tt__app_study_tins_add(
-                r, tins, t, ts[t].label, ts[t].grid,
-                plan.decimate[m] ? "decimate" : "insert",
-                tt_criterion_name(plan.crit[c]), optimizer_used(&plan, &w),
-                tin);
+                r, j->tins, t, j->ts[t].label, j->ts[t].grid,
+                p->decimate[m] ? "decimate" : "insert",
+                tt_criterion_name(p->crit[c]),
+                tt__study_optimizer_used(p, &w), tin);
           tt_tin_destroy(tin);
-          if (st != TT_OK)
-            goto done;
         }
-  nruns += nrows;
+  return st;
+}
 
-  st = write_outputs(r, exists, ts, nterr, &plan, rows, nrows, &steps,
-                     nruns);
+/* The files, then the TINs, then the pictures, then the summary. */
+static tt_status finish(study_job *j)
+{
+  app_run *r = j->r;
+  const tt_app_settings *s = j->s;
+  tt_status st = tt__app_study_write(r, j->exists, j->ts, j->nterr, &j->plan,
+                                     j->rows, j->nrows, &j->steps, j->nruns);
+  if (st == TT_OK && j->tins)
+    st = tt__app_study_tins_commit(r, j->tins);
+  if (st == TT_OK && j->python)
+    st = tt__app_study_plot_run(r, j->python, j->script, s->output);
   if (st != TT_OK)
-    goto done;
-  /* The TINs, then the pictures, once the tables are committed. */
-  if (tins && (st = tt__app_study_tins_commit(r, tins)) != TT_OK)
-    goto done;
-  if (python &&
-      (st = tt__app_study_plot_run(r, python, script, s->output)) != TT_OK)
-    goto done;
+    return st;
   /* Draws 100%; a stop asked now is too late: the files are committed. */
   (void)tt__app_continue(r, 1.0);
   if (!s->quiet) {
     fprintf(r->out, "%s: %zu runs over %zu terrain%s (curves.csv, tables.md, "
-            "runs.json%s%s); %.2f s\n", s->output, nruns + ntin, nterr,
-            nterr == 1 ? "" : "s", tins ? ", tins/" : "",
-            python ? ", plots/" : "", tt__app_now() - r->t0);
-    if (python)
-      fprintf(r->out, "plots drawn by %s %s\n", python, script);
+            "runs.json%s%s); %.2f s\n", s->output, j->nruns + j->ntin,
+            j->nterr, j->nterr == 1 ? "" : "s", j->tins ? ", tins/" : "",
+            j->python ? ", plots/" : "", tt__app_now() - r->t0);
+    if (j->python)
+      fprintf(r->out, "plots drawn by %s %s\n", j->python, j->script);
     fflush(r->out);
   }
-done:
-  for (size_t t = 0; ts && t < nterr; t++) {
-    tt_grid_destroy(ts[t].grid);
-    CPLFree(ts[t].path);
+  return TT_OK;
+}
+
+tt_status tt__app_study(app_run *r)
+{
+  study_job j;
+  memset(&j, 0, sizeof j);
+  j.r = r;
+  j.s = r->s;
+  tt_status st = prepare(&j);
+  if (st == TT_OK)
+    st = load_terrains(&j);
+  if (st == TT_OK)
+    st = run_checkpoints(&j);
+  if (st == TT_OK)
+    st = run_curves(&j);
+  if (st == TT_OK && j.s->tin_points)
+    st = run_tins(&j);
+  if (st == TT_OK) {
+    j.nruns += j.nrows;
+    st = finish(&j);
   }
-  tt__app_study_tins_free(tins);
-  CPLFree(python);
-  CPLFree(script);
-  free(ts);
-  free(rows);
-  free(steps.w);
+
+  for (size_t t = 0; j.ts && t < j.nterr; t++) {
+    tt_grid_destroy(j.ts[t].grid);
+    CPLFree(j.ts[t].path);
+  }
+  tt__app_study_tins_free(j.tins);
+  CPLFree(j.python);
+  CPLFree(j.script);
+  free(j.ts);
+  free(j.rows);
+  free(j.steps.w);
   return st;
 }

@@ -1,9 +1,11 @@
 /*
- * study.h -- what the files of `terratin study` share (internal):
- * study.c (the plan, the -percent runs, the files), study_curves.c
+ * study.h -- apps/study/: the study command, a folder over the core
+ * (apps/core/). This header: what the files of `terratin study` share
+ * (internal): study.c (the plan, the terrains, the runs), study_curves.c
  * (the -points runs: a row at every step, from the engine's recorder),
  * study_crater.c (Crater Lake found), study_plot.c (the plots) and
- * study_files.c (OUTDIR and the TINs of -tin_points).
+ * study_files.c (OUTDIR, its curves.csv, tables.md and runs.json, and the
+ * TINs of -tin_points).
  */
 #ifndef TT_APP_STUDY_H
 #define TT_APP_STUDY_H
@@ -98,5 +100,19 @@ tt_repair tt__study_repair(tt_criterion c);
 tt_status tt__study_curve_run(app_run *r, const study_terrain *t,
                               const study_plan *p, const study_row *key,
                               study_rows *out);
+
+/* The final pass a run made: auto resolved as the engine resolves it
+ * (with the study's repair for insertion). study.c. */
+const char *tt__study_optimizer_used(const study_plan *p, const study_row *w);
+
+/* study_files.c: OUTDIR's three files (curves.csv: the nrows -percent
+ * rows, then the -points steps; tables.md; runs.json, counting nruns
+ * runs) under temporary names, then renamed; OUTDIR made first unless it
+ * exists. TT_OK, or the failure recorded and nothing left behind. */
+tt_status tt__app_study_write(app_run *r, int exists,
+                              const study_terrain *ts, size_t nterr,
+                              const study_plan *p, const study_row *rows,
+                              size_t nrows, const study_rows *steps,
+                              size_t nruns);
 
 #endif /* TT_APP_STUDY_H */

@@ -1,12 +1,13 @@
 /*
- * study_crater.c -- where `terratin study -terrain crater` finds Crater
+ * study_crater.c -- apps/study/: the study command, a folder over the core
+ * (apps/core/). This file: where `terratin study -terrain crater` finds Crater
  * Lake, the DEM of the 2004 study's Tables 1 and 2 (336 x 459 samples,
- * garland_heckbert_terra_scape/crater.stm.vrt of the shared test data, see
- * its CATALOG.md). "crater=PATH" reads PATH instead; "crater" looks in
+ * garland_heckbert_terra_scape/crater.stm.vrt of the shared test data, see its
+ * CATALOG.md). "crater=PATH" reads PATH instead; "crater" looks in
  * $TT_SHARED_TESTDATA when it is set (and nowhere else then), else in
- * ../shared/testdata of the current directory, then ../shared/testdata
- * beside the source tree the command was built from. The terrain is
- * labelled "crater" either way.
+ * ../shared/testdata of the current directory, then ../shared/testdata beside
+ * the source tree the command was built from. The terrain is labelled "crater"
+ * either way.
  */
 #include "study.h"
 

@@ -1,7 +1,8 @@
 /*
- * study_curves.c -- the curves of `terratin study -points N` (issue 15):
- * for each terrain, method, optimiser and criterion one engine run that
- * reports every step through the engine's recorder, a row per step.
+ * study_curves.c -- apps/study/: the study command, a folder over the core
+ * (apps/core/). This file: the curves of `terratin study -points N` (issue 15):
+ * for each terrain, method, optimiser and criterion one engine run that reports
+ * every step through the engine's recorder, a row per step.
  *
  * Insertion: tt_refine_run to N vertices, a row at every vertex count from
  * the start's to N. The measures come from the per-triangle sums the

@@ -1,11 +1,12 @@
 /*
- * study_plot.c -- `terratin study -plot`: runs tools/plot_study.py on the
- * study's OUTDIR once its files are written. The python is $TT_PYTHON when
- * set, else Debian's /usr/bin/python3 when it exists, else python3 from
- * PATH (which may be a python without Debian's packages, such as a pyenv
- * one: hence Debian's first). The script is the installed one,
- * <prefix>/share/terratin/plot_study.py beside <prefix>/bin/terratin, else
- * the source tree's tools/plot_study.py.
+ * study_plot.c -- apps/study/: the study command, a folder over the core
+ * (apps/core/). This file: `terratin study -plot`: runs tools/plot_study.py on
+ * the study's OUTDIR once its files are written. The python is $TT_PYTHON when
+ * set, else Debian's /usr/bin/python3 when it exists, else python3 from PATH
+ * (which may be a python without Debian's packages, such as a pyenv one: hence
+ * Debian's first). The script is the installed one,
+ * <prefix>/share/terratin/plot_study.py beside <prefix>/bin/terratin, else the
+ * source tree's tools/plot_study.py.
  *
  * Both are checked before the first run of the study (`plot_study.py
  * --check` imports matplotlib), so a study that cannot be plotted fails

@@ -1,7 +1,9 @@
 /*
- * tiles.h -- what `terratin tiles plan`, `tiles run` and `tiles merge`
- * share (tiles_plan.c, tiles_run.c, tiles_merge.c): the plan as read back
- * and simplify's command line rebuilt from it.
+ * tiles.h -- apps/tiles/: the tiles command, a folder over the core
+ * (apps/core/), simplify's tiled run as independent jobs for a cluster. This
+ * header: what `terratin tiles plan`, `tiles run` and `tiles merge` share
+ * (tiles_plan.c, tiles_run.c, tiles_merge.c): the plan as read back and
+ * simplify's command line rebuilt from it.
  */
 #ifndef TT_APP_TILES_H
 #define TT_APP_TILES_H

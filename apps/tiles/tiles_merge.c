@@ -1,11 +1,13 @@
 /*
- * tiles_merge.c -- `terratin tiles merge PLAN.json OUT.gpkg [-overwrite]
- * [-q]`: every piece of a plan read back (tt_tin_piece_decode) and merged
- * by simplify's tiled path (tiled.c) in tile order, written as simplify
- * writes (triangles, vertices, run_parameters; temporary name, rename,
- * nothing left behind on failure or interruption): the same layers as
- * `simplify -tile_size` with the plan's options. A missing piece, or one of
- * another plan (stale), is refused before anything is written.
+ * tiles_merge.c -- apps/tiles/: the tiles command, a folder over the core
+ * (apps/core/), simplify's tiled run as independent jobs for a cluster. This
+ * file: `terratin tiles merge PLAN.json OUT.gpkg [-overwrite] [-q]`: every
+ * piece of a plan read back (tt_tin_piece_decode) and merged by simplify's
+ * tiled path (tiled.c) in tile order, written as simplify writes (triangles,
+ * vertices, run_parameters; temporary name, rename, nothing left behind on
+ * failure or interruption): the same layers as `simplify -tile_size` with the
+ * plan's options. A missing piece, or one of another plan (stale), is refused
+ * before anything is written.
  */
 #include "tiles.h"
 

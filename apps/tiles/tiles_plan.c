@@ -1,5 +1,7 @@
 /*
- * tiles_plan.c -- `terratin tiles plan DEM PLAN.json [simplify options]`,
+ * tiles_plan.c -- apps/tiles/: the tiles command, a folder over the core
+ * (apps/core/), simplify's tiled run as independent jobs for a cluster.
+ * This file: `terratin tiles plan DEM PLAN.json [simplify options]`,
  * the dispatch of `terratin tiles ...`, and the plan read back by `tiles
  * run` and `tiles merge` (docs/scale.md).
  *
@@ -95,19 +97,34 @@ static bool has_control(const char *s)
   return false;
 }
 
-static void plan_cmd(char **argv, tt_app_result *res)
+/* One `tiles plan` job: the words, simplify's options checked, the DEM,
+ * the plan's files. */
+typedef struct plan_job {
+  const char *dem, *plan;  /* as given */
+  int overwrite, quiet;
+  char **words;            /* simplify's options as given (CSL) */
+  char **sv;               /* simplify's command line that checks them */
+  tt_app_options *o;       /* and what it said */
+  char *abs;               /* the DEM's absolute path */
+  uint64_t bytes, ns;      /* its size and modification time */
+  GDALDatasetH ds;
+  size_t width, height, tile_size, tiles_x, tiles_y;
+  char *dir;               /* the pieces' folder */
+  char *tmp;               /* the plan's temporary name */
+  VSILFILE *f;
+} plan_job;
+
+/* The words: DEM, PLAN.json, -overwrite, -q, and simplify's options. */
+static bool read_words(plan_job *j, char **argv, tt_app_result *res)
 {
-  const char *dem = NULL, *plan = NULL;
-  int overwrite = 0, quiet = 0;
-  char **words = NULL;
   for (size_t i = 0; argv[i]; i++) {
     const char *w = argv[i];
     if (tt__app_str_ieq(w, "-overwrite")) {
-      overwrite = 1;
+      j->overwrite = 1;
       continue;
     }
     if (tt__app_str_ieq(w, "-q")) {
-      quiet = 1;
+      j->quiet = 1;
       continue;
     }
     if (w[0] == '-' && w[1] && !(w[1] >= '0' && w[1] <= '9')) {
@@ -115,47 +132,44 @@ static void plan_cmd(char **argv, tt_app_result *res)
       if (d && (d->id == O_JSON || !(d->commands & FOR_S))) {
         tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                            "tiles plan: %s is not an option of the plan", w);
-        CSLDestroy(words);
-        return;
+        return false;
       }
-      words = CSLAddString(words, w);
-      if (d && d->takes_value && argv[i + 1])
-        words = CSLAddString(words, argv[++i]);
+      j->words = CSLAddString(j->words, w);
+      if (d && tt__app_opt_takes_value(d) && argv[i + 1])
+        j->words = CSLAddString(j->words, argv[++i]);
       continue;
     }
-    if (!dem)
-      dem = w;
-    else if (!plan)
-      plan = w;
+    if (!j->dem)
+      j->dem = w;
+    else if (!j->plan)
+      j->plan = w;
     else {
       tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                          "tiles plan: unexpected argument %s\n%s", w,
                          PLAN_USAGE);
-      CSLDestroy(words);
-      return;
+      return false;
     }
   }
-  if (!dem || !plan) {
+  if (!j->dem || !j->plan) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                        "tiles plan: DEM and PLAN.json are needed\n%s",
                        PLAN_USAGE);
-    CSLDestroy(words);
-    return;
+    return false;
   }
-  /* simplify's own parser checks the options */
-  char **sv = CSLAddString(NULL, "simplify");
-  for (size_t i = 0; words && words[i]; i++)
-    sv = CSLAddString(sv, words[i]);
-  sv = CSLAddString(sv, dem);
-  sv = CSLAddString(sv, "tiles-plan-check.gpkg");
-  tt_app_options *o = NULL;
-  char *abs = NULL;
-  VSILFILE *f = NULL;
-  char *tmp = NULL, *dir = NULL;
-  GDALDatasetH ds = NULL;
-  if (tt_app_options_new(sv, &o, res) != TT_OK)
-    goto done;
-  const tt_app_settings *s = tt_app_options_settings(o);
+  return true;
+}
+
+/* simplify's own parser checks the options; a plan needs a bound. */
+static bool check_options(plan_job *j, tt_app_result *res)
+{
+  j->sv = CSLAddString(NULL, "simplify");
+  for (size_t i = 0; j->words && j->words[i]; i++)
+    j->sv = CSLAddString(j->sv, j->words[i]);
+  j->sv = CSLAddString(j->sv, j->dem);
+  j->sv = CSLAddString(j->sv, "tiles-plan-check.gpkg");
+  if (tt_app_options_new(j->sv, &j->o, res) != TT_OK)
+    return false;
+  const tt_app_settings *s = tt_app_options_settings(j->o);
   /* A budget becomes a bound only after a pass over every tile
    * (tiled_budget.c): not a plan's job, whose tiles are independent. */
   if (!s->tile_size || s->max_error < 0 || s->max_points ||
@@ -166,109 +180,146 @@ static void plan_cmd(char **argv, tt_app_result *res)
                        "-max_points, -max_triangles or -percent: their bound "
                        "needs a pass over every tile first, which simplify "
                        "-tile_size makes)");
-    goto done;
+    return false;
   }
-  for (size_t i = 0; words && words[i]; i++)
-    if (has_control(words[i])) {
+  for (size_t i = 0; j->words && j->words[i]; i++)
+    if (has_control(j->words[i])) {
       tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                          "tiles plan: an option holds a control character");
-      goto done;
+      return false;
     }
-  abs = realpath(dem, NULL);
-  uint64_t bytes = 0, ns = 0;
-  if (!abs || has_control(abs) || !dem_identity(abs, &bytes, &ns)) {
+  j->tile_size = s->tile_size;
+  return true;
+}
+
+/* The DEM's identity and size, and the tiles of tile_size cells. */
+static bool open_dem(plan_job *j, tt_app_result *res)
+{
+  const tt_app_settings *s = tt_app_options_settings(j->o);
+  j->abs = realpath(j->dem, NULL);
+  if (!j->abs || has_control(j->abs) ||
+      !dem_identity(j->abs, &j->bytes, &j->ns)) {
     tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
-                       "%s: cannot open the DEM (%s)", dem,
-                       abs ? "control character in its path" : strerror(errno));
-    goto done;
+                       "%s: cannot open the DEM (%s)", j->dem,
+                       j->abs ? "control character in its path"
+                              : strerror(errno));
+    return false;
   }
-  ds = GDALOpenEx(abs, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL, NULL, NULL);
-  if (!ds || s->band > GDALGetRasterCount(ds)) {
+  j->ds = GDALOpenEx(j->abs, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL, NULL,
+                     NULL);
+  if (!j->ds || s->band > GDALGetRasterCount(j->ds)) {
     tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
-                       "%s: %s", dem, ds ? "no such band (-b)"
-                                         : "not a raster GDAL can open");
-    goto done;
+                       "%s: %s", j->dem, j->ds ? "no such band (-b)"
+                                               : "not a raster GDAL can open");
+    return false;
   }
-  size_t W = (size_t)GDALGetRasterXSize(ds), H = (size_t)GDALGetRasterYSize(ds);
+  size_t W = (size_t)GDALGetRasterXSize(j->ds);
+  size_t H = (size_t)GDALGetRasterYSize(j->ds);
   if (W < 2 || H < 2) {
     tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_DATA, "%s: raster is "
-                       "%zu x %zu pixels: at least 2 x 2 are needed", dem, W,
-                       H);
-    goto done;
+                       "%zu x %zu pixels: at least 2 x 2 are needed", j->dem,
+                       W, H);
+    return false;
   }
-  size_t N = s->tile_size, ntx = (W - 2) / N + 1, nty = (H - 2) / N + 1;
-  VSIStatBufL sb;
-  if (!overwrite && VSIStatL(plan, &sb) == 0) {
-    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS,
-                       "%s: exists; use -overwrite to replace it", plan);
-    goto done;
-  }
-  dir = CPLStrdup(CPLSPrintf("%s.tiles", plan));
-  if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
-    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
-                       "%s: cannot make the pieces' folder (%s)", dir,
-                       strerror(errno));
-    goto done;
-  }
-  tmp = CPLStrdup(CPLSPrintf("%s.tmp%ld", plan, (long)getpid()));
-  f = VSIFOpenL(tmp, "wb");
-  if (!f) {
-    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
-                       "%s: cannot write (%s)", plan, strerror(errno));
-    goto done;
-  }
+  j->width = W;
+  j->height = H;
+  j->tiles_x = (W - 2) / j->tile_size + 1;
+  j->tiles_y = (H - 2) / j->tile_size + 1;
+  return true;
+}
+
+/* The plan's text: the DEM, its tiles and their windows, the options. */
+static void put_plan(const plan_job *j, VSILFILE *f)
+{
+  size_t W = j->width, H = j->height, N = j->tile_size, ntx = j->tiles_x;
+  size_t ntiles = ntx * j->tiles_y;
   VSIFPrintfL(f, "%s\n  \"dem\": ", PLAN_HEAD);
-  put_str(f, abs);
+  put_str(f, j->abs);
   VSIFPrintfL(f, ",\n  \"dem_bytes\": %llu,\n  \"dem_mtime_ns\": %llu,\n"
               "  \"width\": %zu,\n  \"height\": %zu,\n  \"tile_size\": %zu,\n"
               "  \"tiles_x\": %zu,\n  \"tiles_y\": %zu,\n  \"tiles\": %zu,\n"
-              "  \"options\": [", (unsigned long long)bytes,
-              (unsigned long long)ns, W, H, N, ntx, nty, ntx * nty);
-  for (size_t i = 0; words && words[i]; i++) {
+              "  \"options\": [", (unsigned long long)j->bytes,
+              (unsigned long long)j->ns, W, H, N, ntx, j->tiles_y, ntiles);
+  for (size_t i = 0; j->words && j->words[i]; i++) {
     VSIFPrintfL(f, i ? ", " : "");
-    put_str(f, words[i]);
+    put_str(f, j->words[i]);
   }
   VSIFPrintfL(f, "],\n  \"tile_list\": [\n");
-  for (size_t k = 0; k < ntx * nty; k++) {
+  for (size_t k = 0; k < ntiles; k++) {
     tt_tile t;
-    size_t i = k % ntx, j = k / ntx, c0, r0, w, h;
+    size_t i = k % ntx, jj = k / ntx, c0, r0, w, h;
     t.col0 = i * N;
-    t.row0 = j * N;
+    t.row0 = jj * N;
     t.col1 = (i + 1) * N < W - 1 ? (i + 1) * N : W - 1;
-    t.row1 = (j + 1) * N < H - 1 ? (j + 1) * N : H - 1;
+    t.row1 = (jj + 1) * N < H - 1 ? (jj + 1) * N : H - 1;
     t.dem_width = W;
     t.dem_height = H;
     tt_tile_window(&t, &c0, &r0, &w, &h);
     VSIFPrintfL(f, "    {\"id\": %zu, \"cols\": [%zu, %zu], \"rows\": [%zu, "
                 "%zu], \"window\": [%zu, %zu, %zu, %zu]}%s\n", k, t.col0,
                 t.col1, t.row0, t.row1, c0, r0, w, h,
-                k + 1 < ntx * nty ? "," : "");
+                k + 1 < ntiles ? "," : "");
   }
   VSIFPrintfL(f, "  ]\n}\n");
-  int bad = VSIFCloseL(f) != 0;
-  f = NULL;
-  if (bad || rename(tmp, plan) != 0) {
-    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
-                       "%s: cannot write (%s)", plan, strerror(errno));
-    goto done;
+}
+
+/* PLAN.json through a temporary name, and the pieces' folder. */
+static bool write_plan(plan_job *j, tt_app_result *res)
+{
+  VSIStatBufL sb;
+  if (!j->overwrite && VSIStatL(j->plan, &sb) == 0) {
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS,
+                       "%s: exists; use -overwrite to replace it", j->plan);
+    return false;
   }
-  if (!quiet)
-    printf("%s: %zu tiles of %zu cells (%zu x %zu) of %s; pieces in %s\n",
-           plan, ntx * nty, N, ntx, nty, abs, dir);
-  tt__app_result_ok(res);
-done:
-  if (f)
-    VSIFCloseL(f);
-  if (tmp)
-    VSIUnlink(tmp);
-  if (ds)
-    GDALClose(ds);
-  CPLFree(tmp);
-  CPLFree(dir);
-  free(abs);
-  tt_app_options_destroy(o);
-  CSLDestroy(sv);
-  CSLDestroy(words);
+  j->dir = CPLStrdup(CPLSPrintf("%s.tiles", j->plan));
+  if (mkdir(j->dir, 0777) != 0 && errno != EEXIST) {
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
+                       "%s: cannot make the pieces' folder (%s)", j->dir,
+                       strerror(errno));
+    return false;
+  }
+  j->tmp = CPLStrdup(CPLSPrintf("%s.tmp%ld", j->plan, (long)getpid()));
+  if (!(j->f = VSIFOpenL(j->tmp, "wb"))) {
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
+                       "%s: cannot write (%s)", j->plan, strerror(errno));
+    return false;
+  }
+  put_plan(j, j->f);
+  int bad = VSIFCloseL(j->f) != 0;
+  j->f = NULL;
+  if (bad || rename(j->tmp, j->plan) != 0) {
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
+                       "%s: cannot write (%s)", j->plan, strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+static void plan_cmd(char **argv, tt_app_result *res)
+{
+  plan_job j;
+  memset(&j, 0, sizeof j);
+  if (read_words(&j, argv, res) && check_options(&j, res) &&
+      open_dem(&j, res) && write_plan(&j, res)) {
+    if (!j.quiet)
+      printf("%s: %zu tiles of %zu cells (%zu x %zu) of %s; pieces in %s\n",
+             j.plan, j.tiles_x * j.tiles_y, j.tile_size, j.tiles_x,
+             j.tiles_y, j.abs, j.dir);
+    tt__app_result_ok(res);
+  }
+  if (j.f)
+    VSIFCloseL(j.f);
+  if (j.tmp)
+    VSIUnlink(j.tmp);
+  if (j.ds)
+    GDALClose(j.ds);
+  CPLFree(j.tmp);
+  CPLFree(j.dir);
+  free(j.abs);
+  tt_app_options_destroy(j.o);
+  CSLDestroy(j.sv);
+  CSLDestroy(j.words);
 }
 
 /* --- the plan read back: only what plan_cmd writes, in its layout --- */

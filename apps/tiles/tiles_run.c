@@ -1,9 +1,11 @@
 /*
- * tiles_run.c -- `terratin tiles run PLAN.json TILE_ID [-overwrite]`: one
- * tile of a plan refined (simplify's tiled path, tiled.c, on that tile
- * alone) and its piece written to PLAN.json.tiles/TILE_ID.ttp
- * (tt_tin_piece_encode: exact values, the plan's hash, a checksum) through
- * a temporary name and a rename, so a piece is whole or absent.
+ * tiles_run.c -- apps/tiles/: the tiles command, a folder over the core
+ * (apps/core/), simplify's tiled run as independent jobs for a cluster. This
+ * file: `terratin tiles run PLAN.json TILE_ID [-overwrite]`: one tile of a plan
+ * refined (simplify's tiled path, tiled.c, on that tile alone) and its piece
+ * written to PLAN.json.tiles/TILE_ID.ttp (tt_tin_piece_encode: exact values,
+ * the plan's hash, a checksum) through a temporary name and a rename, so a
+ * piece is whole or absent.
  */
 #include "tiles.h"
 
