@@ -93,8 +93,6 @@ long=$(find apps src/gdal -type f -name '*.c' -print0 | sort -z | xargs -0 awk '
 known_long="
 apps/simplify/simplify.c tt__app_simplify
 apps/simplify/tiled.c tt__app_simplify_tiled
-apps/simplify/simplify.c tt__app_simplify
-apps/simplify/tiled.c tt__app_simplify_tiled
 "
 new_long=$(echo "$long" | while read -r at name rest; do
   [ -n "$at" ] || continue
