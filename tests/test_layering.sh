@@ -83,8 +83,6 @@ known_long="
 apps/core/options.c tt_app_options_new
 apps/eval/eval.c tt__app_eval
 apps/optimize/optimize.c tt__app_optimize
-apps/simplify/simplify.c tt__app_simplify
-apps/simplify/tiled.c tt__app_simplify_tiled
 apps/study/study.c tt__app_study
 apps/tiles/tiles_plan.c plan_cmd
 src/gdal/georef/georef_conformal.c tt__georef_ground_points
