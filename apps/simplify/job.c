@@ -162,8 +162,10 @@ void tt__app_job_free(app_simplify_job *job)
   CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", NULL);
   if (job->src)
     GDALClose(job->src);
-  tt__app_stream_close(&job->so); /* an unfinished write: before the removal */
-  tt_output_destroy(job->outp); /* removes the temporary files unless committed */
+  /* an unfinished streamed write undone, then the temporary files removed
+   * unless committed */
+  tt__app_stream_close(&job->so);
+  tt_output_destroy(job->outp);
   if (job->srs)
     OSRDestroySpatialReference(job->srs);
   CSLDestroy(job->wopts);

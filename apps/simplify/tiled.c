@@ -62,8 +62,9 @@ static tt_status merge_all(tiled *T, const double gt[6], tt_tin **out_tin)
   return st;
 }
 
-/* Every tile run and streamed (r->sink): the rows written as each piece
- * merges (unless a budget pass drops them), the summary in the sink. */
+/* Every tile run and streamed (the job's sink): the rows written as each
+ * piece merges (unless a budget pass drops them), the summary in the
+ * sink. */
 static tt_status stream_all(tiled *T, const double gt[6])
 {
   app_run *r = T->r;

@@ -14,8 +14,10 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 
+/* A tiled run: set up by tiled.c from the job, shared with the worker
+ * threads (tiled_workers.c). */
 typedef struct tiled {
-  app_simplify_job *job;
+  app_simplify_job *job;    /* what to run, and where its results go */
   app_run *r;
   GDALRasterBandH band;
   const char *path;
@@ -46,8 +48,8 @@ typedef struct tiled {
   size_t max_memory;        /* -max_memory, 0: not given */
   size_t inflight_bytes;    /* what the tiles in flight may hold */
   char merge_msg[TT_APP_MESSAGE_MAX]; /* the main thread's failure */
-  /* a streamed GeoPackage (the job's sink, tiled_stream.c): the pieces merged
-   * by the stream and their rows written at once, instead of a merger */
+  /* a streamed GeoPackage (the job's sink, tiled_stream.c): the pieces
+   * merged by the stream and their rows written at once, not a merger */
   tt__tin_stream *stream;
   tt_app_tile_sink *sink;
   bool write;               /* this pass's rows are written (stream_all) */
