@@ -1,12 +1,25 @@
 /*
- * simplify.h -- what the files of `terratin simplify` share (internal):
- * simplify.c (the run: the options, the method, the output, the report),
- * ogr_output.c (the output's checks before any work: the OGR dry run, the
- * creation options, a database output), tiled.c (the tiled path: tiles
- * read, refined or decimated on the workers, merged), tiled_budget.c (a
- * budget in tiles: the curves and the bound), tiled_tiles.c (a tile's
- * curve and its samples) and tiled_stream.c (a tiled run's GeoPackage
- * written as the tiles merge).
+ * simplify.h -- what the files of apps/simplify/, the simplify command,
+ * share (internal). A run is one pipeline over one job description
+ * (app_simplify_job): the settings read into it, the output chosen and
+ * planned, the DEM opened, the tiling chosen, the TIN made whole or in
+ * tiles, written, reported.
+ *
+ *   simplify.c      tt__app_simplify: the pipeline, the input, the
+ *                   tiling's choice, the whole run and the tiled run
+ *   job.c           the job from the settings: the method's options, the
+ *                   memory, the threads, the default bound
+ *   output.c        the output's choice (OGR file, database, mesh file,
+ *                   streamed GeoPackage), its plan and writer options
+ *   ogr_output.c    the OGR output's checks before any work (the dry run,
+ *                   the creation options, a database output)
+ *   write.c         the write of the TIN into the output, and its commit
+ *   run_fields.c    the run_parameters layer's fields of a run
+ *   tiled.c         the tiled path: the passes over the tiles, merged
+ *   tiled_workers.c the tiles read and run on worker threads (tiled.h)
+ *   tiled_budget.c  a budget in tiles: the curves and the bound
+ *   tiled_tiles.c   a tile's curve, its samples, the tiles' memory
+ *   tiled_stream.c  a tiled run's GeoPackage written as the tiles merge
  */
 #ifndef TT_APP_SIMPLIFY_H
 #define TT_APP_SIMPLIFY_H
@@ -16,6 +29,140 @@
 #include <ogr_api.h>
 
 #include <stdbool.h>
+
+/* A tiled run's GeoPackage built as the tiles merge (tiled_stream.c,
+ * docs/scale.md): with the job's output streamed, tt__app_simplify_tiled()
+ * calls open before merging the first piece (tile 0's raster facts, the
+ * bound), then hands every piece's rows to out as it is merged, and
+ * returns no TIN but the whole TIN's summary and height range here; the
+ * write finishes and closes out. discard drops what out wrote (a budget
+ * pass not kept) and closes it; the next open starts the file again. */
+typedef struct tt_app_tile_sink {
+  tt_status (*open)(struct tt_app_tile_sink *sink,
+                    const tt_raster_info *info, double max_error);
+  void (*discard)(struct tt_app_tile_sink *sink);
+  struct tt__gpkg_stream *out;
+  tt_tin_summary sum;
+  double zmin, zmax;
+} tt_app_tile_sink;
+
+typedef struct app_simplify_job app_simplify_job;
+/* tiled_stream.c: the sink of simplify's streamed GeoPackage. */
+typedef struct tt_app_stream {
+  tt_app_tile_sink sink; /* first: the sink tiled.c calls */
+  app_simplify_job *job;
+} tt_app_stream;
+
+/* Where the TIN goes (output.c). */
+typedef enum app_output_kind {
+  APP_OUTPUT_FILE,     /* an OGR dataset in a file: written under
+                          tt_output's temporary name, then committed */
+  APP_OUTPUT_DATABASE, /* a datasource that is no file (PG:...), opened
+                          before the work, written in one transaction */
+  APP_OUTPUT_MESH,     /* a mesh or survey file (2DM, PLY, OBJ, LandXML)
+                          written by tt_mesh_write() */
+  APP_OUTPUT_STREAM    /* a tiled run's GeoPackage file, its rows written
+                          as the tiles merge (tiled_stream.c) */
+} app_output_kind;
+
+/* One run of simplify, from the settings to the report: what it reads,
+ * how it simplifies, where it writes, and what it made. The pipeline
+ * (simplify.c) fills it step by step; tt__app_job_free() releases what it
+ * holds. */
+struct app_simplify_job {
+  app_run *r;
+  const tt_app_settings *s;
+  /* the method (job.c): the options of the whole run for either method,
+   * from the settings; a tiled run makes each tile's from them */
+  int decimate;               /* -method decimate */
+  tt_refine_options ro;       /* limits, criterion, optimiser, repair,
+                                 threads, memory limit, progress */
+  tt_decimate_options dopt;   /* the same, and -start, -importance,
+                                 -selection, -onepass, -hole */
+  size_t mem_limit;           /* -max_memory, else what the system allows */
+  const char *mem_source;     /* what set mem_limit, for messages */
+  int workers;                /* the threads of a tiled run (>= 1) */
+  /* the input (simplify.c): s->input's band s->band */
+  GDALDatasetH src;           /* open until the DEM is read */
+  GDALRasterBandH band;
+  size_t width, height;
+  /* the tiling (simplify.c): 0 for a whole run, else the tiles' size */
+  size_t tile_size;
+  int ground;                 /* the DEM is measured on ground points */
+  /* the output (output.c) */
+  app_output_kind kind;
+  tt_mesh_format mesh;        /* APP_OUTPUT_MESH's format, else none */
+  GDALDriverH drv;            /* the OGR driver (not for a mesh) */
+  const char *drvname;        /* the driver's or the mesh format's name */
+  char shown[TT_APP_MESSAGE_MAX]; /* OUTPUT without its password */
+  tt_output *outp;            /* the planned file (not for a database) */
+  GDALDatasetH dst;           /* a database's, or a file's while written */
+  char **wopts, **dsco;       /* tt_ogr_write_tin's options, -dsco */
+  OGRSpatialReferenceH srs;   /* the layers' CRS (the DEM's), or NULL */
+  tt_app_stream so;           /* APP_OUTPUT_STREAM's sink */
+  /* what the run made */
+  tt_grid *grid;              /* a whole run's DEM, until simplified */
+  tt_raster_info *info;
+  tt_tin *tin;                /* NULL when streamed */
+  app_simplify_report rep;
+};
+
+/* job.c: the job of r's settings (nothing is opened yet): the method's
+ * options, OUTPUT's shown name. */
+void tt__app_job_init(app_simplify_job *job, app_run *r);
+/* The settings' checks that need GDAL: OUTPUT is not the input, -work_srs
+ * and -t_srs are CRSs (-work_srs projected). The failure is recorded. */
+tt_status tt__app_job_check(app_simplify_job *job);
+/* The memory the run may hold (asked after the output is planned, before
+ * the DEM is read: the heights count against it), and decimation's
+ * refusal of -max_memory. The failure is recorded. */
+tt_status tt__app_job_memory(app_simplify_job *job);
+/* The engine's threads (-threads, GDAL_NUM_THREADS: tt__app_threads, which
+ * may warn) into the options, and the workers of a tiled run. */
+void tt__app_job_threads(app_simplify_job *job);
+/* Whether the bound is the default one (no -max_error, no budget), and
+ * that bound set from the height range: 0.5 % of it. */
+int tt__app_job_default_wanted(const app_simplify_job *job);
+void tt__app_job_default_bound(app_simplify_job *job, double zmin,
+                               double zmax);
+/* Closes and frees what the job holds; an unfinished output is removed. */
+void tt__app_job_free(app_simplify_job *job);
+
+/* output.c: the kind of output and its driver (-of, else OUTPUT's form),
+ * the mesh formats' refusals of the OGR options. */
+tt_status tt__app_output_choose(app_simplify_job *job);
+/* The output planned before any work: a database opened and checked, a
+ * file's temporary name and sidecars, what is in the way refused. */
+tt_status tt__app_output_plan(app_simplify_job *job);
+/* The OGR writer's options and creation options, and (for a file) the
+ * dry run, once the DEM is open. */
+tt_status tt__app_output_options(app_simplify_job *job);
+/* A tiled run into a GeoPackage file streams (unless `tiles run` keeps
+ * its one tile, or TERRATIN_TILE_STREAM=NO): the kind becomes
+ * APP_OUTPUT_STREAM. */
+void tt__app_output_choose_stream(app_simplify_job *job);
+
+/* write.c: the TIN (or the streamed rows) written into the output and
+ * committed; the write's times in the report. The failure is recorded. */
+tt_status tt__app_simplify_write(app_simplify_job *job);
+/* The layers' CRS from info's (a warning when it cannot be parsed), unless
+ * the job has it already. */
+void tt__app_write_srs(app_simplify_job *job, const tt_raster_info *info);
+/* The OGR dataset created at the output's temporary name with -dsco
+ * (checked only when given); NULL with GDAL's reason in r->msg.last. */
+GDALDatasetH tt__app_write_create(app_simplify_job *job);
+
+/* run_fields.c: the run_parameters fields of a run from its job and report
+ * so far (its info among them); the strings they point to are kept
+ * beside them. */
+#define TT__APP_RUN_FIELDS 48
+typedef struct app_run_fields {
+  char created[32], start_name[48];
+  tt_run_field v[TT__APP_RUN_FIELDS];
+  size_t n;
+} app_run_fields;
+void tt__app_simplify_fields(const app_simplify_job *job,
+                             app_run_fields *out);
 
 /* ogr_output.c: the dry run of the OGR writer on a two-triangle TIN in
  * /vsimem/ with drv, -layers, the creation options dsco and the writer's
@@ -39,37 +186,21 @@ GDALDriverH tt__app_database_driver(app_run *r);
 GDALDatasetH tt__app_database_open(app_run *r, GDALDriverH drv,
                                    const char *shown);
 
-/* simplify.c: the run_parameters fields of a run from its report so far
- * (created, and start_name of 48 bytes, hold strings they point to); allf
- * has room for TT__APP_RUN_FIELDS. Returns the count used. */
-#define TT__APP_RUN_FIELDS 48
-size_t tt__app_simplify_fields(app_run *r, const app_simplify_report *rep,
-                               const tt_refine_options *ro,
-                               const tt_raster_info *info,
-                               const char *created, char *start_name,
-                               tt_run_field *allf);
-
+/* report.c (the core): the summary and the JSON. */
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p);
 void tt__app_print_simplify_summary(app_run *r,
                                     const app_simplify_report *p);
 
-/* tiled.c: the DEM of band read and refined in tiles of tile_size cells
- * on the workers, merged into *out_tin; ro's max_error < 0 asks for the
- * default bound (then set, and *default_error); ro's max_points,
- * max_triangles or percent, a budget of the whole DEM, is turned into a
- * bound (tiled_budget.c; ro->max_error is set to it, *out_passes says how
- * many runs at a bound it took). With dopt (else NULL) the
- * tiles are decimated with its options, its max_error that of ro. The
- * failure is recorded. */
-tt_status tt__app_simplify_tiled(app_run *r, GDALRasterBandH band,
-                                 const char *path, size_t tile_size,
-                                 tt_refine_options *ro,
-                                 tt_decimate_options *dopt,
-                                 int *default_error,
-                                 tt_tin **out_tin, tt_raster_info **out_info,
-                                 size_t *out_valid, double *out_zmin,
-                                 double *out_zmax, size_t *out_tiles,
-                                 int *out_threads, int *out_passes);
+/* tiled.c: the job's DEM read and simplified in tiles of job->tile_size
+ * cells on job->workers threads (fewer if there are fewer tiles), merged
+ * into job->tin or, when streamed, written as they merge; job->ro's
+ * max_error < 0 asks for the default bound (then set), a budget of the
+ * whole DEM (max_points, max_triangles, percent) is turned into a bound
+ * (tiled_budget.c; job->ro.max_error is set to it). job->info, the
+ * report's tiles, threads, passes, valid samples and height range are
+ * set. With `tiles run`'s hook the one tile is handed to it and no TIN
+ * is made. The failure is recorded. */
+tt_status tt__app_simplify_tiled(app_simplify_job *job);
 /* tiled_budget.c: a tile's error-against-count curve, thinned (the points
  * where the error reaches a new low, one every 2 % of vertices, and the
  * last), and the bound that makes the tiles' counts meet a budget. */
@@ -121,39 +252,10 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
                                 size_t valid, const tt_refine_options *ro,
                                 const app_budget_pass *p, double *out_bound,
                                 int *out_passes);
-/* A tiled run's GeoPackage built as the tiles merge (tiled_stream.c,
- * docs/scale.md): with r->sink set, tt__app_simplify_tiled() calls open
- * before merging the first piece (tile 0's raster facts, the bound), then
- * hands every piece's rows to out as it is merged, and returns no TIN but
- * the whole TIN's summary and height range here; the caller finishes and
- * closes out. discard drops what out wrote (a budget pass not kept) and
- * closes it; the next open starts the file again. */
-typedef struct tt_app_tile_sink {
-  tt_status (*open)(struct tt_app_tile_sink *sink,
-                    const tt_raster_info *info, double max_error);
-  void (*discard)(struct tt_app_tile_sink *sink);
-  struct tt__gpkg_stream *out;
-  tt_tin_summary sum;
-  double zmin, zmax;
-} tt_app_tile_sink;
-/* tiled_stream.c: the sink of simplify's streamed GeoPackage. */
-typedef struct tt_app_stream {
-  tt_app_tile_sink sink; /* first: the sink tiled.c calls */
-  app_run *r;
-  tt_output *outp;
-  GDALDriverH drv;
-  char **dsco, ***wopts;
-  OGRSpatialReferenceH *srs;
-  app_simplify_report *rep;
-  tt_refine_options *ro;
-} tt_app_stream;
-/* Whether a tiled run into drvname streams (GPKG files, unless
- * TERRATIN_TILE_STREAM=NO). */
-int tt__app_stream_wanted(const char *drvname, int database, int mesh);
-void tt__app_stream_init(tt_app_stream *so, app_run *r, tt_output *outp,
-                         GDALDriverH drv, char **dsco, char ***wopts,
-                         OGRSpatialReferenceH *srs,
-                         app_simplify_report *rep, tt_refine_options *ro);
+/* tiled_stream.c: whether a tiled run into a file of drvname streams
+ * (GPKG, unless TERRATIN_TILE_STREAM=NO), and the sink of job's. */
+int tt__app_stream_wanted(const char *drvname);
+void tt__app_stream_init(tt_app_stream *so, app_simplify_job *job);
 /* After the last tile: the R-trees, extents, counts, the final
  * run_parameters (fields) and styles; closes the writer. */
 tt_status tt__app_stream_finish(tt_app_stream *so, const tt_run_field *fields,

@@ -1,8 +1,9 @@
 /*
- * tiled_stream.c -- a tiled run's GeoPackage built as its tiles merge
- * (issue 19, docs/scale.md): the layers are made when the first piece is
- * about to merge, every piece's rows are appended to them at once
- * (tiled.c, src/tile/stream.c, src/gdal/gpkg/gpkg_stream.c), and after the
+ * tiled_stream.c -- apps/simplify/, the simplify command: a tiled run's
+ * GeoPackage built as its tiles merge (issue 19, docs/scale.md): the
+ * layers are made when the first piece is about to merge, every piece's
+ * rows are appended to them at once (tiled.c, src/tile/stream.c,
+ * src/gdal/gpkg/gpkg_stream.c), and after the
  * last tile the R-trees, extents, counts, the run_parameters row and the
  * styles are written. The rows are those the merged-TIN path writes for
  * the same run, byte for byte; memory is the tiles in flight, about one
@@ -39,9 +40,9 @@
 
 #include <string.h>
 
-int tt__app_stream_wanted(const char *drvname, int database, int mesh)
+int tt__app_stream_wanted(const char *drvname)
 {
-  return !database && !mesh && tt__app_str_ieq(drvname, "GPKG") &&
+  return tt__app_str_ieq(drvname, "GPKG") &&
          CPLTestBool(CPLGetConfigOption("TERRATIN_TILE_STREAM", "YES"));
 }
 
@@ -51,39 +52,21 @@ int tt__app_stream_wanted(const char *drvname, int database, int mesh)
 static tt_status stream_open(tt_app_tile_sink *sink,
                              const tt_raster_info *info, double max_error)
 {
-  tt_app_stream *so = (tt_app_stream *)sink;
-  app_run *r = so->r;
-  const tt_app_settings *s = r->s;
-  const char *temp = tt_output_temp_path(so->outp);
+  app_simplify_job *job = ((tt_app_stream *)sink)->job;
+  app_run *r = job->r;
+  const char *temp = tt_output_temp_path(job->outp);
   tt_status st = TT_OK;
   if (!info)
     return tt__error(r->ctx, TT_ERR_INTERNAL, "no raster facts from tile 0");
-  if (info->crs_wkt && *info->crs_wkt && !*so->srs) {
-    *so->srs = OSRNewSpatialReference(info->crs_wkt);
-    if (*so->srs)
-      OSRSetAxisMappingStrategy(*so->srs, OAMS_TRADITIONAL_GIS_ORDER);
-    else
-      tt__app_warn(&r->msg, "%s: the raster's CRS could not be parsed; the "
-                   "layers have none", s->input);
-  }
-  so->ro->max_error = max_error;
-  so->rep->info = info;
-  char created[32], start_name[48];
-  tt__app_iso8601_utc(created, sizeof created);
-  tt_run_field allf[TT__APP_RUN_FIELDS];
-  size_t nallf = tt__app_simplify_fields(r, so->rep, so->ro, info, created,
-                                         start_name, allf);
-  *so->wopts = CSLSetNameValue(*so->wopts, "ROWS", "DEFERRED");
-  *so->wopts = CSLSetNameValue(*so->wopts, "JOURNAL", "MEMORY");
-  *so->wopts = CSLSetNameValue(*so->wopts, "PAGES", "YES");
-  int validate = s->dsco && s->dsco[0];
-  r->msg.last[0] = '\0';
-  if (!validate)
-    CPLSetThreadLocalConfigOption("GDAL_VALIDATE_CREATION_OPTIONS", "NO");
-  GDALDatasetH dst = GDALCreate(so->drv, temp, 0, 0, 0, GDT_Unknown,
-                                (CSLConstList)so->dsco);
-  if (!validate)
-    CPLSetThreadLocalConfigOption("GDAL_VALIDATE_CREATION_OPTIONS", NULL);
+  tt__app_write_srs(job, info);
+  job->ro.max_error = max_error;
+  job->rep.info = info;
+  app_run_fields f;
+  tt__app_simplify_fields(job, &f);
+  job->wopts = CSLSetNameValue(job->wopts, "ROWS", "DEFERRED");
+  job->wopts = CSLSetNameValue(job->wopts, "JOURNAL", "MEMORY");
+  job->wopts = CSLSetNameValue(job->wopts, "PAGES", "YES");
+  GDALDatasetH dst = tt__app_write_create(job);
   if (!dst)
     return tt__error(r->ctx, TT_ERR_IO, "cannot create GPKG dataset: %s",
                      r->msg.last[0] ? r->msg.last : "unknown reason");
@@ -92,11 +75,11 @@ static tt_status stream_open(tt_app_tile_sink *sink,
   double none = 0; /* arrays of no element, never read */
   memset(&empty, 0, sizeof empty);
   empty.t_max = empty.v_ins_err = &none;
-  empty.summary.criterion = so->ro->criterion;
+  empty.summary.criterion = job->ro.criterion;
   /* decimated (tt__records_decimated): the vertices' importance field */
-  empty.summary.start_vertices = s->decimate ? 1 : 0;
-  st = tt_ogr_write_tin(r->ctx, dst, &empty, *so->srs, allf, nallf,
-                        *so->wopts, NULL, NULL);
+  empty.summary.start_vertices = job->decimate ? 1 : 0;
+  st = tt_ogr_write_tin(r->ctx, dst, &empty, job->srs, f.v, f.n, job->wopts,
+                        NULL, NULL);
   unsigned failures = r->msg.failures;
   GDALClose(dst);
   if (st == TT_OK && r->msg.failures != failures)
@@ -106,11 +89,11 @@ static tt_status stream_open(tt_app_tile_sink *sink,
    * leaves are written (the page writer's RTREE_BLOCK; tests make it small
    * to get many blocks from a small DEM) */
   const char *block = CPLGetConfigOption("TERRATIN_RTREE_BLOCK", NULL);
-  char **o = CSLDuplicate(*so->wopts);
+  char **o = CSLDuplicate(job->wopts);
   if (block && *block)
     o = CSLSetNameValue(o, "RTREE_BLOCK", block);
   if (st == TT_OK)
-    st = tt__gpkg_stream_open(r->ctx, temp, *so->srs, o, s->decimate,
+    st = tt__gpkg_stream_open(r->ctx, temp, job->srs, o, job->decimate,
                               &sink->out);
   CSLDestroy(o);
   return st;
@@ -123,31 +106,21 @@ static void stream_discard(tt_app_tile_sink *sink)
   tt_app_stream *so = (tt_app_stream *)sink;
   tt__gpkg_stream_close(sink->out);
   sink->out = NULL;
-  tt_output_clear(so->outp);
+  tt_output_clear(so->job->outp);
 }
 
-void tt__app_stream_init(tt_app_stream *so, app_run *r, tt_output *outp,
-                         GDALDriverH drv, char **dsco, char ***wopts,
-                         OGRSpatialReferenceH *srs,
-                         app_simplify_report *rep, tt_refine_options *ro)
+void tt__app_stream_init(tt_app_stream *so, app_simplify_job *job)
 {
   memset(so, 0, sizeof *so);
   so->sink.open = stream_open;
   so->sink.discard = stream_discard;
-  so->r = r;
-  so->outp = outp;
-  so->drv = drv;
-  so->dsco = dsco;
-  so->wopts = wopts;
-  so->srs = srs;
-  so->rep = rep;
-  so->ro = ro;
+  so->job = job;
 }
 
 tt_status tt__app_stream_finish(tt_app_stream *so, const tt_run_field *fields,
                                 size_t nfields)
 {
-  app_run *r = so->r;
+  app_run *r = so->job->r;
   tt_status st = tt__gpkg_stream_finish(so->sink.out, fields, nfields,
                                         tt__app_phase_fn, &r->prog);
   tt__gpkg_stream_close(so->sink.out);
