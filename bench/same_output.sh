@@ -21,12 +21,14 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 work=${2:-$(mktemp -d)}
 mkdir -p "$work"
 cd "$work"
-dem=$here/testdata/jacksboro_fault_dem.tif
+# the DEM copied in, so that no output or report holds this checkout's path
+cp "$here/testdata/jacksboro_fault_dem.tif" geo.tif
+dem=geo.tif
 
 # Inputs: the bundled geographic DEM, a UTM copy with a nodata hole, a Web
 # Mercator copy, and a generated fractal.
 if [ ! -f utm.tif ]; then
-  gdalwarp -q -t_srs EPSG:32616 -r bilinear -dstnodata -9999 "$dem" utm0.tif
+  gdalwarp -q -t_srs EPSG:32616 -r bilinear -dstnodata -9999 geo.tif utm0.tif
   # a round nodata hole (a lake masked out), burnt in by gdal_rasterize
   gdalinfo -json utm0.tif | python3 -c 'import json, math, sys
 c = json.load(sys.stdin)["cornerCoordinates"]
