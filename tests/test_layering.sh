@@ -68,8 +68,7 @@ bad=$(cat /tmp/tt_layering_$$.txt); rm -f /tmp/tt_layering_$$.txt
 
 # 5. every file opens with a paragraph that names its folder's role
 # ("Part of src/mesh/, the mesh stage: ...", "apps/eval/: the eval command")
-# (apps/ and src/gdal/ are being named in issue 25's branches)
-unnamed=$(for f in $(find src include apps -path src/gdal -prune -o -path apps -prune -o -type f \( -name '*.c' -o -name '*.h' \) -print | sort); do
+unnamed=$(for f in $(find src include apps -type f \( -name '*.c' -o -name '*.h' \) | sort); do
   dir=$(dirname "$f")/
   awk 'NR == 1 && !/^\/\*/ { exit 1 } { print } /\*\// { exit }' "$f" |
     grep -qF "$dir" || echo "$f"
