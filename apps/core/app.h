@@ -6,7 +6,8 @@
  * read and write, and one entry point per command.
  *
  *   terratin.c      main(): the words to an options object, run, exit
- *   options.c       the parser; option_table.c the table it reads
+ *   options.c       the parser; option_table.c the table it reads and
+ *                   the readers of each kind of value
  *   settings.c      the options object's lists and accessors
  *   values.c        numbers, sizes, booleans and grid sizes of words
  *   help.c          the help texts
