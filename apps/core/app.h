@@ -84,8 +84,6 @@ int tt__app_parse_double(const char *w, double *out);
  * NUM_TOO_LARGE beyond 2^64 - 1 (resp. SIZE_MAX). */
 int tt__app_parse_u64(const char *w, uint64_t *out);
 int tt__app_parse_size(const char *w, size_t *out);
-/* -tile_size: a whole number of cells from 16 to 65536; 0 otherwise. */
-int tt__app_parse_tile_size(const char *w, size_t *out);
 /* Bytes, or a number with K, M, G or T (powers of 1024, then B or iB). */
 int tt__app_parse_mem_size(const char *w, size_t *out);
 /* One of the words GDAL's CPLTestBool reads as a boolean. */

@@ -184,12 +184,3 @@ const char *tt__app_layer_list(unsigned mask, char *buf, size_t size)
     }
   return buf;
 }
-
-int tt__app_parse_tile_size(const char *w, size_t *out)
-{
-  size_t z = 0;
-  if (tt__app_parse_size(w, &z) != NUM_OK || z < 16 || z > 65536)
-    return 0;
-  *out = z;
-  return 1;
-}
