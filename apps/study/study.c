@@ -286,6 +286,47 @@ done:
   return st == TT_OK;
 }
 
+tt_status tt__study_method_run(app_run *r, const study_terrain *t,
+                               const study_method *m, tt_tin **out_tin)
+{
+  const tt_app_settings *s = r->s;
+  if (m->decimate) {
+    tt_decimate_options d;
+    tt_decimate_options_init(&d);
+    d.max_error = -1.0;
+    d.percent = m->percent;
+    d.max_points = m->max_points;
+    d.criterion = m->criterion;
+    d.optimize = m->optimize;
+    d.anneal = s->anneal;
+    d.start = s->start;
+    d.start_points = s->start_points;
+    d.importance = s->importance;
+    d.threads = tt__app_threads(r);
+    d.progress = tt__app_phase_fn;
+    d.progress_arg = &r->prog;
+    d.step = m->step;
+    d.step_arg = m->step_arg;
+    return tt_decimate_run(r->ctx, t->grid, &d, out_tin);
+  }
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.max_error = -1.0;
+  o.percent = m->percent;
+  o.max_points = m->max_points;
+  o.criterion = m->criterion;
+  o.repair = tt__study_repair(m->criterion);
+  o.optimize = m->optimize;
+  o.anneal = s->anneal;
+  o.threads = tt__app_threads(r);
+  o.progress = tt__app_phase_fn;
+  o.progress_arg = &r->prog;
+  o.step = m->step;
+  o.step_arg = m->step_arg;
+  o.step_until = m->step_until;
+  return tt_refine_run(r->ctx, t->grid, &o, out_tin);
+}
+
 /* One run, as `terratin simplify -percent P` with the same options (or
  * -max_points N when max_points is not 0; *out_tin then keeps the TIN). */
 static tt_status run_one(app_run *r, const study_terrain *t,
@@ -297,37 +338,10 @@ static tt_status run_one(app_run *r, const study_terrain *t,
   tt_tin_summary sum;
   tt_status st;
   int dec = p->decimate[row->method];
-  if (dec) {
-    tt_decimate_options d;
-    tt_decimate_options_init(&d);
-    d.max_error = -1.0;
-    d.percent = max_points ? 0 : p->pct[row->percent];
-    d.max_points = max_points;
-    d.criterion = p->crit[row->criterion];
-    d.optimize = p->opt[row->optimizer];
-    d.anneal = s->anneal;
-    d.start = s->start;
-    d.start_points = s->start_points;
-    d.importance = s->importance;
-    d.threads = tt__app_threads(r);
-    d.progress = tt__app_phase_fn;
-    d.progress_arg = &r->prog;
-    st = tt_decimate_run(r->ctx, t->grid, &d, &tin);
-  } else {
-    tt_refine_options o;
-    tt_refine_options_init(&o);
-    o.max_error = -1.0;
-    o.percent = max_points ? 0 : p->pct[row->percent];
-    o.max_points = max_points;
-    o.criterion = p->crit[row->criterion];
-    o.repair = tt__study_repair(o.criterion);
-    o.optimize = p->opt[row->optimizer];
-    o.anneal = s->anneal;
-    o.threads = tt__app_threads(r);
-    o.progress = tt__app_phase_fn;
-    o.progress_arg = &r->prog;
-    st = tt_refine_run(r->ctx, t->grid, &o, &tin);
-  }
+  study_method m = {dec, p->crit[row->criterion], p->opt[row->optimizer],
+                    max_points ? 0 : p->pct[row->percent], max_points,
+                    NULL, NULL, 0};
+  st = tt__study_method_run(r, t, &m, &tin);
   if (st == TT_ERR_INTERRUPTED) {
     tt__app_fail_tt(r, st, s->output);
   } else if (st != TT_OK) {

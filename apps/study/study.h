@@ -91,6 +91,24 @@ typedef struct study_rows {
  * Delaunay's flips (TT_REPAIR_DELAUNAY, so that the optimiser 'auto' is
  * the local swap); the others as the engine resolves them. */
 tt_repair tt__study_repair(tt_criterion c);
+/* One run of the study's: a method, criterion and optimiser to a
+ * -percent (percent > 0) or a point count, with -start, -importance,
+ * -anneal_* and the threads of the command line, and an optional step
+ * recorder (step_until: refinement reports steps up to it). study.c's
+ * -percent runs and study_curves.c's -points runs both make their TINs
+ * here. The caller owns *out_tin (tt_tin_destroy()). */
+typedef struct study_method {
+  int decimate;
+  tt_criterion criterion;
+  tt_optimize optimize;
+  double percent;
+  size_t max_points;
+  tt_step_fn step;
+  void *step_arg;
+  size_t step_until;
+} study_method;
+tt_status tt__study_method_run(app_run *r, const study_terrain *t,
+                               const study_method *m, tt_tin **out_tin);
 
 /* The -points run of one terrain, method, optimiser and criterion (plan
  * indices in `key`: terrain, method, optimizer, criterion): insertion up to

@@ -84,40 +84,9 @@ tt_status tt__study_curve_run(app_run *r, const study_terrain *t,
   tt_criterion crit = p->crit[key->criterion];
   rec_arg a = {out, out->n, *key, 0};
   a.key.percent = SIZE_MAX; /* not a -percent row */
-  if (dec) {
-    tt_decimate_options d;
-    tt_decimate_options_init(&d);
-    d.max_error = -1.0;
-    d.max_points = p->points;
-    d.criterion = crit;
-    d.optimize = p->opt[key->optimizer];
-    d.anneal = s->anneal;
-    d.start = s->start;
-    d.start_points = s->start_points;
-    d.importance = s->importance;
-    d.threads = tt__app_threads(r);
-    d.progress = tt__app_phase_fn;
-    d.progress_arg = &r->prog;
-    d.step = on_step;
-    d.step_arg = &a;
-    st = tt_decimate_run(r->ctx, t->grid, &d, &tin);
-  } else {
-    tt_refine_options o;
-    tt_refine_options_init(&o);
-    o.max_error = -1.0;
-    o.max_points = p->points;
-    o.criterion = crit;
-    o.repair = tt__study_repair(crit);
-    o.optimize = p->opt[key->optimizer];
-    o.anneal = s->anneal;
-    o.threads = tt__app_threads(r);
-    o.progress = tt__app_phase_fn;
-    o.progress_arg = &r->prog;
-    o.step = on_step;
-    o.step_arg = &a;
-    o.step_until = p->points;
-    st = tt_refine_run(r->ctx, t->grid, &o, &tin);
-  }
+  study_method m = {dec, crit, p->opt[key->optimizer], 0, p->points,
+                    on_step, &a, p->points};
+  st = tt__study_method_run(r, t, &m, &tin);
   tt_tin_destroy(tin);
   if (a.nomem)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
