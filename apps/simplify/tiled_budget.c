@@ -1,7 +1,7 @@
 /*
- * tiled_budget.c -- -max_points, -max_triangles and -percent in tiles
- * (docs/scale.md): a budget of the whole DEM turned into the one bound E
- * every tile is refined to.
+ * tiled_budget.c -- apps/simplify/, the simplify command: -max_points,
+ * -max_triangles and -percent in tiles (docs/scale.md): a budget of the
+ * whole DEM turned into the one bound E every tile is refined to.
  *
  * A first pass records each tile's error-against-count curve
  * (tt_tile_curve: the tile refined without its border vertices, the
