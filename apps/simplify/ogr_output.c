@@ -1,6 +1,7 @@
 /*
- * ogr_output.c -- apps/simplify/, the simplify command: what it checks about
- * an OGR output before any work, and the outputs that are no file.
+ * ogr_output.c -- apps/simplify/, the simplify command: what it checks
+ * about an OGR output before any work (output.c asks), and the outputs
+ * that are no file.
  *
  *  - The dry run: tt_ogr_write_tin() itself, with the same driver, layers
  *    (-layers), -dsco, -lco and -t_srs, writes a TIN of two triangles into

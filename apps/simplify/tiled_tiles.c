@@ -1,9 +1,9 @@
 /*
- * tiled_tiles.c -- apps/simplify/, the simplify command: what tiled.c asks
- * of one tile beside running it: the memory the tiles in flight take (for
- * -max_memory and the report), whether a DEM's tiles carry ground points,
- * and, for a budget's curve pass, a tile's curve points and the valid
- * samples it counts.
+ * tiled_tiles.c -- apps/simplify/, the simplify command: what its tiled
+ * path (tiled.c, tiled_workers.c) asks of one tile beside running it: the
+ * memory the tiles in flight take (for -max_memory and the report),
+ * whether a DEM's tiles carry ground points, and, for a budget's curve
+ * pass, a tile's curve points and the valid samples it counts.
  */
 #include "simplify.h"
 #include "gdal/georef/georef.h" /* tt__georef_is_web_mercator */
