@@ -149,8 +149,6 @@ typedef struct app_run {
   app_messages msg;
   app_phase prog;
   double t0;
-  struct tt_app_tile_sink *sink; /* a tiled run's streamed GeoPackage, or
-                                    NULL (tiled_stream.c) */
 } app_run;
 
 /* Records the run's failure "<file>: <problem>" (or "<problem>" when file
@@ -180,6 +178,11 @@ int tt__app_continue(app_run *r, double at);
  * one line why and returns NULL. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
                                  GDALRasterBandH *out_band);
+/* The read options of -srcnodata, -z_factor, -z_unit and -work_srs
+ * (tt_gdal_read_grid's SRCNODATA, Z_FACTOR, Z_UNIT, WORK_SRS), for a
+ * whole DEM (tt__app_read_dem adds MAX_MEMORY) and a tiled run's windows
+ * alike. The caller frees the list with CSLDestroy(). */
+char **tt__app_read_options(const tt_app_settings *s);
 /* Reads the band into a grid (with -srcnodata, -z_factor, -z_unit,
  * -work_srs) and checks it has valid samples. The caller owns *out_grid and
  * *out_info. */

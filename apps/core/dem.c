@@ -236,6 +236,23 @@ static void warn_fill_values(app_run *r, const tt_grid *grid,
   }
 }
 
+char **tt__app_read_options(const tt_app_settings *s)
+{
+  char **ropts = NULL;
+  if (s->srcnodata)
+    ropts = CSLSetNameValue(ropts, "SRCNODATA", s->srcnodata);
+  if (s->z_factor != 1.0 || s->z_factor_set) {
+    char num[40];
+    tt__app_format_double(num, sizeof num, s->z_factor);
+    ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
+  }
+  if (s->z_unit)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", s->z_unit);
+  if (s->work_srs)
+    ropts = CSLSetNameValue(ropts, "WORK_SRS", s->work_srs);
+  return ropts;
+}
+
 /* Reads the band into a grid and checks it has usable samples. */
 tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
                           tt_progress_fn progress, void *progress_arg,
@@ -245,18 +262,7 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
   tt_grid *grid = NULL;
   tt_raster_info *info = NULL;
   size_t valid = 0;
-  char **ropts = NULL;
-  if (r->s->srcnodata)
-    ropts = CSLSetNameValue(ropts, "SRCNODATA", r->s->srcnodata);
-  if (r->s->z_factor != 1.0 || r->s->z_factor_set) {
-    char num[40];
-    tt__app_format_double(num, sizeof num, r->s->z_factor);
-    ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
-  }
-  if (r->s->z_unit)
-    ropts = CSLSetNameValue(ropts, "Z_UNIT", r->s->z_unit);
-  if (r->s->work_srs)
-    ropts = CSLSetNameValue(ropts, "WORK_SRS", r->s->work_srs);
+  char **ropts = tt__app_read_options(r->s);
   if (r->s->max_memory)
     ropts = CSLSetNameValue(ropts, "MAX_MEMORY",
                             CPLSPrintf("%zu", r->s->max_memory));

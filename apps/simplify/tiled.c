@@ -189,26 +189,6 @@ static tt_status tiled_size(tiled *T, app_simplify_job *job)
   return TT_OK;
 }
 
-/* The read options of every window but its WINDOW (those
- * tt__app_read_dem gives a whole DEM, but -max_memory: the tiles in
- * flight are bounded instead). */
-static char **read_options(const tt_app_settings *s)
-{
-  char **ropts = NULL;
-  if (s->srcnodata)
-    ropts = CSLSetNameValue(ropts, "SRCNODATA", s->srcnodata);
-  if (s->z_factor != 1.0 || s->z_factor_set) {
-    char num[40];
-    tt__app_format_double(num, sizeof num, s->z_factor);
-    ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
-  }
-  if (s->z_unit)
-    ropts = CSLSetNameValue(ropts, "Z_UNIT", s->z_unit);
-  if (s->work_srs)
-    ropts = CSLSetNameValue(ropts, "WORK_SRS", s->work_srs);
-  return ropts;
-}
-
 /* Each tile's options: the job's, on one thread, polling the stop flag,
  * without a memory limit (the tiles in flight are bounded, simplify.c);
  * a budget of the whole DEM becomes a bound (budget_run). */
@@ -261,7 +241,9 @@ static void hold_cache(tiled *T)
 static tt_status tiled_init(tiled *T)
 {
   const app_simplify_job *job = T->job;
-  T->ropts = read_options(job->s);
+  /* every window's read options but its WINDOW: a whole DEM's, but
+   * -max_memory (the tiles in flight are bounded instead) */
+  T->ropts = tt__app_read_options(job->s);
   T->max_memory = job->s->max_memory;
   T->inflight_bytes = tt__app_tile_bytes(T->N, T->W, T->H, T->nthreads,
                                          job->ground);
