@@ -6,7 +6,7 @@
 # The same interpreter either way; nothing is defined when python3 is
 # missing, so the test's own `command -v python3` still skips.
 # TT_APPS: this folder (tests/apps), absolute, for the helper scripts
-# (layers_md5.py, same_gpkg.py, tin_topology.py) once the test has left
+# (same_gpkg.py, tin_topology.py) once the test has left
 # for its work folder
 TT_APPS=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 if [ -z "${TT_PY:-}" ] && command -v python3 >/dev/null 2>&1; then
