@@ -6,15 +6,25 @@
 # of the script itself, so a helper call or a loop counts whole on the
 # line that called it. For finding what to shrink when a test is slow.
 #
-#   bench/profile_test.sh [-n TOP] BUILD_DIR tests/apps/test_tiles.sh
+#   bench/profile_test.sh [-n TOP] [-f FILE] BUILD_DIR tests/apps/test_tiles.sh
+#
+# -f FILE: the lines of FILE instead (a helper the test sources, such as
+# tt_tiles_lib.sh), to see inside a helper that a test calls.
 #
 # BUILD_DIR gives the command (BUILD_DIR/terratin) and the environment of
 # the ctest (TT_TESTDATA, TT_SHARED_TESTDATA=../shared/testdata).
 set -u
 top=15
-if [ "${1:-}" = -n ]; then top=$2; shift 2; fi
+file=
+while [ $# -gt 2 ]; do
+  case $1 in
+    -n) top=$2; shift 2 ;;
+    -f) file=$2; shift 2 ;;
+    *) break ;;
+  esac
+done
 if [ $# -ne 2 ]; then
-  echo "usage: $0 [-n TOP] BUILD_DIR TEST.sh" >&2
+  echo "usage: $0 [-n TOP] [-f FILE] BUILD_DIR TEST.sh" >&2
   exit 2
 fi
 build=$(cd "$1" && pwd) || exit 2
@@ -30,14 +40,14 @@ start=$EPOCHREALTIME
 # the trace on fd 9, the test's own output as usual; PS4 is set inside
 # (bash run as root does not take it from the environment) and the test
 # sourced with $0 its own path
-bash -c 'PS4='\''+${EPOCHREALTIME}|${BASH_SOURCE[0]##*/}:${LINENO}|'\''
+bash -c 'PS4='\''+${EPOCHREALTIME}|${BASH_SOURCE[0]-}:${LINENO}|'\''
 BASH_XTRACEFD=9; set -x; . "$0"' "$test" 9>"$trace"
 rc=$?
 end=$EPOCHREALTIME
-python3 - "$trace" "$(basename "$test")" "$top" "$start" "$end" "$rc" <<'PY'
+python3 - "$trace" "$(basename "${file:-$test}")" "$top" "$start" "$end" "$rc" <<'PY'
 import collections, re, sys
 trace, script, top, start, end, rc = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5]), sys.argv[6]
-pat = re.compile(r"^\++(\d+\.\d+)\|([^:|]*):(\d+)\|(.*)$")
+pat = re.compile(r"^\++(\d+\.\d+)\|(?:[^:|]*/)?([^/:|]*):(\d+)\|(.*)$")
 marks = []  # (time, line, text) of the script's own commands
 for raw in open(trace, errors="replace"):
     m = pat.match(raw.rstrip("\n"))

@@ -11,6 +11,7 @@
 # folder with GDAL's own tools. Prints "N passed, M failed"; exits 1 on any
 # failure, 77 (skip) when a tool is missing.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/tt_python.sh"
 
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then

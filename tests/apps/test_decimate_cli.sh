@@ -8,6 +8,7 @@
 # usage errors (exit 2, one line). Exits 1 on a failure, 77 when a tool is
 # missing.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/tt_python.sh"
 
 T=${TT_TERRATIN:-}
 if [ -z "$T" ] || [ ! -x "$T" ]; then

@@ -6,6 +6,7 @@
 # and validity from an alpha band and from an external .msk mask. Each is simplified, then measured by `terratin eval`: every
 # valid sample covered once, the bound met, the valid count right.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/tt_python.sh"
 T=${TT_TERRATIN:?} D=${TT_TESTDATA:?}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

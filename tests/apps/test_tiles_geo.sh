@@ -30,7 +30,8 @@ set -u
 . "$(dirname "${BASH_SOURCE[0]}")/tt_tiles_lib.sh" || exit 1
 
 # same_triangles A.gpkg B.gpkg: the attributes of the triangles both TINs
-# have (the same three samples) are equal; prints how many there are
+# have (the same three samples) are equal; prints how many there are (at
+# least 1,000 and a tenth of them)
 cat >same.py <<'PY'
 import sqlite3, sys
 COLS = "area_2d, area_3d, slope, aspect, min_angle, max_angle"
@@ -55,12 +56,15 @@ for k in common:
 print("%d of %d triangles in common, largest relative difference %.3g%s" % (
     len(common), len(a), worst,
     (" at %s: %s vs %s" % (at, a[at], b[at])) if at else ""))
-sys.exit(0 if len(common) * 2 > len(a) and worst <= 1e-12 else 1)
+# enough of them to mean something: thousands (a fifth of the triangles at
+# max error 8; more than half at 4, whose TINs are three times the size)
+sys.exit(0 if len(common) >= 1000 and len(common) * 10 > len(a) and worst <= 1e-12 else 1)
 PY
 
 run generate diamond_square ds.tif -size 257 -seed 7 -q
 check "generate: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-E=4
+# (max error 8: 9,500 vertices in each frame; 30,000 at 4)
+E=8
 # name, SRS, extent (ulx uly lrx lry), the frame the untiled run chooses
 cases=(
   "utm|EPSG:4326|10 70 11 69.5|UTM zone 32N"
@@ -108,7 +112,7 @@ done
 # decimation and budgets of geographic and Web Mercator DEMs, streamed
 streamed_vs_merged "stereo, decimation, 2 threads" stereo.tif -method decimate -max_error $E -tile_size 64 -threads 2
 streamed_vs_merged "webmerc, decimation, 1 thread" webmerc.tif -method decimate -max_error $E -tile_size 64 -threads 1
-streamed_vs_merged "stereo, -max_points 8000, 2 threads" stereo.tif -max_points 8000 -tile_size 64 -threads 2
+streamed_vs_merged "stereo, -max_points 3000, 2 threads" stereo.tif -max_points 3000 -tile_size 64 -threads 2
 streamed_vs_merged "webmerc, -percent 3, 1 thread" webmerc.tif -percent 3 -tile_size 64 -threads 1
 # 2 % of the 66,049 samples is 1,320 vertices: every pass at the bounds the
 # tiles' curves give makes one to three too many (their borders thin out
@@ -117,13 +121,14 @@ streamed_vs_merged "webmerc, -percent 3, 1 thread" webmerc.tif -percent 3 -tile_
 streamed_vs_merged "webmerc, -percent 2, 2 threads" webmerc.tif -percent 2 -tile_size 64 -threads 2
 check "webmerc, -percent 2: $(jget s.json vertices) <= 1320 vertices" [ "$(jget s.json vertices)" -le 1320 ]
 check "webmerc, -percent 2: at least 97 % of them" [ "$(jget s.json vertices)" -ge 1280 ]
-streamed_vs_merged "utm, decimation -max_triangles 12000, 2 threads" utm.tif -method decimate -max_triangles 12000 -tile_size 64 -threads 2
-check "utm, decimation -max_triangles 12000: $(jget s.json triangles) <= 12000" [ "$(jget s.json triangles)" -le 12000 ]
+streamed_vs_merged "utm, decimation -max_triangles 6000, 2 threads" utm.tif -method decimate -max_triangles 6000 -tile_size 64 -threads 2
+check "utm, decimation -max_triangles 6000: $(jget s.json triangles) <= 6000" [ "$(jget s.json triangles)" -le 6000 ]
 
 # interrupted while a geographic DEM's GeoPackage is streamed
-run generate diamond_square in/big.tif -size 1025 -seed 1 -q
+# (513^2: 2.1 s in Release, longer under the sanitizers)
+run generate diamond_square in/big.tif -size 513 -seed 1 -q
 gdal_translate -q -a_srs EPSG:4326 -a_ullr 10 76 20 70 in/big.tif in/big_geo.tif
-for d in 0.5 1.5 3; do
+for d in 0.3 0.8 1.4; do
   interrupted "geographic, streamed" $d -max_error 0.5 -tile_size 128 -threads 2 in/big_geo.tif
 done
 

@@ -14,6 +14,7 @@
 # metres.
 # Exits 1 on a failure, 77 when a tool is missing.
 set -u
+. "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_python.sh"
 T=${TT_TERRATIN:-}
 D=${TT_TESTDATA:-}
 if [ -z "$T" ] || [ ! -x "$T" ] || [ -z "$D" ]; then
