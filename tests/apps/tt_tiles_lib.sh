@@ -177,13 +177,14 @@ interrupted() {
 # left 320 x 256 corner (2,100 vertices; the collar along two sides) in
 # tiles of 64, or with REAL_FULL=1 (tests/long/) the whole 1013 x 799 in
 # tiles of 128; Vinschgau (252 x 194) whole at max error 60 in tiles of
-# 64, or at 20 in tiles of 128.
+# 64, or at 20 in tiles of 128. REAL_DEMS="PATH:E ..." (relative to the
+# shared test data) names other DEMs, or only one of these.
 real_dems() {
   local label=$1
   shift
   local S=${TT_SHARED_TESTDATA:-} rel p e b nu nv dem n=64
   [ -n "${REAL_FULL:-}" ] && n=128
-  for rel in gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschgau.tif:20; do
+  for rel in ${REAL_DEMS:-gdalraster/lf_elev_220_mt_hood_utm.tif:20 rspatial_terra/elev_vinschgau.tif:20}; do
     p=${rel%%:*}
     e=${rel##*:}
     if [ -z "$S" ] || [ ! -f "$S/$p" ]; then

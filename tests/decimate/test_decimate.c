@@ -116,11 +116,13 @@ static const tt_importance IMPORTANCES[] = {
 
 /* Every importance x selection (x onepass), on terrain with and without
  * nodata, from every start: the bound holds by the oracle, the mesh stays
- * valid after each removal. */
+ * valid after each removal. 108 runs, each validating the whole mesh
+ * after every removal (quadratic in the size): on 27 x 25 samples, where
+ * 41 x 37 took 7 times as long (38 s of the test's 39 in Release). */
 static void test_exact_bound(void)
 {
   for (int holes = 0; holes <= 1; holes++) {
-    tt_grid *g = terrain(41, 37, 7 + (uint64_t)holes, 3.0, holes ? 3 : 0);
+    tt_grid *g = terrain(27, 25, 7 + (uint64_t)holes, 3.0, holes ? 3 : 0);
     size_t valid = 0;
     tt_grid_check(ctx, g, &valid);
     size_t uncarriable = tt_oracle_uncarriable(g);
@@ -135,7 +137,7 @@ static void test_exact_bound(void)
                                  : TT_SELECTION_INDEPENDENT;
           o.onepass = sel == 1;
           o.start = (tt_decimate_start)st;
-          o.start_points = 600;
+          o.start_points = 270; /* 40 % of the samples */
           checker k = {0, 0, (uint64_t)(ii * 100 + (size_t)sel * 10 +
                                         (size_t)st)};
           tt_tin *tin = NULL;
