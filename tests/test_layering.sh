@@ -103,4 +103,4 @@ done)
 [ -z "$stale" ] || broken "functions no longer over 150 lines: take them off known_long" "$stale"
 
 [ "$fail" = 0 ] || exit 1
-echo "test_layering: the engine is free of GDAL and of the glue, the glue is in its roles, each command in its folder over the core, no function over 150 lines"
+echo "test_layering: the engine is free of GDAL and of the glue, the glue is in its roles, each command in its folder over the core, every file naming its folder, no function over 150 lines"
