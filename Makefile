@@ -18,7 +18,7 @@ DEB_PKGS   := cmake make gcc g++ pkg-config libgdal-dev libproj-dev gdal-bin lib
 DEMO_IN    ?= testdata/jacksboro_fault_dem.tif
 DEMO_OUT   ?= demo-out/jacksboro_tin.gpkg
 
-.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study
+.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study doc-tables
 
 all: build
 
@@ -83,6 +83,10 @@ bench: build
 # in ../shared/testdata (or CRATER=PATH).
 study: build
 	tools/study.sh $(BUILD)/terratin
+
+# The tables of docs/ that scripts print, rerun in place (README "Tests").
+doc-tables: build
+	bench/doc_tables.py --update --tier long $(BUILD)/terratin
 
 clean:
 	rm -rf $(BUILD) $(BUILD_SAN) demo-out

@@ -11,12 +11,16 @@
   speed    1025^2 fractal from -start all to 2 % against greedy insertion
            to the same vertex count, wall and CPU seconds, peak memory.
   select   importance x selection at one bound on Crater Lake.
+  budget   Crater Lake at 10,000 vertices: insertion and both selections.
+
+Each prints the table of docs/decimation.md it makes (bench/doc_tables.py
+reruns them there); it exits 77 when a shared DEM is absent.
 
 Usage: bench/decimate.py WHAT [TERRATIN]   (TERRATIN default build/terratin)
 Shared DEMs come from $TT_SHARED_TESTDATA (default ../shared/testdata).
 Prints a markdown table; runs are short, one at a time.
 """
-import json, os, resource, subprocess, sys, tempfile, time
+import atexit, json, os, resource, shutil, subprocess, sys, tempfile, time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 T = sys.argv[2] if len(sys.argv) > 2 else os.path.join(HERE, "..", "build", "terratin")
@@ -24,6 +28,7 @@ SHARED = os.environ.get("TT_SHARED_TESTDATA", os.path.join(HERE, "..", "..", "sh
 CRATER = os.path.join(SHARED, "garland_heckbert_terra_scape", "crater.stm.vrt")
 HOOD = os.path.join(SHARED, "gdalraster", "lf_elev_220_mt_hood_utm.tif")
 TMP = tempfile.mkdtemp(prefix="tt_bench_dec.")
+atexit.register(shutil.rmtree, TMP, True)
 CRITERIA = ["delaunay", "minmax_angle", "min_area", "mean_curvature",
             "gaussian_curvature", "abn", "l2"]
 PUBLISHED = {  # SPEC section 6, decimation of Crater Lake, average error
@@ -59,33 +64,57 @@ def fractal():
     return f
 
 
+def need(path):
+    """Exit 77 (skipped, for bench/doc_tables.py) when a shared DEM is absent."""
+    if not os.path.exists(path):
+        sys.stderr.write(f"SKIP: {path} is absent (shared test data)\n")
+        raise SystemExit(77)
+
+
 def table2():
-    print("| % deleted | points | " + " | ".join(CRITERIA) + " |")
+    """docs/decimation.md: the study's Table 2 beside the published column."""
+    need(CRATER)
+    print("| deleted | | " + " | ".join(CRITERIA).replace("mean_curvature", "mean_curv.")
+          .replace("gaussian_curvature", "gaussian") + " |")
     print("|---|---|" + "---|" * len(CRITERIA))
-    res = {}
     for pct in (10, 25, 50, 75):
         keep = 100000 - 1000 * pct
-        row = []
-        for c in CRITERIA:
-            d = run(CRATER, "-method", "decimate", "-start", "greedy:100000",
-                    "-importance", "hdh", "-selection", "independent",
-                    "-criterion", c, "-max_points", keep)
-            row.append(d)
-            res[(pct, c)] = d
-        print(f"| {pct} ours | {keep} | " +
-              " | ".join(f"{d['mean_abs_error']:.6g}" for d in row) + " |")
-        print(f"| {pct} study | {100000 - keep} deleted | " +
-              " | ".join(f"{v:.6g}" for v in PUBLISHED[pct]) + " |")
-        print(f"| {pct} seconds | | " +
-              " | ".join(f"{d['_wall']:.1f}" for d in row) + " |", flush=True)
+        row = [run(CRATER, "-method", "decimate", "-start", "greedy:100000",
+                   "-importance", "hdh", "-selection", "independent",
+                   "-criterion", c, "-max_points", keep) for c in CRITERIA]
+        print(f"| {pct} % | ours | " +
+              " | ".join(f"{d['mean_abs_error']:.4f}" for d in row) + " |")
+        print("| | study | " +
+              " | ".join(f"{v:.4f}" for v in PUBLISHED[pct]) + " |", flush=True)
+        sys.stderr.write(f"{pct} %: seconds " +
+                         " ".join(f"{d['_wall']:.1f}" for d in row) + "\n")
+
+
+def budget():
+    """docs/decimation.md: Crater Lake at 10,000 vertices, each selection."""
+    need(CRATER)
+    print("| Crater Lake, 10,000 vertices | RMSE | mean | max |")
+    print("|---|---|---|---|")
+    runs = [("insert", [])]
+    for sel in ("independent", "sequential"):
+        runs.append((f"decimate `-importance error -selection {sel}`",
+                     ["-method", "decimate", "-start", "greedy",
+                      "-importance", "error", "-selection", sel]))
+    for label, args in runs:
+        d = run(CRATER, *args, "-max_points", 10000)
+        print(f"| {label} | {d['rmse']:.4g} | {d['mean_abs_error']:.4g} | "
+              f"{d['max_error']:.6g} |", flush=True)
 
 
 def versus():
-    dems = [("Crater Lake", CRATER, 2.0, 10000),
-            ("Mt Hood", HOOD, 5.0, 20000),
-            ("fractal 1025^2", fractal(), 4.0, 21000)]
-    print("| DEM | method | at -max_error: vertices | s (cpu) | "
-          "at the budget: RMSE | mean | max |")
+    """docs/decimation.md: decimate against insert at a bound and a budget."""
+    need(CRATER)
+    need(HOOD)
+    dems = [("Crater Lake", CRATER, 2, 10000),
+            ("Mt Hood", HOOD, 5, 20000),
+            ("fractal 1025²", fractal(), 4, 21000)]
+    print("| DEM (bound, budget) | method | vertices at the bound | s (CPU) | "
+          "RMSE | mean | max |")
     print("|---|---|---|---|---|---|---|")
     for name, dem, e, budget in dems:
         start = "all" if "fractal" in name else "greedy"
@@ -95,13 +124,21 @@ def versus():
                    "error", "-selection", sel]
             runs.append((f"decimate {sel}", dec + ["-max_error", e],
                          dec + ["-max_points", budget]))
-        for label, at_bound, at_budget in runs:
-            a = run(dem, *at_bound)
-            b = run(dem, *at_budget)
-            print(f"| {name} (E {e}, budget {budget}) | {label} | "
-                  f"{a['vertices']} | {a['_wall']:.2f} ({a['_cpu']:.2f}) | "
-                  f"{b['rmse']:.4g} | {b['mean_abs_error']:.4g} | "
-                  f"{b['max_error']:.4g} |", flush=True)
+        got = [(label, run(dem, *at_bound), run(dem, *at_budget))
+               for label, at_bound, at_budget in runs]
+        low = {k: min(x[2 if k != "vertices" else 1][k] for x in got)
+               for k in ("vertices", "rmse", "mean_abs_error", "max_error")}
+
+        def cell(d, k, text):
+            return f"**{text}**" if d[k] == low[k] else text
+        for i, (label, a, b) in enumerate(got):
+            dem_cell = f"{name} ({e}, {budget:,})" if i == 0 else ""
+            print(f"| {dem_cell} | {label} | "
+                  + cell(a, "vertices", format(a["vertices"], ",")) + " | "
+                  + f"{a['_wall']:.2f} ({a['_cpu']:.2f}) | "
+                  + " | ".join(cell(b, k, format(b[k], ".4g"))
+                               for k in ("rmse", "mean_abs_error",
+                                         "max_error")) + " |", flush=True)
 
 
 def speed():
@@ -119,19 +156,26 @@ def speed():
 
 
 def select():
-    print("| importance | selection | vertices | wall s | cpu s |")
-    print("|---|---|---|---|---|")
+    """docs/decimation.md: vertices left at -max_error 2 (CPU seconds)."""
+    need(CRATER)
+    sels = (["-selection", "independent"],
+            ["-selection", "independent", "-onepass"],
+            ["-selection", "sequential"])
+    rows = {}
     for imp in ("degree", "hdh", "abh", "volume", "drop", "error"):
-        for sel in (["-selection", "independent"],
-                    ["-selection", "independent", "-onepass"],
-                    ["-selection", "sequential"]):
-            d = run(CRATER, "-method", "decimate", "-start", "greedy",
-                    "-importance", imp, *sel, "-max_error", 2)
-            print(f"| {imp} | {' '.join(sel[1:])} | {d['vertices']} | "
-                  f"{d['_wall']:.2f} | {d['_cpu']:.2f} |", flush=True)
+        rows[imp] = [run(CRATER, "-method", "decimate", "-start", "greedy",
+                         "-importance", imp, *sel, "-max_error", 2)
+                     for sel in sels]
+    best = min(d["vertices"] for r in rows.values() for d in r)
+    print("| importance | independent | independent -onepass | sequential |")
+    print("|---|---|---|---|")
+    for imp, r in rows.items():
+        cell = [(f"**{d['vertices']:,}**" if d["vertices"] == best
+                 else f"{d['vertices']:,}") + f" ({d['_cpu']:.2f})" for d in r]
+        print(f"| {imp} | " + " | ".join(cell) + " |")
 
 
 if __name__ == "__main__":
     what = sys.argv[1] if len(sys.argv) > 1 else "table2"
-    {"table2": table2, "versus": versus, "speed": speed,
+    {"table2": table2, "budget": budget, "versus": versus, "speed": speed,
      "select": select}[what]()

@@ -225,20 +225,22 @@ def report(study_out, out_dir):
       "hold every parameter). terratin %s, %s; %d runs."
       % (ins_meta["version"], ins_meta["created"], nruns))
     w("")
-    seen = {}
-    for r in ins_rows:
-        seen.setdefault(r["criterion"], set()).add(r["optimizer"])
-    opts = ["%s %s" % (SHORT.get(c, c), "/".join(sorted(seen[c])))
-            for c in C7 if c in seen]
+    def final_passes(rows):
+        seen = {}
+        for r in rows:
+            seen.setdefault(r["criterion"], set()).add(r["optimizer"])
+        return ", ".join("%s %s" % (SHORT.get(c, c), "/".join(sorted(seen[c])))
+                         for c in C7 if c in seen)
     w("Each criterion is run as `terratin study` runs it by default "
       "(`-optimizers auto`, [docs/cli.md](../cli.md) says how each is "
       "inserted); the final pass of each (the `optimizer` column of the "
-      "CSVs): %s. The study inserted Delaunay and Min-Max angle with "
+      "CSVs) in the insertion runs: %s; in the decimation runs: %s. The "
+      "study inserted Delaunay and Min-Max angle with "
       "their flips, min area with the dynamic programme over the hole, "
       "and every other criterion by Delaunay insertion followed by the "
       "local swap (SPEC section 6). The error measure of the tables is "
       "the average absolute error over the valid samples."
-      % ", ".join(opts))
+      % (final_passes(ins_rows), final_passes(dec_rows)))
     w("")
     w("A finding that is checked over many rows is **confirmed** when it "
       "holds in at least %d %% of them, **refuted** otherwise; the counts "
