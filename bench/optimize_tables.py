@@ -89,7 +89,7 @@ def crater():
                 cells.append("(local)")
                 continue
             d = optimize(CRATER, tin, "-criterion", c, "-optimize", m)
-            cell = (f"{d['after']['mean_abs_error']:.4g} / "
+            cell = (f"{d['after']['mean_abs_error']:#.4g} / "
                     f"{d['seconds']['optimize']:.3g} s")
             if c.startswith("minmax_angle"):
                 cell += f" / {d['after']['largest_angle_deg']:.2f}°"
