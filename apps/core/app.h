@@ -256,6 +256,10 @@ typedef struct app_simplify_report {
   int tile_threads, auto_tiled;
   int budget_passes;  /* tiled runs to a budget: the runs at a bound */
   int streamed;       /* the GeoPackage written as the tiles merged */
+  /* the CRS the layers are written in: -t_srs, or the one a format takes
+   * only (GPX: EPSG:4326, chosen by the dry run); NULL: the DEM's */
+  const char *t_srs;
+  int t_srs_auto;     /* t_srs was chosen for the format, not given */
 } app_simplify_report;
 
 /* --- the subcommands ----------------------------------------------------- */

@@ -13,8 +13,14 @@
  *    the -layers that the driver takes (each layer is then tried alone) or,
  *    for a format that writes a folder of files when OUTPUT has no
  *    extension, that form. What the drivers' metadata says is not enough:
- *    DXF and GPX claim several layers. A driver that cannot even create a
- *    dataset in memory is not judged (the real write will say).
+ *    DXF and GPX claim several layers. A driver that cannot create a
+ *    dataset in memory gets its dry run in a folder of the system's
+ *    temporary directory; one that can create none is refused.
+ *  - The read-back (ogr_readback.c): what the dry run wrote is read back
+ *    and every x, y and z compared with the TIN written; a format that
+ *    changes them is refused, naming what changed, and one that holds
+ *    longitude/latitude only (GPX) is written in that CRS (the summary
+ *    says so).
  *  - Databases (PostgreSQL through "PG:..."; any driver that writes no file
  *    and holds transactions): the datasource is opened before the work,
  *    its layers of our names refused without -overwrite, and the TIN is
@@ -31,6 +37,7 @@
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,11 +51,18 @@ static const tt_run_field probe_fields[] = {
     {"max_error", TT_FIELD_REAL, NULL, 0, 1.5},
 };
 
-/* A two-triangle TIN on the DEM's first 2 x 2 samples (its geotransform),
- * for the dry run. NULL when the engine cannot make it. */
-static tt_tin *probe_tin(tt_context *ctx, const double gt[6])
+/* A two-triangle TIN on the DEM's first 2 x 2 samples (its geotransform,
+ * its origin moved by an irrational share of a pixel so that the
+ * coordinates have every digit), for the dry run: heights that use every
+ * bit of a float, so that a format that rounds them shows it. NULL when
+ * the engine cannot make it. */
+static tt_tin *probe_tin(tt_context *ctx, const double dem_gt[6])
 {
-  static const float z[4] = {1, 2, 3, 5};
+  static const float z[4] = {2602.37f, 2578.13f, 2597.91f, -12.3457f};
+  double gt[6];
+  memcpy(gt, dem_gt, sizeof gt);
+  gt[0] += 0.3183098861837907 * gt[1];
+  gt[3] += 0.2718281828459045 * gt[5];
   tt_grid *grid = NULL;
   tt_tin *tin = NULL;
   tt_refine_options ro;
@@ -69,10 +83,17 @@ typedef struct probe {
   OGRSpatialReferenceH srs;
   char why[TT_APP_MESSAGE_MAX];
   unsigned seq;
+  /* the read-back (ogr_readback.c) of what a probe wrote */
+  const char *t_srs;      /* T_SRS of wopts, or NULL */
+  double tol_xy;          /* in the TIN's CRS */
+  int lossy;              /* the last probe written did not read back */
+  char lost[TT_APP_MESSAGE_MAX]; /* what changed */
+  char *imposed;          /* the driver's own geographic CRS (GPX) */
 } probe;
 
-/* 1: the driver wrote the layers of mask; 0: it refused (p->why says
- * why); -1: no dataset could be made in memory, nothing is known. */
+/* 1: the driver wrote the layers of mask (p->lossy: not as they were
+ * given); 0: it refused or could create no dataset (p->why says why); -1:
+ * nothing is known (no context). */
 static int probe_run(probe *p, unsigned mask, const char *ext)
 {
   char list[64];
@@ -91,6 +112,33 @@ static int probe_run(probe *p, unsigned mask, const char *ext)
   GDALDatasetH ds = ctx ? GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
                                      (CSLConstList)p->dsco)
                         : NULL;
+  if (!ds && ctx) {
+    /* A driver that writes only real files (FITS, netCDF, BAG): the dry
+     * run in a folder of the system's temporary directory instead. */
+    const char *tmp = getenv("TMPDIR");
+    char *real = CPLStrdup(CPLSPrintf("%s/terratin_probe_XXXXXX",
+                                      tmp && *tmp ? tmp : "/tmp"));
+    VSIRmdirRecursive(dir);
+    if (mkdtemp(real)) {
+      CPLFree(dir);
+      CPLFree(name);
+      dir = real;
+      name = CPLStrdup(CPLSPrintf("%s/out%s", dir, ext));
+      CPLErrorReset();
+      ds = GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
+                      (CSLConstList)p->dsco);
+    } else {
+      CPLFree(real);
+    }
+    if (!ds) {
+      /* nowhere: the real write would fail the same way */
+      snprintf(p->why, sizeof p->why, "cannot create a %s dataset: %s",
+               GDALGetDriverShortName(p->drv),
+               *CPLGetLastErrorMsg() ? CPLGetLastErrorMsg()
+                                     : "no details from GDAL");
+      result = 0;
+    }
+  }
   if (ds) {
     tt_status st = tt_ogr_write_tin(ctx, ds, p->tin, p->srs, probe_fields,
                                     sizeof probe_fields /
@@ -113,6 +161,28 @@ static int probe_run(probe *p, unsigned mask, const char *ext)
       snprintf(p->why, sizeof p->why, "the driver writes a folder of one "
                "file a layer for them");
       result = 0;
+    }
+    /* Written: does it read back as written? */
+    p->lossy = 0;
+    if (result == 1 && (mask & 3u)) {
+      char *imposed = NULL;
+      /* Shapefile layers are files of their own beside OUTPUT: the
+       * folder reads as one dataset of them */
+      VSIStatBufL nb;
+      const char *back =
+          tt__app_str_ieq(GDALGetDriverShortName(p->drv), "ESRI Shapefile") &&
+                  !(VSIStatL(name, &nb) == 0 && VSI_ISDIR(nb.st_mode))
+              ? dir
+              : name;
+      if (!tt__app_read_back(p->drv, back, mask, p->tin, p->srs, p->t_srs,
+                             p->tol_xy, p->lost, sizeof p->lost,
+                             &imposed)) {
+        p->lossy = 1;
+        if (imposed && !p->imposed)
+          p->imposed = imposed;
+        else
+          CPLFree(imposed);
+      }
     }
   }
   VSIRmdirRecursive(dir);
@@ -153,9 +223,20 @@ char **tt__app_output_dsco(const char *drvname, const char *const *dsco)
   return out;
 }
 
-int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
-                             char **dsco, char **wopts)
+/* A driver that does not keep the TIN as written: refused, naming what
+ * changed and what works instead. */
+static void refuse_lossy(app_run *r, const char *dname, const char *lost)
 {
+  tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+               "simplify: -of %s cannot hold the TIN faithfully (%s); "
+               "write -of GPKG or \"ESRI Shapefile\", or a mesh format "
+               "(2DM, PLY, OBJ, LandXML, DXF)", dname, lost);
+}
+
+int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
+                             char **dsco, char **wopts, char **auto_t_srs)
+{
+  *auto_t_srs = NULL;
   const tt_app_settings *s = r->s;
   const char *dname = GDALGetDriverShortName(drv);
   probe p;
@@ -171,6 +252,8 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
       p.wopts = CSLAddString(p.wopts, *o);
   double gt[6] = {0, 1, 0, 0, 0, -1};
   GDALGetGeoTransform(src, gt);
+  p.t_srs = CSLFetchNameValue(wopts, "T_SRS");
+  p.tol_xy = 1e-6 * fmin(fabs(gt[1]), fabs(gt[5]));
   const char *wkt = GDALGetProjectionRef(src);
   if (wkt && *wkt) {
     p.srs = OSRNewSpatialReference(wkt);
@@ -185,6 +268,28 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
 
   const unsigned want = s->layers;
   int all = probe_run(&p, want, p.ext);
+  if (all == 1 && p.lossy && p.imposed && !p.t_srs) {
+    /* A driver that takes only longitude/latitude of its own CRS (GPX):
+     * written in that CRS, which the summary states, when that keeps the
+     * TIN. */
+    probe q = p;
+    q.wopts = CSLSetNameValue(CSLDuplicate(p.wopts), "T_SRS", p.imposed);
+    q.t_srs = p.imposed;
+    q.imposed = NULL;
+    int again = probe_run(&q, want, p.ext);
+    CSLDestroy(q.wopts);
+    CPLFree(q.imposed);
+    if (again == 1 && !q.lossy) {
+      *auto_t_srs = p.imposed;
+      p.imposed = NULL;
+      goto done;
+    }
+  }
+  if (all == 1 && p.lossy) {
+    ok = 0;
+    refuse_lossy(r, dname, p.lost);
+    goto done;
+  }
   if (all != 0)
     goto done; /* it holds them, or it cannot be judged */
   char why_all[TT_APP_MESSAGE_MAX];
@@ -236,6 +341,11 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
   char why_one[TT_APP_MESSAGE_MAX] = "";
   for (unsigned bit = 1; bit <= 4; bit <<= 1) {
     int k = probe_run(&p, bit, p.ext);
+    if (k == 1 && p.lossy && !p.imposed) {
+      ok = 0;
+      refuse_lossy(r, dname, p.lost);
+      goto done;
+    }
     if (k != 0)
       alone |= bit;
     else if (want & bit) {
@@ -292,6 +402,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
                "with %s", dname, list, why_all, choices);
 
 done:
+  CPLFree(p.imposed);
   tt_tin_destroy(p.tin);
   tt_context_destroy(ctx);
   if (p.srs)

@@ -105,6 +105,7 @@ typedef struct write_state {
                               the triangles and vertices */
   OGRLayerH tri_layer, vtx_layer, run_layer, style_layer;
   int tri_idx[TT__TF_COUNT], vtx_idx[TT__VF_COUNT];
+  int ele_idx;             /* GPX: the waypoints' "ele" field, else -1 */
   int *run_idx;
   tt_progress_fn progress;
   void *progress_arg;
@@ -459,6 +460,8 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
     set_int64(f, idx[TT__VF_STAR_N], (int64_t)v.star_samples);
     if (decimated)
       set_real(f, idx[TT__VF_IMPORTANCE], v.importance);
+    if (w->ele_idx >= 0)
+      OGR_F_SetFieldDouble(f, w->ele_idx, v.z);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(pt);
@@ -628,6 +631,12 @@ static tt_status make_layer(write_state *w, const tt_tin *tin,
     if (s == TT_OK)
       s = create_fields(w, w->vtx_layer, tt__vertex_fields,
                         tt__records_vertex_fields(tin), w->vtx_idx);
+    /* GDAL 3.6's GPX writer takes a waypoint's height from its "ele"
+     * field (<ele>), not from the point's Z */
+    w->ele_idx = -1;
+    if (s == TT_OK && strcasecmp(w->drv_name, "GPX") == 0)
+      w->ele_idx = OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(w->vtx_layer),
+                                        "ele");
   } else {
     s = create_layer(w, "run_parameters", NULL, wkbNone, &w->run_layer);
     if (s == TT_OK)
