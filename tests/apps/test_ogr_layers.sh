@@ -169,6 +169,25 @@ run simplify -q -t_srs EPSG:4326 -layers triangles nocrs.tif ref/n.geojson
 check "no CRS to transform from: exit 1, not a driver refusal ($rc)" [ "$rc" -eq 1 ]
 check "no CRS to transform from: says so" grep -q "no CRS" err.txt
 check "no CRS to transform from: nothing left" [ -z "$(ls -A ref)" ]
+# a DEM without a CRS is in pixel or map units: "Undefined Cartesian SRS"
+# (srs_id -1) in the layers and in every geometry blob, whole and tiled
+# (the tiled rows are written by terratin's own page writer)
+for how in whole tiled; do
+  opt=()
+  [ $how = tiled ] && opt=(-tile_size 16)
+  run simplify -q "${opt[@]}" nocrs.tif nocrs_$how.gpkg
+  check "no CRS, $how: exit 0 ($(head -c 200 err.txt))" [ "$rc" -eq 0 ]
+  check "no CRS, $how: srs_id -1 in gpkg_geometry_columns and every blob" \
+    python3 - nocrs_$how.gpkg <<'EOF'
+import sqlite3, struct, sys
+db = sqlite3.connect(sys.argv[1])
+assert {r[0] for r in db.execute(
+    "SELECT srs_id FROM gpkg_geometry_columns")} == {-1}
+for t in ("triangles", "vertices"):
+    for (g,) in db.execute("SELECT geom FROM " + t):
+        assert struct.unpack("<i", g[4:8])[0] == -1, t
+EOF
+done
 # the folder forms hold them all
 run simplify -q -max_error 1 -of FlatGeobuf dem.tif ref/fg
 check "FlatGeobuf folder: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]

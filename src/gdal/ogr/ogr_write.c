@@ -295,7 +295,18 @@ static tt_status create_layer(write_state *w, const char *suffix,
                               OGRwkbGeometryType type, OGRLayerH *out_layer)
 {
   char *name = CPLStrdup(CPLSPrintf("%s%s", w->prefix, suffix));
+  /* A GeoPackage layer without a CRS gets srs_id 0, "Undefined geographic
+   * SRS", from GDAL; a DEM without one is in pixel or map units, which is
+   * -1, "Undefined Cartesian SRS": GDAL maps this WKT to it. */
+  OGRSpatialReferenceH undefined = NULL;
+  if (!srs && w->gpkg && type != wkbNone) {
+    undefined = OSRNewSpatialReference(
+        "LOCAL_CS[\"Undefined cartesian SRS\"]");
+    srs = undefined;
+  }
   tt_status s = create_named_layer(w, name, srs, type, w->lco, out_layer);
+  if (undefined)
+    OSRDestroySpatialReference(undefined);
   CPLFree(name);
   return s;
 }
