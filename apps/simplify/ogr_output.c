@@ -223,6 +223,20 @@ char **tt__app_output_dsco(const char *drvname, const char *const *dsco)
   return out;
 }
 
+/* opts with the user's -nln taken off the end of NLN_PREFIX (which may
+ * begin with the prefix a Shapefile's OUTPUT gives). */
+static char **without_nln(char **opts, const char *nln)
+{
+  const char *pre = CSLFetchNameValue(opts, "NLN_PREFIX");
+  size_t n = pre ? strlen(pre) : 0, m = strlen(nln);
+  if (!m || n < m || strcmp(pre + n - m, nln) != 0)
+    return opts;
+  char *kept = CPLStrdup(CPLSPrintf("%.*s", (int)(n - m), pre));
+  opts = CSLSetNameValue(opts, "NLN_PREFIX", kept);
+  CPLFree(kept);
+  return opts;
+}
+
 /* A driver that does not keep the TIN as written: refused, naming what
  * changed and what works instead. */
 static void refuse_lossy(app_run *r, const char *dname, const char *lost)
@@ -294,6 +308,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
     goto done; /* it holds them, or it cannot be judged */
   char why_all[TT_APP_MESSAGE_MAX];
   snprintf(why_all, sizeof why_all, "%s", p.why);
+
   {
     /* The same into a GeoPackage, which holds everything: when that fails
      * too, the fault is not the driver's (a -t_srs the DEM's CRS cannot
@@ -306,6 +321,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
     for (char **o = p.wopts; o && *o; o++)
       if (strncasecmp(*o, "LCO=", 4) != 0 && strncasecmp(*o, "STYLE=", 6))
         g.wopts = CSLAddString(g.wopts, *o);
+    g.wopts = without_nln(g.wopts, s->nln);
     g.dsco = (char **)none;
     int control = gpkg ? probe_run(&g, want, ".gpkg") : -1;
     CSLDestroy(g.wopts);
@@ -316,14 +332,16 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
       goto done;
     }
   }
-  if ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0])) {
-    /* Without the user's -lco and -dsco? Then those are at fault. */
+  if ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0]) || s->nln[0]) {
+    /* Without the user's -lco, -dsco and -nln? Then those are at fault
+     * (a name the format reserves, a FID column named as a field). */
     probe q = p;
     static const char *const none[] = {NULL};
     q.wopts = NULL;
     for (char **o = p.wopts; o && *o; o++)
       if (strncasecmp(*o, "LCO=", 4) != 0)
         q.wopts = CSLAddString(q.wopts, *o);
+    q.wopts = without_nln(q.wopts, s->nln);
     q.dsco = tt__app_output_dsco(dname, none);
     int plain = probe_run(&q, want, p.ext);
     CSLDestroy(q.wopts);
@@ -331,8 +349,8 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
     if (plain == 1) {
       ok = 0;
       tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                   "simplify: -of %s cannot write the TIN with the -lco and "
-                   "-dsco given: %s", dname, why_all);
+                   "simplify: -of %s cannot write the TIN with the -nln, "
+                   "-lco and -dsco given: %s", dname, why_all);
       goto done;
     }
   }

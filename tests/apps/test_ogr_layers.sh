@@ -161,8 +161,20 @@ refused_early "GPX, triangles" "-layers vertices" \
   simplify -max_error 1 -layers triangles dem.tif ref/o.gpx
 refused_early "DXF -layers" "-layers is for OGR outputs" \
   simplify -max_error 1 -layers triangles dem.tif ref/o.dxf
-refused_early "a -lco the driver refuses" "-lco" \
+refused_early "-lco FID= one of the TIN's fields" "v0 is a field of the triangles layer" \
   simplify -max_error 1 -lco FID=v0 dem.tif ref/o.gpkg
+refused_early "-lco FID=vertex_id" "vertex_id is a field of the vertices layer" \
+  simplify -max_error 1 -lco FID=vertex_id dem.tif ref/o.gpkg
+refused_early "-lco FID=max_error" "max_error is a field of the run_parameters" \
+  simplify -max_error 1 -lco FID=max_error dem.tif ref/o.gpkg
+refused_early "-nln gpkg_" "reserves the table names that begin with \"gpkg\"" \
+  simplify -max_error 1 -nln gpkg_ dem.tif ref/o.gpkg
+refused_early "-nln sqlite_" "reserves the table names that begin with \"sqlite_\"" \
+  simplify -max_error 1 -nln sqlite_ dem.tif ref/o.gpkg
+refused_early "-nln sqlite_ into SQLite" "SQLite reserves" \
+  simplify -max_error 1 -nln sqlite_ dem.tif ref/o.sqlite
+refused_early "a -lco the driver refuses" "-lco" \
+  simplify -max_error 1 -lco GEOMETRY_NAME=fid dem.tif ref/o.gpkg
 # a failure that is not the driver's is said as the write would say it
 run generate bump nocrs.tif -size 30 -q
 run simplify -q -t_srs EPSG:4326 -layers triangles nocrs.tif ref/n.geojson

@@ -127,6 +127,40 @@ static const char *ogr_msg(void)
   return m && *m ? m : "no details from GDAL";
 }
 
+/* The layer and column names the options give, checked before anything
+ * is written: a GeoPackage reserves table names that begin with "gpkg",
+ * SQLite those that begin with "sqlite_"; a FID column (LCO FID=) named as
+ * one of the layers' own fields would collide with it. */
+static tt_status check_names(write_state *w)
+{
+  const char *prefix = w->prefix ? w->prefix : "";
+  int sqlite = strcasecmp(w->drv_name, "SQLite") == 0;
+  if ((w->gpkg || sqlite) && strncasecmp(prefix, "sqlite_", 7) == 0)
+    return tt__error(w->ctx, TT_ERR_ARG, "layer name prefix \"%s\": "
+                     "SQLite reserves the table names that begin with "
+                     "\"sqlite_\"; choose another prefix", prefix);
+  if (w->gpkg && strncasecmp(prefix, "gpkg", 4) == 0)
+    return tt__error(w->ctx, TT_ERR_ARG, "layer name prefix \"%s\": a "
+                     "GeoPackage reserves the table names that begin with "
+                     "\"gpkg\"; choose another prefix", prefix);
+  const char *fid = CSLFetchNameValue(w->lco, "FID");
+  if (fid) {
+    for (int i = 0; i < TT__TF_COUNT; i++)
+      if (strcasecmp(fid, tt__triangle_fields[i].name) == 0)
+        return tt__error(w->ctx, TT_ERR_ARG, "layer creation option "
+                         "FID=%s: %s is a field of the triangles layer; the "
+                         "FID column needs a name of its own", fid,
+                         tt__triangle_fields[i].name);
+    for (int i = 0; i < TT__VF_COUNT; i++)
+      if (strcasecmp(fid, tt__vertex_fields[i].name) == 0)
+        return tt__error(w->ctx, TT_ERR_ARG, "layer creation option "
+                         "FID=%s: %s is a field of the vertices layer; the "
+                         "FID column needs a name of its own", fid,
+                         tt__vertex_fields[i].name);
+  }
+  return TT_OK;
+}
+
 static tt_status parse_options(write_state *w, char **options)
 {
   for (char **o = options; o && *o; o++) {
@@ -210,7 +244,7 @@ static tt_status parse_options(write_state *w, char **options)
     w->lco = CSLSetNameValue(w->lco, "ENCODING", "UTF-8");
   if (w->shapefile && !CSLFetchNameValue(w->lco, "SPATIAL_INDEX"))
     w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "YES");
-  return TT_OK;
+  return check_names(w);
 }
 
 /* Called after every feature: the callback is asked every time, so a stop
@@ -605,6 +639,12 @@ static tt_status check_run_fields(write_state *w, const tt_run_field *fields,
       if (strcasecmp(fields[k].name, rf->name) == 0)
         return tt__error(w->ctx, TT_ERR_ARG, "run parameter \"%s\" is given "
                          "twice", rf->name);
+    const char *fid = CSLFetchNameValue(w->lco, "FID");
+    if (fid && strcasecmp(fid, rf->name) == 0)
+      return tt__error(w->ctx, TT_ERR_ARG, "layer creation option "
+                       "FID=%s: %s is a field of the run_parameters layer; "
+                       "the FID column needs a name of its own", fid,
+                       rf->name);
   }
   return TT_OK;
 }
