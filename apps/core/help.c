@@ -314,7 +314,9 @@ static const char help_optimize[] =
     "  -optimize MODE    local (default), lookahead, anneal or\n"
     "                    edge_insertion (-criterion minmax_angle only)\n"
     "  -max_error E      refuse every move that makes a triangle with a\n"
-    "                    sample farther than E from it (z units)\n"
+    "                    sample farther than E from it (z units; default:\n"
+    "                    the input TIN's own max error, which thus never\n"
+    "                    grows)\n"
     ANNEAL_HELP
     "  -b, -srcnodata, -z_factor, -z_unit   as simplify\n"
     "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
