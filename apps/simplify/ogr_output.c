@@ -247,6 +247,56 @@ static void refuse_lossy(app_run *r, const char *dname, const char *lost)
                "(2DM, PLY, OBJ, LandXML, DXF)", dname, lost);
 }
 
+/* The probe of drv for OUTPUT output, on the DEM src's geotransform and
+ * CRS, with its creation options dsco and the writer's options wopts
+ * (LAYERS taken out: each probe sets its own); p->tin is NULL when ctx is
+ * (nothing to judge with). */
+static void probe_init(probe *p, tt_context *ctx, GDALDriverH drv,
+                       GDALDatasetH src, const char *output, char **dsco,
+                       char **wopts)
+{
+  memset(p, 0, sizeof *p);
+  p->drv = drv;
+  p->dsco = dsco;
+  const char *base = strrchr(output, '/');
+  base = base ? base + 1 : output;
+  const char *dot = strrchr(base, '.');
+  p->ext = dot && dot != base ? dot : "";
+  for (char **o = wopts; o && *o; o++)
+    if (strncasecmp(*o, "LAYERS=", 7) != 0)
+      p->wopts = CSLAddString(p->wopts, *o);
+  double gt[6] = {0, 1, 0, 0, 0, -1};
+  GDALGetGeoTransform(src, gt);
+  p->t_srs = CSLFetchNameValue(wopts, "T_SRS");
+  p->tol_xy = 1e-6 * fmin(fabs(gt[1]), fabs(gt[5]));
+  const char *wkt = GDALGetProjectionRef(src);
+  if (wkt && *wkt) {
+    p->srs = OSRNewSpatialReference(wkt);
+    if (p->srs)
+      OSRSetAxisMappingStrategy(p->srs, OAMS_TRADITIONAL_GIS_ORDER);
+  }
+  p->tin = ctx ? probe_tin(ctx, gt) : NULL;
+}
+
+/* A driver that takes only longitude/latitude of its own CRS (GPX): the
+ * probe again in that CRS; when it keeps the TIN so, that CRS (the
+ * caller's to CPLFree, p->imposed taken over), else NULL. */
+static char *in_own_crs(probe *p, unsigned want)
+{
+  probe q = *p;
+  q.wopts = CSLSetNameValue(CSLDuplicate(p->wopts), "T_SRS", p->imposed);
+  q.t_srs = p->imposed;
+  q.imposed = NULL;
+  int again = probe_run(&q, want, p->ext);
+  CSLDestroy(q.wopts);
+  CPLFree(q.imposed);
+  if (again != 1 || q.lossy)
+    return NULL;
+  char *crs = p->imposed;
+  p->imposed = NULL;
+  return crs;
+}
+
 int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
                              char **dsco, char **wopts, char **auto_t_srs)
 {
@@ -254,51 +304,17 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
   const tt_app_settings *s = r->s;
   const char *dname = GDALGetDriverShortName(drv);
   probe p;
-  memset(&p, 0, sizeof p);
-  p.drv = drv;
-  p.dsco = dsco;
-  const char *base = strrchr(s->output, '/');
-  base = base ? base + 1 : s->output;
-  const char *dot = strrchr(base, '.');
-  p.ext = dot && dot != base ? dot : "";
-  for (char **o = wopts; o && *o; o++)
-    if (strncasecmp(*o, "LAYERS=", 7) != 0)
-      p.wopts = CSLAddString(p.wopts, *o);
-  double gt[6] = {0, 1, 0, 0, 0, -1};
-  GDALGetGeoTransform(src, gt);
-  p.t_srs = CSLFetchNameValue(wopts, "T_SRS");
-  p.tol_xy = 1e-6 * fmin(fabs(gt[1]), fabs(gt[5]));
-  const char *wkt = GDALGetProjectionRef(src);
-  if (wkt && *wkt) {
-    p.srs = OSRNewSpatialReference(wkt);
-    if (p.srs)
-      OSRSetAxisMappingStrategy(p.srs, OAMS_TRADITIONAL_GIS_ORDER);
-  }
   tt_context *ctx = tt_context_create();
-  p.tin = ctx ? probe_tin(ctx, gt) : NULL;
+  probe_init(&p, ctx, drv, src, s->output, dsco, wopts);
   int ok = 1;
   if (!p.tin)
     goto done; /* nothing to judge with */
 
   const unsigned want = s->layers;
   int all = probe_run(&p, want, p.ext);
-  if (all == 1 && p.lossy && p.imposed && !p.t_srs) {
-    /* A driver that takes only longitude/latitude of its own CRS (GPX):
-     * written in that CRS, which the summary states, when that keeps the
-     * TIN. */
-    probe q = p;
-    q.wopts = CSLSetNameValue(CSLDuplicate(p.wopts), "T_SRS", p.imposed);
-    q.t_srs = p.imposed;
-    q.imposed = NULL;
-    int again = probe_run(&q, want, p.ext);
-    CSLDestroy(q.wopts);
-    CPLFree(q.imposed);
-    if (again == 1 && !q.lossy) {
-      *auto_t_srs = p.imposed;
-      p.imposed = NULL;
-      goto done;
-    }
-  }
+  if (all == 1 && p.lossy && p.imposed && !p.t_srs &&
+      (*auto_t_srs = in_own_crs(&p, want)) != NULL)
+    goto done;
   if (all == 1 && p.lossy) {
     ok = 0;
     refuse_lossy(r, dname, p.lost);

@@ -151,6 +151,59 @@ static int set_transform(readback *rb, OGRLayerH layer,
   return 1;
 }
 
+/* The dataset name opened with drv alone; GPX keeps a point's height in
+ * <ele>, which GDAL 3.6's reader gives as Z only when asked
+ * (GPX_ELE_AS_25D). */
+static GDALDatasetH open_back(GDALDriverH drv, const char *name)
+{
+  const char *allowed[] = {GDALGetDriverShortName(drv), NULL};
+  int gpx = strcmp(allowed[0], "GPX") == 0;
+  char *old = NULL;
+  if (gpx) {
+    const char *o = CPLGetThreadLocalConfigOption("GPX_ELE_AS_25D", NULL);
+    old = o ? CPLStrdup(o) : NULL;
+    CPLSetThreadLocalConfigOption("GPX_ELE_AS_25D", "YES");
+  }
+  GDALDatasetH ds = GDALOpenEx(name, GDAL_OF_VECTOR | GDAL_OF_READONLY,
+                               allowed, NULL, NULL);
+  if (gpx) {
+    CPLSetThreadLocalConfigOption("GPX_ELE_AS_25D", old);
+    CPLFree(old);
+  }
+  return ds;
+}
+
+/* One feature's geometry g of layer: a point or a triangle, with Z, every
+ * point one written; counted. */
+static void check_feature(readback *rb, OGRLayerH layer, OGRGeometryH g,
+                          size_t *points, size_t *polygons)
+{
+  if (OGR_G_IsEmpty(g)) {
+    snprintf(rb->why, rb->n, "a feature of layer %s reads back with an "
+             "empty geometry", OGR_L_GetName(layer));
+    rb->bad = 1;
+    return;
+  }
+  OGRwkbGeometryType t = wkbFlatten(OGR_G_GetGeometryType(g));
+  if (t == wkbPoint) {
+    (*points)++;
+  } else if (is_triangle(g)) {
+    (*polygons)++;
+  } else {
+    snprintf(rb->why, rb->n, "a triangle reads back as a %s",
+             OGR_G_GetGeometryName(g));
+    rb->bad = 1;
+    return;
+  }
+  if (!OGR_G_Is3D(g)) {
+    snprintf(rb->why, rb->n, "it drops the heights: the %s read back has "
+             "no Z", OGR_G_GetGeometryName(g));
+    rb->bad = 1;
+    return;
+  }
+  check_geometry(rb, g);
+}
+
 int tt__app_read_back(GDALDriverH drv, const char *name, unsigned layers,
                       const tt_tin *tin,
                       OGRSpatialReferenceH tin_srs, const char *t_srs,
@@ -192,22 +245,7 @@ int tt__app_read_back(GDALDriverH drv, const char *name, unsigned layers,
   } else if (tin_srs) {
     written = OSRClone(tin_srs);
   }
-  const char *allowed[] = {GDALGetDriverShortName(drv), NULL};
-  /* GPX keeps a point's height in <ele>, which GDAL 3.6's reader gives as
-   * Z only when asked (GPX_ELE_AS_25D) */
-  int gpx = strcmp(allowed[0], "GPX") == 0;
-  char *old = NULL;
-  if (gpx) {
-    const char *o = CPLGetThreadLocalConfigOption("GPX_ELE_AS_25D", NULL);
-    old = o ? CPLStrdup(o) : NULL;
-    CPLSetThreadLocalConfigOption("GPX_ELE_AS_25D", "YES");
-  }
-  ds = GDALOpenEx(name, GDAL_OF_VECTOR | GDAL_OF_READONLY, allowed, NULL,
-                  NULL);
-  if (gpx) {
-    CPLSetThreadLocalConfigOption("GPX_ELE_AS_25D", old);
-    CPLFree(old);
-  }
+  ds = open_back(drv, name);
   if (!ds) {
     snprintf(why, n, "what it wrote cannot be read back to check it");
     goto done;
@@ -220,37 +258,14 @@ int tt__app_read_back(GDALDriverH drv, const char *name, unsigned layers,
     OGRFeatureH f;
     while (!rb.bad && (f = OGR_L_GetNextFeature(layer)) != NULL) {
       OGRGeometryH g = OGR_F_GetGeometryRef(f);
-      if (g && OGR_G_IsEmpty(g)) {
-        snprintf(why, n, "a feature of layer %s reads back with an empty "
-                 "geometry", OGR_L_GetName(layer));
-        rb.bad = 1;
-      } else if (g) {
-        if (!transform_set &&
-            !set_transform(&rb, layer, tin_srs, written, &geo)) {
-          OGR_F_Destroy(f);
-          break;
-        }
-        transform_set = 1;
-        OGRwkbGeometryType t = wkbFlatten(OGR_G_GetGeometryType(g));
-        if (t == wkbPoint) {
-          points++;
-        } else if (is_triangle(g)) {
-          polygons++;
-        } else {
-          snprintf(why, n, "a triangle reads back as a %s",
-                   OGR_G_GetGeometryName(g));
-          rb.bad = 1;
-        }
-        if (rb.bad) {
-          /* said */
-        } else if (!OGR_G_Is3D(g)) {
-          snprintf(why, n, "it drops the heights: the %s read back has "
-                   "no Z", OGR_G_GetGeometryName(g));
-          rb.bad = 1;
-        } else {
-          check_geometry(&rb, g);
-        }
+      if (g && !OGR_G_IsEmpty(g) && !transform_set &&
+          !set_transform(&rb, layer, tin_srs, written, &geo)) {
+        OGR_F_Destroy(f);
+        break;
       }
+      transform_set = transform_set || (g && !OGR_G_IsEmpty(g));
+      if (g)
+        check_feature(&rb, layer, g, &points, &polygons);
       OGR_F_Destroy(f);
     }
   }
