@@ -399,8 +399,8 @@ static bool parse_options(const char *path, cursor *c, tiles_plan *p,
     if (lit(c, "]"))
       return true;
     if (i >= WORDS_MAX)
-      return REFUSE(res, TT_ERR_ARG, "%s: more than %d option words (at "
-                    "most %d in a plan)", path, WORDS_MAX, WORDS_MAX);
+      return REFUSE(res, TT_ERR_ARG, "%s: more than %d option words (the "
+                    "most a plan holds)", path, WORDS_MAX);
     char *w = NULL;
     size_t wlen = 0;
     int r = (i == 0 || lit(c, ", ")) ? str(c, WORD_MAX, &w, &wlen) : 0;
