@@ -451,13 +451,6 @@ const char *tt_app_help(tt_app_command topic)
 
 const char *tt__app_command_name(tt_app_command c)
 {
-  switch (c) {
-  case TT_APP_SIMPLIFY: return "simplify";
-  case TT_APP_GENERATE: return "generate";
-  case TT_APP_EVAL: return "eval";
-  case TT_APP_OPTIMIZE: return "optimize";
-  case TT_APP_STUDY: return "study";
-  case TT_APP_RASTERIZE: return "rasterize";
-  default: return "";
-  }
+  const tt__app_command_def *d = tt__app_command_def_of(c);
+  return d ? d->name : "";
 }
