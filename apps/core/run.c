@@ -126,11 +126,14 @@ static uint64_t text_hash(const char *s)
 
 void tt__app_warn(app_messages *m, const char *fmt, ...)
 {
-  char buf[TT_APP_MESSAGE_MAX];
+  char raw[TT_APP_MESSAGE_MAX], buf[TT_APP_MESSAGE_MAX];
   va_list ap;
   va_start(ap, fmt);
-  vformat_fit(buf, sizeof buf, fmt, ap);
+  vformat_fit(raw, sizeof raw, fmt, ap);
   va_end(ap);
+  /* a connection string a driver echoed, with its password masked */
+  if (tt__app_secrets_mask(&m->secrets, raw, buf, sizeof buf) == raw)
+    memcpy(buf, raw, sizeof buf);
   uint64_t h = text_hash(buf);
   for (size_t i = 0; i < m->nseen; i++)
     if (m->seen[i] == h)
@@ -154,14 +157,16 @@ static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
                                         const char *msg)
 {
   app_messages *m = CPLGetErrorHandlerUserData();
-  char named[TT_APP_MESSAGE_MAX];
+  char named[TT_APP_MESSAGE_MAX], masked[TT_APP_MESSAGE_MAX];
   (void)num;
   if (!m || !msg)
     return;
   /* GDAL names the dataset it was given: the temporary name of an output;
-   * the user knows it by its final name. */
+   * the user knows it by its final name. A connection string is shown
+   * with its password masked. */
   if (tt_output_rename_in_text(msg, named, sizeof named))
     msg = named;
+  msg = tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked);
   if (cls == CE_Debug) {
     fprintf(m->err, "terratin: debug: %s\n", msg);
   } else if (cls == CE_Warning) {
@@ -186,12 +191,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
     TT_APP_PRINTF_(5, 6);
 
-/* Records the run's failure "<file>: <problem>" (or "<problem>"). */
+/* Records the run's failure "<file>: <problem>" (or "<problem>"), with
+ * the password of any connection string in it masked. */
 tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
 {
   char buf[TT_APP_MESSAGE_MAX], name[TT_TEXT_WORD_MAX + 1];
-  char named[TT_APP_MESSAGE_MAX];
+  char named[TT_APP_MESSAGE_MAX], masked[TT_APP_MESSAGE_MAX];
+  char masked_file[TT_APP_MESSAGE_MAX];
   va_list ap;
   va_start(ap, fmt);
   vformat_fit(buf, sizeof buf, fmt, ap);
@@ -199,11 +206,16 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
   /* a driver's message kept by the glue may name a temporary file */
   if (tt_output_rename_in_text(buf, named, sizeof named))
     memcpy(buf, named, sizeof buf);
+  const app_secrets *sec = &r->msg.secrets;
+  const char *why = tt__app_secrets_mask(sec, buf, masked, sizeof masked);
   if (file)
     tt__app_result_set(r->res, exit_code, st, "%s: %s",
-                       tt_text_fit(name, sizeof name, file), buf);
+                       tt_text_fit(name, sizeof name,
+                                   tt__app_secrets_mask(sec, file, masked_file,
+                                                        sizeof masked_file)),
+                       why);
   else
-    tt__app_result_set(r->res, exit_code, st, "%s", buf);
+    tt__app_result_set(r->res, exit_code, st, "%s", why);
   return st;
 }
 
@@ -512,29 +524,6 @@ static void print_version(FILE *out)
           GDALVersionInfo("--version"), maj, min, pat);
 }
 
-void tt__app_mask_password(const char *name, char *buf, size_t size)
-{
-  snprintf(buf, size, "%s", name);
-  char *p = buf;
-  while ((p = strstr(p, "password=")) != NULL) {
-    p += 9;
-    char *e = p;
-    if (*e == '\'') { /* libpq's quoted values */
-      e++;
-      while (*e && *e != '\'')
-        e += e[0] == '\\' && e[1] ? 2 : 1;
-      if (*e)
-        e++;
-    } else {
-      while (*e && *e != ' ')
-        e++;
-    }
-    memmove(p + 3, e, strlen(e) + 1);
-    memcpy(p, "***", 3);
-    p += 3;
-  }
-}
-
 /* Set by `terratin tiles run` and `tiles merge` around a simplify run
  * (app.h); all zero otherwise. */
 tt_app_tiles_hook tt__app_tiles_hook;
@@ -584,6 +573,23 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
                "missing command: simplify, generate or eval");
     return TT_ERR_ARG;
   }
+
+  /* The names that may be connection strings carrying a password: shown
+   * masked from here on. One libpq cannot parse is refused before it is
+   * passed on: libpq's error would quote the words it could not read. */
+  const char *names[] = {o->s.input, o->s.output, o->s.tin,
+                         o->s.error_raster};
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+    if (tt__app_secrets_add(&r.msg.secrets, names[i]) ==
+        TT_APP_MASK_UNPARSED) {
+      tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                         "%s: libpq cannot parse this connection string, "
+                         "so it is not used (quote a value with blanks or "
+                         "quotes as 'a b', and write ' and \\ in it as "
+                         "\\' and \\\\)",
+                         tt__app_secrets_shown(&r.msg.secrets, names[i]));
+      return TT_ERR_ARG;
+    }
 
   /* Configuration first, so that GDAL_SKIP, GDAL_DRIVER_PATH and friends
    * apply to the drivers registered and to every file opened. */

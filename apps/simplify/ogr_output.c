@@ -326,8 +326,11 @@ GDALDriverH tt__app_database_driver(app_run *r)
     return NULL;
   }
   /* No -of: a connection string names its driver (GDAL 3.6 does not
-   * declare PostgreSQL's "PG:" prefix). */
-  if (strncasecmp(out, "PG:", 3) == 0)
+   * declare PostgreSQL's "PG:" prefix, nor the libpq URI its driver also
+   * opens). */
+  if (strncasecmp(out, "PG:", 3) == 0 ||
+      strncmp(out, "postgresql://", 13) == 0 ||
+      strncmp(out, "postgres://", 11) == 0)
     return GDALGetDriverByName("PostgreSQL");
   for (int i = 0; i < GDALGetDriverCount(); i++) {
     GDALDriverH drv = GDALGetDriver(i);
