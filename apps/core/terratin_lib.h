@@ -15,6 +15,9 @@
  *
  * Exit codes (documented in `terratin --help` and docs/cli.md):
  *   0 success, 1 processing failure, 2 usage error, 3 eval threshold exceeded.
+ *   A run stopped through its progress callback fails with
+ *   TT_ERR_INTERRUPTED and exit code 1; the command, stopped by a signal N,
+ *   ends by that signal (the shell's 128+N: 130 for SIGINT).
  *
  * Messages: a failure is reported as one line in tt_app_result.message,
  * "<file>: <problem>" or "<problem>" for usage errors, without the leading
