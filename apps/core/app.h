@@ -163,6 +163,12 @@ typedef struct app_messages {
   app_secrets secrets;       /* the run's names that carry a password */
 } app_messages;
 
+/* Pushes a CPL error handler that drops GDAL's failures and warnings (for
+ * calls whose failure is expected or told otherwise) but prints debug
+ * lines as the run does, "terratin: debug: ..."; CPLPopErrorHandler()
+ * removes it. m may be NULL (stderr, nothing masked). */
+void tt__app_quiet_push(const app_messages *m);
+
 /* Prints "terratin: warning: ..." (at most a fixed number per run). */
 void tt__app_warn(app_messages *m, const char *fmt, ...) TT_APP_PRINTF_(2, 3);
 

@@ -100,7 +100,13 @@ int tt__app_str_ieq(const char *a, const char *b)
  * (the run turns them into its one-line message, so the user never sees
  * GDAL's line and ours), warnings are printed as "terratin: warning: ..."
  * (at most MAX_WARNINGS, then one line saying the rest were dropped), debug
- * messages (only emitted with CPL_DEBUG on) pass through.
+ * messages (only emitted with CPL_DEBUG on) as "terratin: debug: ...".
+ * Every debug line carries that prefix, whoever emits it: a handler that
+ * silences GDAL for a while (tt__app_quiet_push) still prints debug lines
+ * so, the glue's CPLQuietErrorHandler passes them down to ours
+ * (CPLSetCurrentErrorHandlerCatchDebug), and threads that push no handler
+ * (GDAL's own, the tiled run's workers before they push theirs) meet the
+ * run's process-wide handler, which prefixes their lines too.
  * ========================================================================= */
 
 #define MAX_WARNINGS 20
@@ -153,6 +159,54 @@ void tt__app_warn(app_messages *m, const char *fmt, ...)
   fprintf(m->err, "terratin: warning: %s\n", buf);
 }
 
+/* "terratin: debug: <msg>", the run's connection strings masked. Called
+ * from any thread: reads m's secrets only (set before any thread runs). */
+static void print_debug(const app_messages *m, const char *msg, int bar)
+{
+  char masked[TT_APP_MESSAGE_MAX];
+  msg = m ? tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked)
+          : msg;
+  if (bar && m)
+    tt_app_term_progress_break(m->bar);
+  fprintf(m && m->err ? m->err : stderr, "terratin: debug: %s\n", msg);
+}
+
+/* The handler of tt__app_quiet_push: failures and warnings dropped, debug
+ * lines printed. */
+static void CPL_STDCALL on_gdal_quiet(CPLErr cls, CPLErrorNum num,
+                                      const char *msg)
+{
+  (void)num;
+  if (cls == CE_Debug && msg)
+    print_debug(CPLGetErrorHandlerUserData(), msg, 0);
+}
+
+void tt__app_quiet_push(const app_messages *m)
+{
+  CPLPushErrorHandlerEx(on_gdal_quiet, (void *)m);
+}
+
+/* The process-wide handler while a run is active, for the threads that
+ * push none: debug lines and warnings prefixed (not counted: the run's
+ * counters belong to its own thread), failures, which the thread's caller
+ * reports, as "terratin: warning: ". */
+static void CPL_STDCALL on_gdal_thread_message(CPLErr cls, CPLErrorNum num,
+                                               const char *msg)
+{
+  const app_messages *m = CPLGetErrorHandlerUserData();
+  (void)num;
+  if (!msg || cls == CE_None)
+    return;
+  if (cls == CE_Debug) {
+    print_debug(m, msg, 0);
+    return;
+  }
+  char masked[TT_APP_MESSAGE_MAX];
+  msg = m ? tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked)
+          : msg;
+  fprintf(m && m->err ? m->err : stderr, "terratin: warning: %s\n", msg);
+}
+
 static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
                                         const char *msg)
 {
@@ -168,7 +222,7 @@ static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
     msg = named;
   msg = tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked);
   if (cls == CE_Debug) {
-    fprintf(m->err, "terratin: debug: %s\n", msg);
+    print_debug(m, msg, 1);
   } else if (cls == CE_Warning) {
     tt__app_warn(m, "%s", msg);
   } else if (cls != CE_None) {
@@ -594,6 +648,11 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   /* Configuration first, so that GDAL_SKIP, GDAL_DRIVER_PATH and friends
    * apply to the drivers registered and to every file opened. */
   apply_config(&o->s);
+  /* The process-wide handler first: set while this thread's stack is
+   * empty, GDAL takes it without a debug line saying it will not. It is
+   * restored at the end (GDAL tells no previous user data: none then). */
+  CPLErrorHandler old_handler =
+      CPLSetErrorHandlerEx(on_gdal_thread_message, &r.msg);
   CPLPushErrorHandlerEx(on_gdal_message, &r.msg);
   GDALAllRegister();
   r.ctx = tt_context_create();
@@ -615,6 +674,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
 done:
   tt_context_destroy(r.ctx);
   CPLPopErrorHandler();
+  CPLSetErrorHandler(old_handler);
   fflush(r.out);
   fflush(r.err);
   if (st != TT_OK && res->exit_code == TT_APP_EXIT_OK)

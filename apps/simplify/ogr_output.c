@@ -69,6 +69,7 @@ typedef struct probe {
   OGRSpatialReferenceH srs;
   char why[TT_APP_MESSAGE_MAX];
   unsigned seq;
+  const app_messages *msg; /* the run's, for the debug lines */
 } probe;
 
 /* 1: the driver wrote the layers of mask; 0: it refused (p->why says
@@ -85,7 +86,7 @@ static int probe_run(probe *p, unsigned mask, const char *ext)
   opts = CSLSetNameValue(opts, "ROWS", "NOW");
   tt_context *ctx = tt_context_create(); /* silent: no warnings printed */
   int result = -1;
-  CPLPushErrorHandler(CPLQuietErrorHandler);
+  tt__app_quiet_push(p->msg);
   VSIMkdir(dir, 0755);
   CPLErrorReset();
   GDALDatasetH ds = ctx ? GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
@@ -160,6 +161,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
   const char *dname = GDALGetDriverShortName(drv);
   probe p;
   memset(&p, 0, sizeof p);
+  p.msg = &r->msg;
   p.drv = drv;
   p.dsco = dsco;
   const char *base = strrchr(s->output, '/');
@@ -382,7 +384,7 @@ GDALDatasetH tt__app_database_open(app_run *r, GDALDriverH drv,
       continue;
     char *name = CPLStrdup(CPLSPrintf("%s%s%s%s", schema ? schema : "",
                                       schema ? "." : "", s->nln, names[i]));
-    CPLPushErrorHandler(CPLQuietErrorHandler);
+    tt__app_quiet_push(&r->msg);
     OGRLayerH l = GDALDatasetGetLayerByName(ds, name);
     CPLPopErrorHandler();
     CPLErrorReset();
