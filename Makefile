@@ -13,7 +13,7 @@ BUILD_SAN  ?= build-asan
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 DEB_PKGS   := cmake make gcc g++ pkg-config libgdal-dev libproj-dev gdal-bin libxml2-dev \
               python3 python3-cffi python3-dev zip libsqlite3-dev libnetcdf-dev \
-              python3-matplotlib \
+              python3-matplotlib libpq-dev \
               libxml2-utils
 DEMO_IN    ?= testdata/jacksboro_fault_dem.tif
 DEMO_OUT   ?= demo-out/jacksboro_tin.gpkg

@@ -18,6 +18,7 @@
  *   raster_output.c the raster writer (rasterize, eval -error_raster)
  *   progress.c      the text progress bar and the phase scaling
  *   report.c        the JSON writer and simplify's summary and JSON
+ *   conninfo.c      connection strings shown with their password masked
  *
  * The commands, a folder each over this core (none includes another's
  * headers): simplify/ (with the tiled path and the output choice; its
@@ -111,6 +112,45 @@ void tt__app_result_set(tt_app_result *res, int exit_code, tt_status status,
 void tt__app_result_ok(tt_app_result *res);
 int tt__app_str_ieq(const char *a, const char *b);
 
+/* --- connection strings (conninfo.c) ------------------------------------ */
+
+/* What tt__app_mask_password did. */
+enum {
+  TT_APP_MASK_UNPARSED = -1, /* a password libpq cannot parse: cut at it */
+  TT_APP_MASK_NONE = 0,      /* no password: the name unchanged */
+  TT_APP_MASK_DONE = 1       /* rebuilt from libpq's parse, password *** */
+};
+/* name (a datasource name: a file, or a PostgreSQL connection string in
+ * libpq's keyword/value or URI form, with or without GDAL's "PG:") with
+ * its password replaced by ***, into buf (cut to size, never overrun). */
+int tt__app_mask_password(const char *name, char *buf, size_t size);
+
+/* The datasource names of a run that carry a password, with their shown
+ * forms; raw points at the caller's string. */
+#define TT_APP_MAX_SECRETS 4
+typedef struct app_secret {
+  const char *raw;
+  char shown[TT_APP_MESSAGE_MAX];
+  char password[256]; /* "" when longer: the last net then skips it */
+  size_t typed_len;   /* the password's value as typed (keyword form) */
+} app_secret;
+typedef struct app_secrets {
+  size_t n;
+  app_secret item[TT_APP_MAX_SECRETS];
+} app_secrets;
+/* Adds name when it carries a password; returns what
+ * tt__app_mask_password returned for it. */
+int tt__app_secrets_add(app_secrets *sec, const char *name);
+/* The shown form of name (name itself when it carries no password). */
+const char *tt__app_secrets_shown(const app_secrets *sec, const char *name);
+/* text with every name of sec, as given or without its "PG:", replaced
+ * by its shown form, the value of any other "password=" masked (at least
+ * as many characters as the longest typed password), and any password of
+ * 4 or more characters still left replaced by "***": buf, or text itself
+ * when sec holds nothing. */
+const char *tt__app_secrets_mask(const app_secrets *sec, const char *text,
+                                 char *buf, size_t size);
+
 /* GDAL's failures and warnings while a run is active (run.c). */
 typedef struct app_messages {
   FILE *err;
@@ -120,7 +160,14 @@ typedef struct app_messages {
   tt_app_term_progress *bar; /* the text bar, if the run draws one */
   unsigned failures;         /* GDAL failures seen */
   char last[TT_APP_MESSAGE_MAX];
+  app_secrets secrets;       /* the run's names that carry a password */
 } app_messages;
+
+/* Pushes a CPL error handler that drops GDAL's failures and warnings (for
+ * calls whose failure is expected or told otherwise) but prints debug
+ * lines as the run does, "terratin: debug: ..."; CPLPopErrorHandler()
+ * removes it. m may be NULL (stderr, nothing masked). */
+void tt__app_quiet_push(const app_messages *m);
 
 /* Prints "terratin: warning: ..." (at most a fixed number per run). */
 void tt__app_warn(app_messages *m, const char *fmt, ...) TT_APP_PRINTF_(2, 3);
@@ -150,6 +197,10 @@ typedef struct app_run {
   app_phase prog;
   double t0;
 } app_run;
+
+/* A datasource name of the run as it is shown: a connection string with
+ * its password masked, anything else unchanged (conninfo.c). */
+const char *tt__app_shown(const app_run *r, const char *name);
 
 /* Records the run's failure "<file>: <problem>" (or "<problem>" when file
  * is NULL) and returns st. */
@@ -212,8 +263,6 @@ void tt__app_iso8601_utc(char *buf, size_t size);
 int tt__app_threads(app_run *r);
 /* The output driver of simplify: -of, else OUTPUT's extension, else GPKG. */
 GDALDriverH tt__app_output_driver(app_run *r);
-/* name with the value of every password= replaced by *** (run.c). */
-void tt__app_mask_password(const char *name, char *buf, size_t size);
 /* Whether two paths name the same existing file. */
 int tt__app_same_file(const char *a, const char *b);
 

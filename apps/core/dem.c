@@ -104,7 +104,7 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
                "is an empty file, not a raster");
       return NULL;
     }
-    CPLPushErrorHandler(CPLQuietErrorHandler);
+    tt__app_quiet_push(&r->msg);
     GDALDatasetH vec = GDALOpenEx(path, GDAL_OF_VECTOR | GDAL_OF_READONLY,
                                   NULL, NULL, NULL);
     CPLPopErrorHandler();

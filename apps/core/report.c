@@ -168,11 +168,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   const tt_refine_options *ro = p->ropt;
   const tt_error_stats *e = &p->sum.errors;
   tt__json_begin(&j, r->out);
-  tt__json_str(&j, "input", r->s->input);
+  tt__json_str(&j, "input", tt__app_shown(r, r->s->input));
   tt__json_size(&j, "band", (size_t)r->s->band);
-  char shown[TT_APP_MESSAGE_MAX]; /* a connection's password masked */
-  tt__app_mask_password(r->s->output, shown, sizeof shown);
-  tt__json_str(&j, "output", shown);
+  tt__json_str(&j, "output", tt__app_shown(r, r->s->output));
   tt__json_str(&j, "format", p->driver);
   tt__json_str(&j, "method", p->dopt ? "decimate" : "insert");
   tt__json_str(&j, "criterion", tt_criterion_name(p->sum.criterion));
@@ -321,8 +319,7 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
     snprintf(zu, sizeof zu, "%s (%s)", unit, in->z_unit_source);
   else
     snprintf(zu, sizeof zu, "unknown");
-  char shown[TT_APP_MESSAGE_MAX]; /* a connection's password masked */
-  tt__app_mask_password(r->s->output, shown, sizeof shown);
+  const char *shown = tt__app_shown(r, r->s->output);
   fprintf(r->out,
           "%s: %zu cells, %zu valid samples -> %zu vertices, %zu triangles; "
           "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s%s; "
@@ -338,7 +335,7 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
           p->driver ? p->driver : "?", p->t_total);
   if (p->tiles) {
     fprintf(r->out, "%s: %zu tiles of %zu cells on %d thread%s%s; the tiles "
-            "in flight hold at most about %.0f MiB\n", r->s->output, p->tiles,
+            "in flight hold at most about %.0f MiB\n", shown, p->tiles,
             p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
             p->auto_tiled ? " (chosen because the heights do not fit the "
                             "memory limit)" : "",
@@ -346,7 +343,7 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
     if (p->budget_passes)
       fprintf(r->out, "%s: the budget is met at the bound %g, found from "
               "the tiles' curves (one pass) and %d run%s at a bound\n",
-              r->s->output, p->ropt ? p->ropt->max_error : 0.0,
+              shown, p->ropt ? p->ropt->max_error : 0.0,
               p->budget_passes, p->budget_passes == 1 ? "" : "s");
   }
   if (p->dopt)

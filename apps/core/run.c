@@ -102,7 +102,13 @@ int tt__app_str_ieq(const char *a, const char *b)
  * (the run turns them into its one-line message, so the user never sees
  * GDAL's line and ours), warnings are printed as "terratin: warning: ..."
  * (at most MAX_WARNINGS, then one line saying the rest were dropped), debug
- * messages (only emitted with CPL_DEBUG on) pass through.
+ * messages (only emitted with CPL_DEBUG on) as "terratin: debug: ...".
+ * Every debug line carries that prefix, whoever emits it: a handler that
+ * silences GDAL for a while (tt__app_quiet_push) still prints debug lines
+ * so, the glue's CPLQuietErrorHandler passes them down to ours
+ * (CPLSetCurrentErrorHandlerCatchDebug), and threads that push no handler
+ * (GDAL's own, the tiled run's workers before they push theirs) meet the
+ * run's process-wide handler, which prefixes their lines too.
  * ========================================================================= */
 
 #define MAX_WARNINGS 20
@@ -128,11 +134,14 @@ static uint64_t text_hash(const char *s)
 
 void tt__app_warn(app_messages *m, const char *fmt, ...)
 {
-  char buf[TT_APP_MESSAGE_MAX];
+  char raw[TT_APP_MESSAGE_MAX], buf[TT_APP_MESSAGE_MAX];
   va_list ap;
   va_start(ap, fmt);
-  vformat_fit(buf, sizeof buf, fmt, ap);
+  vformat_fit(raw, sizeof raw, fmt, ap);
   va_end(ap);
+  /* a connection string a driver echoed, with its password masked */
+  if (tt__app_secrets_mask(&m->secrets, raw, buf, sizeof buf) == raw)
+    memcpy(buf, raw, sizeof buf);
   uint64_t h = text_hash(buf);
   for (size_t i = 0; i < m->nseen; i++)
     if (m->seen[i] == h)
@@ -152,20 +161,70 @@ void tt__app_warn(app_messages *m, const char *fmt, ...)
   fprintf(m->err, "terratin: warning: %s\n", buf);
 }
 
+/* "terratin: debug: <msg>", the run's connection strings masked. Called
+ * from any thread: reads m's secrets only (set before any thread runs). */
+static void print_debug(const app_messages *m, const char *msg, int bar)
+{
+  char masked[TT_APP_MESSAGE_MAX];
+  msg = m ? tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked)
+          : msg;
+  if (bar && m)
+    tt_app_term_progress_break(m->bar);
+  fprintf(m && m->err ? m->err : stderr, "terratin: debug: %s\n", msg);
+}
+
+/* The handler of tt__app_quiet_push: failures and warnings dropped, debug
+ * lines printed. */
+static void CPL_STDCALL on_gdal_quiet(CPLErr cls, CPLErrorNum num,
+                                      const char *msg)
+{
+  (void)num;
+  if (cls == CE_Debug && msg)
+    print_debug(CPLGetErrorHandlerUserData(), msg, 0);
+}
+
+void tt__app_quiet_push(const app_messages *m)
+{
+  CPLPushErrorHandlerEx(on_gdal_quiet, (void *)m);
+}
+
+/* The process-wide handler while a run is active, for the threads that
+ * push none: debug lines and warnings prefixed (not counted: the run's
+ * counters belong to its own thread), failures, which the thread's caller
+ * reports, as "terratin: warning: ". */
+static void CPL_STDCALL on_gdal_thread_message(CPLErr cls, CPLErrorNum num,
+                                               const char *msg)
+{
+  const app_messages *m = CPLGetErrorHandlerUserData();
+  (void)num;
+  if (!msg || cls == CE_None)
+    return;
+  if (cls == CE_Debug) {
+    print_debug(m, msg, 0);
+    return;
+  }
+  char masked[TT_APP_MESSAGE_MAX];
+  msg = m ? tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked)
+          : msg;
+  fprintf(m && m->err ? m->err : stderr, "terratin: warning: %s\n", msg);
+}
+
 static void CPL_STDCALL on_gdal_message(CPLErr cls, CPLErrorNum num,
                                         const char *msg)
 {
   app_messages *m = CPLGetErrorHandlerUserData();
-  char named[TT_APP_MESSAGE_MAX];
+  char named[TT_APP_MESSAGE_MAX], masked[TT_APP_MESSAGE_MAX];
   (void)num;
   if (!m || !msg)
     return;
   /* GDAL names the dataset it was given: the temporary name of an output;
-   * the user knows it by its final name. */
+   * the user knows it by its final name. A connection string is shown
+   * with its password masked. */
   if (tt_output_rename_in_text(msg, named, sizeof named))
     msg = named;
+  msg = tt__app_secrets_mask(&m->secrets, msg, masked, sizeof masked);
   if (cls == CE_Debug) {
-    fprintf(m->err, "terratin: debug: %s\n", msg);
+    print_debug(m, msg, 1);
   } else if (cls == CE_Warning) {
     tt__app_warn(m, "%s", msg);
   } else if (cls != CE_None) {
@@ -188,12 +247,14 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
     TT_APP_PRINTF_(5, 6);
 
-/* Records the run's failure "<file>: <problem>" (or "<problem>"). */
+/* Records the run's failure "<file>: <problem>" (or "<problem>"), with
+ * the password of any connection string in it masked. */
 tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
                           const char *file, const char *fmt, ...)
 {
   char buf[TT_APP_MESSAGE_MAX], name[TT_TEXT_WORD_MAX + 1];
-  char named[TT_APP_MESSAGE_MAX];
+  char named[TT_APP_MESSAGE_MAX], masked[TT_APP_MESSAGE_MAX];
+  char masked_file[TT_APP_MESSAGE_MAX];
   va_list ap;
   va_start(ap, fmt);
   vformat_fit(buf, sizeof buf, fmt, ap);
@@ -201,11 +262,16 @@ tt_status tt__app_fail(app_run *r, int exit_code, tt_status st,
   /* a driver's message kept by the glue may name a temporary file */
   if (tt_output_rename_in_text(buf, named, sizeof named))
     memcpy(buf, named, sizeof buf);
+  const app_secrets *sec = &r->msg.secrets;
+  const char *why = tt__app_secrets_mask(sec, buf, masked, sizeof masked);
   if (file)
     tt__app_result_set(r->res, exit_code, st, "%s: %s",
-                       tt_text_fit(name, sizeof name, file), buf);
+                       tt_text_fit(name, sizeof name,
+                                   tt__app_secrets_mask(sec, file, masked_file,
+                                                        sizeof masked_file)),
+                       why);
   else
-    tt__app_result_set(r->res, exit_code, st, "%s", buf);
+    tt__app_result_set(r->res, exit_code, st, "%s", why);
   return st;
 }
 
@@ -514,29 +580,6 @@ static void print_version(FILE *out)
           GDALVersionInfo("--version"), maj, min, pat);
 }
 
-void tt__app_mask_password(const char *name, char *buf, size_t size)
-{
-  snprintf(buf, size, "%s", name);
-  char *p = buf;
-  while ((p = strstr(p, "password=")) != NULL) {
-    p += 9;
-    char *e = p;
-    if (*e == '\'') { /* libpq's quoted values */
-      e++;
-      while (*e && *e != '\'')
-        e += e[0] == '\\' && e[1] ? 2 : 1;
-      if (*e)
-        e++;
-    } else {
-      while (*e && *e != ' ')
-        e++;
-    }
-    memmove(p + 3, e, strlen(e) + 1);
-    memcpy(p, "***", 3);
-    p += 3;
-  }
-}
-
 /* Set by `terratin tiles run` and `tiles merge` around a simplify run
  * (app.h); all zero otherwise. */
 tt_app_tiles_hook tt__app_tiles_hook;
@@ -607,9 +650,31 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
     return TT_ERR_ARG;
   }
 
+  /* The names that may be connection strings carrying a password: shown
+   * masked from here on. One libpq cannot parse is refused before it is
+   * passed on: libpq's error would quote the words it could not read. */
+  const char *names[] = {o->s.input, o->s.output, o->s.tin,
+                         o->s.error_raster};
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+    if (tt__app_secrets_add(&r.msg.secrets, names[i]) ==
+        TT_APP_MASK_UNPARSED) {
+      tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                         "%s: libpq cannot parse this connection string, "
+                         "so it is not used (quote a value with blanks or "
+                         "quotes as 'a b', and write ' and \\ in it as "
+                         "\\' and \\\\)",
+                         tt__app_secrets_shown(&r.msg.secrets, names[i]));
+      return TT_ERR_ARG;
+    }
+
   /* Configuration first, so that GDAL_SKIP, GDAL_DRIVER_PATH and friends
    * apply to the drivers registered and to every file opened. */
   apply_config(&o->s);
+  /* The process-wide handler first: set while this thread's stack is
+   * empty, GDAL takes it without a debug line saying it will not. It is
+   * restored at the end (GDAL tells no previous user data: none then). */
+  CPLErrorHandler old_handler =
+      CPLSetErrorHandlerEx(on_gdal_thread_message, &r.msg);
   CPLPushErrorHandlerEx(on_gdal_message, &r.msg);
   GDALAllRegister();
   r.ctx = tt_context_create();
@@ -624,6 +689,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
 done:
   tt_context_destroy(r.ctx);
   CPLPopErrorHandler();
+  CPLSetErrorHandler(old_handler);
   fflush(r.out);
   fflush(r.err);
   if (st != TT_OK && res->exit_code == TT_APP_EXIT_OK)

@@ -139,9 +139,11 @@ int main(int argc, char **argv)
   } else if (tt_app_options_new(argv + 1, &opts, &res) == TT_OK) {
     const tt_app_settings *s = tt_app_options_settings(opts);
     const char *out = s->error_raster ? s->error_raster : s->output;
-    if (out && strlen(out) < sizeof stop_msg - 64)
+    char shown[sizeof stop_msg];
+    if (out && tt_app_mask_password(out, shown, sizeof shown) >= 0 &&
+        strlen(shown) < sizeof stop_msg - 64)
       snprintf(stop_msg, sizeof stop_msg,
-               "terratin: %s: interrupted; nothing written\n", out);
+               "terratin: %s: interrupted; nothing written\n", shown);
     tt_app_term_progress_init(
         &bar, tt_app_options_wants_progress_bar(opts) ? stdout : NULL,
         &caught_signal);
@@ -156,6 +158,9 @@ int main(int argc, char **argv)
     pthread_join(dog, NULL);
   }
   fflush(stdout);
+  /* a connection string quoted by a failure of the parser or of the
+   * tiles commands, which run no tt_app_run of their own */
+  tt_app_mask_words(argv + 1, res.message, sizeof res.message);
   if (res.message[0])
     fprintf(stderr, "terratin: %s\n", res.message);
   tt_app_options_destroy(opts);

@@ -15,6 +15,9 @@
  *
  * Exit codes (documented in `terratin --help` and docs/cli.md):
  *   0 success, 1 processing failure, 2 usage error, 3 eval threshold exceeded.
+ *   A run stopped through its progress callback fails with
+ *   TT_ERR_INTERRUPTED and exit code 1; the command, stopped by a signal N,
+ *   ends by that signal (the shell's 128+N: 130 for SIGINT).
  *
  * Messages: a failure is reported as one line in tt_app_result.message,
  * "<file>: <problem>" or "<problem>" for usage errors, without the leading
@@ -203,6 +206,17 @@ tt_status tt_app_run(const tt_app_options *options, tt_app_result *out_result);
  * argv holds the words after "tiles"; fn is polled for an interruption. */
 void tt_app_tiles(char **argv, tt_progress_fn fn, void *arg,
                   tt_app_result *out_result);
+
+/* name with the password of a PostgreSQL connection string (libpq's
+ * keyword/value or URI form, with or without "PG:") replaced by ***, as
+ * libpq's parser reads it, into buf; a name without one unchanged.
+ * Returns 1 when a password was masked, 0 when there was none, -1 when a
+ * password was found that libpq cannot parse (shown up to it). */
+int tt_app_mask_password(const char *name, char *buf, size_t size);
+/* Masks, in the NUL-terminated text of size bytes, every word of the
+ * NULL-terminated list that carries a password (main() passes argv over
+ * the failure it prints). */
+void tt_app_mask_words(char *const *words, char *text, size_t size);
 
 /* The help text of a command (TT_APP_NONE: the top level). */
 const char *tt_app_help(tt_app_command topic);

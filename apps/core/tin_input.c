@@ -107,7 +107,7 @@ GDALDatasetH tt__app_open_vector(app_run *r, const char *path)
              "no such file or directory");
     return NULL;
   }
-  CPLPushErrorHandler(CPLQuietErrorHandler);
+  tt__app_quiet_push(&r->msg);
   GDALDatasetH ras = GDALOpenEx(path, GDAL_OF_RASTER | GDAL_OF_READONLY,
                                 NULL, NULL, NULL);
   CPLPopErrorHandler();

@@ -222,9 +222,9 @@ static void report_json(const eval_run *e)
   app_json j;
   max_error_at(e, &mx, &my);
   tt__json_begin(&j, r->out);
-  tt__json_str(&j, "dem", s->input);
+  tt__json_str(&j, "dem", tt__app_shown(r, s->input));
   tt__json_size(&j, "band", (size_t)s->band);
-  tt__json_str(&j, "tin", s->tin);
+  tt__json_str(&j, "tin", tt__app_shown(r, s->tin));
   tt__json_str(&j, "layer", e->lname);
   tt__json_size(&j, "cells", info->width * info->height);
   tt__json_size(&j, "valid_samples", er->samples);
@@ -251,7 +251,7 @@ static void report_json(const eval_run *e)
   tt__json_num(&j, "l2", er->l2);
   tt__json_str(&j, "z_unit", tt__app_nonempty_or_null(info->z_unit));
   tt__json_str(&j, "crs", tt__app_nonempty_or_null(info->crs_name));
-  tt__json_str(&j, "error_raster", s->error_raster);
+  tt__json_str(&j, "error_raster", tt__app_shown(r, s->error_raster));
   if (s->max_error >= 0) {
     tt__json_num(&j, "threshold", s->max_error);
     tt__json_bool(&j, "pass", passes(e));
@@ -280,11 +280,12 @@ static void report_text(const eval_run *e)
   int pass = passes(e);
   max_error_at(e, &mx, &my);
   fprintf(o, "DEM: %s, band %d: %zux%zu = %zu cells, %zu valid samples\n",
-          s->input, s->band, info->width, info->height,
+          tt__app_shown(e->r, s->input), s->band, info->width, info->height,
           info->width * info->height, er->samples);
   fprintf(o, "TIN: %s, layer %s: %zu triangles, %zu polygons rejected "
              "(not triangles), %zu degenerate\n",
-          s->tin, e->lname, e->ev.triangles, e->rejected, e->ev.degenerate);
+          tt__app_shown(e->r, s->tin), e->lname, e->ev.triangles, e->rejected,
+          e->ev.degenerate);
   if (er->max_col >= 0)
     fprintf(o, "max error:       %.9g %s at column %lld, row %lld "
                "(x %.10g, y %.10g)\n",
@@ -300,7 +301,8 @@ static void report_text(const eval_run *e)
              "uncovered, %zu overlapped\n",
           er->covered, er->samples, e->ev.uncovered, e->ev.overlapped);
   if (e->outp)
-    fprintf(o, "error raster:    %s (TIN - DEM, %s)\n", s->error_raster,
+    fprintf(o, "error raster:    %s (TIN - DEM, %s)\n",
+            tt__app_shown(e->r, s->error_raster),
             tt_grid_precision(e->grid) == TT_PRECISION_FLOAT64 ? "Float64"
                                                                : "Float32");
   if (s->max_error >= 0)
@@ -323,7 +325,8 @@ static void report(const eval_run *e)
     snprintf(a, sizeof a, "%.9g", e->ev.errors.max_error);
     snprintf(b, sizeof b, "%.9g", s->max_error);
     tt__app_result_set(e->r->res, TT_APP_EXIT_THRESHOLD, TT_OK,
-                       "%s: max error %s %s exceeds -max_error %s", s->tin,
+                       "%s: max error %s %s exceeds -max_error %s",
+                       tt__app_shown(e->r, s->tin),
                        a, tt__app_unit_or(e->info, "z units"), b);
   }
 }

@@ -71,7 +71,8 @@ tt_status tt__app_generate(app_run *r)
     fprintf(r->out,
             "%s: %s terrain, %zux%zu samples, seed %llu, heights %.6g to "
             "%.6g; %.2f s\n",
-            s->output, tt_synth_kind_name(s->synth.kind), s->synth.nx,
+            tt__app_shown(r, s->output), tt_synth_kind_name(s->synth.kind),
+            s->synth.nx,
             s->synth.ny, (unsigned long long)s->synth.seed, lo, hi,
             tt__app_now() - r->t0);
     fflush(r->out);

@@ -206,8 +206,8 @@ static tt_status write_output(optimize_run *p)
   tt__app_iso8601_utc(created, sizeof created);
   const tt_error_stats *e = &p->sum.errors;
   const tt_run_field fields[] = {
-      {"input", TT_FIELD_STRING, s->input, 0, 0},
-      {"in_tin", TT_FIELD_STRING, s->tin, 0, 0},
+      {"input", TT_FIELD_STRING, tt__app_shown(r, s->input), 0, 0},
+      {"in_tin", TT_FIELD_STRING, tt__app_shown(r, s->tin), 0, 0},
       {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
       {"criterion", TT_FIELD_STRING, tt_criterion_name(s->criterion), 0, 0},
       {"optimize", TT_FIELD_STRING, tt_optimize_name(p->mode), 0, 0},
@@ -263,10 +263,10 @@ static void report_json(const optimize_run *p)
   const tt_error_stats *e = &p->sum.errors;
   app_json j;
   tt__json_begin(&j, p->r->out);
-  tt__json_str(&j, "dem", s->input);
-  tt__json_str(&j, "in_tin", s->tin);
+  tt__json_str(&j, "dem", tt__app_shown(p->r, s->input));
+  tt__json_str(&j, "in_tin", tt__app_shown(p->r, s->tin));
   tt__json_str(&j, "layer", p->lname);
-  tt__json_str(&j, "output", s->output);
+  tt__json_str(&j, "output", tt__app_shown(p->r, s->output));
   tt__json_str(&j, "criterion", tt_criterion_name(s->criterion));
   tt__json_str(&j, "optimize", tt_optimize_name(p->mode));
   tt__json_size(&j, "vertices", p->sum.vertices);
@@ -307,8 +307,8 @@ static void report(const optimize_run *p)
     report_json(p);
   } else if (!s->quiet) {
     fprintf(o, "%s: %zu vertices, %zu triangles of %s layer %s, %s by %s "
-               "in %.3f s\n", s->output, p->sum.vertices, p->sum.triangles,
-            s->tin, p->lname, tt_criterion_name(s->criterion),
+               "in %.3f s\n", tt__app_shown(p->r, s->output), p->sum.vertices,
+            p->sum.triangles, tt__app_shown(p->r, s->tin), p->lname, tt_criterion_name(s->criterion),
             tt_optimize_name(p->mode), p->t_opt);
     const char *u = tt__app_unit_or(p->info, "z units");
     fprintf(o, "max error %.9g -> %.9g %s (bound %.9g %s: %s), RMS %.9g -> "

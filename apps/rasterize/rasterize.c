@@ -132,10 +132,10 @@ tt_status tt__app_rasterize(app_run *r)
   if (s->json) {
     app_json j;
     tt__json_begin(&j, r->out);
-    tt__json_str(&j, "tin", s->tin);
+    tt__json_str(&j, "tin", tt__app_shown(r, s->tin));
     tt__json_str(&j, "layer", lname);
-    tt__json_str(&j, "dem", s->input);
-    tt__json_str(&j, "output", s->output);
+    tt__json_str(&j, "dem", tt__app_shown(r, s->input));
+    tt__json_str(&j, "output", tt__app_shown(r, s->output));
     tt__json_str(&j, "driver", GDALGetDriverShortName(drv));
     tt__json_size(&j, "width", nx);
     tt__json_size(&j, "height", ny);
@@ -158,12 +158,12 @@ tt_status tt__app_rasterize(app_run *r)
   } else if (!s->quiet) {
     fprintf(r->out, "%s: %zux%zu, %zu samples in %zu triangles of %s "
                     "layer %s, %zu nodata, in %.3f s\n",
-            s->output, nx, ny, in_tin, ev.triangles, s->tin, lname,
-            nx * ny - in_tin, t_raster + t_write);
+            tt__app_shown(r, s->output), nx, ny, in_tin, ev.triangles,
+            tt__app_shown(r, s->tin), lname, nx * ny - in_tin,
+            t_raster + t_write);
     fprintf(r->out, "against %s: max error %.9g %s, RMS error %.9g %s over "
-                    "%zu of %zu valid samples\n",
-            s->input, e->max_error, unit, e->rmse, unit, e->covered,
-            e->samples);
+                    "%zu of %zu valid samples\n", tt__app_shown(r, s->input),
+            e->max_error, unit, e->rmse, unit, e->covered, e->samples);
   }
   fflush(r->out);
 

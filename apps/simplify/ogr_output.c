@@ -83,6 +83,7 @@ typedef struct probe {
   OGRSpatialReferenceH srs;
   char why[TT_APP_MESSAGE_MAX];
   unsigned seq;
+  const app_messages *msg; /* the run's, for the debug lines */
   /* the read-back (ogr_readback.c) of what a probe wrote */
   const char *t_srs;      /* T_SRS of wopts, or NULL */
   double tol_xy;          /* in the TIN's CRS */
@@ -106,7 +107,7 @@ static int probe_run(probe *p, unsigned mask, const char *ext)
   opts = CSLSetNameValue(opts, "ROWS", "NOW");
   tt_context *ctx = tt_context_create(); /* silent: no warnings printed */
   int result = -1;
-  CPLPushErrorHandler(CPLQuietErrorHandler);
+  tt__app_quiet_push(p->msg);
   VSIMkdir(dir, 0755);
   CPLErrorReset();
   GDALDatasetH ds = ctx ? GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
@@ -306,6 +307,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
   probe p;
   tt_context *ctx = tt_context_create();
   probe_init(&p, ctx, drv, src, s->output, dsco, wopts);
+  p.msg = &r->msg;
   int ok = 1;
   if (!p.tin)
     goto done; /* nothing to judge with */
@@ -471,8 +473,11 @@ GDALDriverH tt__app_database_driver(app_run *r)
     return NULL;
   }
   /* No -of: a connection string names its driver (GDAL 3.6 does not
-   * declare PostgreSQL's "PG:" prefix). */
-  if (strncasecmp(out, "PG:", 3) == 0)
+   * declare PostgreSQL's "PG:" prefix, nor the libpq URI its driver also
+   * opens). */
+  if (strncasecmp(out, "PG:", 3) == 0 ||
+      strncmp(out, "postgresql://", 13) == 0 ||
+      strncmp(out, "postgres://", 11) == 0)
     return GDALGetDriverByName("PostgreSQL");
   for (int i = 0; i < GDALGetDriverCount(); i++) {
     GDALDriverH drv = GDALGetDriver(i);
@@ -524,7 +529,7 @@ GDALDatasetH tt__app_database_open(app_run *r, GDALDriverH drv,
       continue;
     char *name = CPLStrdup(CPLSPrintf("%s%s%s%s", schema ? schema : "",
                                       schema ? "." : "", s->nln, names[i]));
-    CPLPushErrorHandler(CPLQuietErrorHandler);
+    tt__app_quiet_push(&r->msg);
     OGRLayerH l = GDALDatasetGetLayerByName(ds, name);
     CPLPopErrorHandler();
     CPLErrorReset();

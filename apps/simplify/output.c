@@ -66,18 +66,23 @@ static tt_status check_shapefile_names(app_simplify_job *job)
                                       "vertices.shp", "vertices.dbf",
                                       "run_parameters.dbf"};
   const char *slash = strrchr(s->output, '/');
-  int dirlen = slash ? (int)(slash - s->output) : 1;
-  const char *dir = slash ? s->output : ".";
-  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+  /* OUTPUT's folder (CPLSPrintf knows no %.*s) */
+  char *dir = CPLStrdup(slash ? s->output : ".");
+  if (slash)
+    dir[slash - s->output] = '\0';
+  tt_status st = TT_OK;
+  for (size_t i = 0; i < sizeof names / sizeof names[0] && st == TT_OK;
+       i++) {
     VSIStatBufL sb;
-    const char *p = CPLSPrintf("%.*s/%s%s%s", dirlen, dir,
+    const char *p = CPLSPrintf("%s/%s%s%s", dir,
                                tt_output_layer_prefix(job->outp), s->nln,
                                names[i]);
     if (VSIStatL(p, &sb) == 0)
-      return tt__app_fail(job->r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, p,
-                          "exists; use -overwrite to replace it");
+      st = tt__app_fail(job->r, TT_APP_EXIT_FAILURE, TT_ERR_EXISTS, p,
+                        "exists; use -overwrite to replace it");
   }
-  return TT_OK;
+  CPLFree(dir);
+  return st;
 }
 
 tt_status tt__app_output_plan(app_simplify_job *job)

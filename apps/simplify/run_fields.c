@@ -23,7 +23,7 @@ void tt__app_simplify_fields(const app_simplify_job *job,
   tt__app_iso8601_utc(out->created, sizeof out->created);
   const tt_error_stats *e = &rep->sum.errors;
   const tt_run_field fields[] = {
-      {"input", TT_FIELD_STRING, s->input, 0, 0},
+      {"input", TT_FIELD_STRING, tt__app_shown(job->r, s->input), 0, 0},
       {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
       {"driver", TT_FIELD_STRING, info->driver ? info->driver : "", 0, 0},
       {"method", TT_FIELD_STRING, s->decimate ? "decimate" : "insert", 0,

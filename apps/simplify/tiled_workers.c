@@ -189,7 +189,7 @@ static void *worker(void *arg)
 {
   tiled *T = arg;
   tt_context *ctx = tt_context_create();
-  CPLPushErrorHandler(CPLQuietErrorHandler);
+  tt__app_quiet_push(&T->r->msg);
   /* With more than one worker, each opens the DEM again for itself: a
    * GDAL dataset is for one thread at a time, and with a dataset each the
    * reads go in parallel -- with them the projection of a geographic

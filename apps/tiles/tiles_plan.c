@@ -291,7 +291,11 @@ void tt__tiles_simplify(const tiles_plan *p, const char *const *extra,
   tt_app_options *o = NULL;
   if (tt_app_options_new(sv, &o, res) == TT_OK) {
     tt_app_options_set_progress(o, fn, arg);
+    /* the run catches GDAL's messages itself, from an empty handler
+     * stack (tt_app_tiles pushed one for the tiles commands' own) */
+    CPLPopErrorHandler();
     tt_app_run(o, res);
+    tt__app_quiet_push(NULL);
   }
   tt_app_options_destroy(o);
   CSLDestroy(sv);
@@ -304,7 +308,7 @@ void tt_app_tiles(char **argv, tt_progress_fn fn, void *arg,
   memset(res, 0, sizeof *res);
   const char *sub = argv[0];
   GDALAllRegister();
-  CPLPushErrorHandler(CPLQuietErrorHandler); /* the messages are ours */
+  tt__app_quiet_push(NULL); /* the messages are ours; debug lines pass */
   if (sub && strcmp(sub, "plan") == 0)
     plan_cmd(argv + 1, res);
   else if (sub && strcmp(sub, "run") == 0)

@@ -15,7 +15,8 @@
 #    no table, and with -overwrite leaves the old tables as they were;
 #  - SIGTERM (handled as SIGINT) and SIGKILL while the write's
 #    transaction is open leave no table;
-#  - a password in the connection string never appears in messages.
+#  - a password in the connection string never appears in messages, the
+#    summary, -json or run_parameters, in every form libpq reads.
 # Skipped (77) with a message when PostgreSQL's server or PostGIS is not
 # installed (apt-get install postgresql-15 postgresql-15-postgis-3).
 # Prints "N passed, M failed"; exits 1 on any failure.
@@ -185,6 +186,27 @@ run simplify -q -max_error 1 dem.tif "PG:host=$S dbname=nosuchdb user=tt passwor
 check "a database that does not exist: exit 1" [ "$rc" -eq 1 ]
 check "a database that does not exist: one line" [ "$(wc -l <err.txt)" = 1 ]
 check "the password is never shown" not grep -q s3cret err.txt
+# Runs that succeed (the server trusts any password): every form libpq
+# reads, the summary and -json name the connection with *** and nothing of
+# the password (tests/apps/test_passwords.sh has the failing runs).
+SENC=$(python3 -c 'import sys, urllib.parse; print(urllib.parse.quote(sys.argv[1], safe=""))' "$S")
+for conn in "PG:host=$S dbname=postgres user=tt password=s3cretpw" \
+            "PG:host=$S dbname=postgres user=tt password = s3cretpw" \
+            "PG:host=$S dbname=postgres user=tt password='s3c\\'ret pw'" \
+            "PG:postgresql://tt:s3cretpw@$SENC/postgres" \
+            "postgresql://tt:s3cretpw@$SENC/postgres"; do
+  run simplify -overwrite -max_error 3 dem.tif "$conn"
+  check "summary, $conn: exit 0 ($(head -c 300 err.txt))" [ "$rc" -eq 0 ]
+  check "summary, $conn: names ***" grep -qF '***' out.txt
+  check "summary, $conn: no password" not grep -qE "s3c|ret pw|cretpw" out.txt err.txt
+  run simplify -json -overwrite -max_error 3 dem.tif "$conn"
+  check "-json, $conn: exit 0" [ "$rc" -eq 0 ]
+  check "-json, $conn: output names ***" \
+    python3 -c 'import json,sys; assert "***" in json.load(open(sys.argv[1]))["output"]' out.txt
+  check "-json, $conn: no password" not grep -qE "s3c|ret pw|cretpw" out.txt err.txt
+  check "run_parameters, $conn: no password" \
+    not grep -qE "s3c|cretpw" <<<"$(q 'SELECT * FROM run_parameters')"
+done
 
 # Interrupted while the transaction is open: SIGTERM (the run's own stop,
 # as for SIGINT, which a background job of a script ignores: the run rolls

@@ -118,6 +118,7 @@ static int web_mercator_of(OGRSpatialReferenceH srs, source *out)
   if (!srs || !OSRIsProjected(srs))
     return 0;
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
   OGRErr e = OSRExportToProj4(srs, &p4);
   CPLPopErrorHandler();
   if (e != OGRERR_NONE || !p4)
@@ -308,6 +309,7 @@ static tt_status check_web_mercator(tt_context *ctx,
   if (geog) {
     OSRSetAxisMappingStrategy(geog, OAMS_TRADITIONAL_GIS_ORDER);
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     ct = OCTNewCoordinateTransformation(src, geog);
     CPLPopErrorHandler();
   }
@@ -322,6 +324,7 @@ static tt_status check_web_mercator(tt_context *ctx,
       my[k] = y[k] = gt[3] + px * gt[4] + py * gt[5];
     }
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     ok = OCTTransformEx(ct, 5, x, y, NULL, good);
     CPLPopErrorHandler();
     for (int k = 0; ok && k < 5; k++) {
@@ -371,6 +374,7 @@ static tt_status raster_scale_at(tt_context *ctx,
       y[j * w + i] = gt[3] + px * gt[4] + py * gt[5];
     }
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
   int all = OCTTransformEx(ct, (int)(w * h), x, y, NULL, ok);
   CPLPopErrorHandler();
   tt_grid *g = NULL;
@@ -551,6 +555,7 @@ static tt_status working_crs(conformal *cf, OGRSpatialReferenceH srs,
   if (work_srs && *work_srs) {
     cf->work = OSRNewSpatialReference(NULL);
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     if (!cf->work || OSRSetFromUserInput(cf->work, work_srs) != OGRERR_NONE ||
         !OSRIsProjected(cf->work)) {
       CPLPopErrorHandler();
@@ -588,6 +593,7 @@ static tt_status open_transform(conformal *cf, OGRSpatialReferenceH srs,
   }
   OSRSetAxisMappingStrategy(cf->work, OAMS_TRADITIONAL_GIS_ORDER);
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
   cf->ct = cf->src ? OCTNewCoordinateTransformation(cf->src, cf->work) : NULL;
   CPLPopErrorHandler();
   if (!cf->ct)
@@ -626,6 +632,7 @@ static tt_status project_samples(conformal *cf, tt_grid *grid,
       ly[c] = gt[3] + px * gt[4] + py * gt[5];
     }
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     int all = OCTTransformEx(cf->ct, (int)nx, lx, ly, NULL, ok);
     CPLPopErrorHandler();
     for (size_t c = 0; c < nx; c++) {

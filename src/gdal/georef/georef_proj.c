@@ -361,6 +361,7 @@ tt_status tt__georef_ground_frame(tt_context *ctx, OGRSpatialReferenceH srs,
                        "CRS to transform from", work_srs);
     work = OSRNewSpatialReference(NULL);
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     OGRErr e = work ? OSRSetFromUserInput(work, work_srs) : OGRERR_FAILURE;
     CPLPopErrorHandler();
     if (e != OGRERR_NONE) {

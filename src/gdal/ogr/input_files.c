@@ -72,7 +72,9 @@ static tt_status protect_name(tt_context *ctx, tt_output *out,
     for (size_t j = i + 1; j <= n && s == TT_OK; j++) {
       if (!ends_piece(p[j]))
         continue;
-      char *piece = CPLStrdup(CPLSPrintf("%.*s", (int)(j - i), p + i));
+      /* (CPLSPrintf knows no %.*s) */
+      char *piece = CPLStrdup(p + i);
+      piece[j - i] = '\0';
       struct stat st;
       if (CSLFindString(*seen, piece) < 0 && stat(piece, &st) == 0 &&
           S_ISREG(st.st_mode)) {
@@ -105,6 +107,7 @@ static tt_status protect_files(tt_context *ctx, tt_output *out,
     /* A VRT among the sources: its own sources are not in the list. */
     *opened = CSLAddString(*opened, *f);
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     GDALDatasetH sub = GDALOpenEx(*f, GDAL_OF_RASTER | GDAL_OF_READONLY,
                                   NULL, NULL, NULL);
     CPLPopErrorHandler();

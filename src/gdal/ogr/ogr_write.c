@@ -275,6 +275,7 @@ static tt_status delete_existing(write_state *w, const char *name)
   /* by name first: PostgreSQL lists no table without geometry, and adds
    * one to its list when it is asked for by name */
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
   OGRLayerH named = GDALDatasetGetLayerByName(w->dst, full);
   CPLPopErrorHandler();
   CPLErrorReset();

@@ -92,6 +92,7 @@ static tt_status prepare_crs(tt__records *w, tt_context *ctx,
                        "to transform from", t_srs);
     w->out_srs = OSRNewSpatialReference(NULL);
     CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
     OGRErr e = w->out_srs ? OSRSetFromUserInput(w->out_srs, t_srs)
                           : OGRERR_FAILURE;
     CPLPopErrorHandler();

@@ -53,6 +53,7 @@ static tt_status describe_crs(tt_context *ctx, OGRSpatialReferenceH srs,
        * which helps more than "unnamed". Only the name is affected. */
       OGRSpatialReferenceH guess = OSRClone(srs);
       CPLPushErrorHandler(CPLQuietErrorHandler);
+      CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
       int found = guess && OSRAutoIdentifyEPSG(guess) == OGRERR_NONE;
       CPLPopErrorHandler();
       const char *gcode = found ? OSRGetAuthorityCode(guess, NULL) : NULL;
@@ -153,6 +154,7 @@ static tt_status read_geotransform(raster_read *r)
   if (!r->ds)
     return TT_OK;
   CPLPushErrorHandler(CPLQuietErrorHandler);
+  CPLSetCurrentErrorHandlerCatchDebug(FALSE); /* debug: the handler below */
   r->has_gt = GDALGetGeoTransform(r->ds, r->gt) == CE_None;
   CPLPopErrorHandler();
   if (r->has_gt)
