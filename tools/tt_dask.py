@@ -11,6 +11,10 @@ as the driver (a shared file system on a real cluster) and terratin.
              [--plan PLAN.json] [--keep] [--overwrite] [--stats FILE]
              DEM OUT.gpkg -max_error E -tile_size N [simplify options]
 
+The options that shape the TIN go into the plan; those of the output
+(-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs), which a
+plan never carries, go to `terratin tiles merge`.
+
 Without --scheduler a LocalCluster of N worker processes (one thread each)
 is started with every socket (its HTTP servers too) on 127.0.0.1. Exit codes: 0 done, 1 a tile or
 the merge failed (nothing written), 2 usage, 3 distributed is missing.
@@ -23,6 +27,30 @@ import subprocess
 import sys
 import tempfile
 import time
+
+
+# simplify's output options and whether each takes a value: `tiles merge`
+# takes them on its own command line (a plan refuses them)
+OUTPUT_OPTIONS = {"-of": True, "-f": True, "-lco": True, "-dsco": True,
+                  "-nln": True, "-layers": True, "-t_srs": True,
+                  "-nostyle": False, "-obj_local": False}
+
+
+def split_options(opts):
+    """simplify's options as (the plan's, the merge's)."""
+    plan, merge = [], []
+    i = 0
+    while i < len(opts):
+        w = opts[i]
+        name = w[1:] if w.startswith("--") else w
+        if name.lower() in OUTPUT_OPTIONS:
+            n = 2 if OUTPUT_OPTIONS[name.lower()] else 1
+            merge += opts[i:i + n]
+            i += n
+        else:
+            plan.append(w)
+            i += 1
+    return plan, merge
 
 
 def run_tile(terratin, plan, k):
@@ -78,8 +106,9 @@ def main(argv):
               % args.out, file=sys.stderr)
         return 1
     t0 = time.monotonic()
+    plan_opts, merge_opts = split_options(opts)
     r = subprocess.run([terratin, "tiles", "plan", args.dem, plan, "-q",
-                        "-overwrite"] + opts,
+                        "-overwrite"] + plan_opts,
                        stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
         sys.stderr.write(r.stderr)
@@ -123,7 +152,7 @@ def main(argv):
 
     t2 = time.monotonic()
     r = subprocess.run([terratin, "tiles", "merge", plan, args.out, "-q"]
-                       + ow, stderr=subprocess.PIPE, text=True)
+                       + ow + merge_opts, stderr=subprocess.PIPE, text=True)
     t_merge = time.monotonic() - t2
     if r.returncode != 0:
         sys.stderr.write(r.stderr)

@@ -305,6 +305,10 @@ typedef struct app_simplify_report {
   int tile_threads, auto_tiled;
   int budget_passes;  /* tiled runs to a budget: the runs at a bound */
   int streamed;       /* the GeoPackage written as the tiles merged */
+  /* the CRS the layers are written in: -t_srs, or the one a format takes
+   * only (GPX: EPSG:4326, chosen by the dry run); NULL: the DEM's */
+  const char *t_srs;
+  int t_srs_auto;     /* t_srs was chosen for the format, not given */
 } app_simplify_report;
 
 /* --- the subcommands ----------------------------------------------------- */
@@ -315,6 +319,25 @@ tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
 tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+
+/* The dispatch table (run.c): one entry per command, which the parser
+ * (the command word, how many positional words, where they go), the help
+ * and tt_app_run read, and the tests walk, so a command is added in one
+ * place. */
+#define TT_APP_POS_NONE ((size_t)-1) /* a word the command's check reads */
+typedef struct tt__app_command_def {
+  const char *name;                  /* the command word */
+  tt_app_command command;
+  size_t npos;                       /* its positional words, all needed */
+  size_t pos[3];                     /* offsetof(tt_app_settings, field)
+                                        of each (a const char *), or
+                                        TT_APP_POS_NONE */
+  tt_status (*run)(app_run *r);
+} tt__app_command_def;
+/* Every command, in the help's order, ended by an entry of NULL name. */
+extern const tt__app_command_def tt__app_commands[];
+/* The entry of c, or NULL (no command, help, version). */
+const tt__app_command_def *tt__app_command_def_of(tt_app_command c);
 /* raster_output.c, for rasterize and eval -error_raster: the raster
  * driver of -of, else
  * the one path's extension names (NULL path: GTiff), that can write a

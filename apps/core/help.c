@@ -94,7 +94,8 @@ static const char help_simplify[] =
     "  Every limit is exact. A point or triangle budget (or a percentage)\n"
     "  below what the starting triangulation needs -- the 4 corners, or\n"
     "  the hull and the vertices a nodata outline forces -- is refused\n"
-    "  before the run (exit 2) with the count to ask for.\n"
+    "  before the run (exit 2) with the count to ask for; the counts are\n"
+    "  the TIN's vertices and triangles, for either -method.\n"
     "\n"
     "Options:\n"
     "  -b BAND           band of INPUT to read (default 1)\n"
@@ -163,8 +164,11 @@ static const char help_simplify[] =
     "                    beside it: OUTPUT_ins_err.dat, ...), PLY\n"
     "                    (binary, vertex and face error properties, .ply),\n"
     "                    OBJ (.obj), LandXML (1.2 TIN surface, .xml),\n"
-    "                    UGRID (netCDF UGRID 1.0 mesh with the error\n"
-    "                    datasets; by -of only)\n"
+    "                    DXF (3DFACE entities, .dxf), UGRID (netCDF\n"
+    "                    UGRID 1.0 mesh with the error datasets; by -of\n"
+    "                    only). An OGR format that does not give back every\n"
+    "                    x, y and z written (MapInfo, DGN, ...) is refused\n"
+    "                    before the run; GPX is written in EPSG:4326\n"
     "                    or a database: PostgreSQL, OUTPUT \"PG:dbname=...\"\n"
     "                    (tables in one transaction; -lco SCHEMA=NAME)\n"
     "  -obj_local        OBJ: vertices relative to the centre of the extent\n"
@@ -174,7 +178,7 @@ static const char help_simplify[] =
     "  -nln PREFIX       prefix of the three layer names (default: none)\n"
     "  -layers LIST      the layers to write: triangles,vertices,\n"
     "                    run_parameters or any subset (default: all); one\n"
-    "                    layer for GeoJSON, FlatGeobuf, GPX, DXF files\n"
+    "                    layer for GeoJSON, FlatGeobuf, GPX files\n"
     "  -nostyle          no QGIS default style (layer_styles) in a GPKG\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
     "  -q                quiet: no progress bar, no summary line\n"
@@ -319,7 +323,9 @@ static const char help_optimize[] =
     "  -optimize MODE    local (default), lookahead, anneal or\n"
     "                    edge_insertion (-criterion minmax_angle only)\n"
     "  -max_error E      refuse every move that makes a triangle with a\n"
-    "                    sample farther than E from it (z units)\n"
+    "                    sample farther than E from it (z units; default:\n"
+    "                    the input TIN's own max error, which thus never\n"
+    "                    grows)\n"
     ANNEAL_HELP
     "  -b, -srcnodata, -z_factor, -z_unit   as simplify\n"
     "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
@@ -453,13 +459,6 @@ const char *tt_app_help(tt_app_command topic)
 
 const char *tt__app_command_name(tt_app_command c)
 {
-  switch (c) {
-  case TT_APP_SIMPLIFY: return "simplify";
-  case TT_APP_GENERATE: return "generate";
-  case TT_APP_EVAL: return "eval";
-  case TT_APP_OPTIMIZE: return "optimize";
-  case TT_APP_STUDY: return "study";
-  case TT_APP_RASTERIZE: return "rasterize";
-  default: return "";
-  }
+  const tt__app_command_def *d = tt__app_command_def_of(c);
+  return d ? d->name : "";
 }

@@ -35,12 +35,9 @@ static int is_help_word(const char *w)
 /* The command a word names (case-insensitive), or TT_APP_NONE. */
 static tt_app_command command_named(const char *w)
 {
-  static const tt_app_command commands[] = {
-      TT_APP_SIMPLIFY, TT_APP_GENERATE, TT_APP_EVAL,
-      TT_APP_OPTIMIZE, TT_APP_STUDY,    TT_APP_RASTERIZE};
-  for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-    if (tt__app_str_ieq(w, tt__app_command_name(commands[i])))
-      return commands[i];
+  for (const tt__app_command_def *d = tt__app_commands; d->name; d++)
+    if (tt__app_str_ieq(w, d->name))
+      return d->command;
   return TT_APP_NONE;
 }
 
@@ -205,9 +202,8 @@ static tt_status read_option(tt__app_opt_parse *p, char **argv, size_t *i)
 
 static tt_status read_positional(tt__app_opt_parse *p, const char *w)
 {
-  tt_app_command c = p->o->s.command;
-  size_t most = c == TT_APP_OPTIMIZE || c == TT_APP_RASTERIZE ? 3 : 2;
-  if (p->npos >= most)
+  const tt__app_command_def *d = tt__app_command_def_of(p->o->s.command);
+  if (p->npos >= (d ? d->npos : 0))
     return OPT_USAGE(p, "%s: unexpected argument '%s'%s", p->cmdname, w,
                      p->hint);
   p->pos[p->npos++] = w;
@@ -250,14 +246,19 @@ static void apply_given(tt__app_opt_parse *p)
     s->z_factor_set = 1;
 }
 
-/* Keeps the positional words in the fields named, in order. */
-static tt_status keep_positional(tt__app_opt_parse *p, const char **a,
-                                 const char **b, const char **c)
+/* Keeps the positional words where the command's entry in the dispatch
+ * table says (run.c), in order. */
+static tt_status keep_positional(tt__app_opt_parse *p)
 {
-  const char **to[3] = {a, b, c};
-  for (size_t k = 0; k < 3 && to[k]; k++)
-    if (!(*to[k] = tt__app_opt_keep(p->o, p->pos[k])))
+  const tt__app_command_def *d = tt__app_command_def_of(p->o->s.command);
+  for (size_t k = 0; d && k < d->npos && k < p->npos; k++) {
+    if (d->pos[k] == TT_APP_POS_NONE)
+      continue;
+    const char *kept = tt__app_opt_keep(p->o, p->pos[k]);
+    if (!kept)
       return OPT_NOMEM(p);
+    *(const char **)((char *)&p->o->s + d->pos[k]) = kept;
+  }
   return TT_OK;
 }
 
@@ -269,7 +270,7 @@ static tt_status check_simplify(tt__app_opt_parse *p)
   if (p->npos < 2)
     return OPT_USAGE(p, "simplify: missing OUTPUT after '%s'%s", p->pos[0],
                      p->hint);
-  if (keep_positional(p, &s->input, &s->output, NULL) != TT_OK)
+  if (keep_positional(p) != TT_OK)
     return TT_ERR_NOMEM;
   if (p->decimate_only && !s->decimate)
     return OPT_USAGE(p, "simplify: %s applies to -method decimate only",
@@ -290,17 +291,13 @@ static tt_status check_simplify(tt__app_opt_parse *p)
 
 static tt_status check_study(tt__app_opt_parse *p)
 {
-  tt_app_settings *s = &p->o->s;
   if (p->npos < 1)
     return OPT_USAGE(p, "study: missing OUTDIR%s", p->hint);
-  if (p->npos > 1)
-    return OPT_USAGE(p, "study: unexpected argument '%s'%s", p->pos[1],
-                     p->hint);
   if (!p->o->terrains.n)
     return OPT_USAGE(p, "study: no -terrain given (a DEM file or "
                      "fault_smooth, fault_rough, peak_rough, valley_rough, "
                      "hybrid, sphere, cylinder, bump)%s", p->hint);
-  return keep_positional(p, &s->output, NULL, NULL);
+  return keep_positional(p);
 }
 
 static tt_status check_eval(tt__app_opt_parse *p)
@@ -310,7 +307,7 @@ static tt_status check_eval(tt__app_opt_parse *p)
     return OPT_USAGE(p, "eval: missing DEM and TIN%s", p->hint);
   if (p->npos < 2)
     return OPT_USAGE(p, "eval: missing TIN after '%s'%s", p->pos[0], p->hint);
-  if (keep_positional(p, &s->input, &s->tin, NULL) != TT_OK)
+  if (keep_positional(p) != TT_OK)
     return TT_ERR_NOMEM;
   if (!s->error_raster && (s->overwrite || p->o->co.n))
     return OPT_USAGE(p, "eval: option %s does not apply without "
@@ -321,26 +318,24 @@ static tt_status check_eval(tt__app_opt_parse *p)
 
 static tt_status check_rasterize(tt__app_opt_parse *p)
 {
-  tt_app_settings *s = &p->o->s;
   if (p->npos < 3)
     return OPT_USAGE(p, "rasterize: missing %s%s",
                      p->npos == 0   ? "TIN, DEM and OUTPUT"
                      : p->npos == 1 ? "DEM and OUTPUT"
                                     : "OUTPUT",
                      p->hint);
-  return keep_positional(p, &s->tin, &s->input, &s->output);
+  return keep_positional(p);
 }
 
 static tt_status check_optimize(tt__app_opt_parse *p)
 {
-  tt_app_settings *s = &p->o->s;
   if (p->npos < 3)
     return OPT_USAGE(p, "optimize: missing %s%s",
                      p->npos == 0   ? "DEM, IN_TIN and OUTPUT"
                      : p->npos == 1 ? "IN_TIN and OUTPUT"
                                     : "OUTPUT",
                      p->hint);
-  return keep_positional(p, &s->input, &s->tin, &s->output);
+  return keep_positional(p);
 }
 
 /* generate TYPE OUTPUT: the kind's defaults, then the parameters given
@@ -360,8 +355,8 @@ static tt_status check_generate(tt__app_opt_parse *p)
   if (p->npos < 2)
     return OPT_USAGE(p, "generate: missing OUTPUT after '%s'%s", p->pos[0],
                      p->hint);
-  if (!(s->output = tt__app_opt_keep(p->o, p->pos[1])))
-    return OPT_NOMEM(p);
+  if (keep_positional(p) != TT_OK)
+    return TT_ERR_NOMEM;
   const char *kname = tt_synth_kind_name(kind);
   if (!kname)
     kname = p->pos[0];

@@ -257,8 +257,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
                tt__app_nonempty_or_null(p->info->area_or_point));
   tt__json_str(&j, "crs", tt__app_nonempty_or_null(p->info->crs_name));
   tt__json_str(&j, "output_crs",
-               r->s->t_srs ? r->s->t_srs
+               p->t_srs ? p->t_srs
                            : tt__app_nonempty_or_null(p->info->crs_name));
+  tt__json_bool(&j, "output_crs_automatic", p->t_srs_auto);
   tt__json_str(&j, "frame", p->info->frame_name);
   tt__json_size(&j, "warnings", r->msg.warnings);
   if (p->tiles) {
@@ -321,14 +322,15 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
   const char *shown = tt__app_shown(r, r->s->output);
   fprintf(r->out,
           "%s: %zu cells, %zu valid samples -> %zu vertices, %zu triangles; "
-          "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s; "
+          "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s%s; "
           "frame %s; z unit %s; mesh %.2f s, write %.2f s (%s); %.2f s\n",
           shown, p->cells, p->valid, p->sum.vertices,
           p->sum.triangles, p->sum.errors.max_error, unit,
           p->sum.errors.rmse, unit, lim,
           tt_stop_reason_name(p->sum.stop_reason),
           in->crs_name && *in->crs_name ? in->crs_name : "none",
-          r->s->t_srs ? ", written in " : "", r->s->t_srs ? r->s->t_srs : "",
+          p->t_srs ? ", written in " : "", p->t_srs ? p->t_srs : "",
+          p->t_srs_auto ? " (the only CRS the format holds)" : "",
           in->frame_name, zu, p->sum.seconds_mesh, p->t_write,
           p->driver ? p->driver : "?", p->t_total);
   if (p->tiles) {

@@ -1,6 +1,7 @@
 /*
  * run.c -- apps/core/: the command's core, what every command's folder shares.
- * This file: tt_app_run() and what every subcommand shares: the result and its
+ * This file: tt_app_run() and the commands' dispatch table (tt__app_commands,
+ * which the parser and the help read too), and what every subcommand shares: the result and its
  * one-line failure, GDAL's messages while a run is active (failures stored,
  * warnings printed as "terratin: warning: ..."), the causes of a failed write,
  * choosing the output driver and the thread count (the DEM itself is opened and
@@ -21,6 +22,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -616,6 +618,30 @@ static void remove_stale(app_run *r)
  * (app.h); all zero otherwise. */
 tt_app_tiles_hook tt__app_tiles_hook;
 
+#define POS(field) offsetof(tt_app_settings, field)
+#define NONE TT_APP_POS_NONE
+
+const tt__app_command_def tt__app_commands[] = {
+    {"simplify", TT_APP_SIMPLIFY, 2, {POS(input), POS(output), NONE},
+     tt__app_simplify},
+    {"generate", TT_APP_GENERATE, 2, {NONE, POS(output), NONE},
+     tt__app_generate},
+    {"eval", TT_APP_EVAL, 2, {POS(input), POS(tin), NONE}, tt__app_eval},
+    {"optimize", TT_APP_OPTIMIZE, 3, {POS(input), POS(tin), POS(output)},
+     tt__app_optimize},
+    {"study", TT_APP_STUDY, 1, {POS(output), NONE, NONE}, tt__app_study},
+    {"rasterize", TT_APP_RASTERIZE, 3, {POS(tin), POS(input), POS(output)},
+     tt__app_rasterize},
+    {NULL, TT_APP_NONE, 0, {NONE, NONE, NONE}, NULL}};
+
+const tt__app_command_def *tt__app_command_def_of(tt_app_command c)
+{
+  for (const tt__app_command_def *d = tt__app_commands; d->name; d++)
+    if (d->command == c)
+      return d;
+  return NULL;
+}
+
 tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
 {
   tt_app_result local;
@@ -640,25 +666,21 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   r.prog.arg = o->progress_arg;
   r.t0 = tt__app_now();
 
-  switch (o->s.command) {
-  case TT_APP_HELP:
+  const tt__app_command_def *cmd = tt__app_command_def_of(o->s.command);
+  if (o->s.command == TT_APP_HELP) {
     fputs(tt_app_help(o->s.help_topic), r.out);
     fflush(r.out);
     return TT_OK;
-  case TT_APP_VERSION:
+  }
+  if (o->s.command == TT_APP_VERSION) {
     print_version(r.out);
     fflush(r.out);
     return TT_OK;
-  case TT_APP_SIMPLIFY:
-  case TT_APP_GENERATE:
-  case TT_APP_EVAL:
-  case TT_APP_OPTIMIZE:
-  case TT_APP_STUDY:
-  case TT_APP_RASTERIZE:
-    break;
-  default:
+  }
+  if (!cmd) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-               "missing command: simplify, generate or eval");
+                       "missing command: simplify, generate, eval, optimize, "
+                       "study or rasterize");
     return TT_ERR_ARG;
   }
 
@@ -698,14 +720,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   tt_context_set_log(r.ctx, on_engine_warning, &r.msg);
   remove_stale(&r);
 
-  switch (o->s.command) {
-  case TT_APP_SIMPLIFY: st = tt__app_simplify(&r); break;
-  case TT_APP_GENERATE: st = tt__app_generate(&r); break;
-  case TT_APP_OPTIMIZE: st = tt__app_optimize(&r); break;
-  case TT_APP_STUDY: st = tt__app_study(&r); break;
-  case TT_APP_RASTERIZE: st = tt__app_rasterize(&r); break;
-  default: st = tt__app_eval(&r); break;
-  }
+  st = cmd->run(&r);
 done:
   tt_context_destroy(r.ctx);
   CPLPopErrorHandler();

@@ -139,9 +139,9 @@ int main(int argc, char **argv)
   } else if (tt_app_options_new(argv + 1, &opts, &res) == TT_OK) {
     const tt_app_settings *s = tt_app_options_settings(opts);
     const char *out = s->error_raster ? s->error_raster : s->output;
-    char shown[sizeof stop_msg];
+    char shown[sizeof stop_msg - 64]; /* room for the words around it */
     if (out && tt_app_mask_password(out, shown, sizeof shown) >= 0 &&
-        strlen(shown) < sizeof stop_msg - 64)
+        strlen(shown) + 1 < sizeof shown) /* not cut short */
       snprintf(stop_msg, sizeof stop_msg,
                "terratin: %s: interrupted; nothing written\n", shown);
     tt_app_term_progress_init(

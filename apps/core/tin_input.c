@@ -5,7 +5,8 @@
  * rasterize read it (tt__app_read_dem_and_tin in dem.c, and eval).
  *
  * The layer is -layer, else "triangles" or "*_triangles" (a terratin
- * output, a Shapefile prefix), else the first polygon layer.
+ * output, a Shapefile prefix), else the first polygon layer, else the
+ * first layer of mixed geometries (DXF's "entities").
  */
 #include "app.h"
 
@@ -55,7 +56,7 @@ OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds)
     }
     return l;
   }
-  for (int pass = 0; pass < 2; pass++) {
+  for (int pass = 0; pass < 3; pass++) {
     for (int i = 0; i < n; i++) {
       OGRLayerH l = GDALDatasetGetLayer(ds, i);
       const char *name = OGR_L_GetName(l);
@@ -64,6 +65,8 @@ OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds)
            ends_with(name, "_triangles")))
         return l;
       if (pass == 1 && is_polygon_layer(l))
+        return l;
+      if (pass == 2 && OGR_L_GetGeomType(l) == wkbUnknown)
         return l;
     }
   }

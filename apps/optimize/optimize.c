@@ -12,8 +12,10 @@
  *
  * Invariants: neither input is written; an existing output is replaced
  * only with -overwrite and only once the new one is complete; a failure at
- * any phase leaves nothing behind. The summary gives the mean error and
- * the largest angle before and after, so a run says what it changed.
+ * any phase leaves nothing behind. The max error never grows unless asked:
+ * without -max_error the input TIN's own max error is the bound (a move
+ * that would pass it is refused). The summary gives every measure before
+ * and after, so a run says what it changed.
  */
 #include "app.h"
 
@@ -47,6 +49,8 @@ typedef struct optimize_run {
   tt_tin_summary sum;       /* and its errors */
   double angle_after;
   tt_optimize mode;         /* the optimiser that ran */
+  double bound;             /* the max error no move may pass */
+  int bound_given;          /* -max_error set it; else the input's own */
   OGRSpatialReferenceH srs; /* the layers' CRS: the DEM's */
   char **wopts;
   double t_read, t_opt, t_write;
@@ -160,7 +164,10 @@ static tt_status optimise(optimize_run *p)
   tt_optimize_options_init(&oo);
   oo.criterion = s->criterion;
   oo.optimize = s->optimize;
-  oo.max_error = s->max_error;
+  /* the input's own max error, unless -max_error sets another */
+  p->bound_given = s->max_error >= 0;
+  p->bound = p->bound_given ? s->max_error : p->before.errors.max_error;
+  oo.max_error = p->bound;
   oo.anneal = s->anneal;
   double t = tt__app_now();
   tt_status st = tt_optimize_run(r->ctx, p->grid, p->ntri, p->xyz, &oo,
@@ -204,11 +211,14 @@ static tt_status write_output(optimize_run *p)
       {"band", TT_FIELD_INTEGER, NULL, s->band, 0},
       {"criterion", TT_FIELD_STRING, tt_criterion_name(s->criterion), 0, 0},
       {"optimize", TT_FIELD_STRING, tt_optimize_name(p->mode), 0, 0},
-      {"max_error", TT_FIELD_REAL, NULL, 0, s->max_error},
+      {"max_error", TT_FIELD_REAL, NULL, 0, p->bound},
       {"seed", TT_FIELD_INTEGER, NULL, (int64_t)s->anneal.seed, 0},
       {"vertices", TT_FIELD_INTEGER, NULL, (int64_t)p->sum.vertices, 0},
       {"triangles", TT_FIELD_INTEGER, NULL, (int64_t)p->sum.triangles, 0},
       {"in_mean", TT_FIELD_REAL, NULL, 0, p->before.errors.mean_abs},
+      {"in_max", TT_FIELD_REAL, NULL, 0, p->before.errors.max_error},
+      {"in_rmse", TT_FIELD_REAL, NULL, 0, p->before.errors.rmse},
+      {"in_l2", TT_FIELD_REAL, NULL, 0, p->before.errors.l2},
       {"in_angle", TT_FIELD_REAL, NULL, 0, p->angle_before},
       {"ach_max", TT_FIELD_REAL, NULL, 0, e->max_error},
       {"ach_rmse", TT_FIELD_REAL, NULL, 0, e->rmse},
@@ -261,16 +271,21 @@ static void report_json(const optimize_run *p)
   tt__json_str(&j, "optimize", tt_optimize_name(p->mode));
   tt__json_size(&j, "vertices", p->sum.vertices);
   tt__json_size(&j, "triangles", p->sum.triangles);
+  tt__json_num(&j, "max_error_bound", p->bound);
+  tt__json_str(&j, "max_error_bound_from",
+               p->bound_given ? "-max_error" : "input");
   tt__json_open(&j, "before");
   tt__json_num(&j, "mean_abs_error", p->before.errors.mean_abs);
   tt__json_num(&j, "max_error", p->before.errors.max_error);
   tt__json_num(&j, "rmse", p->before.errors.rmse);
+  tt__json_num(&j, "l2", p->before.errors.l2);
   tt__json_num(&j, "largest_angle_deg", p->angle_before);
   tt__json_close(&j);
   tt__json_open(&j, "after");
   tt__json_num(&j, "mean_abs_error", e->mean_abs);
   tt__json_num(&j, "max_error", e->max_error);
   tt__json_num(&j, "rmse", e->rmse);
+  tt__json_num(&j, "l2", e->l2);
   tt__json_num(&j, "largest_angle_deg", p->angle_after);
   tt__json_close(&j);
   tt__json_str(&j, "z_unit", tt__app_nonempty_or_null(p->info->z_unit));
@@ -295,11 +310,16 @@ static void report(const optimize_run *p)
                "in %.3f s\n", tt__app_shown(p->r, s->output), p->sum.vertices,
             p->sum.triangles, tt__app_shown(p->r, s->tin), p->lname, tt_criterion_name(s->criterion),
             tt_optimize_name(p->mode), p->t_opt);
-    fprintf(o, "mean abs error %.9g -> %.9g %s, max error %.9g -> %.9g, "
-               "largest angle %.6g -> %.6g degrees\n",
-            p->before.errors.mean_abs, e->mean_abs,
-            tt__app_unit_or(p->info, "z units"), p->before.errors.max_error,
-            e->max_error, p->angle_before, p->angle_after);
+    const char *u = tt__app_unit_or(p->info, "z units");
+    fprintf(o, "max error %.9g -> %.9g %s (bound %.9g %s: %s), RMS %.9g -> "
+               "%.9g, mean abs %.9g -> %.9g, L2 %.9g -> %.9g, largest "
+               "angle %.6g -> %.6g degrees\n",
+            p->before.errors.max_error, e->max_error, u, p->bound, u,
+            p->bound_given ? "-max_error"
+                           : "the input's own; -max_error sets another",
+            p->before.errors.rmse, e->rmse, p->before.errors.mean_abs,
+            e->mean_abs, p->before.errors.l2, e->l2, p->angle_before,
+            p->angle_after);
   }
   fflush(o);
 }

@@ -55,6 +55,7 @@ void tt__app_job_init(app_simplify_job *job, app_run *r)
   memset(job, 0, sizeof *job);
   job->r = r;
   job->s = s;
+  job->rep.t_srs = s->t_srs;
   job->decimate = s->decimate;
   tt_refine_options_init(&job->ro);
   job->ro.max_error = s->max_error;
@@ -169,6 +170,7 @@ void tt__app_job_free(app_simplify_job *job)
   if (job->srs)
     OSRDestroySpatialReference(job->srs);
   CSLDestroy(job->wopts);
+  CPLFree(job->t_srs_auto);
   CSLDestroy(job->dsco);
   tt_tin_destroy(job->tin);
   tt_grid_destroy(job->grid);

@@ -13,8 +13,14 @@
  *    the -layers that the driver takes (each layer is then tried alone) or,
  *    for a format that writes a folder of files when OUTPUT has no
  *    extension, that form. What the drivers' metadata says is not enough:
- *    DXF and GPX claim several layers. A driver that cannot even create a
- *    dataset in memory is not judged (the real write will say).
+ *    DXF and GPX claim several layers. A driver that cannot create a
+ *    dataset in memory gets its dry run in a folder of the system's
+ *    temporary directory; one that can create none is refused.
+ *  - The read-back (ogr_readback.c): what the dry run wrote is read back
+ *    and every x, y and z compared with the TIN written; a format that
+ *    changes them is refused, naming what changed, and one that holds
+ *    longitude/latitude only (GPX) is written in that CRS (the summary
+ *    says so).
  *  - Databases (PostgreSQL through "PG:..."; any driver that writes no file
  *    and holds transactions): the datasource is opened before the work,
  *    its layers of our names refused without -overwrite, and the TIN is
@@ -31,6 +37,7 @@
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,11 +51,18 @@ static const tt_run_field probe_fields[] = {
     {"max_error", TT_FIELD_REAL, NULL, 0, 1.5},
 };
 
-/* A two-triangle TIN on the DEM's first 2 x 2 samples (its geotransform),
- * for the dry run. NULL when the engine cannot make it. */
-static tt_tin *probe_tin(tt_context *ctx, const double gt[6])
+/* A two-triangle TIN on the DEM's first 2 x 2 samples (its geotransform,
+ * its origin moved by an irrational share of a pixel so that the
+ * coordinates have every digit), for the dry run: heights that use every
+ * bit of a float, so that a format that rounds them shows it. NULL when
+ * the engine cannot make it. */
+static tt_tin *probe_tin(tt_context *ctx, const double dem_gt[6])
 {
-  static const float z[4] = {1, 2, 3, 5};
+  static const float z[4] = {2602.37f, 2578.13f, 2597.91f, -12.3457f};
+  double gt[6];
+  memcpy(gt, dem_gt, sizeof gt);
+  gt[0] += 0.3183098861837907 * gt[1];
+  gt[3] += 0.2718281828459045 * gt[5];
   tt_grid *grid = NULL;
   tt_tin *tin = NULL;
   tt_refine_options ro;
@@ -70,10 +84,17 @@ typedef struct probe {
   char why[TT_APP_MESSAGE_MAX];
   unsigned seq;
   const app_messages *msg; /* the run's, for the debug lines */
+  /* the read-back (ogr_readback.c) of what a probe wrote */
+  const char *t_srs;      /* T_SRS of wopts, or NULL */
+  double tol_xy;          /* in the TIN's CRS */
+  int lossy;              /* the last probe written did not read back */
+  char lost[TT_APP_MESSAGE_MAX]; /* what changed */
+  char *imposed;          /* the driver's own geographic CRS (GPX) */
 } probe;
 
-/* 1: the driver wrote the layers of mask; 0: it refused (p->why says
- * why); -1: no dataset could be made in memory, nothing is known. */
+/* 1: the driver wrote the layers of mask (p->lossy: not as they were
+ * given); 0: it refused or could create no dataset (p->why says why); -1:
+ * nothing is known (no context). */
 static int probe_run(probe *p, unsigned mask, const char *ext)
 {
   char list[64];
@@ -92,6 +113,33 @@ static int probe_run(probe *p, unsigned mask, const char *ext)
   GDALDatasetH ds = ctx ? GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
                                      (CSLConstList)p->dsco)
                         : NULL;
+  if (!ds && ctx) {
+    /* A driver that writes only real files (FITS, netCDF, BAG): the dry
+     * run in a folder of the system's temporary directory instead. */
+    const char *tmp = getenv("TMPDIR");
+    char *real = CPLStrdup(CPLSPrintf("%s/terratin_probe_XXXXXX",
+                                      tmp && *tmp ? tmp : "/tmp"));
+    VSIRmdirRecursive(dir);
+    if (mkdtemp(real)) {
+      CPLFree(dir);
+      CPLFree(name);
+      dir = real;
+      name = CPLStrdup(CPLSPrintf("%s/out%s", dir, ext));
+      CPLErrorReset();
+      ds = GDALCreate(p->drv, name, 0, 0, 0, GDT_Unknown,
+                      (CSLConstList)p->dsco);
+    } else {
+      CPLFree(real);
+    }
+    if (!ds) {
+      /* nowhere: the real write would fail the same way */
+      snprintf(p->why, sizeof p->why, "cannot create a %s dataset: %s",
+               GDALGetDriverShortName(p->drv),
+               *CPLGetLastErrorMsg() ? CPLGetLastErrorMsg()
+                                     : "no details from GDAL");
+      result = 0;
+    }
+  }
   if (ds) {
     tt_status st = tt_ogr_write_tin(ctx, ds, p->tin, p->srs, probe_fields,
                                     sizeof probe_fields /
@@ -114,6 +162,28 @@ static int probe_run(probe *p, unsigned mask, const char *ext)
       snprintf(p->why, sizeof p->why, "the driver writes a folder of one "
                "file a layer for them");
       result = 0;
+    }
+    /* Written: does it read back as written? */
+    p->lossy = 0;
+    if (result == 1 && (mask & 3u)) {
+      char *imposed = NULL;
+      /* Shapefile layers are files of their own beside OUTPUT: the
+       * folder reads as one dataset of them */
+      VSIStatBufL nb;
+      const char *back =
+          tt__app_str_ieq(GDALGetDriverShortName(p->drv), "ESRI Shapefile") &&
+                  !(VSIStatL(name, &nb) == 0 && VSI_ISDIR(nb.st_mode))
+              ? dir
+              : name;
+      if (!tt__app_read_back(p->drv, back, mask, p->tin, p->srs, p->t_srs,
+                             p->tol_xy, p->lost, sizeof p->lost,
+                             &imposed)) {
+        p->lossy = 1;
+        if (imposed && !p->imposed)
+          p->imposed = imposed;
+        else
+          CPLFree(imposed);
+      }
     }
   }
   VSIRmdirRecursive(dir);
@@ -154,43 +224,109 @@ char **tt__app_output_dsco(const char *drvname, const char *const *dsco)
   return out;
 }
 
-int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
-                             char **dsco, char **wopts)
+/* opts with the user's -nln taken off the end of NLN_PREFIX (which may
+ * begin with the prefix a Shapefile's OUTPUT gives). */
+static char **without_nln(char **opts, const char *nln)
 {
+  const char *pre = CSLFetchNameValue(opts, "NLN_PREFIX");
+  size_t n = pre ? strlen(pre) : 0, m = strlen(nln);
+  if (!m || n < m || strcmp(pre + n - m, nln) != 0)
+    return opts;
+  char *kept = CPLStrdup(CPLSPrintf("%.*s", (int)(n - m), pre));
+  opts = CSLSetNameValue(opts, "NLN_PREFIX", kept);
+  CPLFree(kept);
+  return opts;
+}
+
+/* A driver that does not keep the TIN as written: refused, naming what
+ * changed and what works instead. */
+static void refuse_lossy(app_run *r, const char *dname, const char *lost)
+{
+  tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+               "simplify: -of %s cannot hold the TIN faithfully (%s); "
+               "write -of GPKG or \"ESRI Shapefile\", or a mesh format "
+               "(2DM, PLY, OBJ, LandXML, DXF)", dname, lost);
+}
+
+/* The probe of drv for OUTPUT output, on the DEM src's geotransform and
+ * CRS, with its creation options dsco and the writer's options wopts
+ * (LAYERS taken out: each probe sets its own); p->tin is NULL when ctx is
+ * (nothing to judge with). */
+static void probe_init(probe *p, tt_context *ctx, GDALDriverH drv,
+                       GDALDatasetH src, const char *output, char **dsco,
+                       char **wopts)
+{
+  memset(p, 0, sizeof *p);
+  p->drv = drv;
+  p->dsco = dsco;
+  const char *base = strrchr(output, '/');
+  base = base ? base + 1 : output;
+  const char *dot = strrchr(base, '.');
+  p->ext = dot && dot != base ? dot : "";
+  for (char **o = wopts; o && *o; o++)
+    if (strncasecmp(*o, "LAYERS=", 7) != 0)
+      p->wopts = CSLAddString(p->wopts, *o);
+  double gt[6] = {0, 1, 0, 0, 0, -1};
+  GDALGetGeoTransform(src, gt);
+  p->t_srs = CSLFetchNameValue(wopts, "T_SRS");
+  p->tol_xy = 1e-6 * fmin(fabs(gt[1]), fabs(gt[5]));
+  const char *wkt = GDALGetProjectionRef(src);
+  if (wkt && *wkt) {
+    p->srs = OSRNewSpatialReference(wkt);
+    if (p->srs)
+      OSRSetAxisMappingStrategy(p->srs, OAMS_TRADITIONAL_GIS_ORDER);
+  }
+  p->tin = ctx ? probe_tin(ctx, gt) : NULL;
+}
+
+/* A driver that takes only longitude/latitude of its own CRS (GPX): the
+ * probe again in that CRS; when it keeps the TIN so, that CRS (the
+ * caller's to CPLFree, p->imposed taken over), else NULL. */
+static char *in_own_crs(probe *p, unsigned want)
+{
+  probe q = *p;
+  q.wopts = CSLSetNameValue(CSLDuplicate(p->wopts), "T_SRS", p->imposed);
+  q.t_srs = p->imposed;
+  q.imposed = NULL;
+  int again = probe_run(&q, want, p->ext);
+  CSLDestroy(q.wopts);
+  CPLFree(q.imposed);
+  if (again != 1 || q.lossy)
+    return NULL;
+  char *crs = p->imposed;
+  p->imposed = NULL;
+  return crs;
+}
+
+int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
+                             char **dsco, char **wopts, char **auto_t_srs)
+{
+  *auto_t_srs = NULL;
   const tt_app_settings *s = r->s;
   const char *dname = GDALGetDriverShortName(drv);
   probe p;
-  memset(&p, 0, sizeof p);
-  p.msg = &r->msg;
-  p.drv = drv;
-  p.dsco = dsco;
-  const char *base = strrchr(s->output, '/');
-  base = base ? base + 1 : s->output;
-  const char *dot = strrchr(base, '.');
-  p.ext = dot && dot != base ? dot : "";
-  for (char **o = wopts; o && *o; o++)
-    if (strncasecmp(*o, "LAYERS=", 7) != 0)
-      p.wopts = CSLAddString(p.wopts, *o);
-  double gt[6] = {0, 1, 0, 0, 0, -1};
-  GDALGetGeoTransform(src, gt);
-  const char *wkt = GDALGetProjectionRef(src);
-  if (wkt && *wkt) {
-    p.srs = OSRNewSpatialReference(wkt);
-    if (p.srs)
-      OSRSetAxisMappingStrategy(p.srs, OAMS_TRADITIONAL_GIS_ORDER);
-  }
   tt_context *ctx = tt_context_create();
-  p.tin = ctx ? probe_tin(ctx, gt) : NULL;
+  probe_init(&p, ctx, drv, src, s->output, dsco, wopts);
+  p.msg = &r->msg;
   int ok = 1;
   if (!p.tin)
     goto done; /* nothing to judge with */
 
   const unsigned want = s->layers;
   int all = probe_run(&p, want, p.ext);
+  if (all == 1 && p.lossy && p.imposed && !p.t_srs &&
+      (*auto_t_srs = in_own_crs(&p, want)) != NULL)
+    goto done;
+  if (all == 1 && p.lossy) {
+    ok = 0;
+    refuse_lossy(r, dname, p.lost);
+    goto done;
+  }
   if (all != 0)
     goto done; /* it holds them, or it cannot be judged */
   char why_all[TT_APP_MESSAGE_MAX];
   snprintf(why_all, sizeof why_all, "%s", p.why);
+
   {
     /* The same into a GeoPackage, which holds everything: when that fails
      * too, the fault is not the driver's (a -t_srs the DEM's CRS cannot
@@ -203,6 +339,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
     for (char **o = p.wopts; o && *o; o++)
       if (strncasecmp(*o, "LCO=", 4) != 0 && strncasecmp(*o, "STYLE=", 6))
         g.wopts = CSLAddString(g.wopts, *o);
+    g.wopts = without_nln(g.wopts, s->nln);
     g.dsco = (char **)none;
     int control = gpkg ? probe_run(&g, want, ".gpkg") : -1;
     CSLDestroy(g.wopts);
@@ -213,14 +350,16 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
       goto done;
     }
   }
-  if ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0])) {
-    /* Without the user's -lco and -dsco? Then those are at fault. */
+  if ((s->lco && s->lco[0]) || (s->dsco && s->dsco[0]) || s->nln[0]) {
+    /* Without the user's -lco, -dsco and -nln? Then those are at fault
+     * (a name the format reserves, a FID column named as a field). */
     probe q = p;
     static const char *const none[] = {NULL};
     q.wopts = NULL;
     for (char **o = p.wopts; o && *o; o++)
       if (strncasecmp(*o, "LCO=", 4) != 0)
         q.wopts = CSLAddString(q.wopts, *o);
+    q.wopts = without_nln(q.wopts, s->nln);
     q.dsco = tt__app_output_dsco(dname, none);
     int plain = probe_run(&q, want, p.ext);
     CSLDestroy(q.wopts);
@@ -228,8 +367,8 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
     if (plain == 1) {
       ok = 0;
       tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                   "simplify: -of %s cannot write the TIN with the -lco and "
-                   "-dsco given: %s", dname, why_all);
+                   "simplify: -of %s cannot write the TIN with the -nln, "
+                   "-lco and -dsco given: %s", dname, why_all);
       goto done;
     }
   }
@@ -238,6 +377,11 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
   char why_one[TT_APP_MESSAGE_MAX] = "";
   for (unsigned bit = 1; bit <= 4; bit <<= 1) {
     int k = probe_run(&p, bit, p.ext);
+    if (k == 1 && p.lossy && !p.imposed) {
+      ok = 0;
+      refuse_lossy(r, dname, p.lost);
+      goto done;
+    }
     if (k != 0)
       alone |= bit;
     else if (want & bit) {
@@ -294,6 +438,7 @@ int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
                "with %s", dname, list, why_all, choices);
 
 done:
+  CPLFree(p.imposed);
   tt_tin_destroy(p.tin);
   tt_context_destroy(ctx);
   if (p.srs)

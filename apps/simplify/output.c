@@ -151,9 +151,18 @@ tt_status tt__app_output_options(app_simplify_job *job)
   job->dsco = tt__app_output_dsco(job->drvname, s->dsco);
   /* The dry run: a driver that cannot hold the layers is refused before
    * the DEM is read. */
-  if (!database && !tt__app_check_ogr_output(r, job->drv, job->src,
-                                             job->dsco, job->wopts))
-    return r->res->status;
+  if (!database) {
+    char *auto_t_srs = NULL;
+    if (!tt__app_check_ogr_output(r, job->drv, job->src, job->dsco,
+                                  job->wopts, &auto_t_srs))
+      return r->res->status;
+    if (auto_t_srs) {
+      job->wopts = CSLSetNameValue(job->wopts, "T_SRS", auto_t_srs);
+      job->t_srs_auto = auto_t_srs;
+      job->rep.t_srs = auto_t_srs;
+      job->rep.t_srs_auto = 1;
+    }
+  }
   return TT_OK;
 }
 

@@ -99,6 +99,8 @@ struct app_simplify_job {
   GDALDatasetH dst;           /* a database's, or a file's while written */
   char **wopts, **dsco;       /* tt_ogr_write_tin's options, -dsco */
   OGRSpatialReferenceH srs;   /* the layers' CRS (the DEM's), or NULL */
+  char *t_srs_auto;           /* the CRS the format takes only (GPX), in
+                                 which the layers are written (CPLFree) */
   tt_app_stream so;           /* APP_OUTPUT_STREAM's sink */
   /* what the run made */
   tt_grid *grid;              /* a whole run's DEM, until simplified */
@@ -171,7 +173,18 @@ void tt__app_simplify_fields(const app_simplify_job *job,
  * layers (or cannot be judged), else 0 with the refusal recorded (a usage
  * error naming the -layers or OUTPUT form that works). */
 int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
-                             char **dsco, char **wopts);
+                             char **dsco, char **wopts, char **auto_t_srs);
+/* ogr_readback.c: 1 when the dataset name, just written by drv with the
+ * layers (TT_APP_LAYERS_* bits) of tin
+ * (in tin_srs, NULL: none) reprojected to t_srs (NULL: none), reads back
+ * with every vertex's x and y within tol_xy (in tin_srs's units) and its z
+ * within 1e-9 of its magnitude; else 0 with what changed in why, and
+ * *imposed (CPLFree) the geographic CRS the driver wrote in of its own
+ * accord (GPX), if it did. */
+int tt__app_read_back(GDALDriverH drv, const char *name, unsigned layers,
+                      const tt_tin *tin,
+                      OGRSpatialReferenceH tin_srs, const char *t_srs,
+                      double tol_xy, char *why, size_t n, char **imposed);
 /* The dataset creation options of an OGR output: -dsco, and the defaults
  * terratin adds (GPX: GPX_USE_EXTENSIONS=YES, or it keeps no attribute).
  * The caller frees the list with CSLDestroy(). */

@@ -58,6 +58,12 @@ typedef struct tiled {
   double gt[6];             /* the DEM's geotransform */
   tt_tin **out_tin;         /* the merged TIN (not streamed) */
   double range_min, range_max; /* the heights, when the pre-pass ran */
+  /* the warnings of tile 0's read (the DEM's own: no CRS, a map in
+   * feet), taken on its worker and said once by the main thread; the
+   * other tiles' reads would repeat them */
+  char tile0_warn[4][TT_APP_MESSAGE_MAX];
+  int ntile0_warn;
+  bool tile0_read;          /* a pass has read tile 0: not again */
   GIntBig old_cache;        /* GDAL's block cache, to restore */
   int cache_set;            /* ... when it was held for the run */
 } tiled;

@@ -73,6 +73,17 @@ static void fail(tiled *T, size_t k, tt_status st, const char *msg)
   pthread_mutex_unlock(&T->lock);
 }
 
+/* A warning of tile 0's read, kept for the main thread (T->lock). */
+static void keep_tile0_warning(void *arg, const char *message)
+{
+  tiled *T = arg;
+  pthread_mutex_lock(&T->lock);
+  if (T->ntile0_warn < 4)
+    snprintf(T->tile0_warn[T->ntile0_warn++], TT_APP_MESSAGE_MAX, "%s",
+             message);
+  pthread_mutex_unlock(&T->lock);
+}
+
 void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
                             GDALRasterBandH own)
 {
@@ -87,6 +98,10 @@ void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
   tt_raster_info *info = NULL;
   tt_status st = TT_OK;
   const tt_app_tiles_hook *hook = &tt__app_tiles_hook;
+  /* tile 0's read says what is the DEM's own, once a run */
+  bool say = k == 0 && !T->tile0_read;
+  if (say)
+    tt_context_set_log(ctx, keep_tile0_warning, T);
   /* merging pieces from files reads the DEM for tile 0's raster info only */
   if (!(hook->load && k > 0) && own) {
     st = tt_gdal_read_grid(ctx, own, ro, NULL, NULL, &win, &info);
@@ -96,6 +111,10 @@ void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
     pthread_mutex_unlock(&T->gdal);
   }
   CSLDestroy(ro);
+  if (say) {
+    tt_context_set_log(ctx, NULL, NULL);
+    T->tile0_read = true;
+  }
   /* the area function (geographic DEMs) from tile 0's window, set
    * before done[0]: merged after it */
   if (st == TT_OK && k == 0 && T->merger)
@@ -295,7 +314,11 @@ tt_status tt__app_tiled_run_all(tiled *T, tt_tin_merger *merger)
       }
     }
     bool ok = T->done[k];
+    int nwarn = T->ntile0_warn;
+    T->ntile0_warn = 0;
     pthread_mutex_unlock(&T->lock);
+    for (int i = 0; i < nwarn; i++)
+      tt__app_warn(&r->msg, "%s", T->tile0_warn[i]);
     if (!ok) {
       st = TT_ERR_INTERRUPTED;
       break;

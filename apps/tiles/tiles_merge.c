@@ -1,12 +1,14 @@
 /*
  * tiles_merge.c -- apps/tiles/: the tiles command, a folder over the core
  * (apps/core/), simplify's tiled run as independent jobs for a cluster. This
- * file: `terratin tiles merge PLAN.json OUT.gpkg [-overwrite] [-q]`: every
- * piece of a plan read back (tt_tin_piece_decode) and merged by simplify's
- * tiled path (tiled.c) in tile order, written as simplify writes (triangles,
- * vertices, run_parameters; temporary name, rename, nothing left behind on
- * failure or interruption): the same layers as `simplify -tile_size` with the
- * plan's options. A missing piece, or one of another plan (stale), is refused
+ * file: `terratin tiles merge PLAN.json OUT.gpkg [-overwrite] [-q] [-json]
+ * [output options]`: every piece of a plan read back (tt_tin_piece_decode)
+ * and merged by simplify's tiled path (tiled.c) in tile order, written as
+ * simplify writes (triangles, vertices, run_parameters; temporary name,
+ * rename, nothing left behind on failure or interruption): the same layers
+ * as `simplify -tile_size` with the plan's options and the output options
+ * of this command line (-of, -lco, ...: the user's, which a plan never
+ * carries). A missing piece, or one of another plan (stale), is refused
  * before anything is written.
  */
 #include "tiles.h"
@@ -49,14 +51,24 @@ void tt__tiles_merge(char **argv, tt_progress_fn fn, void *arg,
   const char *plan = NULL, *out = NULL;
   char **extra = NULL;
   for (size_t i = 0; argv[i]; i++) {
+    int out_opt = tt__tiles_output_option(argv[i]);
     if (tt__app_str_ieq(argv[i], "-overwrite") ||
-        tt__app_str_ieq(argv[i], "-q") || tt__app_str_ieq(argv[i], "-json"))
+        tt__app_str_ieq(argv[i], "-q") || tt__app_str_ieq(argv[i], "-json") ||
+        out_opt == 0)
       extra = CSLAddString(extra, argv[i]);
-    else if (argv[i][0] == '-' && argv[i][1]) {
-      tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                         "tiles merge: unknown option %s (usage: terratin "
-                         "tiles merge PLAN.json OUT.gpkg [-overwrite] [-q] "
-                         "[-json])", argv[i]);
+    else if (out_opt == 1 && argv[i + 1]) {
+      extra = CSLAddString(extra, argv[i]);
+      extra = CSLAddString(extra, argv[++i]);
+    } else if (argv[i][0] == '-' && argv[i][1]) {
+      if (out_opt == 1)
+        tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                           "tiles merge: option %s needs a value", argv[i]);
+      else
+        tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                           "tiles merge: unknown option %s (usage: terratin "
+                           "tiles merge PLAN.json OUT.gpkg [-overwrite] [-q] "
+                           "[-json] [-of, -lco, -dsco, -nln, -layers, "
+                           "-nostyle, -obj_local, -t_srs])", argv[i]);
       CSLDestroy(extra);
       return;
     } else if (!plan)

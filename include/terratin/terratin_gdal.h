@@ -249,17 +249,19 @@ typedef enum tt_mesh_format {
   TT_MESH_OBJ,     /* v x y z, f a b c (1-based) */
   TT_MESH_LANDXML, /* Surface/Definition surfType="TIN": Pnts P id=
                       "northing easting elevation", Faces F "a b c" */
-  TT_MESH_UGRID    /* netCDF (CDF-2), UGRID 1.0: mesh_node_x/y/z, mesh_face_nodes
+  TT_MESH_UGRID,   /* netCDF (CDF-2), UGRID 1.0: mesh_node_x/y/z, mesh_face_nodes
                       (start_index 0), node and face data variables */
+  TT_MESH_DXF      /* AutoCAD DXF R12: one 3DFACE per triangle (its corners'
+                      x y z, the fourth = the first) on layer "triangles" */
 } tt_mesh_format;
 
-/* The format of an -of name ("2DM", "PLY", "OBJ", "LandXML", "UGRID", any
- * case), or of a path's extension (.2dm, .ply, .obj, .xml, any case; .nc
- * is left to OGR's netCDF driver);
+/* The format of an -of name ("2DM", "PLY", "OBJ", "LandXML", "UGRID",
+ * "DXF", any case), or of a path's extension (.2dm, .ply, .obj, .xml,
+ * .dxf, any case; .nc is left to OGR's netCDF driver);
  * TT_MESH_NONE for anything else. */
 tt_mesh_format tt_mesh_format_from_name(const char *name);
 tt_mesh_format tt_mesh_format_from_path(const char *path);
-/* "2DM", "PLY", "OBJ", "LandXML", "UGRID"; NULL for TT_MESH_NONE. */
+/* "2DM", "PLY", "OBJ", "LandXML", "UGRID", "DXF"; NULL for TT_MESH_NONE. */
 const char *tt_mesh_format_name(tt_mesh_format fmt);
 /* The files a format writes beside OUTPUT, as suffixes that replace its
  * extension (2DM: "_ins_err.dat", ..., "_n_samples_els.dat", its datasets;

@@ -46,6 +46,7 @@
 #include "base/heap.h"
 #include "base/parallel.h"
 #include "optimize/optimize.h"
+#include "refine/refine.h"
 #include "tin/curve.h"
 #include "tin/tin.h"
 
@@ -814,6 +815,27 @@ static tt_status decimate(tt_context *ctx, const tt_grid *grid,
       r.target_v = p ? p : 1;
   }
   r.target_t = opt->max_triangles;
+  /* Every limit is exact: a point budget below the vertices the nodata
+   * outline forces (what insertion's start needs, and the fewest a TIN
+   * that follows the outline has) is refused before any work, as
+   * insertion refuses it, with the count to ask for instead. */
+  if (r.target_v && !borders && valid < grid->nx * grid->ny) {
+    size_t need = 0;
+    status = tt__refine_start_size(ctx, grid, &need);
+    if (status != TT_OK)
+      goto done;
+    if (r.target_v < need) {
+      status = tt__error(ctx, TT_ERR_LIMIT, "the point limit %zu%s is "
+                         "below the %zu vertices the nodata outline "
+                         "forces (the valid samples' hull and the outline's "
+                         "corners, which no TIN that follows it can drop); "
+                         "ask for at least %zu", r.target_v,
+                         opt->percent > 0 && r.target_v != opt->max_points
+                             ? " (from the percentage)" : "",
+                         need, need);
+      goto done;
+    }
+  }
 
   status = tt__dec_start(d, valid);
   if (status != TT_OK)

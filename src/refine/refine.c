@@ -43,6 +43,8 @@
  *
  * Part of src/refine/, the greedy insertion method (tt_refine_run).
  */
+#include "refine/refine.h"
+
 #include "criteria/criterion.h"
 #include "mesh/domain.h"
 #include "base/heap.h"
@@ -93,6 +95,8 @@ typedef struct refine {
   size_t max_points, max_tris;
   double max_error;    /* < 0: none */
   size_t forced;       /* vertices the nodata outline required */
+  size_t *start_size;  /* tt__refine_start_size: stop after the start,
+                          its vertex count here (no scan of the samples) */
   const tt__tile_borders *borders; /* tile runs, else NULL */
   const char *phase;   /* for messages: "inserting", ... */
   /* progress */
@@ -584,7 +588,7 @@ static tt_status start(refine *r, size_t valid)
   if (r->borders && (s = start_borders(r)) != TT_OK)
     return s;
   /* every slot written so far is logged: scan them all */
-  if (!drain(r))
+  if (!r->start_size && !drain(r))
     return oom(r);
   return TT_OK;
 }
@@ -778,7 +782,8 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
 
 static tt_status run(tt_context *ctx, const tt_grid *grid,
                      const tt_refine_options *opt,
-                     const tt__tile_borders *borders, tt_tin **out_tin)
+                     const tt__tile_borders *borders, tt_tin **out_tin,
+                     size_t *start_size)
 {
   double t_start = tt__now();
   if (!grid || !opt || !out_tin)
@@ -802,6 +807,7 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
   r.g = grid;
   r.opt = opt;
   r.borders = borders;
+  r.start_size = start_size;
   r.crit = tt__criterion_get(opt->criterion);
   r.repair = tt_repair_resolve(opt->repair, opt->criterion);
   tt__metric metric;
@@ -854,9 +860,18 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
     status = mem_check(&r, r.m.vcap, r.m.tcap);
   if (status != TT_OK)
     goto done;
+  /* The limits count the TIN's vertices: those in a triangle. A vertex of
+   * the start in none (a lone valid sample on the hull, amid nodata) is
+   * not written, so it does not count. */
+  for (size_t v = 0; v < r.m.nv; v++)
+    r.linked += r.m.v[v].edge >= 0;
+  if (start_size) {
+    *start_size = r.linked;
+    goto done;
+  }
   /* a tile's max_points counts the insertions after its start (tile.h) */
   if (borders && r.max_points)
-    r.max_points += r.m.nv;
+    r.max_points += r.linked;
   /* Every limit is exact: a budget below what the start needs (the four
    * corners, or the hull and the nodata outline's forced vertices, which
    * the run cannot drop) is refused before any insertion, with the count
@@ -864,18 +879,18 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
   char why[96];
   if (r.forced)
     snprintf(why, sizeof why, "%zu of its %zu vertices forced by the nodata "
-             "outline", r.forced, r.m.nv);
+             "outline", r.forced, r.linked);
   else
     snprintf(why, sizeof why, "%s", valid == grid->nx * grid->ny
                                         ? "the grid's four corners"
                                         : "the valid samples' convex hull");
-  if (r.max_points && r.m.nv > r.max_points) {
+  if (r.max_points && r.linked > r.max_points) {
     status = tt__error(ctx, TT_ERR_LIMIT, "the point limit %zu%s is below "
                        "the %zu vertices the starting triangulation needs "
                        "(%s); ask for at least %zu", r.max_points,
                        opt->percent > 0 && r.max_points != opt->max_points
                            ? " (from the percentage)" : "",
-                       r.m.nv, why, r.m.nv);
+                       r.linked, why, r.linked);
     goto done;
   }
   if (r.max_tris && r.m.nlive > r.max_tris) {
@@ -888,8 +903,6 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
   r.phase = "while inserting";
   r.e0 = tt__heap_size(&r.heap) ? tt__heap_top(&r.heap).key : 0;
   size_t nv0 = r.m.nv; /* vertices before the first insertion */
-  for (size_t v = 0; v < r.m.nv; v++)
-    r.linked += r.m.v[v].edge >= 0;
   status = report_step(&r, 0, false);
   if (status != TT_OK)
     goto done;
@@ -917,7 +930,7 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
       reason = TT_STOP_MAX_ERROR;
       break;
     }
-    if (r.max_points && r.m.nv + 1 > r.max_points) {
+    if (r.max_points && r.linked + 1 > r.max_points) {
       reason = TT_STOP_MAX_POINTS;
       break;
     }
@@ -1038,7 +1051,18 @@ done:
 tt_status tt_refine_run(tt_context *ctx, const tt_grid *grid,
                         const tt_refine_options *opt, tt_tin **out_tin)
 {
-  return run(ctx, grid, opt, NULL, out_tin);
+  return run(ctx, grid, opt, NULL, out_tin, NULL);
+}
+
+tt_status tt__refine_start_size(tt_context *ctx, const tt_grid *grid,
+                                size_t *out_vertices)
+{
+  tt_refine_options o;
+  tt_refine_options_init(&o);
+  o.max_error = 0;
+  tt_tin *none = NULL;
+  *out_vertices = 0;
+  return run(ctx, grid, &o, NULL, &none, out_vertices);
 }
 
 tt_status tt__refine_tile(tt_context *ctx, const tt_grid *grid,
@@ -1047,5 +1071,5 @@ tt_status tt__refine_tile(tt_context *ctx, const tt_grid *grid,
 {
   if (!borders)
     return tt__error(ctx, TT_ERR_ARG, "borders must not be NULL");
-  return run(ctx, grid, opt, borders, out_tin);
+  return run(ctx, grid, opt, borders, out_tin, NULL);
 }

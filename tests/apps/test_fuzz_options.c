@@ -4,7 +4,11 @@
  * split into argv words at NUL and newline bytes, parsed, and the outcome
  * checked for consistency (a failure is one non-empty line with exit code 1
  * or 2 and no object; a success holds values inside their documented
- * ranges). Help and version requests are run against /dev/null too.
+ * ranges, and is help, version or a command of the dispatch table,
+ * tt__app_commands in apps/core/run.c, with every positional word the
+ * table gives it). Help and version requests are run against /dev/null
+ * too. The replay also requires that the corpus parses every command of
+ * the table at least once, so a new command needs a corpus entry.
  *
  * Two builds:
  *  - ctest (default): a plain main() replays every file of the checked-in
@@ -22,7 +26,7 @@
  *    the cov-* files there are a coverage corpus merged from such runs
  *    (./fuzz_options -merge=1 NEW_DIR tests/corpus/options RUN_DIR).
  */
-#include "terratin_lib.h"
+#include "app.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -56,7 +60,13 @@ static int valid_list(const char *const *l, int need_equals)
 static void check_settings(const tt_app_settings *s)
 {
   REQUIRE(s != NULL);
-  REQUIRE(s->command >= TT_APP_HELP && s->command <= TT_APP_EVAL);
+  const tt__app_command_def *cmd = tt__app_command_def_of(s->command);
+  REQUIRE(cmd || s->command == TT_APP_HELP || s->command == TT_APP_VERSION);
+  REQUIRE(s->help_topic == TT_APP_NONE ||
+          tt__app_command_def_of(s->help_topic) != NULL);
+  for (size_t k = 0; cmd && k < cmd->npos; k++)
+    if (cmd->pos[k] != TT_APP_POS_NONE)
+      REQUIRE(*(const char *const *)((const char *)s + cmd->pos[k]));
   REQUIRE(s->band >= 1);
   REQUIRE(s->max_error < 0 || (isfinite(s->max_error) && s->max_error >= 0));
   REQUIRE(s->percent == 0 || (s->percent > 0 && s->percent <= 100));
@@ -71,13 +81,14 @@ static void check_settings(const tt_app_settings *s)
   REQUIRE(nconfig % 2 == 0);
   REQUIRE(s->nln != NULL);
   REQUIRE(tt_app_help(s->help_topic) != NULL);
+  /* what the table does not say, per command */
   switch (s->command) {
   case TT_APP_SIMPLIFY:
-    REQUIRE(s->input && s->output);
+  case TT_APP_OPTIMIZE:
     REQUIRE(tt_criterion_name(s->criterion) != NULL);
     break;
-  case TT_APP_EVAL:
-    REQUIRE(s->input && s->tin);
+  case TT_APP_STUDY:
+    REQUIRE(s->terrains && s->terrains[0]);
     break;
   case TT_APP_GENERATE:
     REQUIRE(s->output);
@@ -90,6 +101,9 @@ static void check_settings(const tt_app_settings *s)
     break;
   }
 }
+
+/* The commands parsed so far, a bit each (the replay's coverage check). */
+static uint64_t commands_seen;
 
 static void run_one(const uint8_t *data, size_t size)
 {
@@ -122,6 +136,8 @@ static void run_one(const uint8_t *data, size_t size)
     REQUIRE(res.exit_code == TT_APP_EXIT_OK && res.message[0] == '\0');
     check_settings(tt_app_options_settings(o));
     const tt_app_settings *s = tt_app_options_settings(o);
+    if (s->command < 64)
+      commands_seen |= UINT64_C(1) << s->command;
     if (s->command == TT_APP_HELP || s->command == TT_APP_VERSION) {
       FILE *null = fopen("/dev/null", "w");
       if (null) {
@@ -237,6 +253,14 @@ int main(int argc, char **argv)
     free(dir);
   }
   printf("replayed %zu input(s)\n", count);
-  return count > 0 ? 0 : 1;
+  int missing = 0;
+  for (const tt__app_command_def *d = tt__app_commands; argc == 1 && d->name;
+       d++)
+    if (!(commands_seen & (UINT64_C(1) << d->command))) {
+      fprintf(stderr, "no corpus input parses the command %s: add one to "
+              "tests/corpus/options/\n", d->name);
+      missing = 1;
+    }
+  return count > 0 && !missing ? 0 : 1;
 }
 #endif /* TT_FUZZ_LIBFUZZER */

@@ -106,7 +106,43 @@ if [ -n "$need" ]; then
   rm -f out/*
   expect_failure "-max_points $((need - 1))" 2 "at least $need" simplify -q -max_points $((need - 1)) in/hole.asc out/x.gpkg
   rm -f out/*
+  # decimation takes the same budgets: below the outline refused before
+  # any work (it wrote a TIN of RMSE 312 m with exit 0), at it exact
+  expect_failure "decimate -max_points $((need - 1))" 2 "ask for at least $need" \
+    simplify -q -method decimate -max_points $((need - 1)) in/hole.asc out/x.gpkg
+  rm -f out/*
+  for n in "$need" $((need + 40)); do
+    run simplify -q -json -method decimate -max_points "$n" in/hole.asc out/d.gpkg
+    check "decimate -max_points $n: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+    check "decimate -max_points $n: $n vertices" \
+      [ "$(json_get out.txt vertices 2>/dev/null)" = "$n" ]
+    rm -f out/*
+  done
 fi
+# a lone valid sample on the hull (a corner amid nodata) is in no triangle
+# and not written: the budget counts the TIN's vertices, so -max_points N
+# gives N (it gave N - 1)
+python3 - <<'EOF'
+import math
+nx, ny = 60, 50
+rows = []
+for r in range(ny):
+    row = []
+    for c in range(nx):
+        lone_corner = (r, c) == (0, 0)
+        near = r < 3 and c < 3
+        hole = (c - 30) ** 2 + (r - 25) ** 2 < 64
+        z = "%.2f" % (100 + 10 * math.sin(c / 5.0) * math.cos(r / 7.0))
+        row.append(z if lone_corner or not (near or hole) else "-9999")
+    rows.append(" ".join(row))
+open("in/lone.asc", "w").write("ncols %d\nnrows %d\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value -9999\n%s\n" % (nx, ny, "\n".join(rows)))
+EOF
+for n in 200 333; do
+  run simplify -q -json -max_points $n in/lone.asc out/l.gpkg
+  check "lone hull sample, -max_points $n: $n vertices (got $(json_get out.txt vertices 2>/dev/null))" \
+    [ "$(json_get out.txt vertices 2>/dev/null)" = "$n" ]
+  rm -f out/*
+done
 
 # --- memory: -max_memory, counted as the mesh grows; ulimit -v ---
 expect_failure "-max_memory 2M, dense TIN" 1 "while inserting" simplify -q -max_error 0 -max_memory 2M in/f.tif out/x.gpkg

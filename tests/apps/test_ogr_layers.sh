@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # test_ogr_layers.sh -- `terratin simplify` writing OGR outputs as GIS users
 # open them ($TT_TERRATIN), issue 17:
-#  - -layers: each single-layer format (GeoJSON, FlatGeobuf, KML, GPX,
-#    MapInfo, DXF) with one layer, read back with ogrinfo: the feature
-#    counts equal the run's; KML with all three layers (its writer takes
-#    features only into its last layer);
+#  - -layers: each single-layer format (GeoJSON, FlatGeobuf, KML, GPX)
+#    with one layer, read back with ogrinfo: the feature counts equal the
+#    run's; KML with all three layers (its writer takes features only into
+#    its last layer); GPX written in EPSG:4326 (the summary says so) with
+#    the heights in <ele>; DXF (terratin's own 3DFACE writer) read back by
+#    OGR as the TIN's triangles, eval within the bound;
 #  - a driver that cannot hold the layers asked for is refused before the
 #    DEM is read (the progress bar never reaches 10 %), a usage error that
 #    names the -layers or the OUTPUT form that works, leaving nothing;
@@ -84,10 +86,6 @@ single FlatGeobuf fgb vertices vertices "$NV"
 single FlatGeobuf fgb triangles triangles "$NT"
 single KML kml triangles triangles "$NT"
 single GPX gpx vertices waypoints "$NV"
-single "MapInfo File" tab triangles "" "$NT"
-single "MapInfo File" tab vertices "" "$NV"
-single DXF dxf triangles entities "$NT"
-single DXF dxf vertices entities "$NV"
 # the attributes came along where the format keeps them
 check "GeoJSON: the triangles keep max_err" \
   grep -q '"max_err"' one/triangles.geojson
@@ -102,11 +100,29 @@ for x in f:
     r = x["geometry"]["coordinates"][0]
     assert len(r) == 4 and r[0] == r[3] and all(len(p) == 3 for p in r)
 EOF
-# DXF keeps no attributes: said once, on one line
-run simplify -q -max_error 1 -of DXF -layers vertices -overwrite dem.tif \
-  one/vertices.dxf
-check "DXF: the lost attributes warned about once" \
-  [ "$(grep -c 'keeps no attribute' err.txt)" = 1 ]
+# GPX holds longitude/latitude only: written in EPSG:4326, said so; the
+# heights in <ele>
+run simplify -max_error 1 -layers vertices -overwrite dem.tif one/v2.gpx
+check "GPX: the summary names EPSG:4326" \
+  grep -q "written in EPSG:4326 (the only CRS the format holds)" out.txt
+check "GPX: heights in <ele>" grep -q "<ele>" one/v2.gpx
+python3 - one/v2.gpx <<'EOF' || fail "GPX: longitudes and latitudes, not UTM metres"
+import re, sys
+t = open(sys.argv[1]).read()
+pts = re.findall(r'<wpt lat="([^"]+)" lon="([^"]+)"', t)
+assert pts
+assert all(-90 <= float(a) <= 90 and -180 <= float(o) <= 180 for a, o in pts)
+EOF
+
+# DXF: terratin's own writer, one 3DFACE per triangle at its corners'
+# heights (GDAL's DXF driver would write flat hatches)
+run simplify -q -max_error 1 dem.tif one/tin.dxf
+check "DXF: exit 0 ($(head -c 300 err.txt))" [ "$rc" -eq 0 ]
+check "DXF: $NT 3DFACE entities" [ "$(grep -c '^3DFACE$' one/tin.dxf)" = "$NT" ]
+check "DXF: $NT features read back" [ "$(fcount one/tin.dxf entities)" = "$NT" ]
+run eval -max_error 1 dem.tif one/tin.dxf
+check "DXF: eval within the bound ($(tail -1 out.txt) $(head -c 200 err.txt))" \
+  [ "$rc" -eq 0 ]
 
 # KML holds several layers, written one after the other
 run simplify -q -max_error 1 -of KML dem.tif one/all.kml
@@ -137,22 +153,53 @@ refused_early "GeoJSON, two layers" "-layers vertices" \
   simplify -max_error 1 -layers vertices,triangles dem.tif ref/o.geojson
 refused_early "FlatGeobuf .fgb, three layers" "without '.fgb'" \
   simplify -max_error 1 dem.tif ref/o.fgb
-refused_early "MapInfo .tab, three layers" "without '.tab'" \
+refused_early "MapInfo .tab, three layers" "drops the heights" \
   simplify -max_error 1 -of "MapInfo File" dem.tif ref/o.tab
+refused_early "MapInfo -layers triangles" "drops the heights" \
+  simplify -max_error 1 -of "MapInfo File" -layers triangles dem.tif ref/o.tab
 refused_early "GPX, triangles" "-layers vertices" \
   simplify -max_error 1 -layers triangles dem.tif ref/o.gpx
-refused_early "DXF, three layers" "-layers triangles or -layers vertices" \
-  simplify -max_error 1 dem.tif ref/o.dxf
-refused_early "DXF, two geometry layers" "-layers triangles or -layers vertices" \
-  simplify -max_error 1 -layers triangles,vertices dem.tif ref/o.dxf
-refused_early "a -lco the driver refuses" "-lco" \
+refused_early "DXF -layers" "-layers is for OGR outputs" \
+  simplify -max_error 1 -layers triangles dem.tif ref/o.dxf
+refused_early "-lco FID= one of the TIN's fields" "v0 is a field of the triangles layer" \
   simplify -max_error 1 -lco FID=v0 dem.tif ref/o.gpkg
+refused_early "-lco FID=vertex_id" "vertex_id is a field of the vertices layer" \
+  simplify -max_error 1 -lco FID=vertex_id dem.tif ref/o.gpkg
+refused_early "-lco FID=max_error" "max_error is a field of the run_parameters" \
+  simplify -max_error 1 -lco FID=max_error dem.tif ref/o.gpkg
+refused_early "-nln gpkg_" "reserves the table names that begin with \"gpkg\"" \
+  simplify -max_error 1 -nln gpkg_ dem.tif ref/o.gpkg
+refused_early "-nln sqlite_" "reserves the table names that begin with \"sqlite_\"" \
+  simplify -max_error 1 -nln sqlite_ dem.tif ref/o.gpkg
+refused_early "-nln sqlite_ into SQLite" "SQLite reserves" \
+  simplify -max_error 1 -nln sqlite_ dem.tif ref/o.sqlite
+refused_early "a -lco the driver refuses" "-lco" \
+  simplify -max_error 1 -lco GEOMETRY_NAME=fid dem.tif ref/o.gpkg
 # a failure that is not the driver's is said as the write would say it
 run generate bump nocrs.tif -size 30 -q
 run simplify -q -t_srs EPSG:4326 -layers triangles nocrs.tif ref/n.geojson
 check "no CRS to transform from: exit 1, not a driver refusal ($rc)" [ "$rc" -eq 1 ]
 check "no CRS to transform from: says so" grep -q "no CRS" err.txt
 check "no CRS to transform from: nothing left" [ -z "$(ls -A ref)" ]
+# a DEM without a CRS is in pixel or map units: "Undefined Cartesian SRS"
+# (srs_id -1) in the layers and in every geometry blob, whole and tiled
+# (the tiled rows are written by terratin's own page writer)
+for how in whole tiled; do
+  opt=()
+  [ $how = tiled ] && opt=(-tile_size 16)
+  run simplify -q "${opt[@]}" nocrs.tif nocrs_$how.gpkg
+  check "no CRS, $how: exit 0 ($(head -c 200 err.txt))" [ "$rc" -eq 0 ]
+  check "no CRS, $how: srs_id -1 in gpkg_geometry_columns and every blob" \
+    python3 - nocrs_$how.gpkg <<'EOF'
+import sqlite3, struct, sys
+db = sqlite3.connect(sys.argv[1])
+assert {r[0] for r in db.execute(
+    "SELECT srs_id FROM gpkg_geometry_columns")} == {-1}
+for t in ("triangles", "vertices"):
+    for (g,) in db.execute("SELECT geom FROM " + t):
+        assert struct.unpack("<i", g[4:8])[0] == -1, t
+EOF
+done
 # the folder forms hold them all
 run simplify -q -max_error 1 -of FlatGeobuf dem.tif ref/fg
 check "FlatGeobuf folder: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]

@@ -244,12 +244,12 @@ check "speckled corners: every vertex in a triangle ($nused of $nv)" \
 
 # --- 5. folder outputs ---------------------------------------------------------
 mkdir fold
-# MapInfo has no 64-bit integers: the counts are written as Integer
+# MapInfo keeps no Z: refused before the work, even as a folder
 run simplify -q -of "MapInfo File" in/north.tif fold/mi
-check "MapInfo folder: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-check "MapInfo folder: three .tab in fold/mi" \
-  [ "$(ls fold/mi/*.tab | wc -l)" = 3 ]
-rm -rf fold/mi
+check "MapInfo folder: refused, exit 2 ($(cat err.txt))" [ "$rc" -eq 2 ]
+check "MapInfo folder: says it drops the heights" \
+  grep -q "drops the heights" err.txt
+check "MapInfo folder: nothing left" [ ! -e fold/mi ]
 run simplify -q -of FlatGeobuf in/north.tif fold/fg
 check "FlatGeobuf folder: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "FlatGeobuf folder: three .fgb in fold/fg" \

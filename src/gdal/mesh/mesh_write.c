@@ -5,15 +5,19 @@
  * mesh_write.c -- a TIN written as one mesh or survey file, without
  * OGR: SMS 2DM (QGIS's MDAL reads it as a mesh layer), binary PLY (vertex
  * and face properties), Wavefront OBJ (3-D and game tools) and a LandXML
- * 1.2 TIN surface (civil and survey software); UGRID netCDF is
- * ugrid_write.c's, called from here.
+ * 1.2 TIN surface (civil and survey software) and an AutoCAD DXF (R12)
+ * drawing of 3DFACE entities (CAD; GDAL 3.6's DXF driver writes polygons
+ * as HATCH entities, flat at one height); UGRID netCDF is ugrid_write.c's,
+ * called from here.
  *
  * The coordinates and the triangles come from tin_records.h, as for the
  * OGR layers: the output CRS is the input's or T_SRS with every vertex
  * transformed once, and each triangle's vertices are counter-clockwise in
  * the output coordinates. Every vertex of the TIN is written, in TIN
  * order, so a vertex's index in the file is its index in the TIN (1-based
- * in 2DM, OBJ and LandXML, 0-based in PLY). Numbers are written with
+ * in 2DM, OBJ and LandXML, 0-based in PLY; DXF holds no vertex list: each
+ * 3DFACE carries its three corners, the fourth repeating the first, on
+ * the layer "triangles"). Numbers are written with
  * %.17g (ASCII formats) or as IEEE doubles (PLY): a reader gets back the
  * very doubles. The caller gives the path to write (the temporary name of
  * a tt_output); a failure or an interruption removes the partial file.
@@ -55,6 +59,7 @@ static const struct {
     {TT_MESH_LANDXML, "LandXML", "xml"},
     /* .nc stays the OGR netCDF driver's: UGRID by -of only. */
     {TT_MESH_UGRID, "UGRID", NULL},
+    {TT_MESH_DXF, "DXF", "dxf"},
 };
 enum { N_MESH_FORMATS = sizeof mesh_formats / sizeof mesh_formats[0] };
 
@@ -313,6 +318,22 @@ static void write_header(FILE *f, tt_mesh_format fmt, const char *name,
     fputs("\">\n      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
     break;
   }
+  case TT_MESH_DXF:
+    /* R12 (AC1009): the version, the layer and its line type, then the
+     * entities; AutoCAD, QGIS (GDAL) and the CAD tools read it. */
+    fputs("  0\nSECTION\n  2\nHEADER\n  9\n$ACADVER\n  1\nAC1009\n"
+          "  0\nENDSEC\n"
+          "  0\nSECTION\n  2\nTABLES\n"
+          "  0\nTABLE\n  2\nLTYPE\n 70\n1\n"
+          "  0\nLTYPE\n  2\nCONTINUOUS\n 70\n0\n  3\nSolid line\n"
+          " 72\n65\n 73\n0\n 40\n0.0\n"
+          "  0\nENDTAB\n"
+          "  0\nTABLE\n  2\nLAYER\n 70\n1\n"
+          "  0\nLAYER\n  2\ntriangles\n 70\n0\n 62\n7\n  6\nCONTINUOUS\n"
+          "  0\nENDTAB\n"
+          "  0\nENDSEC\n"
+          "  0\nSECTION\n  2\nENTITIES\n", f);
+    break;
   default:
     break;
   }
@@ -399,8 +420,26 @@ static void write_face(FILE *f, tt_mesh_format fmt, size_t i,
   }
 }
 
+/* DXF's 3DFACE of a triangle: its corners' output coordinates, the
+ * fourth corner (group codes 13, 23, 33) the first again, which closes
+ * the ring GDAL's reader makes of it (the third again leaves it open and
+ * the reader warns once per face). */
+static void write_3dface(FILE *f, const double c[3][3])
+{
+  fputs("  0\n3DFACE\n  8\ntriangles\n", f);
+  for (int k = 0; k < 4; k++) {
+    const double *p = c[k < 3 ? k : 0];
+    for (int a = 0; a < 3; a++) {
+      fprintf(f, " %d\n", 10 * (a + 1) + k);
+      put_nums(f, &p[a], 1, "\n");
+    }
+  }
+}
+
 static void write_footer(FILE *f, tt_mesh_format fmt)
 {
+  if (fmt == TT_MESH_DXF)
+    fputs("  0\nENDSEC\n  0\nEOF\n", f);
   if (fmt == TT_MESH_LANDXML)
     fputs("        </Faces>\n      </Definition>\n    </Surface>\n"
           "  </Surfaces>\n</LandXML>\n", f);
@@ -517,8 +556,19 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   for (size_t i = 0; i < nt && st == TT_OK; i++) {
     tt_triangle_info t;
     st = tt__records_face(&rec, ctx, i, &t);
-    if (st == TT_OK)
+    if (st == TT_OK && fmt == TT_MESH_DXF) {
+      double c[3][3];
+      for (int k = 0; k < 3 && st == TT_OK; k++) {
+        tt_vertex_info v;
+        st = tt__records_vertex(&rec, ctx, (size_t)t.v[k], &v, &c[k][0],
+                                &c[k][1]);
+        c[k][2] = v.z;
+      }
+      if (st == TT_OK)
+        write_3dface(f, c);
+    } else if (st == TT_OK) {
       write_face(f, fmt, i, &t, swap);
+    }
     for (int k = N_VERTEX_DATASETS; st == TT_OK && k < ndat; k++)
       put_nums(dat[k], (const double[1]){face_value(k, &t)}, 1, "\n");
     if (st == TT_OK &&

@@ -105,6 +105,7 @@ typedef struct write_state {
                               the triangles and vertices */
   OGRLayerH tri_layer, vtx_layer, run_layer, style_layer;
   int tri_idx[TT__TF_COUNT], vtx_idx[TT__VF_COUNT];
+  int ele_idx;             /* GPX: the waypoints' "ele" field, else -1 */
   int *run_idx;
   tt_progress_fn progress;
   void *progress_arg;
@@ -124,6 +125,40 @@ static const char *ogr_msg(void)
 {
   const char *m = CPLGetLastErrorMsg();
   return m && *m ? m : "no details from GDAL";
+}
+
+/* The layer and column names the options give, checked before anything
+ * is written: a GeoPackage reserves table names that begin with "gpkg",
+ * SQLite those that begin with "sqlite_"; a FID column (LCO FID=) named as
+ * one of the layers' own fields would collide with it. */
+static tt_status check_names(write_state *w)
+{
+  const char *prefix = w->prefix ? w->prefix : "";
+  int sqlite = strcasecmp(w->drv_name, "SQLite") == 0;
+  if ((w->gpkg || sqlite) && strncasecmp(prefix, "sqlite_", 7) == 0)
+    return tt__error(w->ctx, TT_ERR_ARG, "layer name prefix \"%s\": "
+                     "SQLite reserves the table names that begin with "
+                     "\"sqlite_\"; choose another prefix", prefix);
+  if (w->gpkg && strncasecmp(prefix, "gpkg", 4) == 0)
+    return tt__error(w->ctx, TT_ERR_ARG, "layer name prefix \"%s\": a "
+                     "GeoPackage reserves the table names that begin with "
+                     "\"gpkg\"; choose another prefix", prefix);
+  const char *fid = CSLFetchNameValue(w->lco, "FID");
+  if (fid) {
+    for (int i = 0; i < TT__TF_COUNT; i++)
+      if (strcasecmp(fid, tt__triangle_fields[i].name) == 0)
+        return tt__error(w->ctx, TT_ERR_ARG, "layer creation option "
+                         "FID=%s: %s is a field of the triangles layer; the "
+                         "FID column needs a name of its own", fid,
+                         tt__triangle_fields[i].name);
+    for (int i = 0; i < TT__VF_COUNT; i++)
+      if (strcasecmp(fid, tt__vertex_fields[i].name) == 0)
+        return tt__error(w->ctx, TT_ERR_ARG, "layer creation option "
+                         "FID=%s: %s is a field of the vertices layer; the "
+                         "FID column needs a name of its own", fid,
+                         tt__vertex_fields[i].name);
+  }
+  return TT_OK;
 }
 
 static tt_status parse_options(write_state *w, char **options)
@@ -209,7 +244,7 @@ static tt_status parse_options(write_state *w, char **options)
     w->lco = CSLSetNameValue(w->lco, "ENCODING", "UTF-8");
   if (w->shapefile && !CSLFetchNameValue(w->lco, "SPATIAL_INDEX"))
     w->lco = CSLSetNameValue(w->lco, "SPATIAL_INDEX", "YES");
-  return TT_OK;
+  return check_names(w);
 }
 
 /* Called after every feature: the callback is asked every time, so a stop
@@ -295,7 +330,18 @@ static tt_status create_layer(write_state *w, const char *suffix,
                               OGRwkbGeometryType type, OGRLayerH *out_layer)
 {
   char *name = CPLStrdup(CPLSPrintf("%s%s", w->prefix, suffix));
+  /* A GeoPackage layer without a CRS gets srs_id 0, "Undefined geographic
+   * SRS", from GDAL; a DEM without one is in pixel or map units, which is
+   * -1, "Undefined Cartesian SRS": GDAL maps this WKT to it. */
+  OGRSpatialReferenceH undefined = NULL;
+  if (!srs && w->gpkg && type != wkbNone) {
+    undefined = OSRNewSpatialReference(
+        "LOCAL_CS[\"Undefined cartesian SRS\"]");
+    srs = undefined;
+  }
   tt_status s = create_named_layer(w, name, srs, type, w->lco, out_layer);
+  if (undefined)
+    OSRDestroySpatialReference(undefined);
   CPLFree(name);
   return s;
 }
@@ -460,6 +506,8 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
     set_int64(f, idx[TT__VF_STAR_N], (int64_t)v.star_samples);
     if (decimated)
       set_real(f, idx[TT__VF_IMPORTANCE], v.importance);
+    if (w->ele_idx >= 0)
+      OGR_F_SetFieldDouble(f, w->ele_idx, v.z);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(pt);
@@ -592,6 +640,12 @@ static tt_status check_run_fields(write_state *w, const tt_run_field *fields,
       if (strcasecmp(fields[k].name, rf->name) == 0)
         return tt__error(w->ctx, TT_ERR_ARG, "run parameter \"%s\" is given "
                          "twice", rf->name);
+    const char *fid = CSLFetchNameValue(w->lco, "FID");
+    if (fid && strcasecmp(fid, rf->name) == 0)
+      return tt__error(w->ctx, TT_ERR_ARG, "layer creation option "
+                       "FID=%s: %s is a field of the run_parameters layer; "
+                       "the FID column needs a name of its own", fid,
+                       rf->name);
   }
   return TT_OK;
 }
@@ -629,6 +683,12 @@ static tt_status make_layer(write_state *w, const tt_tin *tin,
     if (s == TT_OK)
       s = create_fields(w, w->vtx_layer, tt__vertex_fields,
                         tt__records_vertex_fields(tin), w->vtx_idx);
+    /* GDAL 3.6's GPX writer takes a waypoint's height from its "ele"
+     * field (<ele>), not from the point's Z */
+    w->ele_idx = -1;
+    if (s == TT_OK && strcasecmp(w->drv_name, "GPX") == 0)
+      w->ele_idx = OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(w->vtx_layer),
+                                        "ele");
   } else {
     s = create_layer(w, "run_parameters", NULL, wkbNone, &w->run_layer);
     if (s == TT_OK)

@@ -296,6 +296,69 @@ static void warn_feet_map(raster_read *r)
              lin_name && *lin_name ? lin_name : "not the metre", lin);
 }
 
+/* Whether a geotransform without a CRS looks like longitude/latitude
+ * degrees: every corner within +-180 by +-90, pixels under a tenth of a
+ * unit (an SRTM grid without its .prj, a netCDF bathymetry in arc
+ * minutes), and heights whose range is more than ten times the smaller
+ * extent -- relief that no terrain has if the coordinates were in the
+ * heights' unit (SRTM: 700 m over 0.1 degree). A grid in pixel units
+ * (pixel 1), in metres, or a synthetic terrain on the unit square never
+ * does. */
+static int looks_like_degrees(const raster_read *r, double ext[4])
+{
+  const double *gt = r->gt;
+  double px = hypot(gt[1], gt[4]), py = hypot(gt[2], gt[5]);
+  if (!(px > 0 && px < 0.1 && py > 0 && py < 0.1))
+    return 0;
+  ext[0] = ext[2] = INFINITY;
+  ext[1] = ext[3] = -INFINITY;
+  for (int k = 0; k < 4; k++) {
+    double c = (k & 1) ? (double)r->xsize : 0;
+    double l = (k & 2) ? (double)r->ysize : 0;
+    double x = gt[0] + c * gt[1] + l * gt[2];
+    double y = gt[3] + c * gt[4] + l * gt[5];
+    ext[0] = fmin(ext[0], x);
+    ext[1] = fmax(ext[1], x);
+    ext[2] = fmin(ext[2], y);
+    ext[3] = fmax(ext[3], y);
+  }
+  if (!(ext[0] >= -180.0001 && ext[1] <= 360.0001 && ext[2] >= -90.0001 &&
+        ext[3] <= 90.0001))
+    return 0;
+  double lo = INFINITY, hi = -INFINITY;
+  const size_t w = tt_grid_width(r->grid), h = tt_grid_height(r->grid);
+  for (size_t y = 0; y < h; y++)
+    for (size_t x = 0; x < w; x++) {
+      double z = tt_grid_sample(r->grid, x, y);
+      if (!isnan(z)) {
+        lo = fmin(lo, z);
+        hi = fmax(hi, z);
+      }
+    }
+  return hi - lo > 10.0 * fmin(ext[1] - ext[0], ext[3] - ext[2]);
+}
+
+tt_status tt__raster_check_degrees(raster_read *r)
+{
+  tt_context *ctx = r->ctx;
+  double ext[4];
+  if (!r->srs && !r->opt.work_srs && looks_like_degrees(r, ext)) {
+    /* Measured in its own units, degrees would pass for metres: slopes
+     * near 90 degrees, areas in square degrees. Said loudly, with the
+     * way out; the frame's name says it too. */
+    tt__warn(ctx, "%s: has no CRS, but its geotransform looks like "
+             "longitude/latitude degrees (x %.6g to %.6g, y %.6g to %.6g, "
+             "pixels of %.3g): slopes, angles and areas are measured as if "
+             "those were the heights' units, which is wrong on the ground; "
+             "give it its CRS, e.g. gdal_translate -of VRT -a_srs "
+             "EPSG:4326 %s dem.vrt, and simplify dem.vrt", r->path, ext[0],
+             ext[1], ext[2], ext[3], hypot(r->gt[1], r->gt[4]), r->path);
+    snprintf(r->frame_name, sizeof r->frame_name, "geotransform (no CRS; "
+             "its coordinates look like degrees, measured as map units)");
+  }
+  return TT_OK;
+}
+
 tt_status tt__raster_frame(raster_read *r)
 {
   tt_context *ctx = r->ctx;

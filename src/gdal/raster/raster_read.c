@@ -407,6 +407,9 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   s = tt__raster_scan(&r);
   if (s != TT_OK)
     goto done;
+  s = tt__raster_check_degrees(&r);
+  if (s != TT_OK)
+    goto done;
   s = fill_info(&r);
 
 done:

@@ -132,9 +132,12 @@ static inline tt_status tt__raster_with_path(tt_context *ctx, tt_status s,
  * height unit and Z_UNIT=m's factor (r->conv). tt__raster_frame: the
  * grid's ground frame (the affine frame, or ground points for a
  * geographic or Web Mercator raster), and the warning for heights of no
- * unit on a map in feet. */
+ * unit on a map in feet. tt__raster_check_degrees, once the heights are
+ * read: the warning for a raster without a CRS whose coordinates look like
+ * longitude/latitude degrees (its frame named so too). */
 TT_HIDDEN tt_status tt__raster_georef(raster_read *r);
 TT_HIDDEN tt_status tt__raster_frame(raster_read *r);
+TT_HIDDEN tt_status tt__raster_check_degrees(raster_read *r);
 
 /* --- the scan (raster_scan.c) --------------------------------------------
  * tt__raster_scan: the band read into r->grid a band of rows at a time
