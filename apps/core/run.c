@@ -580,6 +580,40 @@ static void print_version(FILE *out)
           GDALVersionInfo("--version"), maj, min, pat);
 }
 
+/* A tt_log_fn: "terratin: removed stale temporary ... (left by a killed
+ * run)", a note rather than a warning (nothing is wrong with this run). */
+static void on_stale_note(void *user, const char *message)
+{
+  app_messages *m = user;
+  char masked[TT_APP_MESSAGE_MAX];
+  tt_app_term_progress_break(m->bar);
+  fprintf(m->err, "terratin: %s\n",
+          tt__app_secrets_mask(&m->secrets, message, masked, sizeof masked));
+}
+
+/* The temporaries that killed runs left in the folder of the file this run
+ * writes (output_owner.c): removed before the run adds its own. Names that
+ * are no local file (a connection string, a /vsi path, DRIVER:...) have no
+ * folder to look in. */
+static void remove_stale(app_run *r)
+{
+  const tt_app_settings *s = r->s;
+  const char *out = NULL;
+  switch (s->command) {
+  case TT_APP_SIMPLIFY:
+  case TT_APP_GENERATE:
+  case TT_APP_OPTIMIZE:
+  case TT_APP_RASTERIZE: out = s->output; break;
+  case TT_APP_EVAL: out = s->error_raster; break;
+  default: break;
+  }
+  if (!out || strncmp(out, "/vsi", 4) == 0 ||
+      strcspn(out, ":") < strcspn(out, "/") ||
+      tt__app_secrets_shown(&r->msg.secrets, out) != out)
+    return;
+  tt_output_remove_stale(out, on_stale_note, &r->msg);
+}
+
 /* Set by `terratin tiles run` and `tiles merge` around a simplify run
  * (app.h); all zero otherwise. */
 tt_app_tiles_hook tt__app_tiles_hook;
@@ -684,6 +718,7 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
     goto done;
   }
   tt_context_set_log(r.ctx, on_engine_warning, &r.msg);
+  remove_stale(&r);
 
   st = cmd->run(&r);
 done:

@@ -175,7 +175,7 @@ void tt__app_output_choose_stream(app_simplify_job *job)
    * budget's passes not kept have their rows dropped (tiled.c). The
    * other formats take the merged TIN, written after the last tile. */
   if (tt__app_tiles_hook.save || job->kind != APP_OUTPUT_FILE ||
-      !tt__app_stream_wanted(job->drvname))
+      !tt__app_stream_wanted(job->drvname) || !tt__app_stream_possible(job))
     return;
   tt__app_stream_init(&job->so, job);
   job->kind = APP_OUTPUT_STREAM;

@@ -268,6 +268,12 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
 /* tiled_stream.c: whether a tiled run into a file of drvname streams
  * (GPKG, unless TERRATIN_TILE_STREAM=NO), and the sink of job's. */
 int tt__app_stream_wanted(const char *drvname);
+/* Whether the GeoPackage GDAL makes for job's output can take the rows as
+ * pages, as a stream writes them (no WAL, no auto-vacuum: GDAL's
+ * OGR_SQLITE_PRAGMA may ask for either), found before the tiles run by
+ * making it and removing it again; when not, the merged TIN is written
+ * through SQLite after the last tile, as an untiled run falls back. */
+int tt__app_stream_possible(app_simplify_job *job);
 void tt__app_stream_init(tt_app_stream *so, app_simplify_job *job);
 /* After the last tile: the R-trees, extents, counts, the final
  * run_parameters (fields) and styles; closes the writer. */

@@ -46,6 +46,25 @@ int tt__app_stream_wanted(const char *drvname)
          CPLTestBool(CPLGetConfigOption("TERRATIN_TILE_STREAM", "YES"));
 }
 
+int tt__app_stream_possible(app_simplify_job *job)
+{
+  app_run *r = job->r;
+  GDALDatasetH dst = tt__app_write_create(job);
+  if (!dst) /* the writer will say why, when it tries */
+    return 1;
+  GDALClose(dst);
+  const char *temp = tt_output_temp_path(job->outp);
+  int ok = tt__gpkg_pages_check(r->ctx, temp) == TT_OK;
+  if (!ok)
+    CPLDebug("terratin", "%s: not streamed as the tiles merge, the rows "
+             "go through SQLite after the last tile: %s", temp,
+             tt_context_errmsg(r->ctx));
+  tt_context_clear_error(r->ctx);
+  r->msg.last[0] = '\0';
+  tt_output_clear(job->outp);
+  return ok;
+}
+
 /* The layers (as tt_ogr_write_tin(ROWS=DEFERRED) makes them for the
  * merged TIN, from an empty TIN and the run's fields so far), then the
  * rows' writer. */

@@ -375,16 +375,31 @@ tt_status tt__app_tiled_run_all(tiled *T, tt_tin_merger *merger)
     tt_tin_destroy(T->pieces[k]);
     T->pieces[k] = NULL;
   }
+  /* A failure of this thread's (the stream's write: a full disk; the
+   * merge) stopped the workers: their tiles end "interrupted", which is
+   * its consequence, not the run's failure. */
+  bool own = st != TT_OK && st != TT_ERR_INTERRUPTED;
+  bool worker_failed = T->failed < T->ntiles &&
+                       !(own && T->fail_status == TT_ERR_INTERRUPTED);
   if (st == TT_ERR_NOMEM && T->merge_msg[0])
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, T->path, "%s",
                         T->merge_msg);
-  if (st != TT_OK && st != TT_ERR_INTERRUPTED && T->stream &&
-      T->merge_msg[0] && T->failed == T->ntiles)
-    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, r->s->output, "%s",
-                        T->merge_msg);
-  if (T->failed < T->ntiles && T->fail_status == TT_ERR_INTERRUPTED)
+  if (own && T->stream && T->merge_msg[0] && !worker_failed) {
+    /* the writer's message may name the output first (by its temporary
+     * name): named once */
+    char named[TT_APP_MESSAGE_MAX];
+    const char *m = tt_output_rename_in_text(T->merge_msg, named,
+                                             sizeof named)
+                        ? named : T->merge_msg;
+    const char *out = r->s->output;
+    size_t n = strlen(out);
+    if (strncmp(m, out, n) == 0 && m[n] == ':' && m[n + 1] == ' ')
+      m += n + 2;
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, st, out, "%s", m);
+  }
+  if (worker_failed && T->fail_status == TT_ERR_INTERRUPTED)
     return tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
-  if (T->failed < T->ntiles) {
+  if (worker_failed) {
     tt_tile t;
     tile_of(T, T->failed, &t);
     int code = T->fail_status == TT_ERR_ARG ? TT_APP_EXIT_USAGE

@@ -302,12 +302,24 @@ typedef struct tt_output tt_output;
  * count as final files, and TT_ERR_IO refuses an old file that another
  * process holds open (SQLite's POSIX locks); stale sidecars are removed at
  * commit, before the new file takes the name. Temporary names are
- * `.ttXXXXXXXX` (+ the extension) in path's folder. The caller owns
+ * `.ttXXXXXXXX` (+ the extension) in path's folder, owned by the lock file
+ * `.ttXXXXXXXX.lock` that the output holds with flock() while it lives;
+ * the temporaries of killed runs there (their lock no longer held) are
+ * removed first, each said as a warning (tt_output_remove_stale). The
+ * caller owns
  * *out_output and frees it with tt_output_destroy(), which removes the
  * temporary files (folders included) unless tt_output_commit() succeeded. */
 tt_status tt_output_begin(tt_context *ctx, const char *path,
                           const char *format, int overwrite,
                           tt_output **out_output);
+/* Removes, in the folder of path (an output path), the temporaries of
+ * runs that were killed (SIGKILL, a crash): those whose `.ttXXXXXXXX.lock`
+ * no process holds. A run in progress (its lock held, in any process) and
+ * temporaries without a lock file are never touched, nor what a killed
+ * commit had moved aside (the user's old files). note (may be NULL) gets
+ * "removed stale temporary PATH (left by a killed run)" for each. Returns
+ * how many were removed. Thread-safe. */
+size_t tt_output_remove_stale(const char *path, tt_log_fn note, void *user);
 /* The name to create the dataset under (temporary). */
 const char *tt_output_temp_path(const tt_output *out);
 /* A file written beside a single-file output: the final stem (path without

@@ -12,7 +12,10 @@
  * name works; folder outputs (FlatGeobuf) are removed on failure, renamed
  * into place and replaced only when they hold layer files alone; protected
  * (input) files are refused under any name; stale SQLite sidecars are
- * refused or removed; abandoning removes the temporary files.
+ * refused or removed; abandoning removes the temporary files. Stale
+ * temporaries: removed when their lock file is held by nobody, spared when
+ * a live output of this process holds it, kept when they hold the user's
+ * moved-aside files or have no lock file.
  */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
@@ -689,6 +692,86 @@ static void test_mesh_sidecars(tt_context *ctx)
   CHECK_STR_EQ(listing, "m.2dm m_a.dat m_b_els.dat");
 }
 
+/* A tt_log_fn counting the sweep's notes into an int. */
+static void count_note(void *user, const char *message)
+{
+  (*(int *)user)++;
+  CHECK(strstr(message, "removed stale temporary ") == message);
+  CHECK(strstr(message, "(left by a killed run)") != NULL);
+}
+
+/* Stale temporaries (output_owner.c): a live output's stem has a lock file
+ * that a second output into the same folder of this process leaves alone
+ * (its lock is held there, flock() belonging to the open file); a stem
+ * whose lock file nobody holds is removed, with a note, except what a
+ * killed commit moved aside (STEM.old: the user's old output), which is
+ * kept and, without its lock file, never swept again; a temporary with no
+ * lock file is never touched. */
+static void test_stale(tt_context *ctx)
+{
+  char dir[300], path[400], p2[400], f[420], listing[1024];
+  snprintf(dir, sizeof dir, "%s/stale", tmpdir);
+  mkdir(dir, 0777);
+  static const char *const layers[] = {"vertices", NULL};
+  snprintf(path, sizeof path, "%s/a.gpkg", dir);
+  snprintf(p2, sizeof p2, "%s/b.gpkg", dir);
+  tt_output *a = NULL, *b = NULL;
+  CHECK_OK(ctx, tt_output_begin(ctx, path, "GPKG", 0, &a));
+  if (!a)
+    return;
+  write_vector("GPKG", tt_output_temp_path(a), layers, 1, 0);
+  /* .ttXXXXXXXX.gpkg's owner: .ttXXXXXXXX.lock */
+  snprintf(f, sizeof f, "%s", tt_output_temp_path(a));
+  snprintf(strrchr(f, '.'), 6, ".lock");
+  struct stat st;
+  CHECK(stat(f, &st) == 0);
+  /* stale ones: a dataset and its lock, nobody holding it */
+  snprintf(f, sizeof f, "%s/.tt0000beef.gpkg", dir);
+  put_file(f, "x");
+  snprintf(f, sizeof f, "%s/.tt0000beef.gpkg-journal", dir);
+  put_file(f, "x");
+  snprintf(f, sizeof f, "%s/.tt0000beef.lock", dir);
+  put_file(f, "");
+  /* the old output a killed commit had moved aside */
+  snprintf(f, sizeof f, "%s/.tt0000cafe.old", dir);
+  put_file(f, "old");
+  snprintf(f, sizeof f, "%s/.tt0000cafe.lock", dir);
+  put_file(f, "");
+  /* an older terratin's: no lock */
+  snprintf(f, sizeof f, "%s/.tt0000f00d.gpkg", dir);
+  put_file(f, "x");
+  int notes = 0;
+  CHECK_INT_EQ(tt_output_remove_stale(p2, count_note, &notes), 2);
+  CHECK_INT_EQ(notes, 2);
+  CHECK(stat(tt_output_temp_path(a), &st) == 0);
+  snprintf(f, sizeof f, "%s/.tt0000beef.gpkg", dir);
+  CHECK(stat(f, &st) != 0);
+  snprintf(f, sizeof f, "%s/.tt0000beef.gpkg-journal", dir);
+  CHECK(stat(f, &st) != 0);
+  snprintf(f, sizeof f, "%s/.tt0000beef.lock", dir);
+  CHECK(stat(f, &st) != 0);
+  snprintf(f, sizeof f, "%s/.tt0000cafe.old", dir);
+  CHECK_STR_EQ(first_line(f), "old");
+  snprintf(f, sizeof f, "%s/.tt0000cafe.lock", dir);
+  CHECK(stat(f, &st) != 0);
+  snprintf(f, sizeof f, "%s/.tt0000f00d.gpkg", dir);
+  CHECK(stat(f, &st) == 0);
+  /* begin sweeps too, and spares the live output of this process */
+  CHECK_OK(ctx, tt_output_begin(ctx, p2, "GPKG", 0, &b));
+  CHECK(stat(tt_output_temp_path(a), &st) == 0);
+  if (b) {
+    write_vector("GPKG", tt_output_temp_path(b), layers, 2, 0);
+    CHECK_OK(ctx, tt_output_commit(ctx, b));
+    tt_output_destroy(b);
+  }
+  CHECK_OK(ctx, tt_output_commit(ctx, a));
+  tt_output_destroy(a);
+  CHECK_INT_EQ(read_tag(path, "vertices"), 1);
+  CHECK_INT_EQ(read_tag(p2, "vertices"), 2);
+  list_dir(dir, listing, sizeof listing);
+  CHECK_STR_EQ(listing, ".tt0000cafe.old .tt0000f00d.gpkg a.gpkg b.gpkg");
+}
+
 int main(void)
 {
   GDALAllRegister();
@@ -709,6 +792,7 @@ int main(void)
   TT_RUN(test_sqlite_sidecars(ctx));
   TT_RUN(test_abandon(ctx));
   TT_RUN(test_mesh_sidecars(ctx));
+  TT_RUN(test_stale(ctx));
   CPLPopErrorHandler();
   tt_context_destroy(ctx);
   VSIRmdirRecursive(tmpdir);

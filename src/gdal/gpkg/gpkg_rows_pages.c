@@ -153,6 +153,63 @@ static tt_status layout_find(rows_state *w, const layer_table *t,
   return TT_OK;
 }
 
+/* Why the file of db cannot take pages (WAL mode, auto-vacuum, a page
+ * layout not known), else NULL; its page size and reserved bytes. */
+static const char *file_why_not(sqlite3 *db, int *out_page, int *out_reserve)
+{
+  sqlite3_stmt *st = NULL;
+  char mode[16] = "";
+  int autovac = 0, page = 0;
+  if (sqlite3_prepare_v2(db, "PRAGMA journal_mode", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
+    snprintf(mode, sizeof mode, "%s", sqlite3_column_text(st, 0));
+  sqlite3_finalize(st);
+  if (sqlite3_prepare_v2(db, "PRAGMA auto_vacuum", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    autovac = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  if (sqlite3_prepare_v2(db, "PRAGMA page_size", -1, &st, NULL) ==
+          SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    page = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  int reserve = -1; /* asks, changes nothing */
+  if (sqlite3_file_control(db, "main", SQLITE_FCNTL_RESERVE_BYTES,
+                           &reserve) != SQLITE_OK)
+    reserve = -1;
+  *out_page = page;
+  *out_reserve = reserve;
+  if (strcasecmp(mode, "wal") == 0)
+    return "the database is in WAL mode";
+  if (autovac)
+    return "the database has auto-vacuum";
+  if (page < 512 || reserve < 0 || page - reserve < 480)
+    return "unknown page size";
+  return NULL;
+}
+
+tt_status tt__gpkg_pages_check(tt_context *ctx, const char *path)
+{
+  sqlite3 *db = NULL;
+  if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX,
+                      NULL) != SQLITE_OK) {
+    tt_status s = tt__error(ctx, TT_ERR_IO, "%s: cannot open the "
+                            "GeoPackage: %s", path,
+                            db ? sqlite3_errmsg(db) : "out of memory");
+    sqlite3_close(db);
+    return s;
+  }
+  int page, reserve;
+  const char *why = file_why_not(db, &page, &reserve);
+  sqlite3_close(db);
+  if (why)
+    return tt__error(ctx, TT_ERR_FORMAT, "%s: the rows cannot be written "
+                     "as pages: %s", path, why);
+  return TT_OK;
+}
+
 /* Whether PAGES=YES can be followed for the layers made (lay[0]:
  * triangles, lay[1]: vertices, when written); why not in *why. */
 tt_status tt__rows_pages_possible(rows_state *w, const layer_table *tri,
@@ -160,35 +217,8 @@ tt_status tt__rows_pages_possible(rows_state *w, const layer_table *tri,
                                 int do_vtx, int rtree, int nvfields,
                                 page_layout lay[2], const char **why)
 {
-  *why = NULL;
-  sqlite3_stmt *st = NULL;
-  char mode[16] = "";
-  int autovac = 0, page = 0;
-  if (sqlite3_prepare_v2(w->db, "PRAGMA journal_mode", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
-    snprintf(mode, sizeof mode, "%s", sqlite3_column_text(st, 0));
-  sqlite3_finalize(st);
-  if (sqlite3_prepare_v2(w->db, "PRAGMA auto_vacuum", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW)
-    autovac = sqlite3_column_int(st, 0);
-  sqlite3_finalize(st);
-  if (sqlite3_prepare_v2(w->db, "PRAGMA page_size", -1, &st, NULL) ==
-          SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW)
-    page = sqlite3_column_int(st, 0);
-  sqlite3_finalize(st);
-  int reserve = -1; /* asks, changes nothing */
-  if (sqlite3_file_control(w->db, "main", SQLITE_FCNTL_RESERVE_BYTES,
-                           &reserve) != SQLITE_OK)
-    reserve = -1;
-  if (strcasecmp(mode, "wal") == 0)
-    *why = "the database is in WAL mode";
-  else if (autovac)
-    *why = "the database has auto-vacuum";
-  else if (page < 512 || reserve < 0 || page - reserve < 480)
-    *why = "unknown page size";
+  int page, reserve;
+  *why = file_why_not(w->db, &page, &reserve);
   if (*why)
     return TT_OK;
   const size_t max_payload = tt__sqlite_max_payload((size_t)(page - reserve));

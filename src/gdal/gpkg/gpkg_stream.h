@@ -75,6 +75,13 @@ TT_HIDDEN tt_status tt__gpkg_pages_finish(tt__gpkg_pages *p,
                                           void *progress_arg);
 TT_HIDDEN void tt__gpkg_pages_close(tt__gpkg_pages *p);
 
+/* Whether the rows can be written as pages into the GeoPackage at path
+ * (made by GDAL, with or without its layers): TT_OK, or TT_ERR_FORMAT
+ * saying why not (WAL mode, auto-vacuum, an unusual page layout): then a
+ * streamed merge cannot be written into it, and the whole TIN goes
+ * through SQLite instead (tt_gpkg_write_rows' fallback). */
+TT_HIDDEN tt_status tt__gpkg_pages_check(tt_context *ctx, const char *path);
+
 /* --- gpkg_stream.c: the rows of a streamed merge ----------------------
  * tt__gpkg_stream_open() after the layers were made (as above, srs the
  * layers' input CRS, options those of tt_gpkg_write_rows(), T_SRS

@@ -45,7 +45,11 @@
  * stem, checked like the output, renamed with it.
  * The checks run at begin (fail early) and again at commit.
  * destroy() removes whatever temporary files remain, folders included;
- * clear() removes them earlier, for a writer that starts over.
+ * clear() removes them earlier, for a writer that starts over. Each
+ * temporary stem has an owner, the flock()ed `.ttXXXXXXXX.lock` beside it
+ * (output_owner.c), taken before the temporaries are made and given up
+ * after they are gone; begin() first removes the temporaries of stems whose
+ * owner is gone (a killed run's).
  * Live outputs are kept in a process-wide list, so tt_output_abandon_all()
  * (a signal's watchdog thread) can remove their temporary files while the
  * main thread is stuck in a driver; a mutex orders it with commit and
@@ -53,6 +57,7 @@
  */
 #define _XOPEN_SOURCE 700 /* realpath(), which C11 + POSIX 2008 hide */
 #include "base/internal.h"
+#include "gdal/ogr/output_owner.h"
 #include "terratin/terratin_gdal.h"
 
 #include <dirent.h>
@@ -107,6 +112,7 @@ struct tt_output {
   char *temp_path;     /* the dataset name to create */
   char *temp_stem;     /* single-file: temporary file name without ext */
   char *prefix;        /* layer-name prefix: "<name>_" or "" */
+  int owner_fd;        /* the flock()ed STEM.lock (output_owner.c), or -1 */
   char **finals;       /* shapefile: every final file name (no folder) */
   size_t nfinals;
   protected_file *prot;
@@ -160,31 +166,6 @@ static unsigned random_tag(const void *salt, unsigned attempt)
   return (unsigned)((x ^ (x >> 31)) & 0xffffffffu);
 }
 
-/* Removes a folder and the files and folders in it (symbolic links are
- * removed, not followed). */
-static void remove_tree(const char *path)
-{
-  DIR *d = opendir(path);
-  if (d) {
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-      if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
-        continue;
-      char *p = str_printf("%s/%s", path, e->d_name);
-      if (!p)
-        continue;
-      struct stat st;
-      if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode))
-        remove_tree(p);
-      else
-        unlink(p);
-      free(p);
-    }
-    closedir(d);
-  }
-  rmdir(path);
-}
-
 /* Removes the temporary files that remain: the shapefile folder, or every
  * entry of the folder whose name starts with the temporary stem (the
  * dataset, a driver's sidecars, a folder a driver made). Called with
@@ -194,7 +175,7 @@ static void remove_temp(tt_output *out)
   if (out->committed || out->keep_temp || out->abandoned || !out->temp_path)
     return;
   if (out->shapefile) {
-    remove_tree(out->temp_path);
+    tt__owner_remove_tree(out->temp_path);
     return;
   }
   DIR *d = opendir(out->dir);
@@ -203,17 +184,28 @@ static void remove_temp(tt_output *out)
     return;
   struct dirent *e;
   while ((e = readdir(d)) != NULL) {
-    if (strncmp(e->d_name, out->temp_stem, n) != 0)
-      continue;
+    if (strncmp(e->d_name, out->temp_stem, n) != 0 ||
+        strcmp(e->d_name + n, ".lock") == 0)
+      continue; /* the lock goes last, in release_owner() */
     char *p = str_printf("%s/%s", out->dir, e->d_name);
     struct stat st;
     if (p && lstat(p, &st) == 0 && S_ISDIR(st.st_mode))
-      remove_tree(p);
+      tt__owner_remove_tree(p);
     else if (p)
       unlink(p);
     free(p);
   }
   closedir(d);
+}
+
+/* Gives the temporary stem up (its lock file removed): after the
+ * temporaries are gone or committed, or when they must stay (they hold
+ * the user's files) and never be swept. Called with live_lock held. */
+static void release_owner(tt_output *out)
+{
+  if (out->owner_fd >= 0)
+    tt__owner_release(out->dir, out->temp_stem, out->owner_fd);
+  out->owner_fd = -1;
 }
 
 void tt_output_clear(tt_output *out)
@@ -231,6 +223,7 @@ void tt_output_destroy(tt_output *out)
     return;
   pthread_mutex_lock(&live_lock);
   remove_temp(out);
+  release_owner(out);
   if (out->prev)
     out->prev->next = out->next;
   else if (live_head == out)
@@ -268,6 +261,7 @@ int tt_output_abandon_all(void)
       continue;
     }
     remove_temp(o);
+    release_owner(o);
     o->abandoned = 1;
   }
   pthread_mutex_unlock(&live_lock);
@@ -632,9 +626,10 @@ static tt_status plan_shapefile(tt_context *ctx, tt_output *out,
   return s;
 }
 
-/* Makes the temporary name: a folder (shapefile) or a probe file that is
- * removed again (drivers refuse to create over an existing file). A
- * failure here is the definitive "folder not writable". */
+/* Makes the temporary name: its owner's lock file first (output_owner.c),
+ * then a folder (shapefile) or a probe file that is removed again (drivers
+ * refuse to create over an existing file). A failure here is the
+ * definitive "folder not writable". */
 static tt_status make_temp(tt_context *ctx, tt_output *out, const char *ext)
 {
   for (unsigned attempt = 0; attempt < 64; attempt++) {
@@ -648,6 +643,19 @@ static tt_status make_temp(tt_context *ctx, tt_output *out, const char *ext)
                          : NULL;
     if (!out->temp_path)
       return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+    int owned = tt__owner_take(out->dir, out->temp_stem, &out->owner_fd);
+    if (owned == TT__OWNER_CLASH)
+      continue;
+    if (owned == TT__OWNER_FAILED) {
+      int e = errno;
+      char *failed = out->temp_path;
+      out->temp_path = NULL; /* nothing to clean up */
+      tt_status s = tt__error(ctx, TT_ERR_IO, "cannot write in folder %s: "
+                              "creating %s.lock failed: %s", out->dir,
+                              out->temp_stem, strerror(e));
+      free(failed);
+      return s;
+    }
     int ok;
     if (out->shapefile) {
       ok = mkdir(out->temp_path, 0777) == 0;
@@ -661,6 +669,11 @@ static tt_status make_temp(tt_context *ctx, tt_output *out, const char *ext)
     }
     if (ok)
       return TT_OK;
+    int made_errno = errno;
+    pthread_mutex_lock(&live_lock);
+    release_owner(out);
+    pthread_mutex_unlock(&live_lock);
+    errno = made_errno;
     if (errno != EEXIST) {
       int e = errno;
       char *failed = out->temp_path;
@@ -680,6 +693,38 @@ static tt_status make_temp(tt_context *ctx, tt_output *out, const char *ext)
   return s;
 }
 
+/* A tt__owner_mine_fn: whether a live output of this process has stem
+ * (stems are random: a same stem in another folder only spares it once). */
+static int stem_is_live(const char *dir, const char *stem)
+{
+  (void)dir;
+  int mine = 0;
+  pthread_mutex_lock(&live_lock);
+  for (tt_output *o = live_head; o && !mine; o = o->next)
+    mine = o->temp_stem && strcmp(o->temp_stem, stem) == 0;
+  pthread_mutex_unlock(&live_lock);
+  return mine;
+}
+
+/* A tt_log_fn: the sweep's notes as the context's warnings. */
+static void warn_note(void *user, const char *message)
+{
+  tt__warn(user, "%s", message);
+}
+
+size_t tt_output_remove_stale(const char *path, tt_log_fn note, void *user)
+{
+  if (!path || !*path)
+    return 0;
+  const char *slash = strrchr(path, '/');
+  char *dir = !slash ? str_printf(".")
+              : slash == path ? str_printf("/")
+                              : str_printf("%.*s", (int)(slash - path), path);
+  size_t n = dir ? tt__owner_sweep(dir, stem_is_live, note, user) : 0;
+  free(dir);
+  return n;
+}
+
 tt_status tt_output_begin(tt_context *ctx, const char *path,
                           const char *format, int overwrite,
                           tt_output **out_output)
@@ -695,6 +740,7 @@ tt_status tt_output_begin(tt_context *ctx, const char *path,
   tt_output *out = calloc(1, sizeof *out);
   if (!out)
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  out->owner_fd = -1;
   out->shapefile = strcasecmp(format, "ESRI Shapefile") == 0;
   out->sqlite = strcasecmp(format, "GPKG") == 0 ||
                 strcasecmp(format, "SQLite") == 0;
@@ -726,6 +772,8 @@ tt_status tt_output_begin(tt_context *ctx, const char *path,
     s = check_finals(ctx, out);
   if (s == TT_OK)
     s = check_folder(ctx, out->dir);
+  if (s == TT_OK) /* what killed runs left there */
+    tt__owner_sweep(out->dir, stem_is_live, warn_note, ctx);
   if (s == TT_OK)
     s = make_temp(ctx, out, ext);
 
@@ -831,8 +879,9 @@ static tt_status commit_single(tt_context *ctx, tt_output *out)
   struct dirent *e;
   while (s == TT_OK && (e = readdir(d)) != NULL) {
     if (strncmp(e->d_name, out->temp_stem, n) != 0 ||
-        strcmp(e->d_name, main_name) == 0)
-      continue;
+        strcmp(e->d_name, main_name) == 0 ||
+        strcmp(e->d_name + n, ".lock") == 0)
+      continue; /* the lock is the run's, not a sidecar */
     char *from = str_printf("%s/%s", out->dir, e->d_name);
     char *to = str_printf("%s/%s%s", out->dir, out->final_stem,
                           e->d_name + n);
@@ -930,7 +979,7 @@ static tt_status commit_single(tt_context *ctx, tt_output *out)
       struct stat st;
       if (old_aside && i == moved - 1 && lstat(to[i], &st) == 0 &&
           S_ISDIR(st.st_mode))
-        remove_tree(to[i]);
+        tt__owner_remove_tree(to[i]);
       else
         unlink(to[i]);
     }
@@ -1050,7 +1099,7 @@ static tt_status commit_shapefile(tt_context *ctx, tt_output *out)
       goto rollback;
   }
   /* Done: the old files go, then the temporary folder. */
-  remove_tree(out->temp_path);
+  tt__owner_remove_tree(out->temp_path);
   goto done;
 
 rollback:
@@ -1066,8 +1115,10 @@ rollback:
     char *from = str_printf("%s/%s", old_dir, olds[moved_old]);
     char *to = str_printf("%s/%s", out->dir, olds[moved_old]);
     if (!from || !to || rename(from, to) != 0) {
-      /* Keep the temporary folder: the user's old files are in it. */
+      /* Keep the temporary folder: the user's old files are in it (and
+       * no sweep may take it for a dead run's). */
       out->keep_temp = 1;
+      release_owner(out);
       s = tt__error(ctx, TT_ERR_IO, "commit failed and the old file %s "
                     "could not be put back; it is in %s", to ? to : "?",
                     old_dir);
