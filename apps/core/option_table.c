@@ -16,7 +16,6 @@
 #include <stdio.h>
 #include <string.h>
 
-_Static_assert(O_COUNT <= 64, "tt__app_opt_parse.given has a bit per option");
 _Static_assert(2 * TT_MAX_VERTICES == 2147483646,
                "-max_triangles' message spells out TT_MAX_VERTICES");
 
@@ -506,7 +505,7 @@ tt_status tt__app_opt_apply(tt__app_opt_parse *p, const tt__app_opt_def *d,
   }
   if (st != TT_OK)
     return st;
-  p->given |= OPT_BIT(d->id);
+  OPT_SET_GIVEN(p, d->id);
   if ((d->flags & OPT_DECIMATE) && !p->decimate_only)
     p->decimate_only = d->name;
   return TT_OK;

@@ -35,8 +35,11 @@ enum opt_id {
   O_COUNT
 };
 
-/* The bit of an option in tt__app_opt_parse.given. */
-#define OPT_BIT(id) ((uint64_t)1 << (id))
+/* Whether option id was read (tt__app_opt_parse.given: a bit per option,
+ * as many words as the options need). */
+#define OPT_WORDS ((O_COUNT + 63) / 64)
+#define OPT_GIVEN(p, id) ((((p)->given[(id) / 64]) >> ((id) % 64)) & 1u)
+#define OPT_SET_GIVEN(p, id) ((p)->given[(id) / 64] |= (uint64_t)1 << ((id) % 64))
 
 #define FOR_S (1u << TT_APP_SIMPLIFY)
 #define FOR_G (1u << TT_APP_GENERATE)
@@ -91,7 +94,7 @@ typedef struct tt__app_opt_parse {
   const char *cmdname;      /* "simplify", ...: the messages' first word */
   char hint[64];            /* " (see 'terratin simplify --help')" */
   tt_synth_options synth;   /* generate's terrain parameters as given */
-  uint64_t given;           /* OPT_BIT of every option read */
+  uint64_t given[OPT_WORDS]; /* a bit per option read (OPT_GIVEN) */
   const char *decimate_only; /* the first OPT_DECIMATE option read */
   const char *pos[3];       /* the positional words */
   size_t npos;

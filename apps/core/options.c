@@ -238,11 +238,11 @@ static tt_status read_words(tt__app_opt_parse *p, char **argv)
 static void apply_given(tt__app_opt_parse *p)
 {
   tt_app_settings *s = &p->o->s;
-  if (p->given & OPT_BIT(O_SEED)) {
+  if (OPT_GIVEN(p, O_SEED)) {
     s->seed_set = 1;
     s->anneal.seed = s->seed;
   }
-  if (p->given & OPT_BIT(O_Z_FACTOR))
+  if (OPT_GIVEN(p, O_Z_FACTOR))
     s->z_factor_set = 1;
 }
 
@@ -345,7 +345,6 @@ static tt_status check_generate(tt__app_opt_parse *p)
   tt_app_settings *s = &p->o->s;
   tt_synth_options *y = &s->synth;
   const tt_synth_options *given = &p->synth;
-  uint64_t g = p->given;
   tt_synth_kind kind;
   if (p->npos < 1)
     return OPT_USAGE(p, "generate: missing TYPE and OUTPUT%s", p->hint);
@@ -361,24 +360,24 @@ static tt_status check_generate(tt__app_opt_parse *p)
   if (!kname)
     kname = p->pos[0];
   if (kind != TT_SYNTH_FAULT &&
-      (g & (OPT_BIT(O_ITERATIONS) | OPT_BIT(O_DISPLACEMENT) |
-            OPT_BIT(O_WAVE_SIZE))))
+      (OPT_GIVEN(p, O_ITERATIONS) || OPT_GIVEN(p, O_DISPLACEMENT) ||
+       OPT_GIVEN(p, O_WAVE_SIZE)))
     return OPT_USAGE(p, "generate: -%s applies to fault terrains only, not %s",
-                     (g & OPT_BIT(O_ITERATIONS))     ? "iterations"
-                     : (g & OPT_BIT(O_DISPLACEMENT)) ? "displacement"
+                     (OPT_GIVEN(p, O_ITERATIONS))     ? "iterations"
+                     : (OPT_GIVEN(p, O_DISPLACEMENT)) ? "displacement"
                                                      : "wave_size",
                      kname);
   if (kind != TT_SYNTH_DIAMOND_SQUARE &&
-      (g & (OPT_BIT(O_ROUGHNESS) | OPT_BIT(O_AMPLITUDE) |
-            OPT_BIT(O_SEEDING))))
+      (OPT_GIVEN(p, O_ROUGHNESS) || OPT_GIVEN(p, O_AMPLITUDE) ||
+       OPT_GIVEN(p, O_SEEDING)))
     return OPT_USAGE(p, "generate: -%s applies to diamond_square terrains "
                      "only, not %s",
-                     (g & OPT_BIT(O_ROUGHNESS))   ? "roughness"
-                     : (g & OPT_BIT(O_AMPLITUDE)) ? "amplitude"
+                     (OPT_GIVEN(p, O_ROUGHNESS))   ? "roughness"
+                     : (OPT_GIVEN(p, O_AMPLITUDE)) ? "amplitude"
                                                   : "seeding",
                      kname);
   tt_synth_options_init(y, kind);
-  if (g & OPT_BIT(O_SIZE)) {
+  if (OPT_GIVEN(p, O_SIZE)) {
     y->nx = given->nx;
     y->ny = given->ny;
   }
@@ -386,13 +385,13 @@ static tt_status check_generate(tt__app_opt_parse *p)
       (y->nx != y->ny || !tt__app_is_pow2_plus1(y->nx)))
     return OPT_USAGE(p, "generate: diamond_square needs a square size 2^n+1 "
                      "(e.g. 129, 257, 513), got %zux%zu", y->nx, y->ny);
-  if (g & OPT_BIT(O_SEED)) y->seed = s->seed;
-  if (g & OPT_BIT(O_ITERATIONS)) y->iterations = given->iterations;
-  if (g & OPT_BIT(O_DISPLACEMENT)) y->displacement = given->displacement;
-  if (g & OPT_BIT(O_WAVE_SIZE)) y->wave_size = given->wave_size;
-  if (g & OPT_BIT(O_ROUGHNESS)) y->roughness = given->roughness;
-  if (g & OPT_BIT(O_AMPLITUDE)) y->amplitude = given->amplitude;
-  if (g & OPT_BIT(O_SEEDING)) y->seeding = given->seeding;
+  if (OPT_GIVEN(p, O_SEED)) y->seed = s->seed;
+  if (OPT_GIVEN(p, O_ITERATIONS)) y->iterations = given->iterations;
+  if (OPT_GIVEN(p, O_DISPLACEMENT)) y->displacement = given->displacement;
+  if (OPT_GIVEN(p, O_WAVE_SIZE)) y->wave_size = given->wave_size;
+  if (OPT_GIVEN(p, O_ROUGHNESS)) y->roughness = given->roughness;
+  if (OPT_GIVEN(p, O_AMPLITUDE)) y->amplitude = given->amplitude;
+  if (OPT_GIVEN(p, O_SEEDING)) y->seeding = given->seeding;
   return TT_OK;
 }
 
