@@ -319,6 +319,12 @@ tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
 tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+/* --formats (simplify/formats.c): the output formats simplify writes, each
+ * OGR driver judged by the dry run of its writer (ogr_output.c). */
+tt_status tt__app_formats(app_run *r);
+/* --help-general (help.c): the options of every command, as GDAL's
+ * utilities print them. */
+const char *tt__app_help_general(void);
 
 /* The dispatch table (run.c): one entry per command, which the parser
  * (the command word, how many positional words, where they go), the help

@@ -6,9 +6,38 @@
  */
 #include "app.h"
 
+/* The options of every command: the top help and --help-general. */
+#define GENERAL_OPTIONS                                                       \
+  "  --help              this help, or the help of COMMAND (also -h,\n"      \
+  "                      'terratin help COMMAND')\n"                         \
+  "  --help-general      these options of every command\n"                   \
+  "  --version           terratin, GDAL and PROJ versions\n"                 \
+  "  --formats           the output formats -of accepts: the OGR drivers\n"  \
+  "                      terratin can write, the databases, the mesh formats\n"\
+  "  --config KEY VALUE  set a GDAL configuration option before anything is\n"\
+  "                      opened (repeatable; KEY=VALUE also accepted)\n"     \
+  "  --debug on|off      GDAL debug messages on stderr (CPL_DEBUG; also\n"   \
+  "                      yes|no|true|false|1|0)\n"                           \
+  "  -q, -quiet          no progress bar, no summary line (every command)\n"
+
+static const char help_general[] =
+    "Generic terratin options (every command takes them, before or after\n"
+    "the command word):\n"
+    GENERAL_OPTIONS
+    "\n"
+    "Option names and named values are matched without regard to case, and\n"
+    "'-' matches '_' in them (-max-error is -max_error); --opt is -opt.\n"
+    "A mistyped option is refused with the nearest option of the command\n"
+    "('did you mean -max_error?').\n";
+
+const char *tt__app_help_general(void)
+{
+  return help_general;
+}
+
 static const char help_top[] =
     "Usage: terratin COMMAND [options] ARGUMENTS...\n"
-    "       terratin --help | --version\n"
+    "       terratin --help | --help-general | --version | --formats\n"
     "\n"
     "Turns a DEM into a TIN (triangulated irregular network) whose vertices\n"
     "are grid samples, and measures triangle layers against DEMs.\n"
@@ -23,15 +52,11 @@ static const char help_top[] =
     "  tiles      plan, run and merge a tiled run as separate jobs (clusters)\n"
     "\n"
     "Options of every command:\n"
-    "  --help              this help, or the help of COMMAND\n"
-    "  --version           terratin, GDAL and PROJ versions\n"
-    "  --config KEY VALUE  set a GDAL configuration option before anything is\n"
-    "                      opened (repeatable; KEY=VALUE also accepted)\n"
-    "  --debug on|off      GDAL debug messages on stderr (CPL_DEBUG; also\n"
-    "                      yes|no|true|false|1|0)\n"
+    GENERAL_OPTIONS
     "\n"
     "Option names and named values (criteria, modes, TYPE) are matched\n"
-    "without regard to case; numbers are decimal (no hex, inf or nan).\n"
+    "without regard to case, '-' as '_'; numbers are decimal (no hex, inf\n"
+    "or nan).\n"
     "\n"
     "Exit codes:\n"
     "  0  success\n"

@@ -672,15 +672,20 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
     fflush(r.out);
     return TT_OK;
   }
+  if (o->s.command == TT_APP_HELP_GENERAL) {
+    fputs(tt__app_help_general(), r.out);
+    fflush(r.out);
+    return TT_OK;
+  }
   if (o->s.command == TT_APP_VERSION) {
     print_version(r.out);
     fflush(r.out);
     return TT_OK;
   }
-  if (!cmd) {
+  if (!cmd && o->s.command != TT_APP_FORMATS) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                        "missing command: simplify, generate, eval, optimize, "
-                       "study or rasterize");
+                       "study, rasterize or tiles");
     return TT_ERR_ARG;
   }
 
@@ -720,7 +725,8 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   tt_context_set_log(r.ctx, on_engine_warning, &r.msg);
   remove_stale(&r);
 
-  st = cmd->run(&r);
+  /* --formats: the drivers as this run would see them (after --config) */
+  st = cmd ? cmd->run(&r) : tt__app_formats(&r);
 done:
   tt_context_destroy(r.ctx);
   CPLPopErrorHandler();

@@ -53,7 +53,9 @@ typedef enum tt_app_command {
   TT_APP_EVAL,
   TT_APP_OPTIMIZE,           /* optimize DEM IN_TIN OUTPUT */
   TT_APP_STUDY,              /* study OUTDIR */
-  TT_APP_RASTERIZE           /* rasterize TIN DEM OUTPUT */
+  TT_APP_RASTERIZE,          /* rasterize DEM TIN OUTPUT */
+  TT_APP_FORMATS,            /* --formats: the output formats */
+  TT_APP_HELP_GENERAL        /* --help-general: the options of every command */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
