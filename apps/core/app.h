@@ -325,6 +325,9 @@ tt_status tt__app_formats(app_run *r);
 /* --help-general (help.c): the options of every command, as GDAL's
  * utilities print them. */
 const char *tt__app_help_general(void);
+/* The help page of `terratin tiles SUB` (plan, run, merge; anything else:
+ * the overview of the three). */
+const char *tt__app_tiles_help(const char *sub);
 
 /* The dispatch table (run.c): one entry per command, which the parser
  * (the command word, how many positional words, where they go), the help

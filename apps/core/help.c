@@ -469,6 +469,131 @@ static const char help_rasterize[] =
     "  terratin rasterize tin.gpkg dem.tif tin.tif\n"
     "  terratin eval dem.tif tin.gpkg -error_raster diff.tif  (TIN - DEM)\n";
 
+/* The tiles commands: the overview and a page per subcommand. */
+#define TILES_USAGE                                                          \
+  "Usage: terratin tiles plan DEM PLAN.json -max_error E -tile_size N\n"      \
+  "           [options that shape the TIN] [-overwrite] [-q]\n"               \
+  "       terratin tiles run PLAN.json TILE_ID [-overwrite]\n"                \
+  "       terratin tiles merge PLAN.json OUTPUT [-overwrite] [-q] [-json]\n"  \
+  "           [-of FORMAT] [-lco ...] [-dsco ...] [-nln PREFIX] [-layers L]\n"\
+  "           [-nostyle] [-obj_local] [-t_srs SRS]\n"
+
+#define TILES_CARRIED                                                        \
+  "A plan carries the options that shape the TIN only: -max_error,\n"         \
+  "-tile_size, -method, -start, -importance, -selection, -onepass, -hole,\n"  \
+  "-criterion, -repair, -optimize, -seed, -anneal_*, -b, -srcnodata,\n"       \
+  "-z_factor, -z_unit, -work_srs AUTHORITY:CODE. The output's options\n"      \
+  "(-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs) go to\n"   \
+  "merge. run and merge refuse a plan that is truncated, edited (its\n"       \
+  "checksum), or whose fields or options are not what plan writes.\n"
+
+#define TILES_EXIT                                                           \
+  "\n"                                                                        \
+  "Exit codes: 0 success, 1 processing failure (a missing or stale piece,\n"  \
+  "a changed DEM), 2 usage error (an option a plan may not carry, a bad\n"    \
+  "plan), 128+N stopped by signal N (nothing left behind).\n"
+
+static const char help_tiles[] =
+    TILES_USAGE
+    "\n"
+    "A tiled run (simplify -tile_size) as independent jobs, for a cluster:\n"
+    "  plan   checks simplify's options (-tile_size and -max_error needed),\n"
+    "         writes PLAN.json (the DEM's path, size and time, the tiles and\n"
+    "         their windows, the options, a closing checksum) and makes the\n"
+    "         folder PLAN.json.tiles\n"
+    "  run    simplifies tile TILE_ID (0 .. tiles-1) alone (-method insert\n"
+    "         or decimate), on one thread, and\n"
+    "         writes its piece PLAN.json.tiles/TILE_ID.ttp\n"
+    "  merge  joins every piece into OUTPUT as simplify writes it: the same\n"
+    "         triangles and vertices as simplify -tile_size with the plan's\n"
+    "         options; a missing or stale piece, or a changed DEM, is refused\n"
+    TILES_CARRIED
+    "Each job can run on any machine that sees the same paths; the borders\n"
+    "of neighbouring tiles are computed alike by both. tools/tt_dask.py runs\n"
+    "the jobs on Dask distributed; docs/scale.md shows Slurm too.\n"
+    "\n"
+    "Run 'terratin tiles plan|run|merge --help' for the page of each.\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles plan dem.tif plan.json -max_error 0.5 -tile_size 1024\n"
+    "  for i in $(seq 0 15); do terratin tiles run plan.json $i; done\n"
+    "  terratin tiles merge plan.json tin.gpkg\n";
+
+static const char help_tiles_plan[] =
+    "Usage: terratin tiles plan DEM PLAN.json -max_error E -tile_size N\n"
+    "           [options that shape the TIN] [-overwrite] [-q]\n"
+    "\n"
+    "Checks simplify's options with simplify's parser and writes PLAN.json:\n"
+    "the DEM's absolute path, size in bytes and modification time, its\n"
+    "width and height, the tiles (each tile's columns, rows and the window\n"
+    "it reads), the options as words and a closing checksum; makes the\n"
+    "folder PLAN.json.tiles for the pieces. No budget (-max_points,\n"
+    "-max_triangles, -percent): its bound needs a pass over every tile\n"
+    "first, which simplify -tile_size makes.\n"
+    "\n"
+    TILES_CARRIED
+    "\n"
+    "Options:\n"
+    "  -max_error E      every sample within E of the TIN (needed)\n"
+    "  -tile_size N      tiles of N cells, 16 to 65536 (needed)\n"
+    "  -overwrite        replace PLAN.json when it exists\n"
+    "  -q                no summary line\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles plan dem.tif plan.json -max_error 0.5 -tile_size 1024\n";
+
+static const char help_tiles_run[] =
+    "Usage: terratin tiles run PLAN.json TILE_ID [-overwrite]\n"
+    "\n"
+    "Simplifies tile TILE_ID (0 to tiles - 1, row-major) of the plan alone,\n"
+    "on one thread, by the plan's method, and writes its piece\n"
+    "PLAN.json.tiles/TILE_ID.ttp (the piece's arrays, the plan's hash and\n"
+    "the tile id, a checksum) through a temporary name and a rename. The\n"
+    "DEM must be the one planned (same size and modification time).\n"
+    "\n"
+    "Options:\n"
+    "  -overwrite        replace the piece when it exists (default: keep it)\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles run plan.json 7\n";
+
+static const char help_tiles_merge[] =
+    "Usage: terratin tiles merge PLAN.json OUTPUT [-overwrite] [-q] [-json]\n"
+    "           [-of FORMAT] [-lco NAME=VALUE]... [-dsco NAME=VALUE]...\n"
+    "           [-nln PREFIX] [-layers LIST] [-nostyle] [-obj_local]\n"
+    "           [-t_srs SRS]\n"
+    "\n"
+    "Joins every piece of the plan in tile order and writes OUTPUT as\n"
+    "simplify writes it (temporary name, rename, nothing left behind on a\n"
+    "failure): the triangles and vertices of simplify -tile_size with the\n"
+    "plan's options. A missing piece (counted, the first named), a piece of\n"
+    "another plan or tile, a damaged one, or a changed DEM is refused\n"
+    "before anything is written.\n"
+    "\n"
+    "Options: the output options of simplify (see 'terratin simplify\n"
+    "--help'): -of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local,\n"
+    "-t_srs; and\n"
+    "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
+    "  -q, -json         no summary; one JSON object instead of it\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles merge plan.json tin.gpkg -nln dem_\n";
+
+const char *tt__app_tiles_help(const char *sub)
+{
+  if (sub && tt__app_str_ieq(sub, "plan"))
+    return help_tiles_plan;
+  if (sub && tt__app_str_ieq(sub, "run"))
+    return help_tiles_run;
+  if (sub && tt__app_str_ieq(sub, "merge"))
+    return help_tiles_merge;
+  return help_tiles;
+}
+
 const char *tt_app_help(tt_app_command topic)
 {
   switch (topic) {
@@ -478,6 +603,7 @@ const char *tt_app_help(tt_app_command topic)
   case TT_APP_OPTIMIZE: return help_optimize;
   case TT_APP_STUDY: return help_study;
   case TT_APP_RASTERIZE: return help_rasterize;
+  case TT_APP_TILES: return help_tiles;
   default: return help_top;
   }
 }

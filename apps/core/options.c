@@ -87,6 +87,10 @@ static int asks_help_or_version(tt_app_settings *s, char **argv)
         want_help = 1;
         continue;
       }
+      if (tt__app_str_ieq(w, "tiles")) { /* `terratin help tiles` */
+        first_cmd = TT_APP_TILES;
+        continue;
+      }
       if ((first_cmd = command_named(w)) == TT_APP_NONE)
         break; /* an unknown command: reported by read_words */
     }

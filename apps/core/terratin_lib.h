@@ -55,7 +55,9 @@ typedef enum tt_app_command {
   TT_APP_STUDY,              /* study OUTDIR */
   TT_APP_RASTERIZE,          /* rasterize DEM TIN OUTPUT */
   TT_APP_FORMATS,            /* --formats: the output formats */
-  TT_APP_HELP_GENERAL        /* --help-general: the options of every command */
+  TT_APP_HELP_GENERAL,       /* --help-general: the options of every command */
+  TT_APP_TILES               /* a help topic only: `terratin tiles` runs
+                                through tt_app_tiles() */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024

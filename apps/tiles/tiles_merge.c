@@ -65,10 +65,10 @@ void tt__tiles_merge(char **argv, tt_progress_fn fn, void *arg,
                            "tiles merge: option %s needs a value", argv[i]);
       else
         tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                           "tiles merge: unknown option %s (usage: terratin "
-                           "tiles merge PLAN.json OUT.gpkg [-overwrite] [-q] "
-                           "[-json] [-of, -lco, -dsco, -nln, -layers, "
-                           "-nostyle, -obj_local, -t_srs])", argv[i]);
+                           "tiles merge: unknown option %s (see 'terratin "
+                           "tiles merge --help': -overwrite, -q, -json, "
+                           "-of, -lco, -dsco, -nln, -layers, -nostyle, "
+                           "-obj_local, -t_srs)", argv[i]);
       CSLDestroy(extra);
       return;
     } else if (!plan)
@@ -84,7 +84,8 @@ void tt__tiles_merge(char **argv, tt_progress_fn fn, void *arg,
   }
   if (!plan || !out) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                       "tiles merge: PLAN.json and OUT.gpkg are needed");
+                       "tiles merge: PLAN.json and OUTPUT are needed (see "
+                       "'terratin tiles merge --help')");
     CSLDestroy(extra);
     return;
   }

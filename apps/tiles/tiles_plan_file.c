@@ -255,6 +255,10 @@ static bool refuse_option(const char *who, const char *w,
     return REFUSE(res, TT_ERR_ARG, "%s: '%s' is not an option: a plan holds "
                   "-NAME [VALUE] pairs only (a word of its own would "
                   "become an input or output name)", who, w);
+  const char *near = d ? NULL : tt__app_opt_suggest(w, TT_APP_SIMPLIFY);
+  if (near)
+    return REFUSE(res, TT_ERR_ARG, "%s: unknown option '%s'; did you mean "
+                  "%s?", who, w, near);
   if (d && IN(budget_opts, d->id))
     return REFUSE(res, TT_ERR_ARG, "%s: %s is a budget: a plan needs "
                   "-tile_size N and -max_error E (each tile is simplified "
