@@ -347,6 +347,9 @@ typedef struct tt__app_command_def {
 extern const tt__app_command_def tt__app_commands[];
 /* The entry of c, or NULL (no command, help, version). */
 const tt__app_command_def *tt__app_command_def_of(tt_app_command c);
+/* Which of the run's positional words path is (1 for the first), by the
+ * dispatch table; 0 when it is none of them (study's -terrain). */
+int tt__app_arg_number(const app_run *r, const char *path);
 /* raster_output.c, for rasterize and eval -error_raster: the raster
  * driver of -of, else
  * the one path's extension names (NULL path: GTiff), that can write a

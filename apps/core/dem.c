@@ -110,9 +110,19 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
     CPLPopErrorHandler();
     if (vec) {
       GDALDriverH drv = GDALGetDatasetDriver(vec);
-      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
-               "is a vector dataset (%s), not a raster",
-               drv ? GDALGetDriverShortName(drv) : "?");
+      const char *dname = drv ? GDALGetDriverShortName(drv) : "?";
+      int k = tt__app_arg_number(r, path);
+      /* a positional word: which one, and what the command expects there
+       * (every command that reads a DEM takes it first) */
+      if (k)
+        tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, NULL,
+                     "%s: %s (argument %d) is a vector dataset (%s); the "
+                     "DEM (a raster) comes first",
+                     tt__app_command_name(r->s->command),
+                     tt__app_shown(r, path), k, dname);
+      else
+        tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+                     "is a vector dataset (%s), not a raster", dname);
       GDALClose(vec);
       return NULL;
     }

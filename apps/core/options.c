@@ -379,8 +379,8 @@ static tt_status check_rasterize(tt__app_opt_parse *p)
 {
   if (p->npos < 3)
     return OPT_USAGE(p, "rasterize: missing %s%s",
-                     p->npos == 0   ? "TIN, DEM and OUTPUT"
-                     : p->npos == 1 ? "DEM and OUTPUT"
+                     p->npos == 0   ? "DEM, TIN and OUTPUT"
+                     : p->npos == 1 ? "TIN and OUTPUT"
                                     : "OUTPUT",
                      p->hint);
   return keep_positional(p);

@@ -630,7 +630,8 @@ const tt__app_command_def tt__app_commands[] = {
     {"optimize", TT_APP_OPTIMIZE, 3, {POS(input), POS(tin), POS(output)},
      tt__app_optimize},
     {"study", TT_APP_STUDY, 1, {POS(output), NONE, NONE}, tt__app_study},
-    {"rasterize", TT_APP_RASTERIZE, 3, {POS(tin), POS(input), POS(output)},
+    /* rasterize.c also takes the old order TIN DEM OUTPUT, with a note */
+    {"rasterize", TT_APP_RASTERIZE, 3, {POS(input), POS(tin), POS(output)},
      tt__app_rasterize},
     {NULL, TT_APP_NONE, 0, {NONE, NONE, NONE}, NULL}};
 
@@ -640,6 +641,23 @@ const tt__app_command_def *tt__app_command_def_of(tt_app_command c)
     if (d->command == c)
       return d;
   return NULL;
+}
+
+int tt__app_arg_number(const app_run *r, const char *path)
+{
+  const tt__app_command_def *d = tt__app_command_def_of(r->s->command);
+  /* the setting itself first (eval a.tif a.tif: the TIN is the second),
+   * then any word spelt alike */
+  for (int same = 0; same < 2; same++)
+    for (size_t k = 0; d && path && k < d->npos; k++) {
+      if (d->pos[k] == TT_APP_POS_NONE)
+        continue;
+      const char *w =
+          *(const char *const *)((const char *)r->s + d->pos[k]);
+      if (w && (same ? strcmp(w, path) == 0 : w == path))
+        return (int)k + 1;
+    }
+  return 0;
 }
 
 tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
