@@ -484,7 +484,7 @@ static void test_real_dem(const char *shared)
   char *e[] = {"eval", "-q", dem, (char *)tin, "-error_raster", (char *)err,
                NULL};
   CHECK_INT_EQ(run(e, NULL, 0), 0);
-  char *a[] = {"rasterize", "-q", (char *)ras, dem, (char *)tin, NULL};
+  char *a[] = {"rasterize", "-q", dem, (char *)tin, (char *)ras, NULL};
   CHECK_INT_EQ(run(a, NULL, 0), 0);
   tt_eval_result ref = reference_eval(dem, tin);
   GDALDataType t;
