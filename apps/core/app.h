@@ -254,6 +254,12 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
                           double *out_max);
 const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
 const char *tt__app_nonempty_or_null(const char *s);
+/* Why the heights were converted to metres, in the command's words ("the
+ * CRS is in metres", "asked by -z_to m"); "" when they were not. */
+const char *tt__app_z_unit_why(const tt_raster_info *info);
+/* Where the heights' unit was said: "band unit", "vertical CRS",
+ * "-z_unit", or "". */
+const char *tt__app_z_unit_source(const tt_raster_info *info);
 /* "2026-11-22T10:38:55Z" */
 void tt__app_iso8601_utc(char *buf, size_t size);
 /* The engine's thread count (tt_refine_options.threads): -threads, else

@@ -256,8 +256,14 @@ char **tt__app_read_options(const tt_app_settings *s)
     tt__app_format_double(num, sizeof num, s->z_factor);
     ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
   }
+  /* -z_unit says what the heights are; -z_to whether they become metres
+   * (auto unless asked otherwise) */
   if (s->z_unit)
-    ropts = CSLSetNameValue(ropts, "Z_UNIT", s->z_unit);
+    ropts = CSLSetNameValue(ropts, "SRC_Z_UNIT", s->z_unit);
+  if (!s->z_to || strcmp(s->z_to, "auto") == 0)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", "auto");
+  else if (strcmp(s->z_to, "m") == 0)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", "m");
   if (s->work_srs)
     ropts = CSLSetNameValue(ropts, "WORK_SRS", s->work_srs);
   return ropts;

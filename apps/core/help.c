@@ -92,8 +92,8 @@ static const char help_simplify[] =
     "           [-importance degree|hdh|abh|volume|drop|error]\n"
     "           [-selection independent|sequential] [-onepass]\n"
     "           [-hole minangle|circumradius|dp]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
-    "           [-work_srs SRS] [-t_srs SRS]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
+    "           [-z_to m|native|auto] [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
     "           [-nln PREFIX] [-overwrite] [-q] [-json]\n"
     "           [-layers LIST] [-nostyle]\n"
@@ -128,12 +128,17 @@ static const char help_simplify[] =
     "                    (default: the band's nodata value and mask)\n"
     "  -z_factor F       multiply heights by F, e.g. 0.3048 for feet to\n"
     "                    metres (default 1; after the band's scale/offset)\n"
-    "  -z_unit m         heights declared in ft or us-ft (band unit, else\n"
-    "                    vertical CRS) converted to metres. Combined:\n"
-    "                    z = (raw * scale + offset) * unit factor * F; with\n"
-    "                    an unknown unit it needs -z_factor, which then is\n"
-    "                    the whole conversion. Errors and -max_error are in\n"
-    "                    the output z unit, which the summary names\n"
+    "  -z_unit U         the unit the heights are in: ft, us-ft or m (default:\n"
+    "                    the band's unit, else the vertical CRS's)\n"
+    "  -z_to MODE        auto (default): heights in ft or us-ft converted to\n"
+    "                    metres when the CRS is in metres or geographic,\n"
+    "                    kept when it is in feet or absent; m: converted\n"
+    "                    to metres whatever the CRS (an unknown unit then\n"
+    "                    needs -z_unit or -z_factor, which is then the\n"
+    "                    whole conversion); native: kept in their unit.\n"
+    "                    z = (raw * scale + offset) * unit factor * F.\n"
+    "                    Errors and -max_error are in the output z unit,\n"
+    "                    which the summary names with the reason\n"
     "  -work_srs SRS     conformal projected CRS in metres that measures\n"
     "                    angles, areas and the Delaunay test (default: a\n"
     "                    conformal frame for the extent, every sample\n"
@@ -285,7 +290,8 @@ static const char help_generate[] =
 
 static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m] [-json] [-q]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
+    "           [-z_to m|native|auto] [-json] [-q]\n"
     "           [-max_memory SIZE] [-error_raster OUT.tif [-co NAME=VALUE]...\n"
     "           [-overwrite]]\n"
     "\n"
@@ -300,7 +306,8 @@ static const char help_eval[] =
     "  -b BAND         band of DEM to read (default 1)\n"
     "  -srcnodata V    height to treat as nodata, a number or nan\n"
     "  -z_factor F     multiply heights by F (as given to simplify)\n"
-    "  -z_unit m       ft or us-ft heights to metres (as given to simplify)\n"
+    "  -z_unit U, -z_to MODE  the heights' unit, and whether they become\n"
+    "                  metres (as given to simplify)\n"
     "  -layer NAME     layer to measure (default: a layer named 'triangles'\n"
     "                  or ending in '_triangles', else the first polygon\n"
     "                  layer)\n"
@@ -329,7 +336,7 @@ static const char help_optimize[] =
     "           [-optimize local|lookahead|anneal|edge_insertion]\n"
     "           [-max_error E] [-anneal_t0 T] [-anneal_stages K]\n"
     "           [-anneal_swaps S] [-anneal_good G] [-anneal_r R] [-seed N]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit U] [-z_to MODE]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
     "           [-nln PREFIX] [-overwrite] [-q] [-json]\n"
     "\n"
@@ -352,7 +359,7 @@ static const char help_optimize[] =
     "                    the input TIN's own max error, which thus never\n"
     "                    grows)\n"
     ANNEAL_HELP
-    "  -b, -srcnodata, -z_factor, -z_unit   as simplify\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -z_to   as simplify\n"
     "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
     "\n"
     "Exit codes: 0 success, 1 processing failure, 2 usage error, 128+N\n"
@@ -370,7 +377,8 @@ static const char help_study[] =
     "           [-percent P,P,...] [-start all|greedy|greedy:N]\n"
     "           [-points N]\n"
     "           [-importance NAME] [-b BAND] [-srcnodata VALUE]\n"
-    "           [-z_factor F] [-z_unit m] [-threads N] [-overwrite] [-q]\n"
+    "           [-z_factor F] [-z_unit U] [-z_to MODE] [-threads N]\n"
+    "           [-overwrite] [-q]\n"
     "           [-tin_points N] [-plot]\n"
     "\n"
     "Runs every terrain x method x optimiser x checkpoint x criterion as\n"
@@ -420,7 +428,7 @@ static const char help_study[] =
     "                    study's 500), per round for decimation; alone, no\n"
     "                    -percent checkpoints\n"
     "  -start, -importance   decimation's, as simplify\n"
-    "  -b, -srcnodata, -z_factor, -z_unit, -threads   as simplify\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -z_to, -threads   as simplify\n"
     "  -overwrite        write into an OUTDIR that is not empty\n"
     "  -tin_points N     also each criterion's TIN at N points (a run of\n"
     "                    its own) into OUTDIR/tins: OBJ in pixel space,\n"
@@ -441,8 +449,8 @@ static const char help_study[] =
     "      delaunay,minmax_angle,l2 -methods insert,decimate out/\n";
 
 static const char help_rasterize[] =
-    "Usage: terratin rasterize TIN DEM OUTPUT [-layer NAME] [-b BAND]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "Usage: terratin rasterize DEM TIN OUTPUT [-layer NAME] [-b BAND]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit U] [-z_to MODE]\n"
     "           [-of FORMAT] [-co NAME=VALUE]... [-max_memory SIZE]\n"
     "           [-overwrite] [-q] [-json]\n"
     "\n"
@@ -458,7 +466,8 @@ static const char help_rasterize[] =
     "  -of FORMAT        a GDAL raster driver (default: the one OUTPUT's\n"
     "                    extension names, else GTiff: tiled, DEFLATE)\n"
     "  -co NAME=VALUE    creation option of the driver (repeatable)\n"
-    "  -b, -srcnodata, -z_factor, -z_unit, -max_memory   the DEM, as eval\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -z_to, -max_memory   the DEM,\n"
+    "                    as eval\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
     "  -q, -json         no summary; one JSON object instead of the summary\n"
     "\n"
@@ -466,7 +475,7 @@ static const char help_rasterize[] =
     "stopped by signal N (130 Ctrl-C, 143 SIGTERM; nothing left behind).\n"
     "\n"
     "Example:\n"
-    "  terratin rasterize tin.gpkg dem.tif tin.tif\n"
+    "  terratin rasterize dem.tif tin.gpkg tin.tif\n"
     "  terratin eval dem.tif tin.gpkg -error_raster diff.tif  (TIN - DEM)\n";
 
 /* The tiles commands: the overview and a page per subcommand. */
@@ -482,9 +491,9 @@ static const char help_rasterize[] =
   "A plan carries the options that shape the TIN only: -max_error,\n"         \
   "-tile_size, -method, -start, -importance, -selection, -onepass, -hole,\n"  \
   "-criterion, -repair, -optimize, -seed, -anneal_*, -b, -srcnodata,\n"       \
-  "-z_factor, -z_unit, -work_srs AUTHORITY:CODE. The output's options\n"      \
-  "(-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs) go to\n"   \
-  "merge. run and merge refuse a plan that is truncated, edited (its\n"       \
+  "-z_factor, -z_unit, -z_to, -work_srs AUTHORITY:CODE. The output's\n"      \
+  "options (-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs)\n" \
+  "go to merge. run and merge refuse a plan that is truncated, edited (its\n"       \
   "checksum), or whose fields or options are not what plan writes.\n"
 
 #define TILES_EXIT                                                           \

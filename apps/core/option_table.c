@@ -21,6 +21,26 @@ _Static_assert(2 * TT_MAX_VERTICES == 2147483646,
 
 /* --- the names, as the engine (or the table) knows them ------------------ */
 
+/* Whether the value w is the name: case-insensitive, '-' as '_'. */
+static int name_matches_word(const char *w, const char *name)
+{
+  for (;; w++, name++) {
+    char a = *w, b = *name;
+    if (a >= 'A' && a <= 'Z')
+      a = (char)(a - 'A' + 'a');
+    if (b >= 'A' && b <= 'Z')
+      b = (char)(b - 'A' + 'a');
+    if (a == '-')
+      a = '_';
+    if (b == '-')
+      b = '_';
+    if (a != b)
+      return 0;
+    if (!a)
+      return 1;
+  }
+}
+
 static int name_criterion(tt_context *ctx, const char *w, void *out)
 {
   return tt_criterion_parse(ctx, w, out) == TT_OK;
@@ -87,14 +107,30 @@ static int name_seeding(tt_context *ctx, const char *w, void *out)
   return 0;
 }
 
-/* -z_unit: metres, the one unit heights are converted to. */
+/* -z_unit: the unit the heights are in. */
 static int name_z_unit(tt_context *ctx, const char *w, void *out)
 {
+  static const char *const units[] = {"m", "ft", "us-ft"};
   (void)ctx;
-  if (!tt__app_str_ieq(w, "m"))
-    return 0;
-  *(const char **)out = "m";
-  return 1;
+  for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+    if (name_matches_word(w, units[i])) {
+      *(const char **)out = units[i];
+      return 1;
+    }
+  return 0;
+}
+
+/* -z_to: whether the heights are converted to metres. */
+static int name_z_to(tt_context *ctx, const char *w, void *out)
+{
+  static const char *const modes[] = {"m", "native", "auto"};
+  (void)ctx;
+  for (size_t i = 0; i < sizeof modes / sizeof modes[0]; i++)
+    if (tt__app_str_ieq(w, modes[i])) {
+      *(const char **)out = modes[i];
+      return 1;
+    }
+  return 0;
 }
 
 /* --- the values that fit no kind (OPT_OWN) ------------------------------- */
@@ -187,7 +223,11 @@ static const tt__app_opt_def opt_defs[] = {
      .bad = "must be a finite non-zero number"},
     {"-z_unit", O_Z_UNIT, DEM_READERS, OPT_NAME, AT(s.z_unit),
      .name_fn = name_z_unit,
-     .bad = "must be m (heights in ft or us-ft converted to metres)"},
+     .bad = "must be ft, us-ft or m (the unit the heights are in; -z_to m "
+            "converts them to metres)"},
+    {"-z_to", O_Z_TO, DEM_READERS, OPT_NAME, AT(s.z_to), .name_fn = name_z_to,
+     .bad = "must be m (heights converted to metres), native (kept in their "
+            "unit) or auto (metres when the CRS is in metres or geographic)"},
     {"-work_srs", O_WORK_SRS, FOR_S, OPT_TEXT, AT(s.work_srs),
      .need = CRS_NEEDED},
     {"-t_srs", O_T_SRS, FOR_S, OPT_TEXT, AT(s.t_srs), .need = CRS_NEEDED},

@@ -251,7 +251,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_str(&j, "z_unit_declared",
                tt__app_nonempty_or_null(p->info->z_unit_declared));
   tt__json_str(&j, "z_unit_source",
-               tt__app_nonempty_or_null(p->info->z_unit_source));
+               tt__app_nonempty_or_null(tt__app_z_unit_source(p->info)));
+  tt__json_str(&j, "z_unit_conversion",
+               tt__app_nonempty_or_null(tt__app_z_unit_why(p->info)));
   tt__json_num(&j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
   tt__json_str(&j, "pixel_is",
                tt__app_nonempty_or_null(p->info->area_or_point));
@@ -311,12 +313,13 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
   }
   /* Where the numbers stand: CRS, working frame, height unit. */
   const tt_raster_info *in = p->info;
-  char zu[160];
+  char zu[200];
   if (in->z_unit_factor != 1.0)
-    snprintf(zu, sizeof zu, "%s (from %s, x%.10g)", unit,
-             in->z_unit_declared, in->z_unit_factor);
+    snprintf(zu, sizeof zu, "%s (from %s, %s, x%.10g: %s)", unit,
+             in->z_unit_declared, tt__app_z_unit_source(in),
+             in->z_unit_factor, tt__app_z_unit_why(in));
   else if (in->z_unit && *in->z_unit)
-    snprintf(zu, sizeof zu, "%s (%s)", unit, in->z_unit_source);
+    snprintf(zu, sizeof zu, "%s (%s)", unit, tt__app_z_unit_source(in));
   else
     snprintf(zu, sizeof zu, "unknown");
   const char *shown = tt__app_shown(r, r->s->output);

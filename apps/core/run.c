@@ -410,6 +410,20 @@ const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt)
   return info && info->z_unit && *info->z_unit ? info->z_unit : dflt;
 }
 
+const char *tt__app_z_unit_why(const tt_raster_info *info)
+{
+  const char *why = info ? info->z_unit_why : NULL;
+  if (!why || !*why)
+    return "";
+  return strcmp(why, "asked") == 0 ? "asked by -z_to m" : why;
+}
+
+const char *tt__app_z_unit_source(const tt_raster_info *info)
+{
+  const char *src = info && info->z_unit_source ? info->z_unit_source : "";
+  return strcmp(src, "given") == 0 ? "-z_unit" : src;
+}
+
 const char *tt__app_nonempty_or_null(const char *s)
 {
   return s && *s ? s : NULL;

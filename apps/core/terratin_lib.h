@@ -102,7 +102,12 @@ typedef struct tt_app_settings {
                                 band's own mask (simplify, eval) */
   double z_factor;           /* -z_factor; default 1 (simplify, eval) */
   int z_factor_set;          /* -z_factor was given */
-  const char *z_unit;        /* -z_unit: "m" or NULL (simplify, eval) */
+  const char *z_unit;        /* -z_unit: the heights' unit, "m", "ft" or
+                                "us-ft"; NULL: as the file says */
+  const char *z_to;          /* -z_to: "m" (convert to metres), "native"
+                                (keep the unit) or "auto" (metres when the
+                                CRS is in metres or geographic); NULL:
+                                auto */
   const char *work_srs;      /* -work_srs: the working CRS; NULL: chosen
                                 from the DEM's CRS (simplify) */
   const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the

@@ -202,7 +202,7 @@ static const enum opt_id plan_opts[] = {
     O_MAX_ERROR, O_TILE_SIZE, O_METHOD, O_START, O_IMPORTANCE, O_SELECTION,
     O_ONEPASS, O_HOLE, O_CRITERION, O_REPAIR, O_OPTIMIZE, O_SEED,
     O_ANNEAL_T0, O_ANNEAL_STAGES, O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R,
-    O_B, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS};
+    O_B, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT, O_Z_TO, O_WORK_SRS};
 /* The output's: `tiles merge` takes them from its own command line. */
 static const enum opt_id output_opts[] = {
     O_OF, O_LCO, O_DSCO, O_NLN, O_LAYERS, O_NOSTYLE, O_OBJ_LOCAL, O_T_SRS};

@@ -528,12 +528,13 @@ assert 700000 < x0 < 800000, eu'
   expect_failure "-work_srs geographic" 2 out simplify -work_srs EPSG:4326 "$J" out/x.gpkg
   expect_failure "-work_srs garbage" 2 out simplify -work_srs NOT_A_CRS "$J" out/x.gpkg
   expect_failure "-t_srs garbage" 2 out simplify -t_srs NOT_A_CRS "$J" out/x.gpkg
-  expect_failure "-z_unit ft" 2 out simplify -z_unit ft "$J" out/x.gpkg
+  expect_failure "-z_unit cm" 2 out simplify -z_unit cm "$J" out/x.gpkg
 fi
-expect_failure "-z_unit m, unknown unit" 1 out simplify -z_unit m in/fault.tif out/x.gpkg
-check "-z_unit m, unknown unit: says -z_factor" grep -q -- "-z_factor" err.txt
-run simplify -q -z_unit m -z_factor 0.5 in/fault.tif out/zf.gpkg
-check "-z_unit m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+expect_failure "-z_to m, unknown unit" 1 out simplify -z_to m in/fault.tif out/x.gpkg
+check "-z_to m, unknown unit: says -z_unit and -z_factor" \
+  grep -q -- "-z_unit ft|us-ft|m.*-z_factor" err.txt
+run simplify -q -z_to m -z_factor 0.5 in/fault.tif out/zf.gpkg
+check "-z_to m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 rm -f out/*
 expect_failure "-max_points 0" 2 out simplify -max_points 0 in/fault.tif out/x.gpkg
 expect_failure "-max_triangles 0" 2 out simplify -max_triangles 0 in/fault.tif out/x.gpkg

@@ -563,7 +563,7 @@ static void test_feet(const char *path)
   }
 
   /* The command: the summary names m, the CRS, the frame, valid samples. */
-  char *argv[] = {"simplify", "-z_unit", "m", "-max_error", "1",
+  char *argv[] = {"simplify", "-z_to", "m", "-max_error", "1",
                   (char *)path, (char *)tmp_path("sf.gpkg"), "-overwrite",
                   NULL};
   tt_app_options *opts = NULL;
@@ -582,7 +582,8 @@ static void test_feet(const char *path)
     CHECK(strstr(line, "valid samples") != NULL);
     CHECK(strstr(line, "CRS unnamed (like EPSG:26710)") != NULL);
     CHECK(strstr(line, "frame geotransform") != NULL);
-    CHECK(strstr(line, "z unit m (from ft, x0.3048)") != NULL);
+    CHECK(strstr(line, "z unit m (from ft, band unit, x0.3048: asked by "
+                 "-z_to m)") != NULL);
   }
   if (out)
     fclose(out);
