@@ -477,8 +477,14 @@ assert d["uncovered"] == lone, (d, lone)
 assert d["covered"] + lone == d["valid_samples"] > 0, d' "${lone:-x}" <out.txt
 done
 if [ -n "$S" ] && [ -f "$S/usgs_dem_san_francisco/sanfranciscos.dem" ]; then
+  # heights in ft on a UTM grid: metres by default (-z_to auto), feet kept
+  # with -z_to native
   run simplify -max_points 500 "$S/usgs_dem_san_francisco/sanfranciscos.dem" \
-    real_ft.gpkg
+    real_m.gpkg
+  check "the summary carries the z unit (m, from ft: the CRS is in metres)" \
+    grep -q "max error .* m, RMS .* m;.*z unit m (from ft, band unit, x0.3048: the CRS is in metres)" out.txt
+  run simplify -z_to native -max_points 500 \
+    "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_ft.gpkg
   check "the summary carries the z unit (ft)" grep -q "max error .* ft, RMS .* ft" out.txt
 fi
 
