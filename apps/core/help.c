@@ -500,7 +500,8 @@ static const char help_rasterize[] =
   "\n"                                                                        \
   "Exit codes: 0 success, 1 processing failure (a missing or stale piece,\n"  \
   "a changed DEM), 2 usage error (an option a plan may not carry, a bad\n"    \
-  "plan), 128+N stopped by signal N (nothing left behind).\n"
+  "plan), 128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM; nothing left\n" \
+  "behind).\n"
 
 static const char help_tiles[] =
     TILES_USAGE

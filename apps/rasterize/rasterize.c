@@ -46,14 +46,15 @@ static int opens_as(app_run *r, const char *path, unsigned kind)
 /* The old order, TIN DEM OUTPUT, is still taken: when the first word is
  * no raster but a vector dataset and the second a raster, the two are
  * swapped (in *swapped, which r->s then points to) with a one-line note
- * on stderr. */
-static void take_old_order(app_run *r, tt_app_settings *swapped)
+ * on stderr. Returns the run's settings (r->s). */
+static const tt_app_settings *take_old_order(app_run *r,
+                                             tt_app_settings *swapped)
 {
   const tt_app_settings *s = r->s;
   if (opens_as(r, s->input, GDAL_OF_RASTER) ||
       !opens_as(r, s->input, GDAL_OF_VECTOR) ||
       !opens_as(r, s->tin, GDAL_OF_RASTER))
-    return;
+    return r->s;
   *swapped = *s;
   swapped->input = s->tin;
   swapped->tin = s->input;
@@ -64,13 +65,13 @@ static void take_old_order(app_run *r, tt_app_settings *swapped)
           "'terratin rasterize %s %s %s'\n", tt__app_shown(r, s->tin),
           tt__app_shown(r, s->input), tt__app_shown(r, s->output));
   fflush(r->err);
+  return r->s;
 }
 
 tt_status tt__app_rasterize(app_run *r)
 {
   tt_app_settings swapped;
-  take_old_order(r, &swapped);
-  const tt_app_settings *s = r->s;
+  const tt_app_settings *s = take_old_order(r, &swapped);
   tt_status st = TT_OK;
   tt_output *outp = NULL;
   GDALDatasetH tds = NULL;
