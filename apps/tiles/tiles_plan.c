@@ -157,6 +157,19 @@ static bool open_dem(plan_job *j, tt_app_result *res)
   }
   j->ds = GDALOpenEx(j->p.dem, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL,
                      NULL, NULL);
+  GDALDatasetH vec = j->ds ? NULL
+                           : GDALOpenEx(j->p.dem,
+                                        GDAL_OF_VECTOR | GDAL_OF_READONLY,
+                                        NULL, NULL, NULL);
+  if (vec) { /* the words swapped, or a TIN for the DEM */
+    GDALDriverH drv = GDALGetDatasetDriver(vec);
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT,
+                       "tiles plan: %s (argument 1) is a vector dataset "
+                       "(%s); the DEM (a raster) comes first", j->dem,
+                       drv ? GDALGetDriverShortName(drv) : "?");
+    GDALClose(vec);
+    return false;
+  }
   if (!j->ds || s->band > GDALGetRasterCount(j->ds)) {
     tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
                        "%s: %s", j->dem, j->ds ? "no such band (-b)"

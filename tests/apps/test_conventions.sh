@@ -165,6 +165,10 @@ for c in "eval tin.gpkg dem.tif" "optimize tin.gpkg dem.tif o.gpkg" \
   check "$c: names argument 1 ($(cat err.txt))" grep -qF \
     "terratin: $cmd: tin.gpkg (argument 1) is a vector dataset (GPKG); the DEM (a raster) comes first" err.txt
 done
+run tiles plan tin.gpkg p.json -max_error 1 -tile_size 16
+check "tiles plan TIN: names argument 1 ($(cat err.txt))" grep -qF \
+  "terratin: tiles plan: tin.gpkg (argument 1) is a vector dataset (GPKG); the DEM (a raster) comes first" err.txt
+check "tiles plan TIN: no plan written" test ! -e p.json
 run eval dem.tif dem.tif
 check "eval DEM DEM: names argument 2 ($(cat err.txt))" grep -qF \
   "terratin: eval: dem.tif (argument 2) is a raster; the TIN (a vector dataset of triangles) comes after the DEM" err.txt
