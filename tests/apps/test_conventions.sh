@@ -85,7 +85,15 @@ run simplify -q -max_error 1 -z-factor 2 dem.tif z2.gpkg
 check "-z-factor: exit 0 ($(cat err.txt))" test "$rc" -eq 0
 
 # --- --formats, --help-general ------------------------------------------
-run --formats
+# --formats reads back a dry run of every driver; GDAL 3.6's JML reader
+# leaks its expat parser (as `simplify -of JML` does under ASan): leaks
+# are not ours to see in these two runs, every other error still is.
+formats() {
+  ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 "$T" "$@" \
+    >out.txt 2>err.txt
+  rc=$?
+}
+formats --formats
 check "--formats: exit 0" test "$rc" -eq 0
 check "--formats: GPKG, all layers" grep -qE '^  GPKG +GeoPackage.*: all layers' out.txt
 check "--formats: ESRI Shapefile, all layers" \
@@ -98,7 +106,7 @@ check "--formats: PostgreSQL among the databases" \
 for m in 2DM PLY OBJ LandXML DXF UGRID; do
   check "--formats: mesh format $m" grep -qE "^  $m " out.txt
 done
-run --config GDAL_SKIP GeoJSON --formats
+formats --config GDAL_SKIP GeoJSON --formats
 check "--formats after --config GDAL_SKIP GeoJSON: no GeoJSON" \
   bash -c '! grep -qE "^  GeoJSON " out.txt && grep -qE "^  GPKG " out.txt'
 # every OGR driver listed is one a run writes: GeoJSON's one layer, as listed
