@@ -18,7 +18,8 @@
   "                      opened (repeatable; KEY=VALUE also accepted)\n"     \
   "  --debug on|off      GDAL debug messages on stderr (CPL_DEBUG; also\n"   \
   "                      yes|no|true|false|1|0)\n"                           \
-  "  -q, -quiet          no progress bar, no summary line (every command)\n"
+  "  -q, -quiet          no progress bar, no summary line (every command but\n" \
+  "                      tiles run, which prints nothing)\n"
 
 static const char help_general[] =
     "Generic terratin options (every command takes them, before or after\n"
