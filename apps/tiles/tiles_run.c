@@ -8,6 +8,7 @@
  * piece is whole or absent.
  */
 #include "tiles.h"
+#include "option_table.h"
 
 #include <cpl_conv.h>
 #include <cpl_string.h>
@@ -68,7 +69,14 @@ void tt__tiles_run(char **argv, tt_progress_fn fn, void *arg,
   for (size_t i = 0; argv[i]; i++) {
     if (tt__app_str_ieq(argv[i], "-overwrite"))
       a.overwrite = 1;
-    else if (argv[i][0] == '-' && argv[i][1]) {
+    else if (argv[i][0] == '-' && argv[i][1] &&
+             tt__app_edit_distance(argv[i], "-overwrite") <= 2) {
+      tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                         "tiles run: unknown option '%s'; did you mean "
+                         "-overwrite? (see 'terratin tiles run --help')",
+                         argv[i]);
+      return;
+    } else if (argv[i][0] == '-' && argv[i][1]) {
       tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                          "tiles run: unknown option %s (see 'terratin "
                          "tiles run --help': -overwrite only)", argv[i]);

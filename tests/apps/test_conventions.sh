@@ -2,8 +2,8 @@
 # test_conventions.sh -- the command's messages and GDAL's conventions
 # (issue 27), through the terratin command ($TT_TERRATIN):
 #  - a mistyped option gets "did you mean" the nearest option of that
-#    command (-max_eror, -maxerror, -max-eror), and only of that command;
-#    a mistyped command the nearest command;
+#    command (-max_eror, -maxerror, -max-eror), and only of that command
+#    (tiles plan, run and merge too); a mistyped command the nearest one;
 #  - '-' matches '_' in option names: -max-error is -max_error (same TIN);
 #  - --formats lists GPKG, ESRI Shapefile (all layers), GeoJSON (one
 #    layer), leaves CSV out, lists the mesh formats, and sees --config
@@ -73,6 +73,11 @@ usage "simplfy" "unknown command 'simplfy'; did you mean simplify?" simplfy a b
 usage "rasterise" "did you mean rasterize?" rasterise a b c
 usage "tiles plan -max_eror" "unknown option '-max_eror'; did you mean -max_error?" \
   tiles plan dem.tif p.json -max_eror 1 -tile_size 16
+usage "tiles merge -overwrit" "did you mean -overwrite?" \
+  tiles merge p.json o.gpkg -overwrit
+usage "tiles merge -max_eror: not merge's" "unknown option -max_eror (see" \
+  tiles merge p.json o.gpkg -max_eror 1
+usage "tiles run -overwrit" "did you mean -overwrite?" tiles run p.json 0 -overwrit
 
 # --- '-' for '_' ----------------------------------------------------------
 run simplify -json -max_error 1 dem.tif u.gpkg
