@@ -479,10 +479,14 @@ done
 if [ -n "$S" ] && [ -f "$S/usgs_dem_san_francisco/sanfranciscos.dem" ]; then
   # heights in ft on a UTM grid: metres by default (-z_to auto), feet kept
   # with -z_to native
-  run simplify -max_points 500 "$S/usgs_dem_san_francisco/sanfranciscos.dem" \
-    real_m.gpkg
-  check "the summary carries the z unit (m, from ft: the CRS is in metres)" \
-    grep -q "max error .* m, RMS .* m;.*z unit m (from ft, band unit, x0.3048: the CRS is in metres)" out.txt
+  run simplify -json -max_points 500 \
+    "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_m.gpkg
+  check "ft heights on UTM: metres, because the CRS is in metres" python3 -c '
+import json
+d = json.load(open("out.txt"))
+assert d["z_unit"] == "m" and d["z_unit_declared"] == "ft", d
+assert d["z_unit_conversion"] == "the CRS is in metres", d
+assert abs(d["z_multiplier"] - 0.3048) < 1e-15, d'
   run simplify -z_to native -max_points 500 \
     "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_ft.gpkg
   check "the summary carries the z unit (ft)" grep -q "max error .* ft, RMS .* ft" out.txt

@@ -199,13 +199,15 @@ print(max(float(v) for l in sys.stdin if l.strip()[:1] in "-0123456789" for v in
 gdal_translate -q -of VRT dem.tif ft.vrt || exit 1
 sed -i 's|\(<VRTRasterBand[^>]*>\)|\1<UnitType>ft</UnitType>|' ft.vrt
 gdal_translate -q -of VRT -a_srs EPSG:2263 dem.tif ftcrs.vrt || exit 1
-# zrun WHAT EXPECTED_FACTOR UNIT_WORDS ARGS...: max z = raw x factor, and the
-# summary's z unit says UNIT_WORDS
+"$T" generate fault geo.tif -size 40x30 -seed 3 -a_srs EPSG:4326 -q || exit 1
+# zrun WHAT FACTOR UNIT SOURCE WHY ARGS...: max z = raw x FACTOR, and -json
+# says z_unit UNIT, z_unit_source SOURCE and z_unit_conversion WHY ("" for
+# none: null)
 zrun() {
-  local what=$1 factor=$2 words=$3
-  shift 3
+  local what=$1 factor=$2 unit=$3 source=$4 why=$5
+  shift 5
   rm -f z.obj
-  run simplify -max_error 0 -of OBJ "$@" z.obj
+  run simplify -json -max_error 0 -of OBJ "$@" z.obj
   check "$what: exit 0 ($(cat err.txt))" test "$rc" -eq 0
   local z
   z=$(max_z z.obj 2>/dev/null)
@@ -213,18 +215,28 @@ zrun() {
 import sys
 z, raw, f = map(float, sys.argv[1:])
 assert abs(z - raw * f) <= 1e-6 * max(1, abs(z)), (z, raw * f)' "${z:-nan}" "$raw" "$factor"
-  check "$what: summary 'z unit $words'" grep -qF "z unit $words" out.txt
+  check "$what: -json z_unit $unit, source '$source', why '$why'" python3 -c '
+import json, sys
+d = json.load(open("out.txt"))
+unit, source, why = sys.argv[1:]
+got = (d["z_unit"], d["z_unit_source"], d["z_unit_conversion"])
+assert got == (unit or None, source or None, why or None), got' \
+    "$unit" "$source" "$why"
 }
-zrun "band ft, UTM: metres by default" 0.3048 \
-  "m (from ft, band unit, x0.3048: the CRS is in metres)" ft.vrt
-zrun "band ft, UTM, -z_to native: ft kept" 1 "ft (band unit)" -z_to native ft.vrt
-zrun "band ft, -z_unit m: the heights are metres" 1 "m (-z_unit)" -z_unit m ft.vrt
-zrun "no unit, UTM, -z_unit us-ft" 0.3048006096 \
-  "m (from us-ft, -z_unit, x0.3048006096: the CRS is in metres)" -z_unit us-ft dem.tif
-zrun "no unit, UTM: unknown, kept" 1 "unknown" dem.tif
-zrun "state plane in ft, -z_unit ft: kept in ft" 1 "ft (-z_unit)" -z_unit ft ftcrs.vrt
-zrun "state plane in ft, -z_unit ft -z_to m: converted" 0.3048 \
-  "m (from ft, -z_unit, x0.3048: asked by -z_to m)" -z_unit ft -z_to m ftcrs.vrt
+zrun "band ft, UTM: metres by default" 0.3048 m "band unit" \
+  "the CRS is in metres" ft.vrt
+zrun "band ft, UTM, -z_to native: ft kept" 1 ft "band unit" "" -z_to native ft.vrt
+zrun "band ft, -z_unit m: the heights are metres" 1 m -z_unit "" -z_unit m ft.vrt
+zrun "no unit, UTM, -z_unit us-ft" 0.3048006096 m -z_unit \
+  "the CRS is in metres" -z_unit us-ft dem.tif
+zrun "no unit, UTM: unknown, kept" 1 "" "" "" dem.tif
+zrun "state plane in ft, -z_unit ft: kept in ft" 1 ft -z_unit "" -z_unit ft ftcrs.vrt
+zrun "state plane in ft, -z_unit ft -z_to m: converted" 0.3048 m -z_unit \
+  "asked by -z_to m" -z_unit ft -z_to m ftcrs.vrt
+zrun "geographic, -z_unit ft: converted" 0.3048 m -z_unit \
+  "the CRS is geographic" -z_unit ft geo.tif
+run simplify -max_error 0 -z_unit ft ft.vrt zs.gpkg
+check "the summary says why (-z_unit ft on UTM)" grep -q "the CRS is in metres" out.txt
 run simplify -q -json -max_error 0 -z_unit ft dem.tif zj.gpkg
 check "-json says why: z_unit_conversion" python3 -c '
 import json
