@@ -287,6 +287,8 @@ void tt__json_size(app_json *j, const char *key, size_t v);
 void tt__json_i64(app_json *j, const char *key, int64_t v);
 void tt__json_bool(app_json *j, const char *key, int v);
 void tt__json_null(app_json *j, const char *key);
+/* A list of strings (NULL-terminated; NULL: an empty list). */
+void tt__json_strs(app_json *j, const char *key, char *const *v);
 
 /* What simplify reports, as text or JSON (report.c). */
 typedef struct app_simplify_report {
@@ -296,7 +298,9 @@ typedef struct app_simplify_report {
   double zmin, zmax;
   const tt_refine_options *ropt;  /* the limits, for either method */
   const tt_decimate_options *dopt; /* -method decimate; else NULL */
-  int default_error;            /* max_error came from the 0.5% rule */
+  int default_error;            /* max_error is the default: twice the
+                                   mean step */
+  double step;                  /* the DEM's mean step, when default */
   tt_tin_summary sum;
   double t_read, t_simplify, t_write, t_total;
   /* tiled runs (tiled.c): the tiles, their size, the threads, whether
@@ -309,6 +313,9 @@ typedef struct app_simplify_report {
    * only (GPX: EPSG:4326, chosen by the dry run); NULL: the DEM's */
   const char *t_srs;
   int t_srs_auto;     /* t_srs was chosen for the format, not given */
+  /* what was written, as the user names it (tt__app_output_names): the
+   * files, and the layers of a dataset of several (else NULL) */
+  char **files, **layers;
 } app_simplify_report;
 
 /* --- the subcommands ----------------------------------------------------- */

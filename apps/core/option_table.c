@@ -157,6 +157,7 @@ static const tt__app_opt_def opt_defs[] = {
      .name_fn = name_repair,
      .known = "flip, local, lookahead, delaunay, auto"},
     {"-json", O_JSON, FOR_S | FOR_E | FOR_O | FOR_R, OPT_FLAG, AT(s.json)},
+    {"-verbose", O_VERBOSE, FOR_S, OPT_FLAG, AT(s.verbose)},
     {"-layer", O_LAYER, FOR_E | FOR_O | FOR_R, OPT_TEXT, AT(s.layer),
      .need = "needs a layer name"},
     {"-size", O_SIZE, FOR_G, OPT_OWN, .to = TO_SYNTH, .at = 0, /* nx, ny */

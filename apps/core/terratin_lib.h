@@ -87,6 +87,7 @@ typedef struct tt_app_settings {
   const char *const *config; /* --config pairs: KEY, VALUE, KEY, VALUE, NULL */
   int quiet;                 /* -q */
   int json;                  /* -json (simplify, eval) */
+  int verbose;               /* -verbose: the whole summary (simplify) */
   int overwrite;             /* -overwrite (simplify, generate) */
 
   /* simplify INPUT OUTPUT; eval INPUT TIN; generate TYPE OUTPUT */

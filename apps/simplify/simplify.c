@@ -18,6 +18,8 @@
  */
 #include "simplify.h"
 
+#include <cpl_string.h>
+
 #include <string.h>
 
 /* The DEM opened (its band checked), and every file it is read from (the
@@ -119,8 +121,7 @@ static tt_status run_tiled(app_simplify_job *job)
   return TT_OK;
 }
 
-/* The whole DEM read into a grid (0 - 10 %), for the default bound its
- * height range. */
+/* The whole DEM read into a grid (0 - 10 %), and its height range. */
 static tt_status read_whole(app_simplify_job *job)
 {
   app_run *r = job->r;
@@ -152,8 +153,11 @@ static tt_status run_whole(app_simplify_job *job)
   tt_status st = read_whole(job);
   if (st != TT_OK)
     return st;
-  if (tt__app_job_default_wanted(job))
-    tt__app_job_default_bound(job, rep->zmin, rep->zmax);
+  if (tt__app_job_default_wanted(job)) {
+    app_step step = {0};
+    tt__app_step_of_grid(&step, job->grid);
+    tt__app_job_default_bound(job, &step);
+  }
   tt__app_phase_set(&r->prog, 0.10, 0.85);
   rep->ropt = &job->ro;
   if (job->decimate)
@@ -180,14 +184,19 @@ static tt_status run_whole(app_simplify_job *job)
   return TT_OK;
 }
 
-static void report(const app_simplify_job *job)
+static void report(app_simplify_job *job)
 {
   app_run *r = job->r;
+  app_simplify_report *rep = &job->rep;
+  tt__app_output_names(job, &rep->files, &rep->layers);
   if (job->s->json)
-    tt__app_print_simplify_json(r, &job->rep);
+    tt__app_print_simplify_json(r, rep);
   else if (!job->s->quiet)
-    tt__app_print_simplify_summary(r, &job->rep);
+    tt__app_print_simplify_summary(r, rep);
   fflush(r->out);
+  CSLDestroy(rep->files);
+  CSLDestroy(rep->layers);
+  rep->files = rep->layers = NULL;
 }
 
 tt_status tt__app_simplify(app_run *r)

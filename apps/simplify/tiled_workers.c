@@ -148,6 +148,12 @@ void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
     T->zmin[k] = lo;
     T->zmax[k] = hi;
     T->valid[k] = n;
+    /* the pairs whose first sample the tile owns (its last column and row
+     * are the next tile's, but for the DEM's own last ones) */
+    size_t x1 = t.col1 - (t.col1 + 1 < t.dem_width);
+    size_t y1 = t.row1 - (t.row1 + 1 < t.dem_height);
+    tt__app_step_add(&T->steps[k], win, t.col0 - c0, t.row0 - r0, x1 - c0,
+                     y1 - r0, t.col1 - c0, t.row1 - r0);
   } else if (st == TT_OK && T->curve_pass) {
     /* a budget's first pass: the tile's curve, its valid samples */
     size_t cells = (t.col1 - t.col0 + 1) * (t.row1 - t.row0 + 1);
