@@ -366,6 +366,9 @@ static void say_output(app_run *r, const app_simplify_report *p)
                           : 0.0;
   fprintf(r->out, ": %zu vertices (%.2g%% of the valid samples), %zu "
           "triangles", p->sum.vertices, share, p->sum.triangles);
+  /* nodata splits the TIN: the parts that share no edge */
+  if (p->sum.components > 1)
+    fprintf(r->out, " in %zu components", p->sum.components);
   if (p->t_srs)
     fprintf(r->out, ", in %s%s", p->t_srs,
             p->t_srs_auto ? " (the only CRS the format holds)" : "");
@@ -448,9 +451,6 @@ static void say_details(app_run *r, const app_simplify_report *p)
   else if (in->z_unit_source && *in->z_unit_source)
     fprintf(o, " (the unit from the %s)", in->z_unit_source);
   fputc('\n', o);
-  if (p->sum.components > 1)
-    fprintf(o, "components: %zu (parts of the TIN that share no edge)\n",
-            p->sum.components);
   if (p->tiles) {
     fprintf(o, "tiles:  %zu tiles of %zu cells on %d thread%s%s; the tiles "
             "in flight hold at most about %.0f MiB\n", p->tiles,

@@ -385,11 +385,11 @@ static void test_help_and_version(void)
   const char *ev = tt_app_help(TT_APP_EVAL);
   CHECK(strstr(top, "Exit codes") && strstr(top, "  3  eval"));
   CHECK(strstr(top, "--config KEY VALUE") && strstr(top, "--version"));
-  CHECK(strstr(sim, "0.5% of the DEM's valid") != NULL);
+  CHECK(strstr(sim, "twice the DEM's mean step") != NULL);
   static const char *const simplify_opts[] = {
       "-b ", "-max_error", "-max_points", "-max_triangles", "-percent",
       "-of ", "-lco", "-dsco", "-nln", "-overwrite", "-q ", "-criterion",
-      "-repair", "-optimize", "-json", "Exit codes"};
+      "-repair", "-optimize", "-json", "-verbose", "Exit codes"};
   for (size_t i = 0; i < sizeof simplify_opts / sizeof *simplify_opts; i++)
     if (!strstr(sim, simplify_opts[i]))
       TT_FAIL_("simplify help lacks %s", simplify_opts[i]);
