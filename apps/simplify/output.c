@@ -196,22 +196,34 @@ static char **layer_names(const app_simplify_job *job, const char *prefix,
   return out;
 }
 
+/* name added to list as messages show it: any password in it masked (a
+ * file named like a connection string, and the names made from it) */
+static char **add_shown(char **list, const app_run *r, const char *name)
+{
+  char buf[TT_APP_MESSAGE_MAX];
+  return CSLAddString(list, tt__app_secrets_mask(&r->msg.secrets,
+                                                 tt__app_shown(r, name), buf,
+                                                 sizeof buf));
+}
+
 void tt__app_output_names(const app_simplify_job *job, char ***out_files,
                           char ***out_layers)
 {
   const tt_app_settings *s = job->s;
   char **files = NULL, **layers = NULL;
+  /* the names as every message shows them: a password never */
+  app_run *r = job->r;
   if (job->kind == APP_OUTPUT_DATABASE) {
-    files = CSLAddString(files, job->shown);
+    files = add_shown(files, r, job->shown);
     layers = layer_names(job, "", NULL);
   } else if (job->kind == APP_OUTPUT_MESH) {
-    files = CSLAddString(files, s->output);
+    files = add_shown(files, r, s->output);
     /* the sidecars replace OUTPUT's extension (2DM's datasets) */
     char *stem = CPLStrdup(CPLFormFilename(CPLGetPath(s->output),
                                            CPLGetBasename(s->output), NULL));
     for (const char *const *sc = tt_mesh_format_sidecars(job->mesh); *sc;
          sc++)
-      files = CSLAddString(files, CPLSPrintf("%s%s", stem, *sc));
+      files = add_shown(files, r, CPLSPrintf("%s%s", stem, *sc));
     CPLFree(stem);
   } else if (tt__app_str_ieq(job->drvname, "ESRI Shapefile")) {
     /* files of their own beside OUTPUT: <name>_triangles.shp, ... */
@@ -219,10 +231,13 @@ void tt__app_output_names(const app_simplify_job *job, char ***out_files,
     const char *slash = strrchr(s->output, '/');
     char *dir = CPLStrdup(s->output);
     dir[slash ? (size_t)(slash - s->output) + 1 : 0] = '\0';
-    files = layer_names(job, CPLSPrintf("%s%s", dir,
-                                        tt_output_layer_prefix(job->outp)),
-                        ext);
+    char **names = layer_names(
+        job, CPLSPrintf("%s%s", dir, tt_output_layer_prefix(job->outp)),
+        ext);
     CPLFree(dir);
+    for (size_t i = 0; names && names[i]; i++)
+      files = add_shown(files, r, names[i]);
+    CSLDestroy(names);
   } else {
     VSIStatBufL sb;
     if (VSIStatL(s->output, &sb) == 0 && VSI_ISDIR(sb.st_mode)) {
@@ -233,12 +248,12 @@ void tt__app_output_names(const app_simplify_job *job, char ***out_files,
         for (size_t k = 0; mine && mine[k]; k++)
           if (strncmp(entries[i], mine[k], strlen(mine[k])) == 0 &&
               entries[i][strlen(mine[k])] == '.')
-            files = CSLAddString(files, CPLFormFilename(s->output,
-                                                        entries[i], NULL));
+            files = add_shown(files, r,
+                              CPLFormFilename(s->output, entries[i], NULL));
       CSLDestroy(entries);
       CSLDestroy(mine);
     } else {
-      files = CSLAddString(files, s->output);
+      files = add_shown(files, r, s->output);
       layers = layer_names(job, "", NULL);
     }
   }
