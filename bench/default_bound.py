@@ -9,7 +9,10 @@ of the height range; it prints the share of the valid samples each keeps
 as vertices. docs/cli.md "The default bound" has the table and the reason
 for the rule.
 
-  bench/default_bound.py [build/terratin] [../shared/testdata]
+  bench/default_bound.py [build/terratin] [SHARED_TESTDATA]
+
+(the table on stdout, the range of the shares on stderr; exit 77 without
+the shared DEMs)
 """
 import json
 import os
@@ -56,10 +59,12 @@ def run(terratin, dem, out, extra):
 
 def main():
     terratin = sys.argv[1] if len(sys.argv) > 1 else "build/terratin"
-    data = sys.argv[2] if len(sys.argv) > 2 else "../shared/testdata"
+    data = sys.argv[2] if len(sys.argv) > 2 else os.environ.get(
+        "TT_SHARED_TESTDATA", os.path.join(os.path.dirname(__file__), "..",
+                                           "..", "shared", "testdata"))
     if not os.path.isdir(data):
-        print(f"default_bound: skipped: {data} is not there")
-        return 0
+        print(f"default_bound: skipped: {data} is not there", file=sys.stderr)
+        return 77
     head = ("DEM", "valid", "step", "1 step", "2 steps (default)",
             "4 steps", "0.5 % range")
     print("| " + " | ".join(head) + " |")
@@ -95,9 +100,9 @@ def main():
                   f"{old:.1f} % |")
     if shares:
         shares.sort()
-        print(f"\ndefault bound: {len(shares)} DEMs keep {shares[0]:.1f} % to "
+        print(f"default bound: {len(shares)} DEMs keep {shares[0]:.1f} % to "
               f"{shares[-1]:.1f} % of their valid samples, median "
-              f"{shares[len(shares) // 2]:.1f} %")
+              f"{shares[len(shares) // 2]:.1f} %", file=sys.stderr)
     return 0
 
 
