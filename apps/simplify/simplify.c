@@ -33,8 +33,9 @@ static tt_status open_input(app_simplify_job *job)
     return r->res->status;
   job->width = (size_t)GDALGetRasterBandXSize(job->band);
   job->height = (size_t)GDALGetRasterBandYSize(job->band);
-  tt_status st = job->outp ? tt_output_protect_dataset(r->ctx, job->outp,
-                                                       job->src, s->input)
+  tt_status st = job->outp ? tt_output_protect_dataset(
+                                 r->ctx, job->outp,
+                                 tt__app_raster_file(r, job->src), s->input)
                            : TT_OK;
   if (st != TT_OK)
     tt__app_fail_tt(r, st, s->output);
@@ -106,7 +107,7 @@ static tt_status run_tiled(app_simplify_job *job)
   tt_status st = tt__app_simplify_tiled(job);
   if (st != TT_OK || (!job->tin && job->kind != APP_OUTPUT_STREAM))
     return st;
-  GDALClose(job->src);
+  tt__app_close_raster(job->r, job->src);
   job->src = NULL;
   rep->info = job->info;
   rep->driver = job->drvname;
@@ -131,7 +132,7 @@ static tt_status read_whole(app_simplify_job *job)
                                   &job->info, &valid);
   if (st != TT_OK)
     return st;
-  GDALClose(job->src);
+  tt__app_close_raster(job->r, job->src);
   job->src = NULL;
   rep->info = job->info;
   rep->driver = job->drvname;
