@@ -31,6 +31,13 @@ static tt_status open_input(app_simplify_job *job)
   job->src = tt__app_open_raster(r, s->input, s->band, &job->band);
   if (!job->src)
     return r->res->status;
+  /* a CRS to go from, said before any work: the way forward is -a_srs */
+  const char *needs = s->t_srs ? "-t_srs" : s->work_srs ? "-work_srs" : NULL;
+  if (needs && !GDALGetSpatialRef(job->src))
+    return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: %s %s: the DEM %s has no CRS to transform "
+                        "from; give it one with -a_srs SRS", needs,
+                        s->t_srs ? s->t_srs : s->work_srs, s->input);
   job->width = (size_t)GDALGetRasterBandXSize(job->band);
   job->height = (size_t)GDALGetRasterBandYSize(job->band);
   tt_status st = job->outp ? tt_output_protect_dataset(
