@@ -271,8 +271,19 @@ GDALDatasetH tt__app_view_open(GDALDatasetH src, char **args, char *why,
   CPLErrorReset();
   GDALDatasetH view = GDALTranslate("", src, opts, &usage);
   GDALTranslateOptionsFree(opts);
-  if (!view)
+  if (!view) {
     snprintf(why, size, "the input options cannot be applied: %s",
              CPLGetLastErrorMsg()[0] ? CPLGetLastErrorMsg() : "GDAL failed");
+    return NULL;
+  }
+  /* gdal_translate leaves the bands' units behind, which say the heights'
+   * unit (-z_unit, the summary): the view keeps them. A VRT of no file
+   * writes nothing when changed. */
+  for (int b = 1; b <= GDALGetRasterCount(view); b++) {
+    const char *unit = GDALGetRasterUnitType(GDALGetRasterBand(src, b));
+    GDALRasterBandH vb = GDALGetRasterBand(view, b);
+    if (unit && *unit && !*GDALGetRasterUnitType(vb))
+      GDALSetRasterUnitType(vb, unit);
+  }
   return view;
 }
