@@ -242,6 +242,10 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
 void tt__app_close_raster(app_run *r, GDALDatasetH ds);
 /* The dataset of the DEM's file: r->dem_file under a view, else ds. */
 GDALDatasetH tt__app_raster_file(const app_run *r, GDALDatasetH ds);
+/* ropts with, under a view, the file's name (path) and driver for the
+ * read's messages and info (SOURCE_NAME, SOURCE_DRIVER). */
+char **tt__app_view_read_options(const app_run *r, char **ropts,
+                                 const char *path);
 
 /* dem_view.c: GDAL's input options on a DEM. Whether any applies. */
 int tt__app_view_wanted(const tt_app_settings *s);

@@ -108,6 +108,19 @@ GDALDatasetH tt__app_raster_file(const app_run *r, GDALDatasetH ds)
   return r->dem_file ? r->dem_file : ds;
 }
 
+char **tt__app_view_read_options(const app_run *r, char **ropts,
+                                 const char *path)
+{
+  if (!r->dem_file)
+    return ropts;
+  GDALDriverH drv = GDALGetDatasetDriver(r->dem_file);
+  ropts = CSLSetNameValue(ropts, "SOURCE_NAME", path);
+  if (drv)
+    ropts = CSLSetNameValue(ropts, "SOURCE_DRIVER",
+                            GDALGetDriverShortName(drv));
+  return ropts;
+}
+
 /* Opens a raster for reading and checks the band; on failure explains in
  * one line why: missing, a folder, empty, a vector dataset, unreadable. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
@@ -312,6 +325,7 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
   if (r->s->max_memory)
     ropts = CSLSetNameValue(ropts, "MAX_MEMORY",
                             CPLSPrintf("%zu", r->s->max_memory));
+  ropts = tt__app_view_read_options(r, ropts, path);
   r->msg.last[0] = '\0';
   tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
                                    progress_arg, &grid, &info);
