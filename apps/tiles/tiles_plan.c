@@ -55,7 +55,9 @@
   "A plan carries the options that shape the TIN only: -max_error,\n"       \
   "-tile_size, -method, -start, -importance, -selection, -onepass, -hole,\n"\
   "-criterion, -repair, -optimize, -seed, -anneal_*, -b, -srcnodata,\n"     \
-  "-z_factor, -z_unit, -work_srs AUTHORITY:CODE. The output's options\n"    \
+  "-z_factor, -z_unit, -work_srs AUTHORITY:CODE, and the DEM's window and\n"\
+  "georeferencing: -srcwin, -projwin, -a_ullr, -a_nodata, -a_srs, -s_srs,\n"\
+  "-projwin_srs (CRSs as AUTHORITY:CODE). The output's options\n"           \
   "(-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs) go to\n" \
   "merge. run and merge refuse a plan that is truncated, edited (its\n"     \
   "checksum), or whose fields or options are not what plan writes.\n"       \
