@@ -196,6 +196,11 @@ typedef struct app_run {
   app_messages msg;
   app_phase prog;
   double t0;
+  /* the DEM under GDAL's input options (dem_view.c): the file's dataset
+   * the open view reads from, and the arguments that made the view (a
+   * tiled run's workers make their own from them); NULL: none */
+  GDALDatasetH dem_file;
+  char **view_args;
 } app_run;
 
 /* A datasource name of the run as it is shown: a connection string with
@@ -226,9 +231,36 @@ tt_status tt__app_fail_exists(app_run *r, const char *output);
 int tt__app_continue(app_run *r, double at);
 
 /* Opens a raster for reading and checks the band; on failure explains in
- * one line why and returns NULL. */
+ * one line why and returns NULL. With GDAL's input options (-srcwin,
+ * -projwin, -a_srs, -a_ullr) the dataset returned is the in-memory view
+ * of them over the file's (r->dem_file): close it with
+ * tt__app_close_raster(), and protect tt__app_raster_file()'s files. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
                                  GDALRasterBandH *out_band);
+/* Closes what tt__app_open_raster returned (NULL: nothing), and the file's
+ * dataset under a view. */
+void tt__app_close_raster(app_run *r, GDALDatasetH ds);
+/* The dataset of the DEM's file: r->dem_file under a view, else ds. */
+GDALDatasetH tt__app_raster_file(const app_run *r, GDALDatasetH ds);
+/* ropts with, under a view, the file's name (path) and driver for the
+ * read's messages and info (SOURCE_NAME, SOURCE_DRIVER). */
+char **tt__app_view_read_options(const app_run *r, char **ropts,
+                                 const char *path);
+
+/* dem_view.c: GDAL's input options on a DEM. Whether any applies. */
+int tt__app_view_wanted(const tt_app_settings *s);
+/* gdal_translate's arguments for the view of src (-of VRT, -srcwin with
+ * the window checked and clipped, -a_srs, -a_ullr); NULL with the reason
+ * in why (*out_usage: the options are at fault). A clipped window is
+ * told in warn ("" otherwise). The caller frees the list with
+ * CSLDestroy(). */
+char **tt__app_view_args(const tt_app_settings *s, GDALDatasetH src,
+                         int *out_usage, char *why, size_t size, char *warn,
+                         size_t warn_size);
+/* The in-memory VRT of src under args, or NULL with the reason in why.
+ * It reads from src, which must stay open until it is closed. */
+GDALDatasetH tt__app_view_open(GDALDatasetH src, char **args, char *why,
+                               size_t size);
 /* The read options of -srcnodata, -z_factor, -z_unit and -work_srs
  * (tt_gdal_read_grid's SRCNODATA, Z_FACTOR, Z_UNIT, WORK_SRS), for a
  * whole DEM (tt__app_read_dem adds MAX_MEMORY) and a tiled run's windows

@@ -56,6 +56,26 @@ static const char help_top[] =
   "  -seed N           the random sequence (default 0): the same seed, the\n"\
   "                    same TIN; the best triangulation seen is returned\n"
 
+/* GDAL's input options on the DEM (dem_view.c), shared by the commands
+ * that read one. */
+#define INPUT_USAGE                                                          \
+  "           [-a_srs SRS | -s_srs SRS] [-a_nodata V] [-a_ullr ulx uly lrx lry]\n"\
+  "           [-srcwin xoff yoff xsize ysize | -projwin ulx uly lrx lry\n"    \
+  "           [-projwin_srs SRS]]\n"
+#define INPUT_HELP                                                           \
+  "  -a_srs SRS        the DEM's CRS, for one without or with a wrong one\n"\
+  "  -s_srs SRS        as gdalwarp's source CRS: the same as -a_srs\n"      \
+  "  -a_nodata V       GDAL's name of -srcnodata\n"                         \
+  "  -a_ullr ulx uly lrx lry  the georeferenced bounds of the (windowed)\n" \
+  "                    DEM, for one without a geotransform or over its own\n"\
+  "  -srcwin xoff yoff xsize ysize  read that window of samples only\n"    \
+  "  -projwin ulx uly lrx lry  read the window of those map coordinates\n" \
+  "                    (in the DEM's CRS, or -projwin_srs's, reprojected),\n"\
+  "                    rounded to samples as gdal_translate does. A window\n"\
+  "                    partly outside is read as its part inside (with a\n"\
+  "                    warning); one wholly outside is refused. Coordinates\n"\
+  "                    stay the DEM's; col and row count from the window\n"
+
 static const char help_simplify[] =
     "Usage: terratin simplify [-b BAND] [-max_error E] [-max_points N]\n"
     "           [-max_triangles N] [-percent P] [-criterion NAME]\n"
@@ -68,6 +88,7 @@ static const char help_simplify[] =
     "           [-selection independent|sequential] [-onepass]\n"
     "           [-hole minangle|circumradius|dp]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    INPUT_USAGE
     "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
     "           [-nln PREFIX] [-overwrite] [-q] [-json] [-verbose]\n"
@@ -103,6 +124,7 @@ static const char help_simplify[] =
     "  -b BAND           band of INPUT to read (default 1)\n"
     "  -srcnodata VALUE  height to treat as nodata, a number or nan\n"
     "                    (default: the band's nodata value and mask)\n"
+    INPUT_HELP
     "  -z_factor F       multiply heights by F, e.g. 0.3048 for feet to\n"
     "                    metres (default 1; after the band's scale/offset)\n"
     "  -z_unit m         heights declared in ft or us-ft (band unit, else\n"
@@ -265,6 +287,7 @@ static const char help_generate[] =
 static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit m] [-json] [-q]\n"
+    INPUT_USAGE
     "           [-max_memory SIZE] [-error_raster OUT.tif [-co NAME=VALUE]...\n"
     "           [-overwrite]]\n"
     "\n"
@@ -278,6 +301,8 @@ static const char help_eval[] =
     "Options:\n"
     "  -b BAND         band of DEM to read (default 1)\n"
     "  -srcnodata V    height to treat as nodata, a number or nan\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                  the DEM as simplify reads it (the TIN's window)\n"
     "  -z_factor F     multiply heights by F (as given to simplify)\n"
     "  -z_unit m       ft or us-ft heights to metres (as given to simplify)\n"
     "  -layer NAME     layer to measure (default: a layer named 'triangles'\n"
@@ -332,6 +357,8 @@ static const char help_optimize[] =
     "                    grows)\n"
     ANNEAL_HELP
     "  -b, -srcnodata, -z_factor, -z_unit   as simplify\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                    the DEM, as simplify\n"
     "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
     "\n"
     "Exit codes: 0 success, 1 processing failure, 2 usage error, 128+N\n"
@@ -400,6 +427,8 @@ static const char help_study[] =
     "                    -percent checkpoints\n"
     "  -start, -importance   decimation's, as simplify\n"
     "  -b, -srcnodata, -z_factor, -z_unit, -threads   as simplify\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                    every DEM file, as simplify\n"
     "  -overwrite        write into an OUTDIR that is not empty\n"
     "  -tin_points N     also each criterion's TIN at N points (a run of\n"
     "                    its own) into OUTDIR/tins: OBJ in pixel space,\n"
@@ -438,6 +467,8 @@ static const char help_rasterize[] =
     "                    extension names, else GTiff: tiled, DEFLATE)\n"
     "  -co NAME=VALUE    creation option of the driver (repeatable)\n"
     "  -b, -srcnodata, -z_factor, -z_unit, -max_memory   the DEM, as eval\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                    the DEM, as simplify (OUTPUT on the window's grid)\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
     "  -q, -json         no summary; one JSON object instead of the summary\n"
     "\n"

@@ -107,6 +107,8 @@ static tt_status own_size(tt__app_opt_parse *p, const tt__app_opt_def *d,
                           const char *v, void *out);
 static tt_status own_layers(tt__app_opt_parse *p, const tt__app_opt_def *d,
                             const char *v, void *out);
+static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
+                         const char *v, void *out);
 
 /* --- the table ------------------------------------------------------------ */
 
@@ -178,7 +180,9 @@ static const tt__app_opt_def opt_defs[] = {
      .hi = HUGE_VAL, .bad = "must be a finite number >= 0"},
     {"-seeding", O_SEEDING, FOR_G, OPT_NAME, SYNTH(seeding),
      .name_fn = name_seeding, .bad = "must be none, peak, valley or hybrid"},
-    {"-a_srs", O_A_SRS, FOR_G, OPT_TEXT, AT(s.srs), .need = CRS_NEEDED},
+    /* generate: the output's CRS; the DEM readers: the DEM's (dem_view.c) */
+    {"-a_srs", O_A_SRS, FOR_G | DEM_READERS, OPT_TEXT, AT(s.srs),
+     .need = CRS_NEEDED},
     {"-srcnodata", O_SRCNODATA, DEM_READERS, OPT_OWN, AT(s.srcnodata),
      .own_fn = own_srcnodata,
      .bad = "must be a finite decimal number or nan"},
@@ -255,6 +259,23 @@ static const tt__app_opt_def opt_defs[] = {
     {"-layers", O_LAYERS, FOR_S, OPT_OWN, AT(s.layers),
      .own_fn = own_layers},
     {"-nostyle", O_NOSTYLE, FOR_S, OPT_FLAG, AT(s.nostyle)},
+    /* GDAL's input options (dem_view.c); -s_srs as gdalwarp's: reading,
+     * the same as -a_srs; -a_nodata is -srcnodata's GDAL name */
+    {"-s_srs", O_S_SRS, DEM_READERS, OPT_TEXT, AT(s.srs), .need = CRS_NEEDED},
+    {"-a_nodata", O_A_NODATA, DEM_READERS, OPT_OWN, AT(s.srcnodata),
+     .own_fn = own_srcnodata,
+     .bad = "must be a finite decimal number or nan"},
+    {"-srcwin", O_SRCWIN, DEM_READERS, OPT_OWN, AT(s.srcwin),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs xoff yoff xsize ysize: integers, sizes >= 1"},
+    {"-projwin", O_PROJWIN, DEM_READERS, OPT_OWN, AT(s.projwin),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs ulx uly lrx lry: finite numbers, ulx < lrx, uly > lry"},
+    {"-projwin_srs", O_PROJWIN_SRS, DEM_READERS, OPT_TEXT,
+     AT(s.projwin_srs), .need = CRS_NEEDED},
+    {"-a_ullr", O_A_ULLR, DEM_READERS, OPT_OWN, AT(s.a_ullr),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs ulx uly lrx lry: finite numbers, ulx != lrx, uly != lry"},
 };
 
 #define OPT_DEFS (sizeof opt_defs / sizeof opt_defs[0])
@@ -283,7 +304,9 @@ const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
 
 int tt__app_opt_takes_value(const tt__app_opt_def *d)
 {
-  return d->kind != OPT_FLAG;
+  if (d->kind == OPT_FLAG)
+    return 0;
+  return d->nwords ? (int)d->nwords : 1;
 }
 
 /* The option's name in the messages about its value: its first spelling. */
@@ -441,6 +464,45 @@ static tt_status own_threads(tt__app_opt_parse *p, const tt__app_opt_def *d,
   if (st == TT_OK)
     *(int *)out = (int)z;
   return st;
+}
+
+/* -srcwin, -projwin, -a_ullr: four numbers, the words joined by spaces.
+ * -srcwin's are samples (offsets may be negative: the window is clipped
+ * to the raster when read, as dem_view.c says), -projwin's a window
+ * whose upper left is above and left of its lower right, -a_ullr's any
+ * box of non-zero width and height. */
+static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
+                         const char *v, void *out)
+{
+  tt_app_box *b = out;
+  double x[4];
+  char word[64];
+  const char *at = v;
+  for (int i = 0; i < 4; i++) {
+    const char *e = strchr(at, ' ');
+    size_t n = e ? (size_t)(e - at) : strlen(at);
+    if (n == 0 || n >= sizeof word || (i < 3) != (e != NULL))
+      return refuse(p, d, v);
+    memcpy(word, at, n);
+    word[n] = '\0';
+    if (!tt__app_parse_double(word, &x[i]))
+      return refuse(p, d, v);
+    at = e ? e + 1 : at + n;
+  }
+  if (d->id == O_SRCWIN) {
+    for (int i = 0; i < 4; i++)
+      if (x[i] != floor(x[i]) || fabs(x[i]) > (double)INT_MAX)
+        return refuse(p, d, v);
+    if (x[2] < 1 || x[3] < 1)
+      return refuse(p, d, v);
+  } else if (d->id == O_PROJWIN && !(x[0] < x[2] && x[1] > x[3])) {
+    return refuse(p, d, v);
+  } else if (d->id == O_A_ULLR && (x[0] == x[2] || x[1] == x[3])) {
+    return refuse(p, d, v);
+  }
+  b->set = 1;
+  memcpy(b->v, x, sizeof x);
+  return TT_OK;
 }
 
 /* -size N or NXxNY: out is the parameters (nx and ny). */

@@ -722,6 +722,8 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
 
   st = cmd->run(&r);
 done:
+  tt__app_close_raster(&r, NULL);
+  CSLDestroy(r.view_args);
   tt_context_destroy(r.ctx);
   CPLPopErrorHandler();
   CPLSetErrorHandler(old_handler);

@@ -73,7 +73,9 @@ static tt_status read_dem(eval_run *e)
   if (!(e->src = tt__app_open_raster(r, s->input, s->band, &band)))
     return r->res->status;
   if (e->outp &&
-      (st = tt_output_protect_dataset(r->ctx, e->outp, e->src, s->input)) !=
+      (st = tt_output_protect_dataset(r->ctx, e->outp,
+                                      tt__app_raster_file(r, e->src),
+                                      s->input)) !=
           TT_OK)
     return tt__app_fail_tt(r, st, s->error_raster);
   /* No bar for eval, but the reading still polls for an interruption. */
@@ -82,7 +84,7 @@ static tt_status read_dem(eval_run *e)
                         &e->grid, &e->info, &e->valid);
   if (st != TT_OK)
     return st;
-  GDALClose(e->src);
+  tt__app_close_raster(r, e->src);
   e->src = NULL;
   e->t_read = tt__app_now() - r->t0;
   if (!tt__app_continue(r, 0.3))
@@ -354,7 +356,7 @@ tt_status tt__app_eval(app_run *r)
   if (e.tds)
     GDALClose(e.tds);
   if (e.src)
-    GDALClose(e.src);
+    tt__app_close_raster(r, e.src);
   free(e.xyz);
   tt_grid_destroy(e.grid);
   tt_raster_info_destroy(e.info);

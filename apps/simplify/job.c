@@ -162,7 +162,7 @@ void tt__app_job_free(app_simplify_job *job)
     GDALClose(job->dst);
   CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", NULL);
   if (job->src)
-    GDALClose(job->src);
+    tt__app_close_raster(job->r, job->src);
   /* an unfinished streamed write undone, then the temporary files removed
    * unless committed */
   tt__app_stream_close(&job->so);

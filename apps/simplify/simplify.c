@@ -33,10 +33,18 @@ static tt_status open_input(app_simplify_job *job)
   job->src = tt__app_open_raster(r, s->input, s->band, &job->band);
   if (!job->src)
     return r->res->status;
+  /* a CRS to go from, said before any work: the way forward is -a_srs */
+  const char *needs = s->t_srs ? "-t_srs" : s->work_srs ? "-work_srs" : NULL;
+  if (needs && !GDALGetSpatialRef(job->src))
+    return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: %s %s: the DEM %s has no CRS to transform "
+                        "from; give it one with -a_srs SRS", needs,
+                        s->t_srs ? s->t_srs : s->work_srs, s->input);
   job->width = (size_t)GDALGetRasterBandXSize(job->band);
   job->height = (size_t)GDALGetRasterBandYSize(job->band);
-  tt_status st = job->outp ? tt_output_protect_dataset(r->ctx, job->outp,
-                                                       job->src, s->input)
+  tt_status st = job->outp ? tt_output_protect_dataset(
+                                 r->ctx, job->outp,
+                                 tt__app_raster_file(r, job->src), s->input)
                            : TT_OK;
   if (st != TT_OK)
     tt__app_fail_tt(r, st, s->output);
@@ -108,7 +116,7 @@ static tt_status run_tiled(app_simplify_job *job)
   tt_status st = tt__app_simplify_tiled(job);
   if (st != TT_OK || (!job->tin && job->kind != APP_OUTPUT_STREAM))
     return st;
-  GDALClose(job->src);
+  tt__app_close_raster(job->r, job->src);
   job->src = NULL;
   rep->info = job->info;
   rep->driver = job->drvname;
@@ -132,7 +140,7 @@ static tt_status read_whole(app_simplify_job *job)
                                   &job->info, &valid);
   if (st != TT_OK)
     return st;
-  GDALClose(job->src);
+  tt__app_close_raster(job->r, job->src);
   job->src = NULL;
   rep->info = job->info;
   rep->driver = job->drvname;

@@ -243,7 +243,8 @@ static tt_status tiled_init(tiled *T)
   const app_simplify_job *job = T->job;
   /* every window's read options but its WINDOW: a whole DEM's, but
    * -max_memory (the tiles in flight are bounded instead) */
-  T->ropts = tt__app_read_options(job->s);
+  T->ropts = tt__app_view_read_options(T->r, tt__app_read_options(job->s),
+                                       T->path);
   T->max_memory = job->s->max_memory;
   T->inflight_bytes = tt__app_tile_bytes(T->N, T->W, T->H, T->nthreads,
                                          job->ground);

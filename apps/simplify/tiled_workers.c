@@ -206,9 +206,21 @@ static void *worker(void *arg)
                                                   GDAL_OF_READONLY, NULL,
                                                   NULL, NULL)
                                      : NULL;
-  GDALRasterBandH band = own ? GDALGetRasterBand(own,
-                                                 GDALGetBandNumber(T->band))
-                             : NULL;
+  /* under GDAL's input options, the worker's own view of its dataset,
+   * from the arguments the main thread checked (dem_view.c) */
+  GDALDatasetH view = NULL;
+  if (own && T->r->view_args) {
+    char why[TT_APP_MESSAGE_MAX];
+    view = tt__app_view_open(own, T->r->view_args, why, sizeof why);
+    if (!view) {
+      GDALClose(own);
+      own = NULL;
+    }
+  }
+  GDALDatasetH reads = view ? view : own;
+  GDALRasterBandH band = reads ? GDALGetRasterBand(reads,
+                                                   GDALGetBandNumber(T->band))
+                               : NULL;
   for (;;) {
     pthread_mutex_lock(&T->lock);
     while (!atomic_load(&T->stop) && T->next < T->ntiles &&
@@ -227,6 +239,8 @@ static void *worker(void *arg)
     }
     tt__app_tiled_run_tile(T, ctx, k, band);
   }
+  if (view)
+    GDALClose(view);
   if (own)
     GDALClose(own);
   CPLPopErrorHandler();

@@ -92,7 +92,10 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * only, for a tile: the grid's geotransform is that of its first sample,
  * its ground frame the whole raster's, a geographic or Web Mercator
  * raster's ground points those of the whole raster's samples, bit for bit,
- * a window of nodata only is no error, GDAL's cache is left alone).
+ * a window of nodata only is no error, GDAL's cache is left alone),
+ * SOURCE_NAME=<name> and SOURCE_DRIVER=<driver> (the raster's name in
+ * messages and info->path, its driver in info->driver, for a band of a
+ * view over a file, such as an in-memory VRT, which has neither).
  * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
  * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
 tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
