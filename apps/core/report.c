@@ -337,10 +337,12 @@ static void say_input(app_run *r, const app_simplify_report *p)
     size_t n = strlen(heights);
     snprintf(heights + n, sizeof heights - n, ", times %g", in->z_factor);
   }
-  fprintf(r->out, "input:  %s, band %d: %zu x %zu samples, %s; %s; %s\n",
-          tt__app_shown(r, r->s->input), r->s->band, in->width, in->height,
-          valid, in->crs_name && *in->crs_name ? in->crs_name : "no CRS",
-          heights);
+  const tt_app_settings *s = r->s;
+  fprintf(r->out, "input:  %s, band %d: %zu x %zu samples%s, %s; %s%s; %s\n",
+          tt__app_shown(r, s->input), s->band, in->width, in->height,
+          s->srcwin.set || s->projwin.set ? " (a window)" : "", valid,
+          in->crs_name && *in->crs_name ? in->crs_name : "no CRS",
+          s->srs ? " (given)" : "", heights);
 }
 
 /* What came out: the files (and layers) written, the TIN's size. */
