@@ -89,6 +89,10 @@ tt_status tt__app_read_tin(app_run *r, const tt_raster_info *info,
   tt_status st;
   memset(t, 0, sizeof *t);
   t->format = tt_mesh_read_format(s->tin);
+  if (t->format && s->layer)
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_ARG, s->tin,
+                        "is a %s file, which has no layers (-layer %s)",
+                        t->format, s->layer);
   if (t->format) {
     r->msg.last[0] = '\0';
     st = tt_mesh_read(r->ctx, s->tin, &t->xyz, &t->ntri, &t->rejected,

@@ -19,7 +19,8 @@
 #  - the TIN in another CRS, reprojected for the measurement: ogr2ogr
 #    -t_srs to EPSG:4326, 3857 and 32632, and terratin's own -t_srs into
 #    PLY (comment crs:), LandXML (CoordinateSystem) and UGRID (crs_wkt);
-#  - failures in one line: a face naming a missing vertex (exit 1), a bad
+#  - failures in one line: a face naming a missing vertex, -layer with a
+#    mesh file (exit 1), a bad
 #    -tin_transform or -tin_frame (exit 2), a pixel-frame STL read as map
 #    coordinates (exit 1, naming the options), and -error_raster from an
 #    STL matching its max error.
@@ -204,6 +205,10 @@ for bad in "1,1,1,0,0" "1,1,0,0,0,0" "1,1,1,0,0,x"; do
   check "-tin_transform $bad: one line ($(cat err.txt))" \
     one_line "-tin_transform"
 done
+"$T" eval dem.tif t.ply -layer triangles >/dev/null 2>err.txt
+rc=$?
+check "-layer with a PLY file: exit 1 ($rc)" [ "$rc" -eq 1 ]
+check "-layer with a PLY file: one line ($(cat err.txt))" one_line "no layers"
 "$T" eval dem.tif o/hmm.stl -tin_frame grid >/dev/null 2>err.txt
 rc=$?
 check "-tin_frame grid: exit 2 ($rc)" [ "$rc" -eq 2 ]
