@@ -388,10 +388,11 @@ typedef struct app_tin {
   int other_crs;         /* a CRS on a DEM without one: measured as is */
 } app_tin;
 /* Reads r->s->tin (its OGR dataset protected from outp, which may be
- * NULL) into t. On failure (recorded) the caller still frees t with
+ * NULL) into t, on the DEM of info and grid (whose heights settle an
+ * STL's frame when its extent does not). On failure (recorded) the caller still frees t with
  * tt__app_tin_free. */
 tt_status tt__app_read_tin(app_run *r, const tt_raster_info *info,
-                           tt_output *outp, app_tin *t);
+                           const tt_grid *grid, tt_output *outp, app_tin *t);
 void tt__app_tin_free(app_tin *t);
 
 #endif /* TERRATIN_APP_H */

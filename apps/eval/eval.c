@@ -96,7 +96,7 @@ static tt_status read_triangles(eval_run *e)
   app_run *r = e->r;
   const tt_app_settings *s = e->s;
   app_tin *t = &e->tin;
-  tt_status st = tt__app_read_tin(r, e->info, e->outp, t);
+  tt_status st = tt__app_read_tin(r, e->info, e->grid, e->outp, t);
   if (st != TT_OK)
     return st;
   /* Map coordinates stored in a file carry round-off: a TIN vertex on a

@@ -7,8 +7,10 @@
 #    DXF (3DFACE), UGRID netCDF;
 #  - other tools' files, made by eval_formats.py from the OBJ: ASCII STL
 #    (map coordinates), binary STL in hmm's pixel frame (found by itself,
-#    and with -stl_frame pixel; hmm's heights less 100 put back by
-#    -tin_transform), ascii and big-endian binary PLY with extra
+#    by its extent on a georeferenced DEM, by its heights on generate's
+#    DEM whose map coordinates are its grid, and with -stl_frame pixel;
+#    hmm's heights less 100 put back by -tin_transform, or a refusal
+#    asking for -stl_frame when neither frame is evident), ascii and big-endian binary PLY with extra
 #    properties and elements, OBJ with v/t/n corners and negative indices,
 #    2DM with the elements first, LandXML with sparse ids and an invisible
 #    face, CSV with the whole TIN as one TIN Z WKT, DXF 3DFACE with the
@@ -64,7 +66,7 @@ gdal_translate -q -a_srs EPSG:32633 -a_ullr 500000 5000065 500065 5000000 \
 figures() {
   local f=$1
   shift
-  "$T" eval dem.tif "$f" -json "$@" >e.json 2>e.err || {
+  "$T" eval "${DEM:-dem.tif}" "$f" -json "$@" >e.json 2>e.err || {
     echo "exit $?: $(head -c 300 e.err)"
     return
   }
@@ -146,6 +148,17 @@ check "binary STL: frame pixel in the JSON" [ "$(field frame)" = pixel ]
 same "binary STL, -stl_frame pixel" o/pixel.stl -stl_frame pixel
 close 1e-5 "hmm's STL (z - 100), -tin_transform 1,1,1,0,0,100" o/hmm.stl \
   -tin_transform 1,1,1,0,0,100
+# generate's own grid: map coordinates are the sample indices, so the
+# pixel STL fits both frames and its heights decide; hmm's, whose heights
+# match no sample without -tin_transform, asks for -stl_frame
+DEM=d0.tif same "pixel STL on a DEM whose map frame is its grid" o/pixel.stl
+DEM=d0.tif close 1e-5 "hmm's STL on that DEM, with -tin_transform" \
+  o/hmm.stl -tin_transform 1,1,1,0,0,100
+"$T" eval d0.tif o/hmm.stl >/dev/null 2>err.txt
+rc=$?
+check "hmm's STL, both frames fit, no height matches: exit 1 ($rc)" [ "$rc" -eq 1 ]
+check "hmm's STL, both frames fit: asks for -stl_frame ($(cat err.txt))" \
+  one_line "-stl_frame map or -stl_frame pixel"
 "$T" eval dem.tif o/pixel.stl -stl_frame map >/dev/null 2>err.txt
 rc=$?
 check "pixel STL read as map: exit 1 ($rc)" [ "$rc" -eq 1 ]
