@@ -82,6 +82,26 @@ static const char help_top[] =
   "  -seed N           the random sequence (default 0): the same seed, the\n"\
   "                    same TIN; the best triangulation seen is returned\n"
 
+/* GDAL's input options on the DEM (dem_view.c), shared by the commands
+ * that read one. */
+#define INPUT_USAGE                                                          \
+  "           [-a_srs SRS | -s_srs SRS] [-a_nodata V] [-a_ullr ulx uly lrx lry]\n"\
+  "           [-srcwin xoff yoff xsize ysize | -projwin ulx uly lrx lry\n"    \
+  "           [-projwin_srs SRS]]\n"
+#define INPUT_HELP                                                           \
+  "  -a_srs SRS        the DEM's CRS, for one without or with a wrong one\n"\
+  "  -s_srs SRS        as gdalwarp's source CRS: the same as -a_srs\n"      \
+  "  -a_nodata V       GDAL's name of -srcnodata\n"                         \
+  "  -a_ullr ulx uly lrx lry  the georeferenced bounds of the (windowed)\n" \
+  "                    DEM, for one without a geotransform or over its own\n"\
+  "  -srcwin xoff yoff xsize ysize  read that window of samples only\n"    \
+  "  -projwin ulx uly lrx lry  read the window of those map coordinates\n" \
+  "                    (in the DEM's CRS, or -projwin_srs's, reprojected),\n"\
+  "                    rounded to samples as gdal_translate does. A window\n"\
+  "                    partly outside is read as its part inside (with a\n"\
+  "                    warning); one wholly outside is refused. Coordinates\n"\
+  "                    stay the DEM's; col and row count from the window\n"
+
 static const char help_simplify[] =
     "Usage: terratin simplify [-b BAND] [-max_error E] [-max_points N]\n"
     "           [-max_triangles N] [-percent P] [-criterion NAME]\n"
@@ -94,9 +114,11 @@ static const char help_simplify[] =
     "           [-selection independent|sequential] [-onepass]\n"
     "           [-hole minangle|circumradius|dp]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
-    "           [-z_to m|native|auto] [-work_srs SRS] [-t_srs SRS]\n"
+    "           [-z_to m|native|auto]\n"
+    INPUT_USAGE
+    "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
-    "           [-nln PREFIX] [-overwrite] [-q] [-json]\n"
+    "           [-nln PREFIX] [-overwrite] [-q] [-json] [-verbose]\n"
     "           [-layers LIST] [-nostyle]\n"
     "           [-threads N|ALL_CPUS] [-max_memory SIZE]\n"
     "           [-tile_size N]\n"
@@ -114,9 +136,11 @@ static const char help_simplify[] =
     "  -max_triangles N  at most N triangles (N >= 1)\n"
     "  -percent P        at most P% of the valid samples as vertices\n"
     "                    (0 < P <= 100)\n"
-    "  Default when none is given: -max_error = 0.5% of the DEM's valid\n"
-    "  height range (max - min), printed in the summary; a flat DEM gives\n"
-    "  the two triangles of the corners.\n"
+    "  Default when none is given: -max_error = twice the DEM's mean step\n"
+    "  (the mean height difference between neighbouring valid samples),\n"
+    "  to two significant digits, printed in the summary: a TIN of a few\n"
+    "  per cent of the samples on most DEMs; a flat DEM gives the two\n"
+    "  triangles of the corners.\n"
     "  Every limit is exact. A point or triangle budget (or a percentage)\n"
     "  below what the starting triangulation needs -- the 4 corners, or\n"
     "  the hull and the vertices a nodata outline forces -- is refused\n"
@@ -127,6 +151,7 @@ static const char help_simplify[] =
     "  -b BAND           band of INPUT to read (default 1)\n"
     "  -srcnodata VALUE  height to treat as nodata, a number or nan\n"
     "                    (default: the band's nodata value and mask)\n"
+    INPUT_HELP
     "  -z_factor F       multiply heights by F, e.g. 0.3048 for feet to\n"
     "                    metres (default 1; after the band's scale/offset)\n"
     "  -z_unit U         the unit the heights are in: ft, us-ft or m (default:\n"
@@ -212,9 +237,11 @@ static const char help_simplify[] =
     "                    layer for GeoJSON, FlatGeobuf, GPX files\n"
     "  -nostyle          no QGIS default style (layer_styles) in a GPKG\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
-    "  -q                quiet: no progress bar, no summary line\n"
+    "  -q                quiet: no progress bar, no summary\n"
     "  -json             print one JSON object with the results instead of\n"
-    "                    the progress bar and the summary line\n"
+    "                    the progress bar and the summary\n"
+    "  -verbose          the summary's details too: method, stop, frame,\n"
+    "                    heights, components, tiles, times\n"
     "  -threads N        threads for the raster scans, or ALL_CPUS; the TIN\n"
     "                    is the same for every N (default: GDAL_NUM_THREADS,\n"
     "                    else all CPUs for a million samples or more)\n"
@@ -293,19 +320,29 @@ static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
     "           [-z_to m|native|auto] [-json] [-q]\n"
+    INPUT_USAGE
+    "           [-tin_frame map|pixel] [-tin_transform SX,SY,SZ,OX,OY,OZ]\n"
     "           [-max_memory SIZE] [-error_raster OUT.tif [-co NAME=VALUE]...\n"
     "           [-overwrite]]\n"
     "\n"
-    "Measures a layer of triangles (POLYGON Z, MULTIPOLYGON Z or TIN, from\n"
-    "terratin or any other tool) against band BAND of the raster DEM: the\n"
-    "error |DEM - TIN| over every valid sample (max, RMS, mean and total\n"
-    "absolute, L2, where the max is) and the coverage (valid samples covered,\n"
-    "uncovered, overlapped; polygons that are not triangles, degenerate\n"
-    "triangles). The triangles must be in the DEM's CRS.\n"
+    "Measures a TIN (from terratin or any other tool) against band BAND of\n"
+    "the raster DEM: the error |DEM - TIN| over every valid sample (max,\n"
+    "RMS, mean and total absolute, L2, where the max is) and the coverage\n"
+    "(valid samples covered, uncovered, overlapped; polygons or faces that\n"
+    "are not triangles, degenerate triangles). TIN is a mesh file: STL\n"
+    "(binary or ASCII), PLY (ascii or binary), OBJ, SMS 2DM, LandXML\n"
+    "(first Surface), UGRID netCDF; or any OGR layer of triangles: POLYGON\n"
+    "Z, MULTIPOLYGON Z, TIN, POLYHEDRALSURFACE, or of Unknown type (CSV\n"
+    "with WKT, DXF 3DFACE, MULTIPATCH Shapefile): every format simplify\n"
+    "writes. A TIN in another CRS than the DEM's (the layer's, or the one\n"
+    "a PLY, LandXML or UGRID file declares) is reprojected; one without a\n"
+    "CRS is taken to be in the DEM's.\n"
     "\n"
     "Options:\n"
     "  -b BAND         band of DEM to read (default 1)\n"
     "  -srcnodata V    height to treat as nodata, a number or nan\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                  the DEM as simplify reads it (the TIN's window)\n"
     "  -z_factor F     multiply heights by F (as given to simplify)\n"
     "  -z_unit U, -z_to MODE  the heights' unit, and whether they become\n"
     "                  metres (as given to simplify)\n"
@@ -323,13 +360,27 @@ static const char help_eval[] =
     "                  nodata NaN outside the TIN and at the DEM's nodata)\n"
     "  -co NAME=VALUE  GeoTIFF creation option of OUT (repeatable)\n"
     "  -overwrite      replace OUT when it exists (default: refuse)\n"
+    "  -tin_frame F    (or -stl_frame) the frame of TIN's coordinates: map\n"
+    "                  (map coordinates, reprojected from the TIN's CRS)\n"
+    "                  or pixel (the DEM's samples: x the column, y the row\n"
+    "                  counted up from the last row, as hmm writes STL).\n"
+    "                  Default map, but an STL whose corners miss the DEM's\n"
+    "                  extent and fit its grid is read as pixel (fitting\n"
+    "                  both: the frame whose corners land on samples of\n"
+    "                  their heights, else the run asks for -stl_frame)\n"
+    "  -tin_transform SX,SY,SZ,OX,OY,OZ  first put every corner at\n"
+    "                  x' = SX x + OX, y' = SY y + OY, z' = SZ z + OZ (hmm's\n"
+    "                  STL heights less the DEM's minimum: 1,1,1,0,0,ZMIN;\n"
+    "                  delatin's rows down: 1,-1,1,0,HEIGHT-1,0 -tin_frame\n"
+    "                  pixel)\n"
     "\n"
     "Exit codes: 0 success (and within -max_error), 1 processing failure,\n"
     "2 usage error, 3 the measured max error exceeds -max_error, 128+N\n"
     "stopped by signal N (130 Ctrl-C, 143 SIGTERM; nothing left behind).\n"
     "\n"
     "Example:\n"
-    "  terratin eval dem.tif tin.gpkg -max_error 0.5 -q || echo too coarse\n";
+    "  terratin eval dem.tif tin.gpkg -max_error 0.5 -q || echo too coarse\n"
+    "  terratin eval dem.tif hmm.stl -tin_transform 1,1,1,0,0,412.5\n";
 
 static const char help_optimize[] =
     "Usage: terratin optimize DEM IN_TIN OUTPUT [-b BAND] [-layer NAME]\n"
@@ -361,6 +412,8 @@ static const char help_optimize[] =
     "                    grows)\n"
     ANNEAL_HELP
     "  -b, -srcnodata, -z_factor, -z_unit, -z_to   as simplify\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                    the DEM, as simplify\n"
     "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
     "\n"
     "Exit codes: 0 success, 1 processing failure, 2 usage error, 128+N\n"
@@ -430,6 +483,8 @@ static const char help_study[] =
     "                    -percent checkpoints\n"
     "  -start, -importance   decimation's, as simplify\n"
     "  -b, -srcnodata, -z_factor, -z_unit, -z_to, -threads   as simplify\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                    every DEM file, as simplify\n"
     "  -overwrite        write into an OUTDIR that is not empty\n"
     "  -tin_points N     also each criterion's TIN at N points (a run of\n"
     "                    its own) into OUTDIR/tins: OBJ in pixel space,\n"
@@ -469,6 +524,8 @@ static const char help_rasterize[] =
     "  -co NAME=VALUE    creation option of the driver (repeatable)\n"
     "  -b, -srcnodata, -z_factor, -z_unit, -z_to, -max_memory   the DEM,\n"
     "                    as eval\n"
+    "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
+    "                    the DEM, as simplify (OUTPUT on the window's grid)\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
     "  -q, -json         no summary; one JSON object instead of the summary\n"
     "\n"
@@ -492,9 +549,11 @@ static const char help_rasterize[] =
   "A plan carries the options that shape the TIN only: -max_error,\n"         \
   "-tile_size, -method, -start, -importance, -selection, -onepass, -hole,\n"  \
   "-criterion, -repair, -optimize, -seed, -anneal_*, -b, -srcnodata,\n"       \
-  "-z_factor, -z_unit, -z_to, -work_srs AUTHORITY:CODE. The output's\n"      \
+  "-z_factor, -z_unit, -z_to, -work_srs AUTHORITY:CODE, and the DEM's\n"    \
+  "window and georeferencing: -srcwin, -projwin, -a_ullr, -a_nodata,\n"      \
+  "-a_srs, -s_srs, -projwin_srs (CRSs as AUTHORITY:CODE). The output's\n"    \
   "options (-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs)\n" \
-  "go to merge. run and merge refuse a plan that is truncated, edited (its\n"       \
+  "go to merge. run and merge refuse a plan that is truncated, edited (its\n" \
   "checksum), or whose fields or options are not what plan writes.\n"
 
 #define TILES_EXIT                                                           \

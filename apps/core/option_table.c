@@ -133,6 +133,16 @@ static int name_z_to(tt_context *ctx, const char *w, void *out)
   return 0;
 }
 
+/* -tin_frame (eval): the int tt_app_settings.tin_frame, 1 map, 2 pixel. */
+static int name_tin_frame(tt_context *ctx, const char *w, void *out)
+{
+  (void)ctx;
+  if (!tt__app_str_ieq(w, "map") && !tt__app_str_ieq(w, "pixel"))
+    return 0;
+  *(int *)out = tt__app_str_ieq(w, "map") ? 1 : 2;
+  return 1;
+}
+
 /* --- the values that fit no kind (OPT_OWN) ------------------------------- */
 
 static tt_status own_srcnodata(tt__app_opt_parse *p, const tt__app_opt_def *d,
@@ -143,6 +153,11 @@ static tt_status own_size(tt__app_opt_parse *p, const tt__app_opt_def *d,
                           const char *v, void *out);
 static tt_status own_layers(tt__app_opt_parse *p, const tt__app_opt_def *d,
                             const char *v, void *out);
+static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
+                         const char *v, void *out);
+static tt_status own_tin_transform(tt__app_opt_parse *p,
+                                   const tt__app_opt_def *d, const char *v,
+                                   void *out);
 
 /* --- the table ------------------------------------------------------------ */
 
@@ -193,6 +208,7 @@ static const tt__app_opt_def opt_defs[] = {
      .name_fn = name_repair,
      .known = "flip, local, lookahead, delaunay, auto"},
     {"-json", O_JSON, FOR_S | FOR_E | FOR_O | FOR_R, OPT_FLAG, AT(s.json)},
+    {"-verbose", O_VERBOSE, FOR_S, OPT_FLAG, AT(s.verbose)},
     {"-layer", O_LAYER, FOR_E | FOR_O | FOR_R, OPT_TEXT, AT(s.layer),
      .need = "needs a layer name"},
     {"-size", O_SIZE, FOR_G, OPT_OWN, .to = TO_SYNTH, .at = 0, /* nx, ny */
@@ -213,7 +229,9 @@ static const tt__app_opt_def opt_defs[] = {
      .hi = HUGE_VAL, .bad = "must be a finite number >= 0"},
     {"-seeding", O_SEEDING, FOR_G, OPT_NAME, SYNTH(seeding),
      .name_fn = name_seeding, .bad = "must be none, peak, valley or hybrid"},
-    {"-a_srs", O_A_SRS, FOR_G, OPT_TEXT, AT(s.srs), .need = CRS_NEEDED},
+    /* generate: the output's CRS; the DEM readers: the DEM's (dem_view.c) */
+    {"-a_srs", O_A_SRS, FOR_G | DEM_READERS, OPT_TEXT, AT(s.srs),
+     .need = CRS_NEEDED},
     {"-srcnodata", O_SRCNODATA, DEM_READERS, OPT_OWN, AT(s.srcnodata),
      .own_fn = own_srcnodata,
      .bad = "must be a finite decimal number or nan"},
@@ -294,6 +312,32 @@ static const tt__app_opt_def opt_defs[] = {
     {"-layers", O_LAYERS, FOR_S, OPT_OWN, AT(s.layers),
      .own_fn = own_layers},
     {"-nostyle", O_NOSTYLE, FOR_S, OPT_FLAG, AT(s.nostyle)},
+    /* GDAL's input options (dem_view.c); -s_srs as gdalwarp's: reading,
+     * the same as -a_srs; -a_nodata is -srcnodata's GDAL name */
+    {"-s_srs", O_S_SRS, DEM_READERS, OPT_TEXT, AT(s.srs), .need = CRS_NEEDED},
+    {"-a_nodata", O_A_NODATA, DEM_READERS, OPT_OWN, AT(s.srcnodata),
+     .own_fn = own_srcnodata,
+     .bad = "must be a finite decimal number or nan"},
+    {"-srcwin", O_SRCWIN, DEM_READERS, OPT_OWN, AT(s.srcwin),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs xoff yoff xsize ysize: integers, sizes >= 1"},
+    {"-projwin", O_PROJWIN, DEM_READERS, OPT_OWN, AT(s.projwin),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs ulx uly lrx lry: finite numbers, ulx < lrx, uly > lry"},
+    {"-projwin_srs", O_PROJWIN_SRS, DEM_READERS, OPT_TEXT,
+     AT(s.projwin_srs), .need = CRS_NEEDED},
+    {"-a_ullr", O_A_ULLR, DEM_READERS, OPT_OWN, AT(s.a_ullr),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs ulx uly lrx lry: finite numbers, ulx != lrx, uly != lry"},
+    /* eval: the frame of a TIN file's coordinates, and an affine before */
+    {"-tin_frame", O_TIN_FRAME, FOR_E, OPT_NAME, AT(s.tin_frame),
+     .name_fn = name_tin_frame, .known = "map, pixel"},
+    {"-stl_frame", O_TIN_FRAME, FOR_E, OPT_NAME, AT(s.tin_frame),
+     .name_fn = name_tin_frame, .known = "map, pixel"},
+    {"-tin_transform", O_TIN_TRANSFORM, FOR_E, OPT_OWN, AT(s),
+     .own_fn = own_tin_transform,
+     .bad = "must be six comma-separated numbers sx,sy,sz,ox,oy,oz "
+            "(x' = sx x + ox, ...), sx, sy, sz non-zero"},
 };
 
 #define OPT_DEFS (sizeof opt_defs / sizeof opt_defs[0])
@@ -408,7 +452,9 @@ const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
 
 int tt__app_opt_takes_value(const tt__app_opt_def *d)
 {
-  return d->kind != OPT_FLAG;
+  if (d->kind == OPT_FLAG)
+    return 0;
+  return d->nwords ? (int)d->nwords : 1;
 }
 
 /* The option's name in the messages about its value: its first spelling. */
@@ -568,6 +614,45 @@ static tt_status own_threads(tt__app_opt_parse *p, const tt__app_opt_def *d,
   return st;
 }
 
+/* -srcwin, -projwin, -a_ullr: four numbers, the words joined by spaces.
+ * -srcwin's are samples (offsets may be negative: the window is clipped
+ * to the raster when read, as dem_view.c says), -projwin's a window
+ * whose upper left is above and left of its lower right, -a_ullr's any
+ * box of non-zero width and height. */
+static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
+                         const char *v, void *out)
+{
+  tt_app_box *b = out;
+  double x[4];
+  char word[64];
+  const char *at = v;
+  for (int i = 0; i < 4; i++) {
+    const char *e = strchr(at, ' ');
+    size_t n = e ? (size_t)(e - at) : strlen(at);
+    if (n == 0 || n >= sizeof word || (i < 3) != (e != NULL))
+      return refuse(p, d, v);
+    memcpy(word, at, n);
+    word[n] = '\0';
+    if (!tt__app_parse_double(word, &x[i]))
+      return refuse(p, d, v);
+    at = e ? e + 1 : at + n;
+  }
+  if (d->id == O_SRCWIN) {
+    for (int i = 0; i < 4; i++)
+      if (x[i] != floor(x[i]) || fabs(x[i]) > (double)INT_MAX)
+        return refuse(p, d, v);
+    if (x[2] < 1 || x[3] < 1)
+      return refuse(p, d, v);
+  } else if (d->id == O_PROJWIN && !(x[0] < x[2] && x[1] > x[3])) {
+    return refuse(p, d, v);
+  } else if (d->id == O_A_ULLR && (x[0] == x[2] || x[1] == x[3])) {
+    return refuse(p, d, v);
+  }
+  b->set = 1;
+  memcpy(b->v, x, sizeof x);
+  return TT_OK;
+}
+
 /* -size N or NXxNY: out is the parameters (nx and ny). */
 static tt_status own_size(tt__app_opt_parse *p, const tt__app_opt_def *d,
                           const char *v, void *out)
@@ -634,5 +719,31 @@ tt_status tt__app_opt_apply(tt__app_opt_parse *p, const tt__app_opt_def *d,
   OPT_SET_GIVEN(p, d->id);
   if ((d->flags & OPT_DECIMATE) && !p->decimate_only)
     p->decimate_only = d->name;
+  return TT_OK;
+}
+
+/* -tin_transform sx,sy,sz,ox,oy,oz: out is the settings (the six numbers
+ * and the flag both go there). */
+static tt_status own_tin_transform(tt__app_opt_parse *p,
+                                   const tt__app_opt_def *d, const char *v,
+                                   void *out)
+{
+  tt_app_settings *s = out;
+  double t[6];
+  const char *at = v;
+  for (int k = 0; k < 6; k++) {
+    char word[64];
+    const char *comma = strchr(at, ',');
+    size_t n = comma ? (size_t)(comma - at) : strlen(at);
+    if ((comma == NULL) != (k == 5) || n == 0 || n >= sizeof word)
+      return refuse(p, d, v);
+    memcpy(word, at, n);
+    word[n] = '\0';
+    if (!tt__app_parse_double(word, &t[k]) || (k < 3 && t[k] == 0))
+      return refuse(p, d, v);
+    at = comma ? comma + 1 : at + n;
+  }
+  memcpy(s->tin_transform, t, sizeof t);
+  s->tin_transform_set = 1;
   return TT_OK;
 }

@@ -224,6 +224,7 @@ static int is_option_word(const char *w)
 static tt_status read_option(tt__app_opt_parse *p, char **argv, size_t *i)
 {
   const char *w = argv[*i], *v = NULL;
+  char joined[512]; /* the words of a value of several (-srcwin's four) */
   const tt__app_opt_def *d = tt__app_find_opt(w), *mine;
   if (!d) {
     const char *near = tt__app_opt_suggest(w, p->o->s.command);
@@ -235,11 +236,31 @@ static tt_status read_option(tt__app_opt_parse *p, char **argv, size_t *i)
   if (!(mine = tt__app_opt_for(d, p->o->s.command)))
     return OPT_USAGE(p, "%s: option %s does not apply to this command%s",
                      p->cmdname, d->name, p->hint);
-  if (tt__app_opt_takes_value(mine)) {
+  int n = tt__app_opt_takes_value(mine);
+  if (n == 1) {
     if (!(v = argv[*i + 1]))
       return OPT_USAGE(p, "%s: option %s needs a value%s", p->cmdname,
                        d->name, p->hint);
     *i += 1;
+  } else if (n > 1) {
+    /* the words of one value (-srcwin's four), joined by spaces: a word
+     * missing, or one that holds a space, refused by the reader */
+    size_t len = 0;
+    for (int k = 1; k <= n; k++) {
+      const char *word = argv[*i + (size_t)k];
+      if (!word || *word == '\0')
+        return OPT_USAGE(p, "%s: option %s needs %d values%s", p->cmdname,
+                         d->name, n, p->hint);
+      int m = snprintf(joined + len, sizeof joined - len, "%s%s",
+                       k > 1 ? " " : "", word);
+      if (m < 0 || (size_t)m >= sizeof joined - len)
+        return OPT_USAGE(p, "%s: option %s: values too long", p->cmdname,
+                         d->name);
+      len += (size_t)m;
+      if (k == n)
+        *i += (size_t)n;
+    }
+    v = joined;
   }
   return tt__app_opt_apply(p, mine, v);
 }
@@ -303,6 +324,8 @@ static void apply_given(tt__app_opt_parse *p)
   }
   if (OPT_GIVEN(p, O_Z_FACTOR))
     s->z_factor_set = 1;
+  if (OPT_GIVEN(p, O_S_SRS))
+    s->srs_is_s_srs = 1;
 }
 
 /* Keeps the positional words where the command's entry in the dispatch
@@ -454,11 +477,36 @@ static tt_status check_generate(tt__app_opt_parse *p)
   return TT_OK;
 }
 
+/* GDAL's input options (dem_view.c): each said once, windows one way. */
+static tt_status check_inputs(tt__app_opt_parse *p)
+{
+  if (OPT_GIVEN(p, O_A_SRS) && OPT_GIVEN(p, O_S_SRS) &&
+      p->o->s.command != TT_APP_GENERATE)
+    return OPT_USAGE(p, "%s: -a_srs and -s_srs both give the DEM's CRS: "
+                     "give one", p->cmdname);
+  if (OPT_GIVEN(p, O_SRCNODATA) && OPT_GIVEN(p, O_A_NODATA))
+    return OPT_USAGE(p, "%s: -a_nodata and -srcnodata are the same option: "
+                     "give one", p->cmdname);
+  if (OPT_GIVEN(p, O_SRCWIN) && OPT_GIVEN(p, O_PROJWIN))
+    return OPT_USAGE(p, "%s: -srcwin and -projwin both give the window: "
+                     "give one", p->cmdname);
+  if (OPT_GIVEN(p, O_PROJWIN_SRS) && !OPT_GIVEN(p, O_PROJWIN))
+    return OPT_USAGE(p, "%s: -projwin_srs is the CRS of -projwin, which is "
+                     "not given", p->cmdname);
+  if (OPT_GIVEN(p, O_PROJWIN) && OPT_GIVEN(p, O_A_ULLR))
+    return OPT_USAGE(p, "%s: -projwin with -a_ullr: the window would be in "
+                     "the coordinates -a_ullr replaces; give the window with "
+                     "-srcwin", p->cmdname);
+  return TT_OK;
+}
+
 /* What concerns several options, then each command's positional words. */
 static tt_status check_line(tt__app_opt_parse *p)
 {
   const tt_app_settings *s = &p->o->s;
   apply_given(p);
+  if (check_inputs(p) != TT_OK)
+    return TT_ERR_ARG;
   if (s->optimize == TT_OPTIMIZE_EDGE_INSERTION &&
       s->criterion != TT_CRITERION_MINMAX_ANGLE)
     return OPT_USAGE(p, "%s: -optimize edge_insertion optimises the Min-Max "

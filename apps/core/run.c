@@ -760,6 +760,8 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   /* --formats: the drivers as this run would see them (after --config) */
   st = cmd ? cmd->run(&r) : tt__app_formats(&r);
 done:
+  tt__app_close_raster(&r, NULL);
+  CSLDestroy(r.view_args);
   tt_context_destroy(r.ctx);
   CPLPopErrorHandler();
   CPLSetErrorHandler(old_handler);

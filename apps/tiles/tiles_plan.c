@@ -80,7 +80,7 @@ static bool read_words(plan_job *j, char **argv, tt_app_result *res)
         tt__tiles_plan_check_words("tiles plan", one, res);
         return false;
       }
-      if (tt__app_opt_takes_value(d) && argv[i + 1])
+      for (int k = tt__app_opt_takes_value(d); k > 0 && argv[i + 1]; k--)
         j->p.options = CSLAddString(j->p.options, argv[++i]);
       continue;
     }
@@ -176,8 +176,29 @@ static bool open_dem(plan_job *j, tt_app_result *res)
                                                : "not a raster GDAL can open");
     return false;
   }
-  size_t W = (size_t)GDALGetRasterXSize(j->ds);
-  size_t H = (size_t)GDALGetRasterYSize(j->ds);
+  /* the tiles of the window GDAL's input options read (dem_view.c) */
+  GDALDatasetH view = NULL;
+  if (tt__app_view_wanted(s)) {
+    char why[TT_APP_MESSAGE_MAX], warn[TT_APP_MESSAGE_MAX];
+    int usage = 0;
+    char **args = tt__app_view_args(s, j->ds, &usage, why, sizeof why, warn,
+                                    sizeof warn);
+    if (args)
+      view = tt__app_view_open(j->ds, args, why, sizeof why);
+    CSLDestroy(args);
+    if (!view) {
+      tt__app_result_set(res, usage ? TT_APP_EXIT_USAGE : TT_APP_EXIT_FAILURE,
+                         usage ? TT_ERR_ARG : TT_ERR_DATA, "tiles plan: %s "
+                         "(DEM %s)", why, j->dem);
+      return false;
+    }
+    if (warn[0] && !j->quiet)
+      fprintf(stderr, "terratin: warning: %s: %s\n", j->dem, warn);
+  }
+  size_t W = (size_t)GDALGetRasterXSize(view ? view : j->ds);
+  size_t H = (size_t)GDALGetRasterYSize(view ? view : j->ds);
+  if (view)
+    GDALClose(view);
   if (W < 2 || H < 2) {
     tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_DATA, "%s: raster is "
                        "%zu x %zu pixels: at least 2 x 2 are needed", j->dem,

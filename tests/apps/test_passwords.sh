@@ -163,7 +163,7 @@ done
 run simplify dem.tif "password=s3cretpw.gpkg"
 check "output password=s3cretpw.gpkg: exit 0" test "$rc" = 0
 check "output password=s3cretpw.gpkg: summary names password=***" \
-  grep -qF "password=***: " out.txt
+  grep -qF "output: password=*** (layers " out.txt
 hidden "output password=s3cretpw.gpkg" s3cr cretpw
 
 echo "$passed passed, $failed failed"

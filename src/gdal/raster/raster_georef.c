@@ -378,8 +378,9 @@ tt_status tt__raster_check_degrees(raster_read *r)
              "longitude/latitude degrees (x %.6g to %.6g, y %.6g to %.6g, "
              "pixels of %.3g): slopes, angles and areas are measured as if "
              "those were the heights' units, which is wrong on the ground; "
-             "give it its CRS, e.g. gdal_translate -of VRT -a_srs "
-             "EPSG:4326 %s dem.vrt, and simplify dem.vrt", r->path, ext[0],
+             "give it its CRS: terratin's -a_srs EPSG:4326, or "
+             "gdal_translate -of VRT -a_srs EPSG:4326 %s dem.vrt", r->path,
+             ext[0],
              ext[1], ext[2], ext[3], hypot(r->gt[1], r->gt[4]), r->path);
     snprintf(r->frame_name, sizeof r->frame_name, "geotransform (no CRS; "
              "its coordinates look like degrees, measured as map units)");

@@ -130,6 +130,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->srcnodata_mag = 0;
   opt->max_memory = 0;
   opt->has_window = 0;
+  opt->source_name = NULL;
+  opt->source_driver = NULL;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
     char *key = NULL;
@@ -207,10 +209,14 @@ static tt_status parse_options(tt_context *ctx, char **options,
           opt->win[k] = (size_t)w[k];
         opt->has_window = 1;
       }
+    } else if (strcasecmp(key, "SOURCE_NAME") == 0) {
+      opt->source_name = value;
+    } else if (strcasecmp(key, "SOURCE_DRIVER") == 0) {
+      opt->source_driver = value;
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
                     "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS, "
-                    "WINDOW)", key);
+                    "WINDOW, SOURCE_NAME, SOURCE_DRIVER)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -350,7 +356,10 @@ static tt_status fill_info(raster_read *r)
   GDALDatasetH ds = r->ds;
   info->path = tt__raster_dup_str(r->path);
   GDALDriverH drv = ds ? GDALGetDatasetDriver(ds) : NULL;
-  info->driver = tt__raster_dup_str(drv ? GDALGetDriverShortName(drv) : "");
+  info->driver = tt__raster_dup_str(
+      r->opt.source_driver ? r->opt.source_driver
+      : drv               ? GDALGetDriverShortName(drv)
+                          : "");
   info->band = GDALGetBandNumber(r->band);
   info->width = r->nx;
   info->height = r->ny;
@@ -406,6 +415,8 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   tt_status s = parse_options(ctx, options, &r.opt);
   if (s != TT_OK)
     goto done;
+  if (r.opt.source_name && *r.opt.source_name)
+    r.path = r.opt.source_name;
   s = check_band_type(&r);
   if (s != TT_OK)
     goto done;

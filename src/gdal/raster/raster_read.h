@@ -46,6 +46,8 @@ typedef struct read_options {
   const char *max_memory_source; /* which limit that is (tt_memory_limit) */
   int has_window;        /* WINDOW=col,row,width,height: a tile's window */
   size_t win[4];
+  const char *source_name;   /* SOURCE_NAME, SOURCE_DRIVER: what a view's */
+  const char *source_driver; /* band is read from; NULL: its dataset's */
 } read_options;
 
 /* Where the raw values of a band of rows are: in the grid itself (bands
