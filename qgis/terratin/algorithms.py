@@ -1,0 +1,691 @@
+"""The terratin algorithms of the Processing toolbox: each builds the
+command line of one terratin command from its parameters, runs it
+(runner.py) and returns the figures the command prints as outputs a model
+can use. Every option maps to the command's option of the same name
+(terratin COMMAND --help, docs/cli.md); a parameter left empty is an
+option not given, so the command's own default holds."""
+import csv
+import os
+
+from qgis.core import (QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm,
+                       QgsProcessingContext, QgsProcessingException,
+                       QgsProcessingOutputBoolean, QgsProcessingOutputFile,
+                       QgsProcessingOutputFolder, QgsProcessingOutputNumber,
+                       QgsProcessingOutputString,
+                       QgsProcessingOutputVectorLayer,
+                       QgsProcessingParameterBand,
+                       QgsProcessingParameterBoolean,
+                       QgsProcessingParameterCrs, QgsProcessingParameterEnum,
+                       QgsProcessingParameterFileDestination,
+                       QgsProcessingParameterFolderDestination,
+                       QgsProcessingParameterMultipleLayers,
+                       QgsProcessingParameterNumber,
+                       QgsProcessingParameterRasterDestination,
+                       QgsProcessingParameterRasterLayer,
+                       QgsProcessingParameterString,
+                       QgsProcessingParameterVectorLayer,
+                       QgsProviderRegistry, QgsVectorLayer)
+
+from . import runner
+
+CRITERIA = ["delaunay", "minmax_angle", "minmax_angle_lex", "min_area",
+            "mean_curvature", "gaussian_curvature", "abn", "abn_sum",
+            "abn_sumsq", "l2"]
+REPAIRS = ["default", "flip", "local", "lookahead", "delaunay"]
+OPTIMIZERS = ["default", "local", "lookahead", "anneal", "edge_insertion",
+              "none"]
+METHODS = ["insert", "decimate"]
+# The outputs simplify and optimize write: OGR vector datasets of several
+# layers and the mesh files QGIS opens as mesh layers (MDAL).
+VECTOR_EXTS = {".gpkg": None, ".shp": None, ".sqlite": None,
+               ".fgb": None, ".geojson": None}
+MESH_EXTS = {".2dm": None, ".ply": None, ".nc": "UGRID"}
+OTHER_EXTS = {".obj": None, ".xml": "LandXML", ".dxf": None}
+TIN_FILTER = ";;".join([
+    "GeoPackage (*.gpkg)", "ESRI Shapefile (*.shp)", "SQLite (*.sqlite)",
+    "FlatGeobuf (*.fgb)", "GeoJSON (*.geojson)",
+    "2DM mesh, QGIS mesh layer (*.2dm)", "PLY mesh (*.ply)",
+    "UGRID netCDF mesh (*.nc)", "Wavefront OBJ (*.obj)",
+    "LandXML 1.2 (*.xml)", "DXF 3DFACE (*.dxf)"])
+STUDY_TERRAINS = ["fault_smooth", "fault_rough", "peak_rough",
+                  "valley_rough", "hybrid", "sphere", "cylinder", "bump"]
+
+
+def _raster_path(alg, parameters, name, context):
+    layer = alg.parameterAsRasterLayer(parameters, name, context)
+    if layer is None:
+        raise QgsProcessingException(
+            "%s: no raster layer" % alg.parameterDefinition(name).description())
+    if layer.providerType() != "gdal":
+        raise QgsProcessingException(
+            "%s: %s is not a file GDAL reads" % (name, layer.source()))
+    return layer.source()
+
+
+def _tin_source(alg, parameters, name, context):
+    """(path, layer name or None) of a vector layer parameter."""
+    layer = alg.parameterAsVectorLayer(parameters, name, context)
+    if layer is None:
+        raise QgsProcessingException(
+            "%s: no vector layer" % alg.parameterDefinition(name).description())
+    if layer.providerType() != "ogr":
+        raise QgsProcessingException(
+            "%s: %s is not a file OGR reads" % (name, layer.source()))
+    parts = QgsProviderRegistry.instance().decodeUri("ogr", layer.source())
+    return parts.get("path") or layer.source(), parts.get("layerName") or None
+
+
+def _format_args(path):
+    """-of for the outputs whose driver the extension does not name."""
+    ext = os.path.splitext(path)[1].lower()
+    of = {**VECTOR_EXTS, **MESH_EXTS, **OTHER_EXTS}.get(ext)
+    return ["-of", of] if of else []
+
+
+def _unused_output(path):
+    if not path:
+        raise QgsProcessingException("OUTPUT: no output file")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        os.makedirs(folder, exist_ok=True)
+
+
+class TerratinAlgorithm(QgsProcessingAlgorithm):
+    """What every terratin algorithm shares: the group, the help and the
+    DEM options (band, nodata, heights)."""
+
+    COMMAND = ""
+    HELP = ""
+
+    def createInstance(self):
+        return type(self)()
+
+    def group(self):
+        return "TIN"
+
+    def groupId(self):
+        return "tin"
+
+    def shortHelpString(self):
+        return self.HELP + (
+            "<p>Runs <code>terratin %s</code> (the terratin on PATH, or "
+            "the one set in Settings &gt; Options &gt; Processing &gt; "
+            "Providers &gt; terratin); <code>terratin %s --help</code> and "
+            "docs/cli.md describe every option.</p>" %
+            (self.COMMAND, self.COMMAND))
+
+    def helpUrl(self):
+        return ""
+
+    def _add_dem_options(self, dem_param, with_band=True):
+        if with_band:
+            self.addParameter(QgsProcessingParameterBand(
+                "BAND", "Band", 1, dem_param, True))
+        p = QgsProcessingParameterNumber(
+            "SRCNODATA", "Height to treat as nodata (empty: the band's)",
+            QgsProcessingParameterNumber.Double, None, True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        p = QgsProcessingParameterNumber(
+            "Z_FACTOR", "Z factor (heights times F, e.g. 0.3048 feet to "
+            "metres)", QgsProcessingParameterNumber.Double, 1.0, False, 1e-12)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        p = QgsProcessingParameterBoolean(
+            "Z_UNIT_M", "Heights declared in feet converted to metres "
+            "(-z_unit m)", False)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+
+    def _dem_args(self, parameters, context):
+        args = []
+        if "BAND" in [d.name() for d in self.parameterDefinitions()]:
+            band = self.parameterAsInt(parameters, "BAND", context)
+            if band > 1:
+                args += ["-b", band]
+        if parameters.get("SRCNODATA") not in (None, ""):
+            args += ["-srcnodata", repr(self.parameterAsDouble(
+                parameters, "SRCNODATA", context))]
+        z = self.parameterAsDouble(parameters, "Z_FACTOR", context)
+        if z != 1.0:
+            args += ["-z_factor", repr(z)]
+        if self.parameterAsBoolean(parameters, "Z_UNIT_M", context):
+            args += ["-z_unit", "m"]
+        return args
+
+    def _optional_number(self, parameters, name, context, option, integer):
+        if parameters.get(name) in (None, ""):
+            return []
+        if integer:
+            return [option, self.parameterAsInt(parameters, name, context)]
+        return [option, repr(self.parameterAsDouble(parameters, name,
+                                                    context))]
+
+
+def _load_tin(path, context, name, output_name):
+    """Loads a TIN file when the run is over: the triangles and vertices
+    layers of a vector dataset (with the style a GeoPackage carries) or a
+    mesh layer; returns the triangles' source for the outputs."""
+    ext = os.path.splitext(path)[1].lower()
+    layers = []
+    tri_source = None
+    if ext in MESH_EXTS:
+        layers.append(QgsMeshLayer(path, name, "mdal"))
+    elif ext == ".shp":
+        base = path[:-4]
+        tri_source = base + "_triangles.shp"
+        layers.append(QgsVectorLayer(tri_source, name + " triangles", "ogr"))
+        layers.append(QgsVectorLayer(base + "_vertices.shp",
+                                     name + " vertices", "ogr"))
+    elif ext in VECTOR_EXTS and ext != ".fgb" and ext != ".geojson":
+        tri_source = path + "|layername=triangles"
+        layers.append(QgsVectorLayer(tri_source, name + " triangles", "ogr"))
+        layers.append(QgsVectorLayer(path + "|layername=vertices",
+                                     name + " vertices", "ogr"))
+    elif ext in (".fgb", ".geojson"):
+        tri_source = path
+        layers.append(QgsVectorLayer(path, name + " triangles", "ogr"))
+    if context is not None:
+        for layer in layers:
+            if not layer.isValid():
+                continue
+            context.temporaryLayerStore().addMapLayer(layer)
+            context.addLayerToLoadOnCompletion(
+                layer.id(), QgsProcessingContext.LayerDetails(
+                    layer.name(), context.project(), output_name))
+    return tri_source
+
+
+def _tin_triangles(path):
+    """The triangles' source of a TIN file (for a model's next step)."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".shp":
+        return path[:-4] + "_triangles.shp"
+    if ext in (".gpkg", ".sqlite"):
+        return path + "|layername=triangles"
+    if ext in (".fgb", ".geojson"):
+        return path
+    return ""
+
+
+class SimplifyAlgorithm(TerratinAlgorithm):
+    COMMAND = "simplify"
+    HELP = (
+        "<p>Simplifies a DEM into a TIN whose vertices are grid samples, "
+        "with an exact error bound: with a max error E every valid sample "
+        "of the DEM lies within E (z units) of the TIN.</p>"
+        "<p><b>Stop</b>: max error, max points, max triangles, percent of "
+        "the samples; they combine and the first reached wins. All empty: "
+        "twice the DEM's mean step between samples.</p>"
+        "<p><b>Method</b>: insert (greedy insertion) or decimate (from a "
+        "fine TIN, deleting the least important vertices; fewer vertices "
+        "at the same bound, slower). <b>Criterion</b>: what the best "
+        "triangulation is (delaunay; l2 is the most accurate). "
+        "<b>Optimiser</b>: a final pass that never lifts an error past "
+        "the bound.</p>"
+        "<p><b>Output</b>: a GeoPackage (layers triangles, vertices, "
+        "run_parameters, with a QGIS style), a Shapefile, SQLite, "
+        "FlatGeobuf or GeoJSON (triangles only), or a mesh (2DM, PLY, "
+        "UGRID .nc: loaded as a mesh layer; OBJ, LandXML, DXF). The "
+        "figures (vertices, triangles, max and RMS error) are outputs.</p>")
+
+    def name(self):
+        return "simplify"
+
+    def displayName(self):
+        return "Simplify DEM to TIN"
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(QgsProcessingParameterRasterLayer("INPUT", "DEM"))
+        self._add_dem_options("INPUT")
+        self.addParameter(QgsProcessingParameterEnum(
+            "METHOD", "Method", METHODS, False, 0))
+        self.addParameter(QgsProcessingParameterEnum(
+            "CRITERION", "Criterion", CRITERIA, False, 0))
+        p = QgsProcessingParameterEnum("REPAIR", "Repair", REPAIRS, False, 0)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        self.addParameter(QgsProcessingParameterEnum(
+            "OPTIMIZE", "Optimiser (final pass)", OPTIMIZERS, False, 0))
+        self.addParameter(QgsProcessingParameterNumber(
+            "MAX_ERROR", "Max error (z units)",
+            QgsProcessingParameterNumber.Double, None, True, 0.0))
+        self.addParameter(QgsProcessingParameterNumber(
+            "MAX_POINTS", "Max points", QgsProcessingParameterNumber.Integer,
+            None, True, 1))
+        self.addParameter(QgsProcessingParameterNumber(
+            "MAX_TRIANGLES", "Max triangles",
+            QgsProcessingParameterNumber.Integer, None, True, 1))
+        self.addParameter(QgsProcessingParameterNumber(
+            "PERCENT", "Percent of the valid samples as vertices",
+            QgsProcessingParameterNumber.Double, None, True, 0.0, 100.0))
+        self.addParameter(QgsProcessingParameterCrs(
+            "T_SRS", "Output CRS (empty: the DEM's)", None, True))
+        for name, desc in (("TILE_SIZE", "Tile size (cells, >= 16; empty: "
+                            "untiled unless the DEM does not fit)"),
+                           ("THREADS", "Threads (empty: the default)"),
+                           ("SEED", "Random seed (annealing)")):
+            p = QgsProcessingParameterNumber(
+                name, desc, QgsProcessingParameterNumber.Integer, None, True,
+                16 if name == "TILE_SIZE" else (1 if name == "THREADS"
+                                                else 0))
+            p.setFlags(p.flags() | p.FlagAdvanced)
+            self.addParameter(p)
+        self.addParameter(QgsProcessingParameterFileDestination(
+            "OUTPUT", "TIN", TIN_FILTER))
+        self.addParameter(QgsProcessingParameterBoolean(
+            "LOAD", "Load the result", True))
+        self.addOutput(QgsProcessingOutputVectorLayer(
+            "TRIANGLES", "Triangles layer (vector outputs)",
+            QgsProcessing.TypeVectorPolygon))
+        for name, desc in (("VERTEX_COUNT", "Vertices"),
+                           ("TRIANGLE_COUNT", "Triangles"),
+                           ("MAX_ERROR_ACHIEVED", "Max error achieved"),
+                           ("RMSE", "RMS error")):
+            self.addOutput(QgsProcessingOutputNumber(name, desc))
+
+    def processAlgorithm(self, parameters, context, feedback):
+        dem = _raster_path(self, parameters, "INPUT", context)
+        out = self.parameterAsFileOutput(parameters, "OUTPUT", context)
+        _unused_output(out)
+        args = ["simplify"] + self._dem_args(parameters, context)
+        method = METHODS[self.parameterAsEnum(parameters, "METHOD", context)]
+        if method != "insert":
+            args += ["-method", method]
+        criterion = CRITERIA[self.parameterAsEnum(parameters, "CRITERION",
+                                                  context)]
+        if criterion != "delaunay":
+            args += ["-criterion", criterion]
+        repair = REPAIRS[self.parameterAsEnum(parameters, "REPAIR", context)]
+        if repair != "default":
+            args += ["-repair", repair]
+        optimize = OPTIMIZERS[self.parameterAsEnum(parameters, "OPTIMIZE",
+                                                   context)]
+        if optimize != "default":
+            args += ["-optimize", optimize]
+        args += self._optional_number(parameters, "MAX_ERROR", context,
+                                      "-max_error", False)
+        args += self._optional_number(parameters, "MAX_POINTS", context,
+                                      "-max_points", True)
+        args += self._optional_number(parameters, "MAX_TRIANGLES", context,
+                                      "-max_triangles", True)
+        args += self._optional_number(parameters, "PERCENT", context,
+                                      "-percent", False)
+        args += self._optional_number(parameters, "TILE_SIZE", context,
+                                      "-tile_size", True)
+        args += self._optional_number(parameters, "THREADS", context,
+                                      "-threads", True)
+        args += self._optional_number(parameters, "SEED", context, "-seed",
+                                      True)
+        crs = self.parameterAsCrs(parameters, "T_SRS", context)
+        if crs.isValid():
+            args += ["-t_srs", crs.authid() or crs.toWkt()]
+        args += _format_args(out) + ["-overwrite", dem, out]
+        rc, summary = runner.run(args, feedback)
+        figures = _summary_figures(summary)
+        figures.update(_run_parameters(out))
+        results = {"OUTPUT": out, "TRIANGLES": _tin_triangles(out)}
+        results.update(figures)
+        if self.parameterAsBoolean(parameters, "LOAD", context):
+            _load_tin(out, context, os.path.splitext(
+                os.path.basename(out))[0], "OUTPUT")
+        return results
+
+
+def _summary_figures(lines):
+    """The counts and errors of simplify's summary (the figures of an
+    output without a run_parameters layer: mesh files)."""
+    import re
+    figures = {}
+    for line in lines:
+        m = re.search(r"(\d+) vertices .*?(\d+) triangles", line)
+        if line.startswith("output:") and m:
+            figures["VERTEX_COUNT"] = int(m.group(1))
+            figures["TRIANGLE_COUNT"] = int(m.group(2))
+        m = re.search(r"max ([-0-9.eE+]+).*RMS ([-0-9.eE+]+)", line)
+        if line.startswith("error:") and m:
+            figures["MAX_ERROR_ACHIEVED"] = float(m.group(1))
+            figures["RMSE"] = float(m.group(2))
+    return figures
+
+
+def _run_parameters(path):
+    """The figures of the run_parameters layer, in full precision, when the
+    output has it."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext in (".gpkg", ".sqlite"):
+        source = path + "|layername=run_parameters"
+    elif ext == ".shp":
+        source = path[:-4] + "_run_parameters.dbf"
+    else:
+        return {}
+    layer = QgsVectorLayer(source, "run_parameters", "ogr")
+    if not layer.isValid():
+        return {}
+    for f in layer.getFeatures():
+        return {"VERTEX_COUNT": int(f["vertices"]),
+                "TRIANGLE_COUNT": int(f["triangles"]),
+                "MAX_ERROR_ACHIEVED": float(f["ach_max"]),
+                "RMSE": float(f["ach_rmse"])}
+    return {}
+
+
+class EvalAlgorithm(TerratinAlgorithm):
+    COMMAND = "eval"
+    HELP = (
+        "<p>Measures a layer of triangles (from terratin or any other "
+        "tool, in the DEM's CRS) against the DEM: the error |DEM - TIN| "
+        "over every valid sample (max, RMS, mean and total absolute, L2, "
+        "where the max is) and the coverage (samples covered, uncovered, "
+        "overlapped; polygons that are not triangles). Every figure is an "
+        "output a model can use.</p>"
+        "<p><b>Check against</b>: a max error the TIN must meet; the "
+        "output PASS says whether it does (the run does not fail).</p>"
+        "<p><b>Error raster</b>: TIN - DEM on the DEM's grid, a GeoTIFF "
+        "(NaN outside the TIN).</p>")
+
+    FIGURES = (("MAX_ERROR", "max_error", "Max error"),
+               ("RMSE", "rmse", "RMS error"),
+               ("MEAN_ABS_ERROR", "mean_abs_error", "Mean absolute error"),
+               ("TOTAL_ABS_ERROR", "total_abs_error",
+                "Total absolute error"),
+               ("L2", "l2", "L2 error"),
+               ("TRIANGLE_COUNT", "triangles", "Triangles"),
+               ("REJECTED", "rejected", "Polygons rejected (not triangles)"),
+               ("DEGENERATE", "degenerate", "Degenerate triangles"),
+               ("VALID_SAMPLES", "valid_samples", "Valid samples"),
+               ("COVERED", "covered", "Samples covered"),
+               ("UNCOVERED", "uncovered", "Samples uncovered"),
+               ("OVERLAPPED", "overlapped", "Samples overlapped"))
+
+    def name(self):
+        return "eval"
+
+    def displayName(self):
+        return "Measure TIN against DEM"
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(QgsProcessingParameterRasterLayer("DEM", "DEM"))
+        self.addParameter(QgsProcessingParameterVectorLayer(
+            "TIN", "TIN (triangles)", [QgsProcessing.TypeVectorPolygon]))
+        self._add_dem_options("DEM")
+        self.addParameter(QgsProcessingParameterNumber(
+            "CHECK_MAX_ERROR", "Check against max error (empty: no check)",
+            QgsProcessingParameterNumber.Double, None, True, 0.0))
+        self.addParameter(QgsProcessingParameterRasterDestination(
+            "ERROR_RASTER", "Error raster (TIN - DEM, GeoTIFF)", None, True,
+            False))
+        for name, _, desc in self.FIGURES:
+            self.addOutput(QgsProcessingOutputNumber(name, desc))
+        self.addOutput(QgsProcessingOutputNumber("MAX_ERROR_X",
+                                                 "Max error at x"))
+        self.addOutput(QgsProcessingOutputNumber("MAX_ERROR_Y",
+                                                 "Max error at y"))
+        self.addOutput(QgsProcessingOutputBoolean(
+            "PASS", "Within the max error checked"))
+        self.addOutput(QgsProcessingOutputString("Z_UNIT", "Height unit"))
+
+    def processAlgorithm(self, parameters, context, feedback):
+        dem = _raster_path(self, parameters, "DEM", context)
+        tin, layer = _tin_source(self, parameters, "TIN", context)
+        args = ["eval", dem, tin] + self._dem_args(parameters, context)
+        if layer:
+            args += ["-layer", layer]
+        args += self._optional_number(parameters, "CHECK_MAX_ERROR",
+                                      context, "-max_error", False)
+        raster = None
+        if parameters.get("ERROR_RASTER") not in (None, ""):
+            raster = self.parameterAsOutputLayer(parameters, "ERROR_RASTER",
+                                                 context)
+        if raster:
+            if os.path.splitext(raster)[1].lower() not in (".tif", ".tiff"):
+                raise QgsProcessingException(
+                    "ERROR_RASTER: %s: the error raster is a GeoTIFF "
+                    "(.tif)" % raster)
+            _unused_output(raster)
+            args += ["-error_raster", raster, "-overwrite"]
+        rc, obj = runner.run_json(args, feedback)
+        results = {name: obj.get(key) for name, key, _ in self.FIGURES}
+        at = obj.get("max_error_at") or {}
+        results["MAX_ERROR_X"] = at.get("x")
+        results["MAX_ERROR_Y"] = at.get("y")
+        results["PASS"] = rc == 0
+        results["Z_UNIT"] = obj.get("z_unit") or ""
+        if rc == 3:
+            feedback.pushWarning(
+                "the max error %s exceeds %s" % (obj.get("max_error"),
+                                                 obj.get("threshold")))
+        if raster:
+            results["ERROR_RASTER"] = raster
+        return results
+
+
+class RasterizeAlgorithm(TerratinAlgorithm):
+    COMMAND = "rasterize"
+    HELP = (
+        "<p>Writes the surface of a layer of triangles on the grid of the "
+        "DEM: at every sample centre in a triangle, the linear "
+        "interpolation of its corners' heights; nodata (NaN) outside the "
+        "TIN. One band, the DEM's size, geotransform and CRS; the driver "
+        "is the one the output's extension names (GeoTIFF otherwise).</p>"
+        "<p>The samples covered and the error against the DEM (as "
+        "'Measure TIN against DEM' measures it) are outputs.</p>")
+
+    def name(self):
+        return "rasterize"
+
+    def displayName(self):
+        return "Rasterize TIN"
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(QgsProcessingParameterVectorLayer(
+            "TIN", "TIN (triangles)", [QgsProcessing.TypeVectorPolygon]))
+        self.addParameter(QgsProcessingParameterRasterLayer(
+            "DEM", "DEM (the grid)"))
+        self._add_dem_options("DEM")
+        self.addParameter(QgsProcessingParameterRasterDestination(
+            "OUTPUT", "Surface raster"))
+        for name, desc in (("COVERED", "Samples covered"),
+                           ("MAX_ERROR", "Max error against the DEM"),
+                           ("RMSE", "RMS error against the DEM"),
+                           ("TRIANGLE_COUNT", "Triangles")):
+            self.addOutput(QgsProcessingOutputNumber(name, desc))
+
+    def processAlgorithm(self, parameters, context, feedback):
+        tin, layer = _tin_source(self, parameters, "TIN", context)
+        dem = _raster_path(self, parameters, "DEM", context)
+        out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
+        _unused_output(out)
+        args = ["rasterize", tin, dem, out] + self._dem_args(parameters,
+                                                             context)
+        if layer:
+            args += ["-layer", layer]
+        args += ["-overwrite"]
+        rc, obj = runner.run_json(args, feedback)
+        return {"OUTPUT": out, "COVERED": obj.get("covered"),
+                "MAX_ERROR": obj.get("max_error"), "RMSE": obj.get("rmse"),
+                "TRIANGLE_COUNT": obj.get("triangles")}
+
+
+class OptimizeAlgorithm(TerratinAlgorithm):
+    COMMAND = "optimize"
+    HELP = (
+        "<p>Keeps a TIN's vertices (DEM samples) and outline and "
+        "re-triangulates it for a criterion, never letting an error pass "
+        "the bound (default: the input TIN's own max error, which thus "
+        "never grows). Writes the layers simplify writes.</p>"
+        "<p>The errors before and after are outputs.</p>")
+
+    def name(self):
+        return "optimize"
+
+    def displayName(self):
+        return "Re-optimise a TIN"
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(QgsProcessingParameterRasterLayer("DEM", "DEM"))
+        self.addParameter(QgsProcessingParameterVectorLayer(
+            "TIN", "TIN (triangles)", [QgsProcessing.TypeVectorPolygon]))
+        self._add_dem_options("DEM")
+        self.addParameter(QgsProcessingParameterEnum(
+            "CRITERION", "Criterion", CRITERIA, False, 0))
+        self.addParameter(QgsProcessingParameterEnum(
+            "OPTIMIZE", "Optimiser", OPTIMIZERS[1:5], False, 0))
+        self.addParameter(QgsProcessingParameterNumber(
+            "MAX_ERROR", "Max error bound (empty: the input's own)",
+            QgsProcessingParameterNumber.Double, None, True, 0.0))
+        p = QgsProcessingParameterNumber(
+            "SEED", "Random seed (annealing)",
+            QgsProcessingParameterNumber.Integer, None, True, 0)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        self.addParameter(QgsProcessingParameterFileDestination(
+            "OUTPUT", "Optimised TIN", TIN_FILTER))
+        self.addParameter(QgsProcessingParameterBoolean(
+            "LOAD", "Load the result", True))
+        self.addOutput(QgsProcessingOutputVectorLayer(
+            "TRIANGLES", "Triangles layer (vector outputs)",
+            QgsProcessing.TypeVectorPolygon))
+        for name, desc in (("VERTEX_COUNT", "Vertices"),
+                           ("TRIANGLE_COUNT", "Triangles"),
+                           ("MAX_ERROR_BEFORE", "Max error before"),
+                           ("MAX_ERROR_AFTER", "Max error after"),
+                           ("RMSE_BEFORE", "RMS error before"),
+                           ("RMSE_AFTER", "RMS error after"),
+                           ("MEAN_ABS_ERROR_BEFORE", "Mean abs error before"),
+                           ("MEAN_ABS_ERROR_AFTER", "Mean abs error after"),
+                           ("L2_BEFORE", "L2 error before"),
+                           ("L2_AFTER", "L2 error after")):
+            self.addOutput(QgsProcessingOutputNumber(name, desc))
+
+    def processAlgorithm(self, parameters, context, feedback):
+        dem = _raster_path(self, parameters, "DEM", context)
+        tin, layer = _tin_source(self, parameters, "TIN", context)
+        out = self.parameterAsFileOutput(parameters, "OUTPUT", context)
+        _unused_output(out)
+        args = ["optimize", dem, tin, out] + self._dem_args(parameters,
+                                                            context)
+        if layer:
+            args += ["-layer", layer]
+        criterion = CRITERIA[self.parameterAsEnum(parameters, "CRITERION",
+                                                  context)]
+        args += ["-criterion", criterion, "-optimize", OPTIMIZERS[
+            1 + self.parameterAsEnum(parameters, "OPTIMIZE", context)]]
+        args += self._optional_number(parameters, "MAX_ERROR", context,
+                                      "-max_error", False)
+        args += self._optional_number(parameters, "SEED", context, "-seed",
+                                      True)
+        args += _format_args(out) + ["-overwrite"]
+        rc, obj = runner.run_json(args, feedback)
+        before, after = obj.get("before") or {}, obj.get("after") or {}
+        results = {"OUTPUT": out, "TRIANGLES": _tin_triangles(out),
+                   "VERTEX_COUNT": obj.get("vertices"),
+                   "TRIANGLE_COUNT": obj.get("triangles")}
+        for key, name in (("max_error", "MAX_ERROR"), ("rmse", "RMSE"),
+                          ("mean_abs_error", "MEAN_ABS_ERROR"),
+                          ("l2", "L2")):
+            results[name + "_BEFORE"] = before.get(key)
+            results[name + "_AFTER"] = after.get(key)
+        if self.parameterAsBoolean(parameters, "LOAD", context):
+            _load_tin(out, context, os.path.splitext(
+                os.path.basename(out))[0], "OUTPUT")
+        return results
+
+
+class StudyAlgorithm(TerratinAlgorithm):
+    COMMAND = "study"
+    HELP = (
+        "<p>Compares criteria (and methods, optimisers) over terrains: "
+        "every terrain x method x optimiser x checkpoint x criterion run as "
+        "'Simplify DEM to TIN' with a percent would run it. Terrains: DEM "
+        "layers and/or the study's generated terrains.</p>"
+        "<p>Writes into the output folder curves.csv (a row per run: "
+        "points, max error, L2, RMS, mean and total absolute error), "
+        "tables.md (the mean absolute error per percentage and criterion) "
+        "and runs.json; with 'Plots', plots/*.png (needs Python 3 with "
+        "matplotlib). curves.csv is loaded as a table.</p>")
+
+    def name(self):
+        return "study"
+
+    def displayName(self):
+        return "Compare criteria"
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(QgsProcessingParameterMultipleLayers(
+            "TERRAINS", "DEMs", QgsProcessing.TypeRaster, None, True))
+        self.addParameter(QgsProcessingParameterEnum(
+            "GENERATED", "Generated terrains", STUDY_TERRAINS, True, None,
+            True))
+        self.addParameter(QgsProcessingParameterEnum(
+            "CRITERIA", "Criteria (none: all)", CRITERIA, True, None, True))
+        self.addParameter(QgsProcessingParameterEnum(
+            "METHODS", "Methods (none: insert)", METHODS, True, None, True))
+        self.addParameter(QgsProcessingParameterEnum(
+            "OPTIMIZERS", "Optimisers (none: each criterion's default)",
+            ["auto"] + OPTIMIZERS[1:], True, None, True))
+        self.addParameter(QgsProcessingParameterString(
+            "PERCENT", "Checkpoints, % of the valid samples (comma "
+            "separated)", "1,10,25,50", False, True))
+        self.addParameter(QgsProcessingParameterNumber(
+            "POINTS", "Curves up to N points (empty: none)",
+            QgsProcessingParameterNumber.Integer, None, True, 1))
+        p = QgsProcessingParameterNumber(
+            "SEED", "Seed of the generated terrains",
+            QgsProcessingParameterNumber.Integer, None, True, 0)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        self.addParameter(QgsProcessingParameterBoolean(
+            "PLOT", "Plots (PNG, needs matplotlib)", False))
+        self.addParameter(QgsProcessingParameterFolderDestination(
+            "OUTPUT", "Output folder"))
+        self.addOutput(QgsProcessingOutputFile("CURVES", "curves.csv"))
+        self.addOutput(QgsProcessingOutputFile("TABLES", "tables.md"))
+        self.addOutput(QgsProcessingOutputFolder("PLOTS", "Plots folder"))
+        self.addOutput(QgsProcessingOutputNumber("RUNS", "Runs"))
+
+    def processAlgorithm(self, parameters, context, feedback):
+        out = self.parameterAsString(parameters, "OUTPUT", context)
+        if not out or out == QgsProcessing.TEMPORARY_OUTPUT:
+            out = self.parameterAsFileOutput(parameters, "OUTPUT", context)
+        args = ["study"]
+        for layer in self.parameterAsLayerList(parameters, "TERRAINS",
+                                               context):
+            args += ["-terrain", layer.source()]
+        for i in self.parameterAsEnums(parameters, "GENERATED", context):
+            args += ["-terrain", STUDY_TERRAINS[i]]
+        if "-terrain" not in args:
+            raise QgsProcessingException(
+                "TERRAINS: give at least one DEM or generated terrain")
+        for name, option, values in (
+                ("CRITERIA", "-criteria", CRITERIA),
+                ("METHODS", "-methods", METHODS),
+                ("OPTIMIZERS", "-optimizers", ["auto"] + OPTIMIZERS[1:])):
+            chosen = self.parameterAsEnums(parameters, name, context)
+            if chosen:
+                args += [option, ",".join(values[i] for i in chosen)]
+        percent = (self.parameterAsString(parameters, "PERCENT", context)
+                   or "").replace(" ", "")
+        points = self._optional_number(parameters, "POINTS", context,
+                                       "-points", True)
+        if percent and not (points and parameters.get("PERCENT") is None):
+            args += ["-percent", percent]
+        args += points
+        args += self._optional_number(parameters, "SEED", context, "-seed",
+                                      True)
+        if self.parameterAsBoolean(parameters, "PLOT", context):
+            args += ["-plot"]
+        args += ["-overwrite", out]
+        rc, summary = runner.run(args, feedback)
+        curves = os.path.join(out, "curves.csv")
+        with open(curves, newline="") as f:
+            runs = sum(1 for _ in csv.DictReader(f))
+        table = QgsVectorLayer(curves, "curves", "ogr")
+        if table.isValid() and context is not None:
+            context.temporaryLayerStore().addMapLayer(table)
+            context.addLayerToLoadOnCompletion(
+                table.id(), QgsProcessingContext.LayerDetails(
+                    "study curves", context.project(), "CURVES"))
+        return {"OUTPUT": out, "CURVES": curves,
+                "TABLES": os.path.join(out, "tables.md"),
+                "PLOTS": os.path.join(out, "plots"), "RUNS": runs}
