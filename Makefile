@@ -18,7 +18,7 @@ DEB_PKGS   := cmake make gcc g++ pkg-config libgdal-dev libproj-dev gdal-bin lib
 DEMO_IN    ?= testdata/jacksboro_fault_dem.tif
 DEMO_OUT   ?= demo-out/jacksboro_tin.gpkg
 
-.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study doc-tables
+.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study doc-tables qgis-plugin
 
 all: build
 
@@ -87,6 +87,11 @@ study: build
 # The tables of docs/ that scripts print, rerun in place (README "Tests").
 doc-tables: build
 	bench/doc_tables.py --update --tier long $(BUILD)/terratin
+
+# The QGIS plugin (qgis/terratin/, docs/qgis.md) as the zip QGIS's
+# "Install from ZIP" takes.
+qgis-plugin:
+	python3 tools/qgis_plugin_zip.py $(BUILD)/terratin-qgis.zip
 
 clean:
 	rm -rf $(BUILD) $(BUILD_SAN) demo-out

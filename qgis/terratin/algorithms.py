@@ -128,12 +128,12 @@ class TerratinAlgorithm(QgsProcessingAlgorithm):
         self.addParameter(p)
         p = QgsProcessingParameterNumber(
             "Z_FACTOR", "Z factor (heights times F, e.g. 0.3048 feet to "
-            "metres)", QgsProcessingParameterNumber.Double, 1.0, False, 1e-12)
+            "metres)", QgsProcessingParameterNumber.Double, 1.0, True, 1e-12)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
         p = QgsProcessingParameterBoolean(
             "Z_UNIT_M", "Heights declared in feet converted to metres "
-            "(-z_unit m)", False)
+            "(-z_unit m)", False, True)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
 
@@ -239,14 +239,15 @@ class SimplifyAlgorithm(TerratinAlgorithm):
         self.addParameter(QgsProcessingParameterRasterLayer("INPUT", "DEM"))
         self._add_dem_options("INPUT")
         self.addParameter(QgsProcessingParameterEnum(
-            "METHOD", "Method", METHODS, False, 0))
+            "METHOD", "Method", METHODS, False, 0, True))
         self.addParameter(QgsProcessingParameterEnum(
-            "CRITERION", "Criterion", CRITERIA, False, 0))
-        p = QgsProcessingParameterEnum("REPAIR", "Repair", REPAIRS, False, 0)
+            "CRITERION", "Criterion", CRITERIA, False, 0, True))
+        p = QgsProcessingParameterEnum("REPAIR", "Repair", REPAIRS, False, 0, True)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
         self.addParameter(QgsProcessingParameterEnum(
-            "OPTIMIZE", "Optimiser (final pass)", OPTIMIZERS, False, 0))
+            "OPTIMIZE", "Optimiser (final pass)", OPTIMIZERS, False, 0,
+            True))
         self.addParameter(QgsProcessingParameterNumber(
             "MAX_ERROR", "Max error (z units)",
             QgsProcessingParameterNumber.Double, None, True, 0.0))
@@ -274,7 +275,7 @@ class SimplifyAlgorithm(TerratinAlgorithm):
         self.addParameter(QgsProcessingParameterFileDestination(
             "OUTPUT", "TIN", TIN_FILTER))
         self.addParameter(QgsProcessingParameterBoolean(
-            "LOAD", "Load the result", True))
+            "LOAD", "Load the result", True, True))
         self.addOutput(QgsProcessingOutputVectorLayer(
             "TRIANGLES", "Triangles layer (vector outputs)",
             QgsProcessing.TypeVectorPolygon))
@@ -528,9 +529,9 @@ class OptimizeAlgorithm(TerratinAlgorithm):
             "TIN", "TIN (triangles)", [QgsProcessing.TypeVectorPolygon]))
         self._add_dem_options("DEM")
         self.addParameter(QgsProcessingParameterEnum(
-            "CRITERION", "Criterion", CRITERIA, False, 0))
+            "CRITERION", "Criterion", CRITERIA, False, 0, True))
         self.addParameter(QgsProcessingParameterEnum(
-            "OPTIMIZE", "Optimiser", OPTIMIZERS[1:5], False, 0))
+            "OPTIMIZE", "Optimiser", OPTIMIZERS[1:5], False, 0, True))
         self.addParameter(QgsProcessingParameterNumber(
             "MAX_ERROR", "Max error bound (empty: the input's own)",
             QgsProcessingParameterNumber.Double, None, True, 0.0))
@@ -542,7 +543,7 @@ class OptimizeAlgorithm(TerratinAlgorithm):
         self.addParameter(QgsProcessingParameterFileDestination(
             "OUTPUT", "Optimised TIN", TIN_FILTER))
         self.addParameter(QgsProcessingParameterBoolean(
-            "LOAD", "Load the result", True))
+            "LOAD", "Load the result", True, True))
         self.addOutput(QgsProcessingOutputVectorLayer(
             "TRIANGLES", "Triangles layer (vector outputs)",
             QgsProcessing.TypeVectorPolygon))
@@ -636,7 +637,7 @@ class StudyAlgorithm(TerratinAlgorithm):
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
         self.addParameter(QgsProcessingParameterBoolean(
-            "PLOT", "Plots (PNG, needs matplotlib)", False))
+            "PLOT", "Plots (PNG, needs matplotlib)", False, True))
         self.addParameter(QgsProcessingParameterFolderDestination(
             "OUTPUT", "Output folder"))
         self.addOutput(QgsProcessingOutputFile("CURVES", "curves.csv"))
