@@ -199,6 +199,8 @@ def run(args, feedback, bar=True):
         message = "\n".join(errors) or (
             "terratin %s: failed with exit code %d" % (args[0], rc))
         raise QgsProcessingException(message)
+    for line in errors:
+        feedback.pushWarning(line)
     if bar:
         feedback.setProgress(100)
         return rc, summary
@@ -220,14 +222,16 @@ def run_json(args, feedback):
 
 
 def _err_line(raw, errors, feedback):
+    """A line of stderr: "terratin: warning: ..." shown as a warning as it
+    comes; the others (the error that ends a failed run) kept for the
+    exception, or shown as warnings after a run that succeeds."""
     line = raw.decode("utf-8", "replace").rstrip("\r")
     if not line.strip():
         return
-    errors.append(line)
-    if "warning" in line.lower():
+    if ": warning: " in line or line.startswith("warning: "):
         feedback.pushWarning(line)
     else:
-        feedback.reportError(line, False)
+        errors.append(line)
 
 
 def _wait(proc):
