@@ -6,6 +6,7 @@ can use. Every option maps to the command's option of the same name
 option not given, so the command's own default holds."""
 import csv
 import os
+import re
 
 from qgis.core import (QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm,
                        QgsProcessingContext, QgsProcessingException,
@@ -336,7 +337,6 @@ class SimplifyAlgorithm(TerratinAlgorithm):
 def _summary_figures(lines):
     """The counts and errors of simplify's summary (the figures of an
     output without a run_parameters layer: mesh files)."""
-    import re
     figures = {}
     for line in lines:
         m = re.search(r"(\d+) vertices .*?(\d+) triangles", line)
@@ -497,8 +497,13 @@ class RasterizeAlgorithm(TerratinAlgorithm):
         dem = _raster_path(self, parameters, "DEM", context)
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
         _unused_output(out)
-        args = ["rasterize", tin, dem, out] + self._dem_args(parameters,
-                                                             context)
+        # rasterize TIN DEM OUTPUT; a terratin whose usage says DEM TIN
+        # OUTPUT gets them in that order
+        if re.search(r"rasterize\s+DEM\s+TIN", runner.usage_of("rasterize")):
+            args = ["rasterize", dem, tin, out]
+        else:
+            args = ["rasterize", tin, dem, out]
+        args += self._dem_args(parameters, context)
         if layer:
             args += ["-layer", layer]
         args += ["-overwrite"]

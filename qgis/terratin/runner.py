@@ -78,6 +78,23 @@ def checked_executable():
     return path
 
 
+_usages = {}
+
+
+def usage_of(command):
+    """The usage lines of `terratin COMMAND --help` (to follow the
+    arguments' order of the binary that runs), cached as the version."""
+    path = checked_executable()
+    key = (path, os.stat(path).st_mtime, command)
+    if key not in _usages:
+        out = subprocess.run([path, command, "--help"],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             timeout=30)
+        text = out.stdout.decode("utf-8", "replace")
+        _usages[key] = text.split("\n\n")[0]
+    return _usages[key]
+
+
 def installed_version():
     """The --version line of the terratin that would run, or None."""
     try:

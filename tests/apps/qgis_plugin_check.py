@@ -165,7 +165,74 @@ def check_simplify():
     check("simplify 2DM: one mesh layer to load (%s)" % layers,
           len(layers) == 1 and isinstance(layers[0], QgsMeshLayer) and
           layers[0].dataProvider().faceCount() == j["triangles"])
+    check_simplify_options()
     return out
+
+
+def check_simplify_options():
+    """Option sets through the dialog's parameters, each against the
+    command line given the same options."""
+    runs = [
+        ({"METHOD": 1, "MAX_ERROR": 20, "TILE_SIZE": 128,
+          "T_SRS": "EPSG:32616"},
+         ["-method", "decimate", "-max_error", 20, "-tile_size", 128,
+          "-t_srs", "EPSG:32616"]),
+        ({"MAX_ERROR": 20, "SRCNODATA": 300, "Z_FACTOR": 0.5,
+          "THREADS": 2, "CRITERION": 1, "REPAIR": 3, "OPTIMIZE": 2},
+         ["-max_error", 20, "-srcnodata", 300, "-z_factor", 0.5,
+          "-threads", 2, "-criterion", "minmax_angle", "-repair",
+          "lookahead", "-optimize", "lookahead"]),
+        ({"PERCENT": 3, "MAX_TRIANGLES": 5000, "OUTPUT_EXT": ".shp"},
+         ["-percent", 3, "-max_triangles", 5000]),
+    ]
+    for i, (params, options) in enumerate(runs):
+        ext = params.pop("OUTPUT_EXT", ".gpkg")
+        out = os.path.join(W, "opt%d%s" % (i, ext))
+        params.update({"INPUT": DEM, "OUTPUT": out, "LOAD": False})
+        r = processing.run("terratin:simplify", params)
+        rc, j = cli("simplify", DEM, os.path.join(W, "opt%d_cli%s" %
+                                                  (i, ext)), *options)
+        got = tuple(r.get(k) for k in ("VERTEX_COUNT", "TRIANGLE_COUNT",
+                                       "MAX_ERROR_ACHIEVED", "RMSE"))
+        want = (j["vertices"], j["triangles"], j["max_error"], j["rmse"])
+        check("simplify %s: %s (command line %s)" % (
+            " ".join(str(o) for o in options), got, want), got == want)
+        tl = QgsVectorLayer(r["TRIANGLES"], "t", "ogr")
+        check("simplify %s: the triangles layer %s in %s" % (
+            options[:2], r["TRIANGLES"], tl.crs().authid()),
+            tl.isValid() and tl.featureCount() == j["triangles"] and
+            tl.crs().authid() == ("EPSG:32616" if "-t_srs" in options
+                                  else "EPSG:4326"))
+
+
+def check_task():
+    """A run as the dialog (and batch mode) makes it: a task on QGIS's
+    task manager, the algorithm in another thread."""
+    from qgis.core import QgsProcessingAlgRunnerTask, QgsTask
+    alg = QgsApplication.processingRegistry().createAlgorithmById(
+        "terratin:simplify")
+    context = QgsProcessingContext()
+    context.setProject(QgsProject.instance())
+    fb = Feedback()
+    out = os.path.join(W, "task.gpkg")
+    results = {}
+    task = QgsProcessingAlgRunnerTask(alg, {"INPUT": DEM, "MAX_POINTS": 3000,
+                                            "OUTPUT": out}, context, fb)
+    task.executed.connect(lambda ok, res: results.update(ok=ok, res=res))
+    QgsApplication.taskManager().addTask(task)
+    import time
+    deadline = time.monotonic() + 60
+    while "ok" not in results and time.monotonic() < deadline:
+        QgsApplication.processEvents()
+        time.sleep(0.02)
+    rc, j = cli("simplify", DEM, os.path.join(W, "task_cli.gpkg"),
+                "-max_points", 3000)
+    res = results.get("res") or {}
+    check("a task in another thread: %s, %s vertices (command line %s)" % (
+        results.get("ok"), res.get("VERTEX_COUNT"), j["vertices"]),
+        results.get("ok") is True and res.get("VERTEX_COUNT") ==
+        j["vertices"] and fb.values and fb.values[-1] == 100)
+    del task
 
 
 def check_eval(tin):
@@ -294,6 +361,27 @@ def check_error():
     r = processing.run("terratin:simplify", {"INPUT": DEM, "MAX_POINTS": 100,
                                              "OUTPUT": out})
     check("the setting's terratin runs", r.get("VERTEX_COUNT") == 100)
+    # a terratin whose rasterize takes DEM TIN OUTPUT (its usage says so):
+    # the plugin follows the usage
+    swapped = os.path.join(W, "swapped_terratin")
+    with open(swapped, "w") as f:
+        f.write('#!/bin/sh\n'
+                'if [ "$1" = rasterize ] && [ "$2" = --help ]; then\n'
+                '  echo "Usage: terratin rasterize DEM TIN OUTPUT"; exit 0\n'
+                'fi\n'
+                'if [ "$1" = rasterize ]; then\n'
+                '  shift; d=$1; t=$2; shift 2\n'
+                '  exec "%s" rasterize "$t" "$d" "$@"\n'
+                'fi\n'
+                'exec "%s" "$@"\n' % (T, T))
+    os.chmod(swapped, 0o755)
+    ProcessingConfig.setSettingValue("TERRATIN_PATH", swapped)
+    tin = os.path.join(W, "s.gpkg")
+    r = processing.run("terratin:rasterize", {
+        "TIN": tin, "DEM": DEM, "OUTPUT": os.path.join(W, "swapped.tif")})
+    rc, j = cli("rasterize", tin, DEM, os.path.join(W, "swapped_cli.tif"))
+    check("rasterize DEM TIN OUTPUT followed from the usage (%s, %s)" % (
+        r.get("COVERED"), j["covered"]), r.get("COVERED") == j["covered"])
     ProcessingConfig.setSettingValue("TERRATIN_PATH", "")
 
 
@@ -369,6 +457,7 @@ def check_model():
 def main():
     install()
     tin = check_simplify()
+    check_task()
     check_eval(tin)
     check_rasterize(tin)
     check_optimize(tin)
