@@ -12,6 +12,7 @@ taken in QGIS (run under Xvfb: xvfb-run -a /usr/bin/python3 ...):
 The plugin is loaded from qgis/terratin/ of this tree, the run is
 processing.run() as the dialog's Run button does it."""
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -31,6 +32,9 @@ from qgis.PyQt.QtCore import QSize  # noqa: E402
 from qgis.PyQt.QtGui import QColor  # noqa: E402
 
 work = tempfile.mkdtemp(prefix="tt_qgis_shots.")
+# a copy: QGIS's statistics of a raster layer go to a .aux.xml beside it
+shutil.copy(DEM, os.path.join(work, "jacksboro_fault_dem.tif"))
+DEM = os.path.join(work, "jacksboro_fault_dem.tif")
 app = QgsApplication([], True, os.path.join(work, "profile"))
 app.initQgis()
 from processing.core.Processing import Processing  # noqa: E402
@@ -59,15 +63,17 @@ def dialog_shot(alg_id, png, params):
     app.processEvents()
 
 
-dialog_shot("terratin:simplify", "qgis_simplify_dialog.png",
-            {"INPUT": DEM, "MAX_ERROR": 20, "CRITERION": 9,
-             "OUTPUT": os.path.join(work, "jacksboro_tin.gpkg")})
-dialog_shot("terratin:eval", "qgis_eval_dialog.png", {"DEM": DEM})
-
 tin = os.path.join(work, "jacksboro_tin.gpkg")
 r = processing.run("terratin:simplify", {"INPUT": DEM, "MAX_ERROR": 20,
                                          "CRITERION": 9, "LOAD": False,
                                          "OUTPUT": tin})
+dialog_shot("terratin:simplify", "qgis_simplify_dialog.png",
+            {"INPUT": DEM, "MAX_ERROR": 20, "CRITERION": 9,
+             "OUTPUT": os.path.join(work, "jacksboro_tin.gpkg")})
+dialog_shot("terratin:eval", "qgis_eval_dialog.png",
+            {"DEM": DEM, "TIN": r["TRIANGLES"], "CHECK_MAX_ERROR": 20,
+             "ERROR_RASTER": os.path.join(work, "error.tif")})
+
 shade = os.path.join(work, "hillshade.tif")
 subprocess.run(["gdaldem", "hillshade", "-q", "-s", "111120", DEM, shade],
                check=True)
@@ -100,3 +106,4 @@ print("qgis_screenshots: %s: %d vertices, %d triangles, max error %g; "
                     r["MAX_ERROR_ACHIEVED"], OUT))
 plugin.unload()
 app.exitQgis()
+shutil.rmtree(work)
