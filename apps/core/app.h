@@ -412,4 +412,26 @@ OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds);
 /* Whether the layer declares a CRS that is not the DEM's (tin_input.c). */
 int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info);
 
+/* tin_read.c, for eval: a TIN from a mesh file or an OGR layer, on the
+ * DEM's pixel-centre grid. */
+typedef struct app_tin {
+  GDALDatasetH ds;       /* the OGR dataset; NULL for a mesh file */
+  const char *format;    /* "STL", "PLY", ... or the OGR driver's name */
+  const char *layer;     /* the layer's name (ds owns it); NULL: a file */
+  double *xyz;           /* ntri triangles, corners in pixel space */
+  size_t ntri, rejected;
+  char *crs_wkt;         /* the CRS the TIN declares (malloc'd) or NULL */
+  char crs_name[128];    /* its name, when it was reprojected */
+  int pixel;             /* read in the DEM's pixel frame */
+  int reprojected;       /* reprojected from crs_wkt to the DEM's CRS */
+  int other_crs;         /* a CRS on a DEM without one: measured as is */
+} app_tin;
+/* Reads r->s->tin (its OGR dataset protected from outp, which may be
+ * NULL) into t, on the DEM of info and grid (whose heights settle an
+ * STL's frame when its extent does not). On failure (recorded) the caller still frees t with
+ * tt__app_tin_free. */
+tt_status tt__app_read_tin(app_run *r, const tt_raster_info *info,
+                           const tt_grid *grid, tt_output *outp, app_tin *t);
+void tt__app_tin_free(app_tin *t);
+
 #endif /* TERRATIN_APP_H */

@@ -97,6 +97,16 @@ static int name_z_unit(tt_context *ctx, const char *w, void *out)
   return 1;
 }
 
+/* -tin_frame (eval): the int tt_app_settings.tin_frame, 1 map, 2 pixel. */
+static int name_tin_frame(tt_context *ctx, const char *w, void *out)
+{
+  (void)ctx;
+  if (!tt__app_str_ieq(w, "map") && !tt__app_str_ieq(w, "pixel"))
+    return 0;
+  *(int *)out = tt__app_str_ieq(w, "map") ? 1 : 2;
+  return 1;
+}
+
 /* --- the values that fit no kind (OPT_OWN) ------------------------------- */
 
 static tt_status own_srcnodata(tt__app_opt_parse *p, const tt__app_opt_def *d,
@@ -109,6 +119,9 @@ static tt_status own_layers(tt__app_opt_parse *p, const tt__app_opt_def *d,
                             const char *v, void *out);
 static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
                          const char *v, void *out);
+static tt_status own_tin_transform(tt__app_opt_parse *p,
+                                   const tt__app_opt_def *d, const char *v,
+                                   void *out);
 
 /* --- the table ------------------------------------------------------------ */
 
@@ -276,6 +289,15 @@ static const tt__app_opt_def opt_defs[] = {
     {"-a_ullr", O_A_ULLR, DEM_READERS, OPT_OWN, AT(s.a_ullr),
      .own_fn = own_box, .nwords = 4,
      .bad = "needs ulx uly lrx lry: finite numbers, ulx != lrx, uly != lry"},
+    /* eval: the frame of a TIN file's coordinates, and an affine before */
+    {"-tin_frame", O_TIN_FRAME, FOR_E, OPT_NAME, AT(s.tin_frame),
+     .name_fn = name_tin_frame, .known = "map, pixel"},
+    {"-stl_frame", O_TIN_FRAME, FOR_E, OPT_NAME, AT(s.tin_frame),
+     .name_fn = name_tin_frame, .known = "map, pixel"},
+    {"-tin_transform", O_TIN_TRANSFORM, FOR_E, OPT_OWN, AT(s),
+     .own_fn = own_tin_transform,
+     .bad = "must be six comma-separated numbers sx,sy,sz,ox,oy,oz "
+            "(x' = sx x + ox, ...), sx, sy, sz non-zero"},
 };
 
 #define OPT_DEFS (sizeof opt_defs / sizeof opt_defs[0])
@@ -571,5 +593,31 @@ tt_status tt__app_opt_apply(tt__app_opt_parse *p, const tt__app_opt_def *d,
   OPT_SET_GIVEN(p, d->id);
   if ((d->flags & OPT_DECIMATE) && !p->decimate_only)
     p->decimate_only = d->name;
+  return TT_OK;
+}
+
+/* -tin_transform sx,sy,sz,ox,oy,oz: out is the settings (the six numbers
+ * and the flag both go there). */
+static tt_status own_tin_transform(tt__app_opt_parse *p,
+                                   const tt__app_opt_def *d, const char *v,
+                                   void *out)
+{
+  tt_app_settings *s = out;
+  double t[6];
+  const char *at = v;
+  for (int k = 0; k < 6; k++) {
+    char word[64];
+    const char *comma = strchr(at, ',');
+    size_t n = comma ? (size_t)(comma - at) : strlen(at);
+    if ((comma == NULL) != (k == 5) || n == 0 || n >= sizeof word)
+      return refuse(p, d, v);
+    memcpy(word, at, n);
+    word[n] = '\0';
+    if (!tt__app_parse_double(word, &t[k]) || (k < 3 && t[k] == 0))
+      return refuse(p, d, v);
+    at = comma ? comma + 1 : at + n;
+  }
+  memcpy(s->tin_transform, t, sizeof t);
+  s->tin_transform_set = 1;
   return TT_OK;
 }

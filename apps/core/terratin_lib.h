@@ -159,6 +159,11 @@ typedef struct tt_app_settings {
 
   /* eval, optimize (which reads the TIN from tin and writes output) */
   const char *layer;         /* -layer; NULL: the triangles layer */
+  int tin_frame;             /* eval -tin_frame (-stl_frame): 0 auto (map;
+                                an STL off the DEM's extent: pixel), 1 map,
+                                2 pixel */
+  double tin_transform[6];   /* eval -tin_transform sx,sy,sz,ox,oy,oz */
+  int tin_transform_set;     /* -tin_transform was given */
 
   /* generate */
   tt_synth_options synth;    /* tt_synth_options_init(kind) + the flags */

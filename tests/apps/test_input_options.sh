@@ -59,7 +59,7 @@ check "-srcwin: map coordinates of the full DEM (extent)" \
 "$T" "${S[@]}" -tile_size 32 -threads 2 -srcwin 50 40 120 100 "$SRC" tiled.gpkg
 check "-srcwin, tiled on 2 threads: the tiles of the window" \
   same_tin ref_t.gpkg tiled.gpkg
-"$T" simplify -max_error 5 -overwrite -srcwin 50 40 120 100 -a_srs EPSG:32616 "$SRC" srcwin.gpkg >sum.txt 2>&1
+"$T" simplify -max_error 5 -srcwin 50 40 120 100 -a_srs EPSG:32616 "$SRC" sum.gpkg >sum.txt 2>&1
 check "-srcwin, -a_srs: the summary says a window and a CRS given" \
   grep -q "^input:  .*, band 1: 120 x 100 samples (a window), .*; WGS 84 / UTM zone 16N (EPSG:32616) (given); " sum.txt
 check "-srcwin: run_parameters names the file and its driver" \
