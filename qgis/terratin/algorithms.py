@@ -19,6 +19,7 @@ from qgis.core import (QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm,
                        QgsProcessingParameterCrs, QgsProcessingParameterEnum,
                        QgsProcessingParameterFileDestination,
                        QgsProcessingParameterFolderDestination,
+                       QgsProcessingParameterMapLayer,
                        QgsProcessingParameterMultipleLayers,
                        QgsProcessingParameterNumber,
                        QgsProcessingParameterRasterDestination,
@@ -48,6 +49,9 @@ TIN_FILTER = ";;".join([
     "2DM mesh, QGIS mesh layer (*.2dm)", "PLY mesh (*.ply)",
     "UGRID netCDF mesh (*.nc)", "Wavefront OBJ (*.obj)",
     "LandXML 1.2 (*.xml)", "DXF 3DFACE (*.dxf)"])
+TIN_FRAMES = ["default (map; an STL that fits the grid: pixel)",
+              "map (map coordinates, in the TIN's CRS)",
+              "pixel (the DEM's columns and rows)"]
 STUDY_TERRAINS = ["fault_smooth", "fault_rough", "peak_rough",
                   "valley_rough", "hybrid", "sphere", "cylinder", "bump"]
 
@@ -74,6 +78,21 @@ def _tin_source(alg, parameters, name, context):
             "%s: %s is not a file OGR reads" % (name, layer.source()))
     parts = QgsProviderRegistry.instance().decodeUri("ogr", layer.source())
     return parts.get("path") or layer.source(), parts.get("layerName") or None
+
+
+def _eval_tin_source(alg, parameters, name, context):
+    """(path, layer name or None) of eval's TIN: a polygon layer OGR reads
+    or a mesh layer (2DM, PLY, UGRID, ... through MDAL)."""
+    layer = alg.parameterAsLayer(parameters, name, context)
+    if isinstance(layer, QgsMeshLayer):
+        parts = QgsProviderRegistry.instance().decodeUri("mdal",
+                                                         layer.source())
+        path = parts.get("path") or layer.source()
+        if not os.path.isfile(path):
+            raise QgsProcessingException(
+                "%s: %s is not a mesh file" % (name, layer.source()))
+        return path, None
+    return _tin_source(alg, parameters, name, context)
 
 
 def _format_args(path):
@@ -374,8 +393,11 @@ def _run_parameters(path):
 class EvalAlgorithm(TerratinAlgorithm):
     COMMAND = "eval"
     HELP = (
-        "<p>Measures a layer of triangles (from terratin or any other "
-        "tool, in the DEM's CRS) against the DEM: the error |DEM - TIN| "
+        "<p>Measures a TIN (from terratin or any other tool) against the "
+        "DEM: a layer of triangles (POLYGON Z, TIN, ...; any format OGR "
+        "reads) or a mesh layer (2DM, PLY, UGRID; STL, OBJ and LandXML, "
+        "which QGIS does not open, through the command line). A TIN "
+        "in another CRS is reprojected to the DEM's. The error |DEM - TIN| "
         "over every valid sample (max, RMS, mean and total absolute, L2, "
         "where the max is) and the coverage (samples covered, uncovered, "
         "overlapped; polygons that are not triangles). Every figure is an "
@@ -407,9 +429,19 @@ class EvalAlgorithm(TerratinAlgorithm):
 
     def initAlgorithm(self, config=None):
         self.addParameter(QgsProcessingParameterRasterLayer("DEM", "DEM"))
-        self.addParameter(QgsProcessingParameterVectorLayer(
-            "TIN", "TIN (triangles)", [QgsProcessing.TypeVectorPolygon]))
+        self.addParameter(QgsProcessingParameterMapLayer(
+            "TIN", "TIN (a layer of triangles or a mesh)", None, False,
+            [QgsProcessing.TypeVectorPolygon, QgsProcessing.TypeMesh]))
         self._add_dem_options("DEM")
+        p = QgsProcessingParameterEnum(
+            "TIN_FRAME", "The TIN's coordinates", TIN_FRAMES, False, 0, True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        p = QgsProcessingParameterString(
+            "TIN_TRANSFORM", "Transform of the TIN's corners first: "
+            "SX,SY,SZ,OX,OY,OZ (x' = SX x + OX, ...)", None, False, True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
         self.addParameter(QgsProcessingParameterNumber(
             "CHECK_MAX_ERROR", "Check against max error (empty: no check)",
             QgsProcessingParameterNumber.Double, None, True, 0.0))
@@ -428,10 +460,17 @@ class EvalAlgorithm(TerratinAlgorithm):
 
     def processAlgorithm(self, parameters, context, feedback):
         dem = _raster_path(self, parameters, "DEM", context)
-        tin, layer = _tin_source(self, parameters, "TIN", context)
+        tin, layer = _eval_tin_source(self, parameters, "TIN", context)
         args = ["eval", dem, tin] + self._dem_args(parameters, context)
         if layer:
             args += ["-layer", layer]
+        frame = self.parameterAsEnum(parameters, "TIN_FRAME", context)
+        if frame:
+            args += ["-tin_frame", TIN_FRAMES[frame].split(" ")[0]]
+        transform = (self.parameterAsString(parameters, "TIN_TRANSFORM",
+                                            context) or "").replace(" ", "")
+        if transform:
+            args += ["-tin_transform", transform]
         args += self._optional_number(parameters, "CHECK_MAX_ERROR",
                                       context, "-max_error", False)
         raster = None

@@ -261,6 +261,17 @@ def check_eval(tin):
         check("eval: the error raster is on the DEM's grid",
               (raster.width(), raster.height()) == (dem.width(),
                                                     dem.height()))
+    # a mesh: simplify's 2DM, as a path and as a loaded mesh layer
+    mesh = os.path.join(W, "s.2dm")
+    rc, j2 = cli("eval", DEM, mesh)
+    for what, value in (("path", mesh),
+                        ("mesh layer", QgsMeshLayer(mesh, "m", "mdal"))):
+        r = processing.run("terratin:eval", {"DEM": DEM, "TIN": value})
+        got = (r.get("MAX_ERROR"), r.get("RMSE"), r.get("COVERED"),
+               r.get("TRIANGLE_COUNT"))
+        want = (j2["max_error"], j2["rmse"], j2["covered"], j2["triangles"])
+        check("eval of a 2DM %s: %s (command line %s)" % (what, got, want),
+              got == want)
     r = processing.run("terratin:eval", {"DEM": DEM, "TIN": tin,
                                          "CHECK_MAX_ERROR": 10})
     check("eval: a check failed is PASS false, not an error (%s)" %
