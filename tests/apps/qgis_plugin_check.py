@@ -396,27 +396,52 @@ def check_error():
     ProcessingConfig.setSettingValue("TERRATIN_PATH", "")
 
 
+def running_with(word):
+    """Processes whose command line names word (the run's output)."""
+    found = []
+    for pid in os.listdir("/proc"):
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                if word.encode() in f.read():
+                    found.append(pid)
+        except OSError:
+            pass
+    return found
+
+
 def check_cancel():
-    """Cancel mid-run (during the simplification, 15 % of the bar): the
-    algorithm fails, the process is gone and its folder has nothing."""
-    folder = os.path.join(W, "cancel")
-    os.mkdir(folder)
+    """Cancel mid-run, while simplifying (15 % of the bar) and while
+    writing (90 %): the algorithm fails, the process is gone, the folder
+    holds nothing new and an output that was there is as it was."""
     big = os.path.join(W, "big.tif")
     subprocess.run([T, "generate", "diamond_square", big, "-size", "513",
                     "-q"], check=True)
-    out = os.path.join(folder, "c.gpkg")
-    fb = Feedback(cancel_at=15)
-    try:
-        processing.run("terratin:simplify", {"INPUT": big, "MAX_ERROR": 0,
-                                             "OUTPUT": out}, feedback=fb)
-        check("cancel: the run fails", False)
-    except QgsProcessingException as e:
-        check("cancel: the run fails saying so (%s)" % e,
-              "canceled" in str(e))
-    check("cancel: stopped before the end (%s)" % fb.values[-1:],
-          fb.values and fb.values[-1] < 85)
-    check("cancel: nothing left in the folder (%s)" % os.listdir(folder),
-          os.listdir(folder) == [])
+    for at, old in ((15, None), (90, b"the old output")):
+        folder = os.path.join(W, "cancel%d" % at)
+        os.mkdir(folder)
+        out = os.path.join(folder, "c.gpkg")
+        if old:
+            with open(out, "wb") as f:
+                f.write(old)
+        fb = Feedback(cancel_at=at)
+        try:
+            processing.run("terratin:simplify", {
+                "INPUT": big, "MAX_ERROR": 0, "OUTPUT": out}, feedback=fb)
+            check("cancel at %d%%: the run fails" % at, False)
+        except QgsProcessingException as e:
+            check("cancel at %d%%: the run fails saying so (%s)" % (at, e),
+                  "canceled" in str(e))
+        check("cancel at %d%%: stopped before the end (%s)" % (
+            at, fb.values[-1:]), fb.values and fb.values[-1] < 100)
+        check("cancel at %d%%: no terratin left running" % at,
+              running_with(out) == [])
+        left = sorted(os.listdir(folder))
+        check("cancel at %d%%: nothing new in the folder (%s)" % (at, left),
+              left == (["c.gpkg"] if old else []))
+        if old:
+            with open(out, "rb") as f:
+                check("cancel at %d%%: the old output as it was" % at,
+                      f.read() == old)
 
 
 def check_model():
@@ -457,6 +482,15 @@ def check_model():
     check("the model validates (%s)" % errors, ok)
     r = processing.run(model, {"dem": DEM})
     rc, j = cli("eval", DEM, os.path.join(W, "model_tin.gpkg"))
+    # saved as the modeler saves it (.model3) and read back
+    path = os.path.join(W, "tin_and_check.model3")
+    check("the model saved", model.toFile(path))
+    again = QgsProcessingModelAlgorithm()
+    check("the model read back", again.fromFile(path))
+    r2 = processing.run(again, {"dem": DEM})
+    check("the model read back gives the same (%s)" % r2.get(
+        "eval:max_error"), all(r2.get(k) == r.get(k) for k in (
+            "eval:max_error", "eval:rmse", "eval:covered")))
     got = (r.get("eval:max_error"), r.get("eval:rmse"),
            r.get("eval:covered"))
     check("model simplify -> eval: %s (command line %s)" % (got, (
