@@ -7,6 +7,7 @@ option not given, so the command's own default holds."""
 import csv
 import os
 import re
+import shlex
 
 from qgis.core import (QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm,
                        QgsProcessingContext, QgsProcessingException,
@@ -17,6 +18,7 @@ from qgis.core import (QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm,
                        QgsProcessingParameterBand,
                        QgsProcessingParameterBoolean,
                        QgsProcessingParameterCrs, QgsProcessingParameterEnum,
+                       QgsProcessingParameterExtent,
                        QgsProcessingParameterFileDestination,
                        QgsProcessingParameterFolderDestination,
                        QgsProcessingParameterMapLayer,
@@ -156,6 +158,31 @@ class TerratinAlgorithm(QgsProcessingAlgorithm):
             "(-z_unit m)", False, True)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
+        p = QgsProcessingParameterExtent(
+            "PROJWIN", "Read only this extent of the DEM (-projwin)", None,
+            True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        p = QgsProcessingParameterCrs(
+            "A_SRS", "The DEM's CRS, for one without or with a wrong one "
+            "(-a_srs)", None, True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        self._add_extra()
+
+    def _add_extra(self):
+        p = QgsProcessingParameterString(
+            "EXTRA", "Additional command-line options (as terratin %s "
+            "--help gives them)" % self.COMMAND, None, False, True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+
+    def _extra_args(self, parameters, context):
+        text = self.parameterAsString(parameters, "EXTRA", context) or ""
+        try:
+            return shlex.split(text)
+        except ValueError as e:
+            raise QgsProcessingException("EXTRA: %s: %s" % (text, e))
 
     def _dem_args(self, parameters, context):
         args = []
@@ -171,7 +198,18 @@ class TerratinAlgorithm(QgsProcessingAlgorithm):
             args += ["-z_factor", repr(z)]
         if self.parameterAsBoolean(parameters, "Z_UNIT_M", context):
             args += ["-z_unit", "m"]
-        return args
+        if parameters.get("PROJWIN") not in (None, ""):
+            ext = self.parameterAsExtent(parameters, "PROJWIN", context)
+            crs = self.parameterAsExtentCrs(parameters, "PROJWIN", context)
+            args += ["-projwin"] + [repr(v) for v in (
+                ext.xMinimum(), ext.yMaximum(), ext.xMaximum(),
+                ext.yMinimum())]
+            if crs.isValid():
+                args += ["-projwin_srs", crs.authid() or crs.toWkt()]
+        crs = self.parameterAsCrs(parameters, "A_SRS", context)
+        if parameters.get("A_SRS") not in (None, "") and crs.isValid():
+            args += ["-a_srs", crs.authid() or crs.toWkt()]
+        return args + self._extra_args(parameters, context)
 
     def _optional_number(self, parameters, name, context, option, integer):
         if parameters.get(name) in (None, ""):
@@ -182,7 +220,16 @@ class TerratinAlgorithm(QgsProcessingAlgorithm):
                                                     context))]
 
 
-def _load_tin(path, context, name, output_name):
+def _nln(args):
+    """The layer names' prefix an -nln among args gives ("" without)."""
+    args = [str(a) for a in args]
+    for i, a in enumerate(args[:-1]):
+        if a.lower() == "-nln":
+            return args[i + 1]
+    return ""
+
+
+def _load_tin(path, context, name, output_name, prefix=""):
     """Loads a TIN file when the run is over: the triangles and vertices
     layers of a vector dataset (with the style a GeoPackage carries) or a
     mesh layer; returns the triangles' source for the outputs."""
@@ -192,15 +239,15 @@ def _load_tin(path, context, name, output_name):
     if ext in MESH_EXTS:
         layers.append(QgsMeshLayer(path, name, "mdal"))
     elif ext == ".shp":
-        base = path[:-4]
-        tri_source = base + "_triangles.shp"
+        base = path[:-4] + "_" + prefix
+        tri_source = base + "triangles.shp"
         layers.append(QgsVectorLayer(tri_source, name + " triangles", "ogr"))
-        layers.append(QgsVectorLayer(base + "_vertices.shp",
+        layers.append(QgsVectorLayer(base + "vertices.shp",
                                      name + " vertices", "ogr"))
     elif ext in VECTOR_EXTS and ext != ".fgb" and ext != ".geojson":
-        tri_source = path + "|layername=triangles"
+        tri_source = path + "|layername=%striangles" % prefix
         layers.append(QgsVectorLayer(tri_source, name + " triangles", "ogr"))
-        layers.append(QgsVectorLayer(path + "|layername=vertices",
+        layers.append(QgsVectorLayer(path + "|layername=%svertices" % prefix,
                                      name + " vertices", "ogr"))
     elif ext in (".fgb", ".geojson"):
         tri_source = path
@@ -216,13 +263,13 @@ def _load_tin(path, context, name, output_name):
     return tri_source
 
 
-def _tin_triangles(path):
+def _tin_triangles(path, prefix=""):
     """The triangles' source of a TIN file (for a model's next step)."""
     ext = os.path.splitext(path)[1].lower()
     if ext == ".shp":
-        return path[:-4] + "_triangles.shp"
+        return path[:-4] + "_%striangles.shp" % prefix
     if ext in (".gpkg", ".sqlite"):
-        return path + "|layername=triangles"
+        return path + "|layername=%striangles" % prefix
     if ext in (".fgb", ".geojson"):
         return path
     return ""
@@ -343,13 +390,14 @@ class SimplifyAlgorithm(TerratinAlgorithm):
             args += ["-t_srs", crs.authid() or crs.toWkt()]
         args += _format_args(out) + ["-overwrite", dem, out]
         rc, summary = runner.run(args, feedback)
+        prefix = _nln(args)
         figures = _summary_figures(summary)
-        figures.update(_run_parameters(out))
-        results = {"OUTPUT": out, "TRIANGLES": _tin_triangles(out)}
+        figures.update(_run_parameters(out, prefix))
+        results = {"OUTPUT": out, "TRIANGLES": _tin_triangles(out, prefix)}
         results.update(figures)
         if self.parameterAsBoolean(parameters, "LOAD", context):
             _load_tin(out, context, os.path.splitext(
-                os.path.basename(out))[0], "OUTPUT")
+                os.path.basename(out))[0], "OUTPUT", prefix)
         return results
 
 
@@ -369,14 +417,14 @@ def _summary_figures(lines):
     return figures
 
 
-def _run_parameters(path):
+def _run_parameters(path, prefix=""):
     """The figures of the run_parameters layer, in full precision, when the
     output has it."""
     ext = os.path.splitext(path)[1].lower()
     if ext in (".gpkg", ".sqlite"):
-        source = path + "|layername=run_parameters"
+        source = path + "|layername=%srun_parameters" % prefix
     elif ext == ".shp":
-        source = path[:-4] + "_run_parameters.dbf"
+        source = path[:-4] + "_%srun_parameters.dbf" % prefix
     else:
         return {}
     layer = QgsVectorLayer(source, "run_parameters", "ogr")
@@ -623,7 +671,8 @@ class OptimizeAlgorithm(TerratinAlgorithm):
         args += _format_args(out) + ["-overwrite"]
         rc, obj = runner.run_json(args, feedback)
         before, after = obj.get("before") or {}, obj.get("after") or {}
-        results = {"OUTPUT": out, "TRIANGLES": _tin_triangles(out),
+        prefix = _nln(args)
+        results = {"OUTPUT": out, "TRIANGLES": _tin_triangles(out, prefix),
                    "VERTEX_COUNT": obj.get("vertices"),
                    "TRIANGLE_COUNT": obj.get("triangles")}
         for key, name in (("max_error", "MAX_ERROR"), ("rmse", "RMSE"),
@@ -633,7 +682,7 @@ class OptimizeAlgorithm(TerratinAlgorithm):
             results[name + "_AFTER"] = after.get(key)
         if self.parameterAsBoolean(parameters, "LOAD", context):
             _load_tin(out, context, os.path.splitext(
-                os.path.basename(out))[0], "OUTPUT")
+                os.path.basename(out))[0], "OUTPUT", prefix)
         return results
 
 
@@ -682,6 +731,7 @@ class StudyAlgorithm(TerratinAlgorithm):
         self.addParameter(p)
         self.addParameter(QgsProcessingParameterBoolean(
             "PLOT", "Plots (PNG, needs matplotlib)", False, True))
+        self._add_extra()
         self.addParameter(QgsProcessingParameterFolderDestination(
             "OUTPUT", "Output folder"))
         self.addOutput(QgsProcessingOutputFile("CURVES", "curves.csv"))
@@ -720,6 +770,7 @@ class StudyAlgorithm(TerratinAlgorithm):
                                       True)
         if self.parameterAsBoolean(parameters, "PLOT", context):
             args += ["-plot"]
+        args += self._extra_args(parameters, context)
         args += ["-overwrite", out]
         rc, summary = runner.run(args, feedback)
         curves = os.path.join(out, "curves.csv")

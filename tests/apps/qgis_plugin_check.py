@@ -184,6 +184,13 @@ def check_simplify_options():
           "lookahead", "-optimize", "lookahead"]),
         ({"PERCENT": 3, "MAX_TRIANGLES": 5000, "OUTPUT_EXT": ".shp"},
          ["-percent", 3, "-max_triangles", 5000]),
+        # a window of the DEM (map coordinates, the extent's CRS) and
+        # options the dialog has no field for
+        ({"MAX_ERROR": 10, "PROJWIN": "-84.3,-84.2,36.5,36.6 [EPSG:4326]",
+          "EXTRA": "-nln tt_ -max_memory 500M"},
+         ["-max_error", 10, "-projwin", -84.3, 36.6, -84.2, 36.5,
+          "-projwin_srs", "EPSG:4326", "-nln", "tt_", "-max_memory",
+          "500M"]),
     ]
     for i, (params, options) in enumerate(runs):
         ext = params.pop("OUTPUT_EXT", ".gpkg")
