@@ -3,7 +3,7 @@
 QGIS's Plugins > Manage and Install Plugins > Install from ZIP takes: one
 top folder terratin/ with the plugin's files (no caches).
 
-  tools/qgis_plugin_zip.py OUT.zip      (make qgis-plugin: build/terratin-qgis.zip)
+  tools/qgis_plugin_zip.py OUT.zip  (make qgis-plugin: build/terratin-qgis.zip)
 
 The version in the zip's name is the plugin's metadata.txt's; the files
 are stored in name order with a fixed time, so the same tree gives the

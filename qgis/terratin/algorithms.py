@@ -62,7 +62,8 @@ def _raster_path(alg, parameters, name, context):
     layer = alg.parameterAsRasterLayer(parameters, name, context)
     if layer is None:
         raise QgsProcessingException(
-            "%s: no raster layer" % alg.parameterDefinition(name).description())
+            "%s: no raster layer" %
+            alg.parameterDefinition(name).description())
     if layer.providerType() != "gdal":
         raise QgsProcessingException(
             "%s: %s is not a file GDAL reads" % (name, layer.source()))
@@ -74,7 +75,8 @@ def _tin_source(alg, parameters, name, context):
     layer = alg.parameterAsVectorLayer(parameters, name, context)
     if layer is None:
         raise QgsProcessingException(
-            "%s: no vector layer" % alg.parameterDefinition(name).description())
+            "%s: no vector layer" %
+            alg.parameterDefinition(name).description())
     if layer.providerType() != "ogr":
         raise QgsProcessingException(
             "%s: %s is not a file OGR reads" % (name, layer.source()))
@@ -309,7 +311,8 @@ class SimplifyAlgorithm(TerratinAlgorithm):
             "METHOD", "Method", METHODS, False, 0, True))
         self.addParameter(QgsProcessingParameterEnum(
             "CRITERION", "Criterion", CRITERIA, False, 0, True))
-        p = QgsProcessingParameterEnum("REPAIR", "Repair", REPAIRS, False, 0, True)
+        p = QgsProcessingParameterEnum("REPAIR", "Repair", REPAIRS, False,
+                                       0, True)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
         self.addParameter(QgsProcessingParameterEnum(

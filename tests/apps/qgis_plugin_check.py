@@ -215,7 +215,7 @@ def check_simplify_options():
 def check_task():
     """A run as the dialog (and batch mode) makes it: a task on QGIS's
     task manager, the algorithm in another thread."""
-    from qgis.core import QgsProcessingAlgRunnerTask, QgsTask
+    from qgis.core import QgsProcessingAlgRunnerTask
     alg = QgsApplication.processingRegistry().createAlgorithmById(
         "terratin:simplify")
     context = QgsProcessingContext()
