@@ -742,6 +742,13 @@ class StudyAlgorithm(TerratinAlgorithm):
         self.addOutput(QgsProcessingOutputFolder("PLOTS", "Plots folder"))
         self.addOutput(QgsProcessingOutputNumber("RUNS", "Runs"))
 
+    def _chosen(self, parameters, name, context):
+        """The values chosen of a multiple enum; none when not given
+        (parameterAsEnums gives the first value then)."""
+        if parameters.get(name) in (None, "", []):
+            return []
+        return self.parameterAsEnums(parameters, name, context)
+
     def processAlgorithm(self, parameters, context, feedback):
         out = self.parameterAsString(parameters, "OUTPUT", context)
         if not out or out == QgsProcessing.TEMPORARY_OUTPUT:
@@ -750,7 +757,7 @@ class StudyAlgorithm(TerratinAlgorithm):
         for layer in self.parameterAsLayerList(parameters, "TERRAINS",
                                                context):
             args += ["-terrain", layer.source()]
-        for i in self.parameterAsEnums(parameters, "GENERATED", context):
+        for i in self._chosen(parameters, "GENERATED", context):
             args += ["-terrain", STUDY_TERRAINS[i]]
         if "-terrain" not in args:
             raise QgsProcessingException(
@@ -759,7 +766,7 @@ class StudyAlgorithm(TerratinAlgorithm):
                 ("CRITERIA", "-criteria", CRITERIA),
                 ("METHODS", "-methods", METHODS),
                 ("OPTIMIZERS", "-optimizers", ["auto"] + OPTIMIZERS[1:])):
-            chosen = self.parameterAsEnums(parameters, name, context)
+            chosen = self._chosen(parameters, name, context)
             if chosen:
                 args += [option, ",".join(values[i] for i in chosen)]
         percent = (self.parameterAsString(parameters, "PERCENT", context)

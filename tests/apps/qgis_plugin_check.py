@@ -346,6 +346,21 @@ def check_study():
           (len(got), len(want)), got == want and len(got) == 6)
     check("study: RUNS %s" % r.get("RUNS"), r.get("RUNS") == 6)
     check("study: tables.md", os.path.isfile(r.get("TABLES", "")))
+    # a DEM layer as a terrain, into a temporary folder
+    small = os.path.join(W, "small.tif")
+    subprocess.run(["gdal_translate", "-q", "-srcwin", "0", "0", "120",
+                    "100", DEM, small], check=True)
+    r = processing.run("terratin:study", {
+        "TERRAINS": [small], "CRITERIA": [0], "METHODS": [0, 1],
+        "PERCENT": "5", "OUTPUT": "TEMPORARY_OUTPUT"})
+    ref = os.path.join(W, "study_dem_cli")
+    subprocess.run([T, "study", "-terrain", small, "-criteria", "delaunay",
+                    "-methods", "insert,decimate", "-percent", "5", "-q",
+                    ref], check=True)
+    got, want = rows(r["OUTPUT"]), rows(ref)
+    check("study of a DEM layer, both methods: curves.csv as the command "
+          "line's (%d rows, %d)" % (len(got), len(want)),
+          got == want and len(got) == 2)
 
 
 def check_error():
