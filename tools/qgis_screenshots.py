@@ -4,6 +4,7 @@ taken in QGIS (run under Xvfb: xvfb-run -a /usr/bin/python3 ...):
 
   qgis_simplify_dialog.png  the "Simplify DEM to TIN" dialog of the
                             Processing toolbox, as a user opens it
+  qgis_simplify_log.png     that dialog after Run: its log
   qgis_eval_dialog.png      the "Measure TIN against DEM" dialog
   qgis_result.png           the TIN that dialog makes of the Jacksboro
                             DEM (testdata/), with the style the
@@ -16,6 +17,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 T, OUT = sys.argv[1:3]
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -73,6 +75,32 @@ dialog_shot("terratin:simplify", "qgis_simplify_dialog.png",
 dialog_shot("terratin:eval", "qgis_eval_dialog.png",
             {"DEM": DEM, "TIN": r["TRIANGLES"], "CHECK_MAX_ERROR": 20,
              "ERROR_RASTER": os.path.join(work, "error.tif")})
+
+# the dialog after Run: the log with the command, the summary and the
+# results, the progress bar full
+alg = QgsApplication.processingRegistry().createAlgorithmById(
+    "terratin:simplify")
+d = AlgorithmDialog(alg, False, None)
+d.resize(980, 760)
+d.mainWidget().setParameters({
+    "INPUT": DEM, "MAX_ERROR": 20, "CRITERION": 9, "LOAD": False,
+    "OUTPUT": os.path.join(work, "jacksboro_tin_run.gpkg")})
+d.show()
+app.processEvents()
+d.runAlgorithm()
+for _ in range(600):
+    app.processEvents()
+    if d.results():
+        break
+    time.sleep(0.05)
+for _ in range(20):
+    app.processEvents()
+d.showLog()
+app.processEvents()
+d.grab().save(os.path.join(OUT, "qgis_simplify_log.png"))
+d.close()
+d.deleteLater()
+app.processEvents()
 
 shade = os.path.join(work, "hillshade.tif")
 subprocess.run(["gdaldem", "hillshade", "-q", "-s", "111120", DEM, shade],
