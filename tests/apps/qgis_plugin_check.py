@@ -148,6 +148,10 @@ def check_simplify():
     names = sorted(d.name for d in loaded.values())
     check("simplify: triangles and vertices to load (%s)" % names,
           names == ["s triangles", "s vertices"])
+    styled = [context.getMapLayer(i).renderer().type()
+              for i in loaded if context.getMapLayer(i)]
+    check("simplify: the layers with the GeoPackage's style (%s)" % styled,
+          styled == ["graduatedSymbol", "graduatedSymbol"])
     # a mesh output: the figures from the summary, a mesh layer to load
     context = QgsProcessingContext()
     context.setProject(QgsProject.instance())
