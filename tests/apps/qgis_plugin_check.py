@@ -25,7 +25,8 @@ from qgis.core import (QgsApplication, QgsMeshLayer,  # noqa: E402
                        QgsRasterLayer, QgsVectorLayer)
 
 PROFILE = os.path.join(W, "profile")
-app = QgsApplication([], False, PROFILE)
+# with its GUI (offscreen): the algorithm dialog is run too
+app = QgsApplication([], True, PROFILE)
 app.initQgis()
 from processing.core.Processing import Processing  # noqa: E402
 Processing.initialize()
@@ -525,6 +526,48 @@ def check_model():
         j["max_error"] <= 15)
 
 
+def check_dialog():
+    """The toolbox's dialog, Run pressed: the run in its task, the result
+    loaded into the project (the GeoPackage's layers, a mesh layer, the
+    error raster), nothing twice."""
+    import time
+    from processing.gui.AlgorithmDialog import AlgorithmDialog
+    project = QgsProject.instance()
+    project.clear()
+    runs = [("terratin:simplify", {"INPUT": DEM, "MAX_POINTS": 1500,
+                                   "OUTPUT": os.path.join(W, "dlg.gpkg")}),
+            ("terratin:simplify", {"INPUT": DEM, "MAX_POINTS": 1500,
+                                   "OUTPUT": os.path.join(W, "dlg.2dm")}),
+            ("terratin:eval", {"DEM": DEM,
+                               "TIN": os.path.join(W, "dlg.gpkg") +
+                               "|layername=triangles",
+                               "ERROR_RASTER": os.path.join(W, "dlg.tif")})]
+    for alg_id, params in runs:
+        alg = QgsApplication.processingRegistry().createAlgorithmById(alg_id)
+        d = AlgorithmDialog(alg, False, None)
+        d.mainWidget().setParameters(params)
+        d.show()
+        d.runAlgorithm()
+        deadline = time.monotonic() + 60
+        while not d.results() and time.monotonic() < deadline:
+            QgsApplication.processEvents()
+            time.sleep(0.02)
+        for _ in range(20):
+            QgsApplication.processEvents()
+        check("the %s dialog ran (%s)" % (alg_id, sorted(d.results())),
+              bool(d.results()))
+        d.close()
+        d.deleteLater()
+    layers = sorted((type(la).__name__, la.name(), la.isValid())
+                    for la in project.mapLayers().values())
+    check("the dialogs' results in the project (%s)" % layers, layers == [
+        ("QgsMeshLayer", "dlg", True),
+        ("QgsRasterLayer", "Error raster (TIN - DEM, GeoTIFF)", True),
+        ("QgsVectorLayer", "dlg triangles", True),
+        ("QgsVectorLayer", "dlg vertices", True)])
+    project.clear()
+
+
 def main():
     install()
     tin = check_simplify()
@@ -536,6 +579,7 @@ def main():
     check_error()
     check_cancel()
     check_model()
+    check_dialog()
 
 
 main()
