@@ -8,6 +8,7 @@ are the summary, shown as information. stderr carries warnings and errors
 ("terratin simplify: dem.tif: ..."), shown as they are. Cancel sends
 SIGTERM: terratin removes its temporary files and leaves nothing (exit
 143). POSIX only (select on the pipes)."""
+import codecs
 import json
 import os
 import re
@@ -120,11 +121,18 @@ class BarParser:
     def _bar_ticks(self, line, complete):
         head = line.split(" ")[0]
         tokens = re.findall(r"\d+|\.", head)
-        if tokens and tokens[-1] != "." and not complete and head == line:
-            tokens.pop()  # "1" may be the start of "10"
         ticks = self.line_base
-        for tok in tokens:
-            ticks = ticks + 1 if tok == "." else int(tok) // 10 * 4
+        for i, tok in enumerate(tokens):
+            if tok == ".":
+                ticks += 1
+                continue
+            value = int(tok) // 10 * 4
+            last = i == len(tokens) - 1 and not complete and head == line
+            # a number still being printed counts once it is the next
+            # tick's ("1" may be the start of "10", "10" of "100")
+            if last and not (int(tok) % 10 == 0 and value == ticks + 1):
+                break
+            ticks = value
         return ticks
 
     def _show(self, ticks):
@@ -178,13 +186,20 @@ def run(args, feedback, bar=True):
         feedback.pushInfo(line)
 
     parser = BarParser(feedback.setProgress, on_line)
+    # a character may straddle two reads
+    decoder = codecs.getincrementaldecoder("utf-8")("replace")
     err_buf = [b""]
     open_fds = {proc.stdout.fileno(): "out", proc.stderr.fileno(): "err"}
-    canceled = False
+    canceled = None
     while open_fds:
-        if feedback.isCanceled() and not canceled:
-            canceled = True
+        if feedback.isCanceled() and canceled is None:
+            canceled = time.monotonic()
             proc.send_signal(signal.SIGTERM)
+        elif (canceled is not None and time.monotonic() - canceled > 10 and
+              proc.poll() is None):
+            # terratin's own watchdog ends a stopped run within a second;
+            # this is the last resort
+            proc.kill()
         ready, _, _ = select.select(list(open_fds), [], [], 0.1)
         for fd in ready:
             chunk = os.read(fd, 65536)
@@ -192,7 +207,7 @@ def run(args, feedback, bar=True):
                 del open_fds[fd]
                 continue
             if open_fds[fd] == "out":
-                text = chunk.decode("utf-8", "replace")
+                text = decoder.decode(chunk)
                 if bar:
                     parser.feed(text)
                 else:
@@ -208,7 +223,11 @@ def run(args, feedback, bar=True):
     proc.stdout.close()
     proc.stderr.close()
     rc = _wait(proc)
-    if canceled or feedback.isCanceled():
+    if canceled is not None or feedback.isCanceled():
+        if rc == 0:
+            raise QgsProcessingException(
+                "terratin %s: canceled after the run had finished (exit 0): "
+                "its output is written" % args[0])
         raise QgsProcessingException(
             "terratin %s: canceled (exit %d); nothing was written" %
             (args[0], rc))
