@@ -54,6 +54,10 @@ TIN_FILTER = ";;".join([
 TIN_FRAMES = ["default (map; an STL that fits the grid: pixel)",
               "map (map coordinates, in the TIN's CRS)",
               "pixel (the DEM's columns and rows)"]
+# optimize writes the layers of a dataset that holds several
+OPTIMIZE_EXTS = (".gpkg", ".shp", ".sqlite")
+OPTIMIZE_FILTER = ";;".join(["GeoPackage (*.gpkg)", "ESRI Shapefile (*.shp)",
+                             "SQLite (*.sqlite)"])
 STUDY_TERRAINS = ["fault_smooth", "fault_rough", "peak_rough",
                   "valley_rough", "hybrid", "sphere", "cylinder", "bump"]
 
@@ -296,7 +300,9 @@ class SimplifyAlgorithm(TerratinAlgorithm):
         "run_parameters, with a QGIS style), a Shapefile, SQLite, "
         "FlatGeobuf or GeoJSON (triangles only), or a mesh (2DM, PLY, "
         "UGRID .nc: loaded as a mesh layer; OBJ, LandXML, DXF). The "
-        "figures (vertices, triangles, max and RMS error) are outputs.</p>")
+        "figures (vertices, triangles, max and RMS error) are outputs: "
+        "from the run_parameters layer, or for the formats without it "
+        "from the summary (errors to 4 significant digits).</p>")
 
     def name(self):
         return "simplify"
@@ -391,7 +397,11 @@ class SimplifyAlgorithm(TerratinAlgorithm):
         crs = self.parameterAsCrs(parameters, "T_SRS", context)
         if crs.isValid():
             args += ["-t_srs", crs.authid() or crs.toWkt()]
-        args += _format_args(out) + ["-overwrite", dem, out]
+        args += _format_args(out)
+        if (os.path.splitext(out)[1].lower() in (".fgb", ".geojson") and
+                "-layers" not in [str(a).lower() for a in args]):
+            args += ["-layers", "triangles"]  # a file of one layer
+        args += ["-overwrite", dem, out]
         rc, summary = runner.run(args, feedback)
         prefix = _nln(args)
         figures = _summary_figures(summary)
@@ -636,7 +646,7 @@ class OptimizeAlgorithm(TerratinAlgorithm):
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
         self.addParameter(QgsProcessingParameterFileDestination(
-            "OUTPUT", "Optimised TIN", TIN_FILTER))
+            "OUTPUT", "Optimised TIN", OPTIMIZE_FILTER))
         self.addParameter(QgsProcessingParameterBoolean(
             "LOAD", "Load the result", True, True))
         self.addOutput(QgsProcessingOutputVectorLayer(
@@ -658,6 +668,10 @@ class OptimizeAlgorithm(TerratinAlgorithm):
         dem = _raster_path(self, parameters, "DEM", context)
         tin, layer = _tin_source(self, parameters, "TIN", context)
         out = self.parameterAsFileOutput(parameters, "OUTPUT", context)
+        if os.path.splitext(out)[1].lower() not in OPTIMIZE_EXTS:
+            raise QgsProcessingException(
+                "OUTPUT: %s: optimize writes a GeoPackage, a Shapefile or "
+                "an SQLite file (.gpkg, .shp, .sqlite)" % out)
         _unused_output(out)
         args = ["optimize", dem, tin, out] + self._dem_args(parameters,
                                                             context)
@@ -671,7 +685,7 @@ class OptimizeAlgorithm(TerratinAlgorithm):
                                       "-max_error", False)
         args += self._optional_number(parameters, "SEED", context, "-seed",
                                       True)
-        args += _format_args(out) + ["-overwrite"]
+        args += ["-overwrite"]
         rc, obj = runner.run_json(args, feedback)
         before, after = obj.get("before") or {}, obj.get("after") or {}
         prefix = _nln(args)

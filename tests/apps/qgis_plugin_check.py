@@ -189,6 +189,8 @@ def check_simplify_options():
           "lookahead", "-optimize", "lookahead"]),
         ({"PERCENT": 3, "MAX_TRIANGLES": 5000, "OUTPUT_EXT": ".shp"},
          ["-percent", 3, "-max_triangles", 5000]),
+        ({"MAX_POINTS": 800, "OUTPUT_EXT": ".fgb"}, ["-max_points", 800,
+                                                    "-layers", "triangles"]),
         # a window of the DEM (map coordinates, the extent's CRS) and
         # options the dialog has no field for
         ({"MAX_ERROR": 10, "PROJWIN": "-84.3,-84.2,36.5,36.6 [EPSG:4326]",
@@ -207,6 +209,9 @@ def check_simplify_options():
         got = tuple(r.get(k) for k in ("VERTEX_COUNT", "TRIANGLE_COUNT",
                                        "MAX_ERROR_ACHIEVED", "RMSE"))
         want = (j["vertices"], j["triangles"], j["max_error"], j["rmse"])
+        if ext == ".fgb":
+            # no run_parameters: the summary's errors, 4 digits
+            want = want[:2] + tuple(float("%.4g" % v) for v in want[2:])
         check("simplify %s: %s (command line %s)" % (
             " ".join(str(o) for o in options), got, want), got == want)
         tl = QgsVectorLayer(r["TRIANGLES"], "t", "ogr")
@@ -311,6 +316,14 @@ def check_rasterize(tin):
 
 
 def check_optimize(tin):
+    try:
+        processing.run("terratin:optimize", {
+            "DEM": DEM, "TIN": tin, "OUTPUT": os.path.join(W, "o.2dm")})
+        check("optimize into a 2DM: refused", False)
+    except QgsProcessingException as e:
+        check("optimize into a 2DM: refused (%s)" % e,
+              "optimize writes a GeoPackage" in str(e) and
+              not os.path.exists(os.path.join(W, "o.2dm")))
     out = os.path.join(W, "o.gpkg")
     r = processing.run("terratin:optimize", {
         "DEM": DEM, "TIN": tin, "CRITERION": 9, "OUTPUT": out})
