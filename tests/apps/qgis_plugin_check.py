@@ -114,6 +114,10 @@ def install():
     for a in provider.algorithms() if provider else []:
         check(a.id() + ": a help string", len(a.shortHelpString()) > 100)
         check(a.id() + ": a display name", bool(a.displayName()))
+        f = a.flags()
+        check(a.id() + ": batch mode, cancel, threads (flags %s)" % int(f),
+              f & a.FlagSupportsBatch and f & a.FlagCanCancel and
+              not f & a.FlagNoThreading)
     check("the version in the provider's name (%s)" % provider.longName(),
           provider is not None and "terratin 0." in provider.longName())
 
@@ -581,6 +585,54 @@ def check_dialog():
     project.clear()
 
 
+def check_batch():
+    """Batch mode: the toolbox's batch dialog with two rows, Run: each
+    row's TIN as the command line's, both loaded."""
+    from processing.gui.BatchAlgorithmDialog import BatchAlgorithmDialog
+    from processing.tools import dataobjects
+    project = QgsProject.instance()
+    project.clear()
+    alg = QgsApplication.processingRegistry().createAlgorithmById(
+        "terratin:simplify")
+    d = BatchAlgorithmDialog(alg)
+    panel = d.mainWidget()
+    context = dataobjects.createContext()
+    rows = [({"INPUT": DEM, "MAX_POINTS": 300}, ["-max_points", 300]),
+            ({"INPUT": DEM, "MAX_ERROR": 30, "METHOD": 1},
+             ["-max_error", 30, "-method", "decimate"])]
+    while panel.batchRowCount() < len(rows):
+        panel.addRow()
+    for row, (values, _) in enumerate(rows):
+        for name, value in values.items():
+            panel.wrappers[row][panel.parameter_to_column[name]] \
+                .setParameterValue(value, context)
+        panel.tblParameters.cellWidget(
+            row + 1, panel.parameter_to_column["OUTPUT"]).setValue(
+                os.path.join(W, "batch%d.gpkg" % row))
+    d.show()
+    d.runAlgorithm()
+    for _ in range(20):
+        QgsApplication.processEvents()
+    for row, (_, options) in enumerate(rows):
+        rc, j = cli("simplify", DEM, os.path.join(W, "batch%d_cli.gpkg" %
+                                                  row), *options)
+        tl = QgsVectorLayer(os.path.join(W, "batch%d.gpkg" % row) +
+                            "|layername=triangles", "t", "ogr")
+        check("batch row %d: %s triangles (command line %s)" % (
+            row, tl.featureCount(), j["triangles"]),
+            tl.isValid() and tl.featureCount() == j["triangles"])
+    names = sorted(la.name() for la in project.mapLayers().values())
+    check("batch: both rows loaded (%s)" % names, names == [
+        "batch0 triangles", "batch0 vertices", "batch1 triangles",
+        "batch1 vertices"])
+    d.close()
+    d.deleteLater()
+    del panel, d
+    for _ in range(5):
+        QgsApplication.processEvents()
+    project.clear()
+
+
 def main():
     install()
     tin = check_simplify()
@@ -593,6 +645,7 @@ def main():
     check_cancel()
     check_model()
     check_dialog()
+    check_batch()
 
 
 main()
