@@ -18,7 +18,7 @@ DEB_PKGS   := cmake make gcc g++ pkg-config libgdal-dev libproj-dev gdal-bin lib
 DEMO_IN    ?= testdata/jacksboro_fault_dem.tif
 DEMO_OUT   ?= demo-out/jacksboro_tin.gpkg
 
-.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study doc-tables qgis-plugin
+.PHONY: all deps build build-san demo check check-long test test-san ctest ctest-san bench clean study doc-tables
 
 all: build
 
@@ -90,6 +90,7 @@ doc-tables: build
 
 # The QGIS plugin (qgis/terratin/, docs/qgis.md) as the zip QGIS's
 # "Install from ZIP" takes.
+.PHONY: qgis-plugin
 qgis-plugin:
 	python3 tools/qgis_plugin_zip.py $(BUILD)/terratin-qgis.zip
 
