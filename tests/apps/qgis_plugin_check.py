@@ -79,21 +79,33 @@ class Feedback(QgsProcessingFeedback):
 
 
 def install():
-    """The zip unzipped into the fresh profile's python/plugins, found and
-    started by QGIS's plugin loader (its metadata read)."""
-    plugins = os.path.join(PROFILE, "python", "plugins")
-    os.makedirs(plugins, exist_ok=True)
+    """The zip installed as Plugins > Install from ZIP installs it
+    (pyplugin_installer's installFromZipFile: the plugin's name from the
+    shortest metadata.txt, its unzip() into the profile's
+    python/plugins), then found and started by QGIS's plugin loader."""
+    sys.path.insert(0, "/usr/share/qgis/python")
+    from pyplugin_installer.unzip import unzip
     with zipfile.ZipFile(ZIP) as z:
         names = z.namelist()
-        check("the zip has one top folder terratin/ (%s)" % names[:3],
-              all(n.startswith("terratin/") for n in names) and
-              "terratin/metadata.txt" in names)
-        z.extractall(plugins)
+    metadata = sorted(n for n in names if n.endswith("metadata.txt"))
+    check("the zip's plugin is terratin/ (%s)" % metadata[:1],
+          metadata[:1] == ["terratin/metadata.txt"] and
+          all(n.startswith("terratin/") for n in names))
     check("the profile is the fresh one (%s)" %
           QgsApplication.qgisSettingsDirPath(),
           os.path.realpath(QgsApplication.qgisSettingsDirPath()).startswith(
               os.path.realpath(PROFILE)))
-    sys.path.insert(0, plugins)
+    # what QGIS sets qgis.utils.home_plugin_path to (QgsPythonUtils, not
+    # run in a headless application)
+    plugins = os.path.join(QgsApplication.qgisSettingsDirPath(), "python",
+                           "plugins")
+    check("the profile's plugin folder (%s)" % plugins,
+          os.path.realpath(plugins).startswith(os.path.realpath(PROFILE)))
+    check("no terratin plugin there before", not os.path.exists(
+        os.path.join(plugins, "terratin")))
+    unzip(ZIP, plugins)
+    if plugins not in sys.path:
+        sys.path.insert(0, plugins)
     qgis.utils.plugin_paths = [plugins]
     qgis.utils.updateAvailablePlugins()
     check("QGIS lists the plugin (%s)" % qgis.utils.available_plugins,
