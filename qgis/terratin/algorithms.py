@@ -110,7 +110,9 @@ def _format_args(path):
     return ["-of", of] if of else []
 
 
-def _unused_output(path):
+def _output_folder(path):
+    """Makes the folder of an output file (Processing's temporary outputs
+    name one that does not exist yet)."""
     if not path:
         raise QgsProcessingException("OUTPUT: no output file")
     folder = os.path.dirname(os.path.abspath(path))
@@ -364,7 +366,7 @@ class SimplifyAlgorithm(TerratinAlgorithm):
     def processAlgorithm(self, parameters, context, feedback):
         dem = _raster_path(self, parameters, "INPUT", context)
         out = self.parameterAsFileOutput(parameters, "OUTPUT", context)
-        _unused_output(out)
+        _output_folder(out)
         args = ["simplify"] + self._dem_args(parameters, context)
         method = METHODS[self.parameterAsEnum(parameters, "METHOD", context)]
         if method != "insert":
@@ -543,7 +545,7 @@ class EvalAlgorithm(TerratinAlgorithm):
                 raise QgsProcessingException(
                     "ERROR_RASTER: %s: the error raster is a GeoTIFF "
                     "(.tif)" % raster)
-            _unused_output(raster)
+            _output_folder(raster)
             args += ["-error_raster", raster, "-overwrite"]
         rc, obj = runner.run_json(args, feedback)
         results = {name: obj.get(key) for name, key, _ in self.FIGURES}
@@ -596,7 +598,7 @@ class RasterizeAlgorithm(TerratinAlgorithm):
         tin, layer = _tin_source(self, parameters, "TIN", context)
         dem = _raster_path(self, parameters, "DEM", context)
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
-        _unused_output(out)
+        _output_folder(out)
         # rasterize TIN DEM OUTPUT; a terratin whose usage says DEM TIN
         # OUTPUT gets them in that order
         if re.search(r"rasterize\s+DEM\s+TIN", runner.usage_of("rasterize")):
@@ -672,7 +674,7 @@ class OptimizeAlgorithm(TerratinAlgorithm):
             raise QgsProcessingException(
                 "OUTPUT: %s: optimize writes a GeoPackage, a Shapefile or "
                 "an SQLite file (.gpkg, .shp, .sqlite)" % out)
-        _unused_output(out)
+        _output_folder(out)
         args = ["optimize", dem, tin, out] + self._dem_args(parameters,
                                                             context)
         if layer:
