@@ -286,6 +286,12 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
                           double *out_max);
 const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
 const char *tt__app_nonempty_or_null(const char *s);
+/* Why the heights were converted to metres, in the command's words ("the
+ * CRS is in metres", "asked by -z_to m"); "" when they were not. */
+const char *tt__app_z_unit_why(const tt_raster_info *info);
+/* Where the heights' unit was said: "band unit", "vertical CRS",
+ * "-z_unit", or "". */
+const char *tt__app_z_unit_source(const tt_raster_info *info);
 /* "2026-11-22T10:38:55Z" */
 void tt__app_iso8601_utc(char *buf, size_t size);
 /* The engine's thread count (tt_refine_options.threads): -threads, else
@@ -358,6 +364,15 @@ tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
 tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+/* --formats (simplify/formats.c): the output formats simplify writes, each
+ * OGR driver judged by the dry run of its writer (ogr_output.c). */
+tt_status tt__app_formats(app_run *r);
+/* --help-general (help.c): the options of every command, as GDAL's
+ * utilities print them. */
+const char *tt__app_help_general(void);
+/* The help page of `terratin tiles SUB` (plan, run, merge; anything else:
+ * the overview of the three). */
+const char *tt__app_tiles_help(const char *sub);
 
 /* The dispatch table (run.c): one entry per command, which the parser
  * (the command word, how many positional words, where they go), the help
@@ -377,6 +392,9 @@ typedef struct tt__app_command_def {
 extern const tt__app_command_def tt__app_commands[];
 /* The entry of c, or NULL (no command, help, version). */
 const tt__app_command_def *tt__app_command_def_of(tt_app_command c);
+/* Which of the run's positional words path is (1 for the first), by the
+ * dispatch table; 0 when it is none of them (study's -terrain). */
+int tt__app_arg_number(const app_run *r, const char *path);
 /* raster_output.c, for rasterize and eval -error_raster: the raster
  * driver of -of, else
  * the one path's extension names (NULL path: GTiff), that can write a

@@ -268,7 +268,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_str(&j, "z_unit_declared",
                tt__app_nonempty_or_null(p->info->z_unit_declared));
   tt__json_str(&j, "z_unit_source",
-               tt__app_nonempty_or_null(p->info->z_unit_source));
+               tt__app_nonempty_or_null(tt__app_z_unit_source(p->info)));
+  tt__json_str(&j, "z_unit_conversion",
+               tt__app_nonempty_or_null(tt__app_z_unit_why(p->info)));
   tt__json_num(&j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
   tt__json_str(&j, "pixel_is",
                tt__app_nonempty_or_null(p->info->area_or_point));
@@ -321,14 +323,15 @@ static void budget_words(const tt_refine_options *ro, char *buf, size_t size)
 static void say_input(app_run *r, const app_simplify_report *p)
 {
   const tt_raster_info *in = p->info;
-  char valid[64], heights[160];
+  char valid[64], heights[200];
   if (p->valid == p->cells)
     snprintf(valid, sizeof valid, "all valid");
   else
     snprintf(valid, sizeof valid, "%zu valid", p->valid);
   if (in->z_unit_factor != 1.0)
-    snprintf(heights, sizeof heights, "heights in %s, converted to %s",
-             in->z_unit_declared, tt__app_unit_or(in, "?"));
+    snprintf(heights, sizeof heights, "heights in %s, converted to %s (%s)",
+             in->z_unit_declared, tt__app_unit_or(in, "?"),
+             tt__app_z_unit_why(in));
   else if (in->z_unit && *in->z_unit)
     snprintf(heights, sizeof heights, "heights in %s", in->z_unit);
   else
@@ -447,11 +450,15 @@ static void say_details(app_run *r, const app_simplify_report *p)
   fprintf(o, "frame:  %s\n", in->frame_name);
   fprintf(o, "heights: %.6g to %.6g %s", p->zmin, p->zmax,
           tt__app_unit_or(in, "z units"));
+  const char *source = tt__app_z_unit_source(in);
+  int given = strcmp(source, "-z_unit") == 0;
   if (in->z_unit_factor != 1.0)
-    fprintf(o, " (the %s's %s times %.10g)", in->z_unit_source,
-            in->z_unit_declared, in->z_unit_factor);
-  else if (in->z_unit_source && *in->z_unit_source)
-    fprintf(o, " (the unit from the %s)", in->z_unit_source);
+    fprintf(o, given ? " (%s %s times %.10g: %s)"
+                     : " (the %s's %s times %.10g: %s)",
+            source, in->z_unit_declared, in->z_unit_factor,
+            tt__app_z_unit_why(in));
+  else if (*source)
+    fprintf(o, given ? " (as %s says)" : " (the unit from the %s)", source);
   fputc('\n', o);
   if (p->tiles) {
     fprintf(o, "tiles:  %zu tiles of %zu cells on %d thread%s%s; the tiles "

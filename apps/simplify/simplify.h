@@ -200,6 +200,15 @@ void tt__app_simplify_fields(const app_simplify_job *job,
  * error naming the -layers or OUTPUT form that works). */
 int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
                              char **dsco, char **wopts, char **auto_t_srs);
+/* ogr_output.c, for --formats: the dry run of drv (with the -dsco terratin
+ * adds) into a file named with extension ext ("" for a folder), on a TIN
+ * in UTM zone 33N, read back: TT_APP_LAYERS_ALL when it holds the three
+ * layers together as written, else 0, with *out_alone the layers it
+ * holds each alone (all three when together; 0: the driver cannot write
+ * the TIN faithfully) and *out_imposed 1 when it writes them in a CRS of
+ * its own (GPX: EPSG:4326). */
+unsigned tt__app_probe_format(GDALDriverH drv, const char *ext,
+                              unsigned *out_alone, int *out_imposed);
 /* ogr_readback.c: 1 when the dataset name, just written by drv with the
  * layers (TT_APP_LAYERS_* bits) of tin
  * (in tin_srs, NULL: none) reprojected to t_srs (NULL: none), reads back

@@ -56,6 +56,10 @@ typedef struct tt_raster_info {
   char *z_unit_source;    /* "band unit", "vertical CRS" or "" */
   double z_unit_factor;   /* Z_UNIT=m's factor (0.3048 for ft, 1200/3937
                              for us-ft), else 1 */
+  const char *z_unit_why; /* why the heights were converted to metres:
+                             "asked" (Z_UNIT=m), "the CRS is in metres" or
+                             "the CRS is geographic" (Z_UNIT=auto); "" when
+                             they were not (a static string) */
 } tt_raster_info;
 
 void tt_raster_info_destroy(tt_raster_info *info);
@@ -83,11 +87,15 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> or SRCNODATA=nan
  * (replaces the mask; compared with the raw values), MAX_MEMORY=<bytes>
  * (refuse grids whose samples need more; default 3/4 of physical memory),
- * Z_UNIT=m (heights declared in ft or us-ft -- band unit type, else the
- * vertical CRS -- are converted to metres: height = (raw * scale + offset)
- * * (unit factor * Z_FACTOR), in doubles in that order; an unknown unit is
- * refused unless Z_FACTOR is given, which then does the whole
- * conversion), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
+ * SRC_Z_UNIT=m|ft|us-ft (the unit the heights are in, over the band's
+ * unit type and the vertical CRS, which say it otherwise: z_unit_source
+ * "given"), Z_UNIT=m (heights in ft or us-ft -- SRC_Z_UNIT, else the band
+ * unit type, else the vertical CRS -- are converted to metres: height =
+ * (raw * scale + offset) * (unit factor * Z_FACTOR), in doubles in that
+ * order; an unknown unit is refused unless Z_FACTOR is given, which then
+ * does the whole conversion), Z_UNIT=auto (converted so when the CRS is
+ * projected in metres or geographic, kept when it is in feet or absent;
+ * an unknown unit is kept, never refused), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
  * the working frame), WINDOW=col,row,width,height (read those samples
  * only, for a tile: the grid's geotransform is that of its first sample,
  * its ground frame the whole raster's, a geographic or Web Mercator

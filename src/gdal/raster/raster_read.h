@@ -29,6 +29,9 @@ typedef struct read_options {
   double z_factor;
   int has_z_factor;      /* Z_FACTOR was given */
   int z_unit_m;          /* Z_UNIT=m: convert ft and us-ft to metres */
+  int z_unit_auto;       /* Z_UNIT=auto: the same when the CRS is in
+                            metres or geographic */
+  const char *src_z_unit; /* SRC_Z_UNIT: "m", "ft" or "us-ft", NULL */
   const char *work_srs;  /* WORK_SRS, NULL: chosen here (points into the
                             options list) */
   int has_srcnodata;
@@ -86,6 +89,7 @@ typedef struct raster_read {
   const char *unit_source;  /* where it was declared ("band unit", ...) */
   const char *unit_out;     /* the unit of the grid's heights */
   double unit_factor;       /* Z_UNIT=m's factor, else 1 */
+  const char *unit_why;     /* why the heights were converted, "" */
   read_options conv;        /* what the scan multiplies by: Z_FACTOR times
                                unit_factor */
   char frame_name[512];
