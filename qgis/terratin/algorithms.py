@@ -51,6 +51,9 @@ TIN_FILTER = ";;".join([
     "2DM mesh, QGIS mesh layer (*.2dm)", "PLY mesh (*.ply)",
     "UGRID netCDF mesh (*.nc)", "Wavefront OBJ (*.obj)",
     "LandXML 1.2 (*.xml)", "DXF 3DFACE (*.dxf)"])
+Z_UNITS = ["the band's unit, else the vertical CRS's", "ft", "us-ft", "m"]
+Z_TOS = ["auto (when the CRS is in metres or geographic)",
+         "m (whatever the CRS)", "native (kept in their unit)"]
 TIN_FRAMES = ["default (map; an STL that fits the grid: pixel)",
               "map (map coordinates, in the TIN's CRS)",
               "pixel (the DEM's columns and rows)"]
@@ -161,9 +164,13 @@ class TerratinAlgorithm(QgsProcessingAlgorithm):
             "metres)", QgsProcessingParameterNumber.Double, 1.0, True, 1e-12)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
-        p = QgsProcessingParameterBoolean(
-            "Z_UNIT_M", "Heights declared in feet converted to metres "
-            "(-z_unit m)", False, True)
+        p = QgsProcessingParameterEnum(
+            "Z_UNIT", "The heights' unit (-z_unit)", Z_UNITS, False, 0, True)
+        p.setFlags(p.flags() | p.FlagAdvanced)
+        self.addParameter(p)
+        p = QgsProcessingParameterEnum(
+            "Z_TO", "Heights in feet become metres (-z_to)", Z_TOS, False, 0,
+            True)
         p.setFlags(p.flags() | p.FlagAdvanced)
         self.addParameter(p)
         p = QgsProcessingParameterExtent(
@@ -204,8 +211,12 @@ class TerratinAlgorithm(QgsProcessingAlgorithm):
         z = self.parameterAsDouble(parameters, "Z_FACTOR", context)
         if z != 1.0:
             args += ["-z_factor", repr(z)]
-        if self.parameterAsBoolean(parameters, "Z_UNIT_M", context):
-            args += ["-z_unit", "m"]
+        unit = self.parameterAsEnum(parameters, "Z_UNIT", context)
+        if unit:
+            args += ["-z_unit", Z_UNITS[unit]]
+        to = self.parameterAsEnum(parameters, "Z_TO", context)
+        if to:
+            args += ["-z_to", Z_TOS[to].split(" ")[0]]
         if parameters.get("PROJWIN") not in (None, ""):
             ext = self.parameterAsExtent(parameters, "PROJWIN", context)
             crs = self.parameterAsExtentCrs(parameters, "PROJWIN", context)

@@ -211,6 +211,10 @@ def check_simplify_options():
          ["-percent", 3, "-max_triangles", 5000]),
         ({"MAX_POINTS": 800, "OUTPUT_EXT": ".fgb"}, ["-max_points", 800,
                                                     "-layers", "triangles"]),
+        # heights declared in feet, converted to metres (fewer vertices at
+        # the same bound than the heights as they are)
+        ({"MAX_ERROR": 30, "Z_UNIT": 1, "Z_TO": 1},
+         ["-max_error", 30, "-z_unit", "ft", "-z_to", "m"]),
         # a window of the DEM (map coordinates, the extent's CRS) and
         # options the dialog has no field for
         ({"MAX_ERROR": 10, "PROJWIN": "-84.4,-84.3,36.62,36.72 [EPSG:4326]",
@@ -316,11 +320,23 @@ def check_eval(tin):
           j["max_error"])
 
 
+def dem_first():
+    """Whether this terratin's rasterize takes DEM TIN OUTPUT (its usage
+    says; older ones took TIN DEM OUTPUT)."""
+    out = subprocess.run([T, "rasterize", "--help"], stdout=subprocess.PIPE)
+    return b"rasterize DEM TIN" in out.stdout
+
+
+def rasterize_cli(tin, dem, out):
+    first, second = (dem, tin) if dem_first() else (tin, dem)
+    return cli("rasterize", first, second, out)
+
+
 def check_rasterize(tin):
     out = os.path.join(W, "surface.tif")
     r = processing.run("terratin:rasterize", {"TIN": tin, "DEM": DEM,
                                               "OUTPUT": out})
-    rc, j = cli("rasterize", tin, DEM, os.path.join(W, "surface_cli.tif"))
+    rc, j = rasterize_cli(tin, DEM, os.path.join(W, "surface_cli.tif"))
     for name, key in (("COVERED", "covered"), ("MAX_ERROR", "max_error"),
                       ("RMSE", "rmse"), ("TRIANGLE_COUNT", "triangles")):
         check("rasterize %s: %s (command line %s)" % (name, r.get(name),
@@ -432,27 +448,30 @@ def check_error():
     r = processing.run("terratin:simplify", {"INPUT": DEM, "MAX_POINTS": 100,
                                              "OUTPUT": out})
     check("the setting's terratin runs", r.get("VERTEX_COUNT") == 100)
-    # a terratin whose rasterize takes DEM TIN OUTPUT (its usage says so):
-    # the plugin follows the usage
+    # a terratin whose rasterize takes its two inputs the other way round
+    # (its usage says so; rasterize was TIN DEM OUTPUT before DEM TIN
+    # OUTPUT): the plugin follows the usage
     swapped = os.path.join(W, "swapped_terratin")
+    usage = "TIN DEM" if dem_first() else "DEM TIN"
     with open(swapped, "w") as f:
         f.write('#!/bin/sh\n'
                 'if [ "$1" = rasterize ] && [ "$2" = --help ]; then\n'
-                '  echo "Usage: terratin rasterize DEM TIN OUTPUT"; exit 0\n'
+                '  echo "Usage: terratin rasterize %s OUTPUT"; exit 0\n'
                 'fi\n'
                 'if [ "$1" = rasterize ]; then\n'
-                '  shift; d=$1; t=$2; shift 2\n'
-                '  exec "%s" rasterize "$t" "$d" "$@"\n'
+                '  shift; a=$1; b=$2; shift 2\n'
+                '  exec "%s" rasterize "$b" "$a" "$@"\n'
                 'fi\n'
-                'exec "%s" "$@"\n' % (T, T))
+                'exec "%s" "$@"\n' % (usage, T, T))
     os.chmod(swapped, 0o755)
     ProcessingConfig.setSettingValue("TERRATIN_PATH", swapped)
     tin = os.path.join(W, "s.gpkg")
     r = processing.run("terratin:rasterize", {
         "TIN": tin, "DEM": DEM, "OUTPUT": os.path.join(W, "swapped.tif")})
-    rc, j = cli("rasterize", tin, DEM, os.path.join(W, "swapped_cli.tif"))
-    check("rasterize DEM TIN OUTPUT followed from the usage (%s, %s)" % (
-        r.get("COVERED"), j["covered"]), r.get("COVERED") == j["covered"])
+    rc, j = rasterize_cli(tin, DEM, os.path.join(W, "swapped_cli.tif"))
+    check("rasterize %s OUTPUT followed from the usage (%s, %s)" % (
+        usage, r.get("COVERED"), j["covered"]),
+        r.get("COVERED") == j["covered"])
     ProcessingConfig.setSettingValue("TERRATIN_PATH", "")
 
 
