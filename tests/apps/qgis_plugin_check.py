@@ -400,6 +400,22 @@ def check_study():
           (len(got), len(want)), got == want and len(got) == 6)
     check("study: RUNS %s" % r.get("RUNS"), r.get("RUNS") == 6)
     check("study: tables.md", os.path.isfile(r.get("TABLES", "")))
+    # -plot, when matplotlib is there (the command checks it first)
+    have_mpl = subprocess.run(["/usr/bin/python3", "-c", "import matplotlib"],
+                              stderr=subprocess.DEVNULL).returncode == 0
+    if have_mpl:
+        from qgis.PyQt.QtGui import QImage
+        r = processing.run("terratin:study", {
+            "GENERATED": [0], "CRITERIA": [0, 9], "PERCENT": "1,10",
+            "PLOT": True, "OUTPUT": os.path.join(W, "study_plot")})
+        pngs = sorted(os.listdir(r["PLOTS"])) if os.path.isdir(
+            r.get("PLOTS", "")) else []
+        check("study -plot: the PNGs (%s)" % pngs,
+              "fault_smooth_insert_mean_abs_error.png" in pngs and
+              all(not QImage(os.path.join(r["PLOTS"], f)).isNull()
+                  for f in pngs))
+    else:
+        print("note: matplotlib is not installed: study -plot not checked")
     # a DEM layer as a terrain, into a temporary folder
     small = os.path.join(W, "small.tif")
     subprocess.run(["gdal_translate", "-q", "-srcwin", "0", "0", "120",
