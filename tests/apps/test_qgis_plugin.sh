@@ -45,7 +45,8 @@ export XDG_RUNTIME_DIR="$W/xdg"
 mkdir -m 700 "$W/xdg"
 # terratin found on PATH, as a user's would be (the provider's setting is
 # checked in the script too)
-PATH=$(dirname "$T"):$PATH /usr/bin/python3 "$HERE/qgis_plugin_check.py" \
+# (Processing's temporary outputs under TMPDIR: in here, removed with it)
+TMPDIR=$W PATH=$(dirname "$T"):$PATH /usr/bin/python3 "$HERE/qgis_plugin_check.py" \
   "$W/terratin-qgis.zip" "$T" "$DEM" "$W" 2>qgis_err.txt
 rc=$?
 if [ "$rc" -ne 0 ]; then
