@@ -13,7 +13,8 @@
  * geometry column), one row for each geometry layer written.
  *
  * The QML holds a graduated renderer, five classes from the TIN's own
- * values coloured yellow to red (ColorBrewer YlOrRd): max_err for the
+ * values coloured yellow to red (ColorBrewer YlOrRd), the triangles' fills
+ * at 45 % opacity so that a hillshade under them shows through: max_err for the
  * triangles in equal intervals from the smallest to the largest (the
  * errors lie under the bound, and an integer DEM gives most triangles an
  * error of 0, which would merge quantile classes into one); ins_err for
@@ -28,6 +29,7 @@
  * Workload: one sort of the triangles' and vertices' errors (8 bytes
  * each), a QML of a few kilobytes per layer.
  */
+#include "gdal/ogr/field_docs.h"
 #include "gdal/ogr/layer_style.h"
 #include "gdal/ogr/tin_records.h"
 #include "tin/tin.h"
@@ -35,6 +37,7 @@
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
+#include <cpl_vsi.h>
 
 #include <math.h>
 #include <stdarg.h>
@@ -49,6 +52,11 @@ static const char *const ramp[N_CLASSES] = {"255,255,178,255", "254,204,92,255",
                                             "253,141,60,255", "240,59,32,255",
                                             "189,0,38,255"};
 static const char *const null_colour = "160,160,160,255";
+
+/* The triangles' fills are see-through, so that a hillshade or an image
+ * under the TIN stays visible (the terrain shows through, the classes
+ * tint it); their dark outlines stay opaque and draw the mesh. */
+#define FILL_OPACITY "0.45"
 
 /* A growing string; on failure of an allocation it stays failed. */
 typedef struct text {
@@ -102,6 +110,22 @@ static void add_escaped(text *t, const char *s)
     default: add(t, "%c", *s);
     }
   }
+}
+
+/* The fields' titles as QGIS's aliases (the names its attribute table and
+ * forms show): every field of the layer (a vertex field the TIN lacks,
+ * importance, is ignored by QGIS). */
+static void add_aliases(text *t, int point)
+{
+  const tt__field_doc *docs = point ? tt__vertex_docs : tt__triangle_docs;
+  int n = point ? TT__VF_COUNT : TT__TF_COUNT;
+  add(t, "  <aliases>\n");
+  for (int i = 0; i < n; i++) {
+    add(t, "    <alias field=\"%s\" index=\"%d\" name=\"", docs[i].name, i);
+    add_escaped(t, docs[i].title);
+    add(t, "\"/>\n");
+  }
+  add(t, "  </aliases>\n");
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -171,7 +195,7 @@ static void add_symbol(text *t, int name, const char *colour, int point)
         name, colour);
   else
     add(t,
-        "      <symbol type=\"fill\" name=\"%d\" alpha=\"1\" "
+        "      <symbol type=\"fill\" name=\"%d\" alpha=\"" FILL_OPACITY "\" "
         "clip_to_extent=\"1\" force_rhr=\"0\">\n"
         "        <layer class=\"SimpleFill\" pass=\"0\" locked=\"0\" "
         "enabled=\"1\">\n"
@@ -248,7 +272,7 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
   text t;
   memset(&t, 0, sizeof t);
   add(&t, "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
-          "<qgis version=\"3.22.0\" styleCategories=\"Symbology\">\n"
+          "<qgis version=\"3.22.0\" styleCategories=\"Symbology|Fields\">\n"
           "  <renderer-v2 type=\"graduatedSymbol\" attr=\"");
   add_escaped(&t, attr);
   add(&t, "\" graduatedMethod=\"GraduatedColor\" symbollevels=\"0\" "
@@ -280,10 +304,12 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
           "      <labelFormat format=\"%%1 - %%2\" labelprecision=\"4\" "
           "trimtrailingzeroes=\"1\"/>\n"
           "    </classificationMethod>\n"
-          "  </renderer-v2>\n"
-          "  <layerGeometryType>%d</layerGeometryType>\n"
+          "  </renderer-v2>\n",
+      quantiles ? "Quantile" : "EqualInterval");
+  add_aliases(&t, point);
+  add(&t, "  <layerGeometryType>%d</layerGeometryType>\n"
           "</qgis>\n",
-      quantiles ? "Quantile" : "EqualInterval", point ? 0 : 2);
+      point ? 0 : 2);
   if (t.failed) {
     free(t.s);
     return NULL;
@@ -356,6 +382,29 @@ static tt_status insert_row(tt_context *ctx, OGRLayerH layer,
   return TT_OK;
 }
 
+/* The default style of the triangles (tri set) or the vertices of tin:
+ * classes from its own values. NULL when out of memory (said). */
+static char *layer_qml(tt_context *ctx, const tt_tin *tin, int tri)
+{
+  size_t n = tri ? tt_tin_triangle_count(tin) : tt_tin_vertex_count(tin);
+  double *values = malloc((n ? n : 1) * sizeof *values);
+  if (!values) {
+    tt__error(ctx, TT_ERR_NOMEM, "out of memory for the style's classes "
+              "of %zu features", n);
+    return NULL;
+  }
+  /* the TIN's own arrays (tt_tin_triangle() would work out every field
+   * of the triangle for its max_error) */
+  memcpy(values, tri ? tin->t_max : tin->v_ins_err, n * sizeof *values);
+  char *qml = tt__style_graduated_qml(
+      tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri,
+      !tri);
+  free(values);
+  if (!qml)
+    tt__error(ctx, TT_ERR_NOMEM, "out of memory for a style");
+  return qml;
+}
+
 tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                            const tt_tin *tin, const char *prefix,
                            unsigned layers, const char *tri_geom,
@@ -366,20 +415,9 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
     const int tri = k == 0;
     if (!(layers & (tri ? TT__LAYER_TRIANGLES : TT__LAYER_VERTICES)))
       continue;
-    size_t n = tri ? tt_tin_triangle_count(tin) : tt_tin_vertex_count(tin);
-    double *values = malloc((n ? n : 1) * sizeof *values);
-    if (!values)
-      return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the style's "
-                       "classes of %zu features", n);
-    /* the TIN's own arrays (tt_tin_triangle() would work out every field
-     * of the triangle for its max_error) */
-    memcpy(values, tri ? tin->t_max : tin->v_ins_err, n * sizeof *values);
-    char *qml = tt__style_graduated_qml(
-        tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri,
-        !tri);
-    free(values);
+    char *qml = layer_qml(ctx, tin, tri);
     if (!qml)
-      return tt__error(ctx, TT_ERR_NOMEM, "out of memory for a style");
+      return TT_ERR_NOMEM;
     char *table = CPLStrdup(CPLSPrintf("%s%s", prefix,
                                        tri ? "triangles" : "vertices"));
     s = insert_row(ctx, layer, table, tri ? tri_geom : vtx_geom, qml,
@@ -388,6 +426,59 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                        : "terratin: vertices by their insertion error "
                          "(ins_err), quantile classes; grey: none");
     CPLFree(table);
+    CPLFree(qml);
+  }
+  return s;
+}
+
+/* The .qml beside the layer's file: in a folder dataset (a shapefile's
+ * temporary folder, FlatGeobuf's folder of layers) <dir>/<layer>.qml,
+ * else the dataset's file with the extension .qml. */
+static char *qml_path(GDALDatasetH dst, OGRLayerH layer)
+{
+  const char *desc = GDALGetDescription(dst);
+  char **entries = VSIReadDir(desc); /* NULL for a file */
+  int folder = entries != NULL;
+  CSLDestroy(entries);
+  if (folder)
+    return CPLStrdup(CPLFormFilename(desc, OGR_L_GetName(layer), "qml"));
+  return CPLStrdup(CPLResetExtension(desc, "qml"));
+}
+
+static tt_status write_file(tt_context *ctx, const char *path,
+                            const char *qml)
+{
+  VSILFILE *f = VSIFOpenL(path, "wb");
+  if (!f)
+    return tt__error(ctx, TT_ERR_IO, "%s: cannot create the style file",
+                     path);
+  size_t n = strlen(qml);
+  int ok = VSIFWriteL(qml, 1, n, f) == n;
+  if (VSIFCloseL(f) != 0)
+    ok = 0;
+  if (!ok) {
+    VSIUnlink(path);
+    return tt__error(ctx, TT_ERR_IO, "%s: cannot write the style file",
+                     path);
+  }
+  return TT_OK;
+}
+
+tt_status tt__style_write_files(tt_context *ctx, GDALDatasetH dst,
+                                const tt_tin *tin, OGRLayerH tri_layer,
+                                OGRLayerH vtx_layer)
+{
+  tt_status s = TT_OK;
+  for (int k = 0; k < 2 && s == TT_OK; k++) {
+    OGRLayerH layer = k == 0 ? tri_layer : vtx_layer;
+    if (!layer)
+      continue;
+    char *qml = layer_qml(ctx, tin, k == 0);
+    if (!qml)
+      return TT_ERR_NOMEM;
+    char *path = qml_path(dst, layer);
+    s = write_file(ctx, path, qml);
+    CPLFree(path);
     CPLFree(qml);
   }
   return s;

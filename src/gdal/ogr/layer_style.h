@@ -29,6 +29,17 @@ TT_HIDDEN tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                                      unsigned layers, const char *tri_geom,
                                      const char *vtx_geom);
 
+/* Formats without a style table (Shapefile, FlatGeobuf, GeoJSON): the
+ * same default style as a QML file beside each geometry layer's file,
+ * which QGIS loads with the layer (NAME.qml beside NAME.shp): in a
+ * folder dataset <folder>/<layer>.qml, else the dataset's file with the
+ * extension .qml (one geometry layer). tri_layer or vtx_layer may be
+ * NULL (not written). */
+TT_HIDDEN tt_status tt__style_write_files(tt_context *ctx, GDALDatasetH dst,
+                                          const tt_tin *tin,
+                                          OGRLayerH tri_layer,
+                                          OGRLayerH vtx_layer);
+
 /* The QML of a graduated renderer on the expression attr (XML-escaped
  * here) over values (NaN ignored; n may be 0): five classes coloured
  * yellow to red, equal intervals from the smallest value to the largest,
