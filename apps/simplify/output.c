@@ -242,12 +242,14 @@ void tt__app_output_names(const app_simplify_job *job, char ***out_files,
     layers = layer_names(job, "", NULL);
   } else if (job->kind == APP_OUTPUT_MESH) {
     files = add_shown(files, r, s->output);
-    /* the sidecars replace OUTPUT's extension (2DM's datasets) */
+    /* the sidecars replace OUTPUT's extension (2DM's datasets; its .prj,
+     * last, when the TIN has a CRS) */
     char *stem = CPLStrdup(CPLFormFilename(CPLGetPath(s->output),
                                            CPLGetBasename(s->output), NULL));
     for (const char *const *sc = tt_mesh_format_sidecars(job->mesh); *sc;
          sc++)
-      files = add_shown(files, r, CPLSPrintf("%s%s", stem, *sc));
+      if (job->srs || strcmp(*sc, ".prj") != 0)
+        files = add_shown(files, r, CPLSPrintf("%s%s", stem, *sc));
     CPLFree(stem);
   } else if (tt__app_str_ieq(job->drvname, "ESRI Shapefile")) {
     /* files of their own beside OUTPUT: <name>_triangles.shp, ... */

@@ -267,8 +267,9 @@ tt_mesh_format tt_mesh_format_from_path(const char *path);
 /* "2DM", "PLY", "OBJ", "LandXML", "UGRID", "DXF"; NULL for TT_MESH_NONE. */
 const char *tt_mesh_format_name(tt_mesh_format fmt);
 /* The files a format writes beside OUTPUT, as suffixes that replace its
- * extension (2DM: "_ins_err.dat", ..., "_n_samples_els.dat", its datasets;
- * the others: none), NULL-terminated; static storage. */
+ * extension (2DM: "_ins_err.dat", ..., "_n_samples_els.dat", its datasets,
+ * and ".prj", its CRS when it has one; the others: none),
+ * NULL-terminated; static storage. */
 const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt);
 
 /* Writes tin to the file path (create or truncate: give it the temporary
@@ -280,7 +281,8 @@ const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt);
  * Surface name, OBJ object; NULL: "TIN"). local (OBJ only): vertices
  * relative to the centre of the extent rounded to whole units, which a
  * comment line `# origin X Y` gives. 2DM's datasets are written beside
- * path under the names tt_mesh_format_sidecars() gives; PLY's header names
+ * path under the names tt_mesh_format_sidecars() gives, and its CRS (when
+ * there is one) as PATH's stem + ".prj" in ESRI's WKT1; PLY's header names
  * the CRS ("comment crs:WKT"). progress may stop the write
  * (TT_ERR_INTERRUPTED). On any failure the files written are removed. */
 tt_status tt_mesh_write(tt_context *ctx, const char *path,
