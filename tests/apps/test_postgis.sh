@@ -9,6 +9,10 @@
 #  - -of PostgreSQL "PG:..." and the same guessed from the "PG:" prefix:
 #    counts equal the run's, every triangle ST_IsValid, the SRID the DEM's,
 #    ST_Area equal to our area_2d;
+#  - QGIS's layer_styles table with a default style per geometry layer
+#    (catalog, schema, table, geometry column, type; the triangles' QML on
+#    max_err with see-through fills), one per table after -overwrite, in
+#    the -lco SCHEMA's name;
 #  - existing tables refused without -overwrite (before the work, the old
 #    tables untouched), replaced with it; -lco SCHEMA=...;
 #  - a write that fails half way (-lco FID=v0 clashing with a field) leaves
@@ -133,6 +137,18 @@ check "vertex ids 0..$((NV - 1))" [ "$(q "SELECT min(vertex_id) || ',' ||
   "0,$((NV - 1)),$NV" ]
 check "the run's vertices recorded" \
   [ "$(q 'SELECT vertices FROM run_parameters')" = "$NV" ]
+styles() { # the default styles of schema $1: table:geometry column:type
+  q "SELECT string_agg(f_table_name || ':' || f_geometry_column || ':' ||
+     type, ' ' ORDER BY f_table_name) FROM layer_styles WHERE useAsDefault
+     AND f_table_catalog = 'postgres' AND f_table_schema = '$1'"
+}
+check "layer_styles: a default style per geometry layer ($(styles public))" \
+  [ "$(styles public)" = "triangles:wkb_geometry:Polygon vertices:wkb_geometry:Point" ]
+check "layer_styles: the triangles' QML on max_err, see-through" \
+  [ "$(q "SELECT count(*) FROM layer_styles WHERE f_table_name = 'triangles'
+          AND xpath_exists('/qgis/renderer-v2[@attr=\"max_err\"]', styleQML)
+          AND xpath_exists('//symbol[@type=\"fill\" and @alpha < 1]',
+                           styleQML)")" = 1 ]
 
 # --- existing tables ------------------------------------------------------------
 "$T" simplify -max_error 1 dem.tif "$PG" >out.txt 2>err.txt
@@ -150,6 +166,8 @@ check "-overwrite: the new triangles ($NT2, fewer than $NT)" \
   [ "$(q 'SELECT count(*) FROM triangles')" = "$NT2" -a "$NT2" -lt "$NT" ]
 check "-overwrite: one run_parameters row" \
   [ "$(q 'SELECT count(*) FROM run_parameters')" = 1 ]
+check "-overwrite: still one style per layer" \
+  [ "$(q 'SELECT count(*) FROM layer_styles')" = 2 ]
 
 # --- -lco SCHEMA -------------------------------------------------------------
 q 'CREATE SCHEMA tin' >/dev/null
@@ -160,6 +178,8 @@ check "-lco SCHEMA=tin: the tables there" \
 check "-lco SCHEMA=tin: $NT triangles" [ "$(q 'SELECT count(*) FROM tin.triangles')" = "$NT" ]
 check "-lco SCHEMA=tin: public left alone" \
   [ "$(q 'SELECT count(*) FROM public.triangles')" = "$NT2" ]
+check "-lco SCHEMA=tin: its styles name the schema ($(styles tin))" \
+  [ "$(styles tin)" = "triangles:wkb_geometry:Polygon vertices:wkb_geometry:Point" ]
 run simplify -q -max_error 1 -lco SCHEMA=tin dem.tif "$PG"
 check "-lco SCHEMA=tin again: refused" [ "$rc" -eq 1 ]
 check "-lco SCHEMA=tin again: names tin.triangles" grep -q 'tin\.triangles' err.txt

@@ -483,3 +483,109 @@ tt_status tt__style_write_files(tt_context *ctx, GDALDatasetH dst,
   }
   return s;
 }
+
+/* An SQL string literal of s (quotes doubled: PostgreSQL's standard
+ * strings), CPLFree(). */
+static char *sql_literal(const char *s)
+{
+  size_t n = 3;
+  for (const char *p = s; *p; p++)
+    n += *p == '\'' ? 2 : 1;
+  char *q = CPLMalloc(n), *o = q;
+  *o++ = '\'';
+  for (const char *p = s; *p; p++) {
+    *o++ = *p;
+    if (*p == '\'')
+      *o++ = '\'';
+  }
+  *o++ = '\'';
+  *o = '\0';
+  return q;
+}
+
+static tt_status pg_exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
+{
+  CPLErrorReset();
+  OGRLayerH rs = GDALDatasetExecuteSQL(dst, sql, NULL, NULL);
+  if (rs)
+    GDALDatasetReleaseResultSet(dst, rs);
+  if (CPLGetLastErrorType() >= CE_Failure) {
+    const char *m = CPLGetLastErrorMsg();
+    return tt__error(ctx, TT_ERR_IO, "cannot write the layers' style "
+                     "(layer_styles): %s", m && *m ? m : "no details from "
+                     "GDAL");
+  }
+  return TT_OK;
+}
+
+/* QGIS's layer_styles as its PostgreSQL provider creates it. */
+#define PG_STYLE_TABLE                                                         \
+  "CREATE TABLE IF NOT EXISTS layer_styles (id SERIAL PRIMARY KEY, "          \
+  "f_table_catalog varchar, f_table_schema varchar, f_table_name varchar, "   \
+  "f_geometry_column varchar, styleName text, styleQML xml, styleSLD xml, "   \
+  "useAsDefault boolean, description text, owner varchar(63) DEFAULT "        \
+  "CURRENT_USER, ui xml, update_time timestamp DEFAULT CURRENT_TIMESTAMP, "   \
+  "type varchar)"
+
+/* One layer's row: terratin's earlier row for the same table replaced. */
+static tt_status pg_insert_row(tt_context *ctx, GDALDatasetH dst,
+                               const char *schema, OGRLayerH layer,
+                               const char *qml, int tri)
+{
+  /* OGR names a layer of another schema "schema.table" */
+  const char *name = OGR_L_GetName(layer);
+  const char *dot = schema ? strchr(name, '.') : NULL;
+  char *sch = schema ? sql_literal(schema) : CPLStrdup("current_schema()");
+  char *table = sql_literal(dot ? dot + 1 : name);
+  char *geom = sql_literal(OGR_L_GetGeometryColumn(layer));
+  char *doc = sql_literal(qml);
+  const char *description =
+      tri ? "'terratin: triangles by their max error (max_err), equal "
+            "intervals'"
+          : "'terratin: vertices by their insertion error (ins_err), "
+            "quantile classes; grey: none'";
+  char *where = CPLStrdup(CPLSPrintf(
+      "f_table_catalog = current_database() AND f_table_schema = %s AND "
+      "f_table_name = %s AND f_geometry_column = %s", sch, table, geom));
+  char *del = CPLStrdup(CPLSPrintf("DELETE FROM layer_styles WHERE %s AND "
+                                   "description LIKE 'terratin:%%'", where));
+  char *ins = CPLStrdup(CPLSPrintf(
+      "INSERT INTO layer_styles (f_table_catalog, f_table_schema, "
+      "f_table_name, f_geometry_column, styleName, styleQML, useAsDefault, "
+      "description, type) VALUES (current_database(), %s, %s, %s, %s, "
+      "XMLPARSE(DOCUMENT %s), true, %s, '%s')",
+      sch, table, geom, table, doc, description, tri ? "Polygon" : "Point"));
+  tt_status s = pg_exec(ctx, dst, del);
+  if (s == TT_OK)
+    s = pg_exec(ctx, dst, ins);
+  CPLFree(ins);
+  CPLFree(del);
+  CPLFree(where);
+  CPLFree(doc);
+  CPLFree(geom);
+  CPLFree(table);
+  CPLFree(sch);
+  return s;
+}
+
+tt_status tt__style_insert_pg(tt_context *ctx, GDALDatasetH dst,
+                              const tt_tin *tin, const char *schema,
+                              OGRLayerH tri_layer, OGRLayerH vtx_layer)
+{
+  tt_status s = pg_exec(ctx, dst, PG_STYLE_TABLE);
+  /* a table of QGIS before 3.14 has no type column; QGIS adds it too */
+  if (s == TT_OK)
+    s = pg_exec(ctx, dst, "ALTER TABLE layer_styles ADD COLUMN IF NOT "
+                          "EXISTS type varchar");
+  for (int k = 0; k < 2 && s == TT_OK; k++) {
+    OGRLayerH layer = k == 0 ? tri_layer : vtx_layer;
+    if (!layer)
+      continue;
+    char *qml = layer_qml(ctx, tin, k == 0);
+    if (!qml)
+      return TT_ERR_NOMEM;
+    s = pg_insert_row(ctx, dst, schema, layer, qml, k == 0);
+    CPLFree(qml);
+  }
+  return s;
+}

@@ -40,6 +40,17 @@ TT_HIDDEN tt_status tt__style_write_files(tt_context *ctx, GDALDatasetH dst,
                                           OGRLayerH tri_layer,
                                           OGRLayerH vtx_layer);
 
+/* PostgreSQL, inside the write's transaction: QGIS's layer_styles table
+ * (unqualified: the search path's, where QGIS looks) made as QGIS makes
+ * it when missing, and a default row for each geometry layer given (its
+ * table in schema, NULL: the current schema), terratin's earlier row for
+ * that table deleted. QGIS opens the tables with these styles. */
+TT_HIDDEN tt_status tt__style_insert_pg(tt_context *ctx, GDALDatasetH dst,
+                                        const tt_tin *tin,
+                                        const char *schema,
+                                        OGRLayerH tri_layer,
+                                        OGRLayerH vtx_layer);
+
 /* The QML of a graduated renderer on the expression attr (XML-escaped
  * here) over values (NaN ignored; n may be 0): five classes coloured
  * yellow to red, equal intervals from the smallest value to the largest,
