@@ -10,9 +10,10 @@
 #    counts equal the run's, every triangle ST_IsValid, the SRID the DEM's,
 #    ST_Area equal to our area_2d;
 #  - QGIS's layer_styles table with a default style per geometry layer
-#    (catalog, schema, table, geometry column, type; the triangles' QML on
+#    (catalog, schema, table, geometry column; the triangles' QML on
 #    max_err with see-through fills), one per table after -overwrite, in
-#    the -lco SCHEMA's name;
+#    the -lco SCHEMA's name; QGIS opens the table with it (when
+#    python3-qgis is installed);
 #  - existing tables refused without -overwrite (before the work, the old
 #    tables untouched), replaced with it; -lco SCHEMA=...;
 #  - a write that fails half way (-lco FID=v0 clashing with a field) leaves
@@ -137,18 +138,43 @@ check "vertex ids 0..$((NV - 1))" [ "$(q "SELECT min(vertex_id) || ',' ||
   "0,$((NV - 1)),$NV" ]
 check "the run's vertices recorded" \
   [ "$(q 'SELECT vertices FROM run_parameters')" = "$NV" ]
-styles() { # the default styles of schema $1: table:geometry column:type
-  q "SELECT string_agg(f_table_name || ':' || f_geometry_column || ':' ||
-     type, ' ' ORDER BY f_table_name) FROM layer_styles WHERE useAsDefault
+styles() { # the default styles of schema $1: table:geometry column
+  q "SELECT string_agg(f_table_name || ':' || f_geometry_column, ' ' ORDER
+     BY f_table_name) FROM layer_styles WHERE useAsDefault AND type IS NULL
      AND f_table_catalog = 'postgres' AND f_table_schema = '$1'"
 }
 check "layer_styles: a default style per geometry layer ($(styles public))" \
-  [ "$(styles public)" = "triangles:wkb_geometry:Polygon vertices:wkb_geometry:Point" ]
+  [ "$(styles public)" = "triangles:wkb_geometry vertices:wkb_geometry" ]
 check "layer_styles: the triangles' QML on max_err, see-through" \
   [ "$(q "SELECT count(*) FROM layer_styles WHERE f_table_name = 'triangles'
           AND xpath_exists('/qgis/renderer-v2[@attr=\"max_err\"]', styleQML)
           AND xpath_exists('//symbol[@type=\"fill\" and @alpha < 1]',
                            styleQML)")" = 1 ]
+
+# QGIS (when python3-qgis is installed) opens the table with that style
+if /usr/bin/python3 -c 'import qgis.core' >/dev/null 2>&1; then
+  mkdir -m 700 "$W/xdg"
+  QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR="$W/xdg" /usr/bin/python3 - "$S" \
+    >qgis.txt 2>qgis_err.txt <<'EOF'
+import sys
+from qgis.core import QgsApplication, QgsVectorLayer
+app = QgsApplication([], False)
+app.initQgis()
+def main():
+    uri = ("host=%s dbname=postgres user=tt key='ogc_fid' "
+           "table=\"public\".\"triangles\" (wkb_geometry)" % sys.argv[1])
+    layer = QgsVectorLayer(uri, "triangles", "postgres")
+    r = layer.renderer() if layer.isValid() else None
+    print(layer.isValid(), r.type() if r else None,
+          r.classAttribute() if r and r.type() == "graduatedSymbol" else None)
+main()
+app.exitQgis()
+EOF
+  check "QGIS opens the triangles styled ($(cat qgis.txt))" \
+    [ "$(cat qgis.txt)" = "True graduatedSymbol max_err" ]
+else
+  echo "SKIP: python3-qgis is not installed: QGIS reading layer_styles skipped"
+fi
 
 # --- existing tables ------------------------------------------------------------
 "$T" simplify -max_error 1 dem.tif "$PG" >out.txt 2>err.txt
@@ -179,7 +205,7 @@ check "-lco SCHEMA=tin: $NT triangles" [ "$(q 'SELECT count(*) FROM tin.triangle
 check "-lco SCHEMA=tin: public left alone" \
   [ "$(q 'SELECT count(*) FROM public.triangles')" = "$NT2" ]
 check "-lco SCHEMA=tin: its styles name the schema ($(styles tin))" \
-  [ "$(styles tin)" = "triangles:wkb_geometry:Polygon vertices:wkb_geometry:Point" ]
+  [ "$(styles tin)" = "triangles:wkb_geometry vertices:wkb_geometry" ]
 run simplify -q -max_error 1 -lco SCHEMA=tin dem.tif "$PG"
 check "-lco SCHEMA=tin again: refused" [ "$rc" -eq 1 ]
 check "-lco SCHEMA=tin again: names tin.triangles" grep -q 'tin\.triangles' err.txt

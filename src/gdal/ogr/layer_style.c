@@ -527,7 +527,9 @@ static tt_status pg_exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
   "CURRENT_USER, ui xml, update_time timestamp DEFAULT CURRENT_TIMESTAMP, "   \
   "type varchar)"
 
-/* One layer's row: terratin's earlier row for the same table replaced. */
+/* One layer's row: terratin's earlier row for the same table replaced.
+ * type NULL: QGIS matches its geometry type with the layer URI's (absent
+ * from a URI written by hand: "Unknown geometry") or takes NULL as any. */
 static tt_status pg_insert_row(tt_context *ctx, GDALDatasetH dst,
                                const char *schema, OGRLayerH layer,
                                const char *qml, int tri)
@@ -553,8 +555,8 @@ static tt_status pg_insert_row(tt_context *ctx, GDALDatasetH dst,
       "INSERT INTO layer_styles (f_table_catalog, f_table_schema, "
       "f_table_name, f_geometry_column, styleName, styleQML, useAsDefault, "
       "description, type) VALUES (current_database(), %s, %s, %s, %s, "
-      "XMLPARSE(DOCUMENT %s), true, %s, '%s')",
-      sch, table, geom, table, doc, description, tri ? "Polygon" : "Point"));
+      "XMLPARSE(DOCUMENT %s), true, %s, NULL)",
+      sch, table, geom, table, doc, description));
   tt_status s = pg_exec(ctx, dst, del);
   if (s == TT_OK)
     s = pg_exec(ctx, dst, ins);
