@@ -146,9 +146,14 @@ typedef struct tt_run_field {
  * other than GPKG and SQLite: PostgreSQL) gets its tables made inside the
  * transaction, so that a rollback or a lost connection leaves none;
  * OVERWRITE=YES drops the dataset's layers of those names first (inside
- * that transaction; LCO=SCHEMA=<s> looks for s.<name>). STYLE=YES (GPKG):
- * QGIS's layer_styles table with a default graduated style for each
- * geometry layer. Integer64 fields become Integer for drivers without them
+ * that transaction; LCO=SCHEMA=<s> looks for s.<name>). STYLE=YES:
+ * QGIS's default graduated style for each geometry layer, as rows of the
+ * layer_styles table (GPKG; PostgreSQL, the table made when missing) or a
+ * .qml file beside each layer's file (Shapefile, FlatGeobuf, GeoJSON: the
+ * caller's tt_output registers a single file's OUTPUT.qml as a sidecar).
+ * A GPKG gets every field's title and description in gpkg_data_columns
+ * (the schema extension), the errors' unit Z_UNIT=<unit> ("z units" when
+ * absent). Integer64 fields become Integer for drivers without them
  * (MapInfo); a layer that cannot create fields (DXF) is written without
  * attributes, with one warning. */
 tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,

@@ -3,14 +3,18 @@
  * triangles read from one, the features' records, QGIS's default style,
  * safe output paths and the protection of the input's files.
  *
- * layer_style.c -- the default QGIS style saved with a GeoPackage, so that
- * its layers open styled: the `layer_styles` table of QGIS's convention
+ * layer_style.c -- the default QGIS style saved with the layers, so that
+ * they open styled: in a GeoPackage the `layer_styles` table of QGIS's convention
  * (the schema QGIS's OGR provider creates when a user saves a style into a
  * GeoPackage: f_table_catalog, f_table_schema, f_table_name,
  * f_geometry_column, styleName, styleQML, styleSLD, useAsDefault,
  * description, owner, ui, update_time, FID id; QGIS takes the row with
  * useAsDefault = 1, f_table_schema = '' and the layer's table and
- * geometry column), one row for each geometry layer written.
+ * geometry column), one row for each geometry layer written; in
+ * PostgreSQL the same table as QGIS's PostgreSQL provider makes it (xml
+ * columns, a type column), through SQL in the write's transaction; beside
+ * a Shapefile's, FlatGeobuf's or GeoJSON's layer file a NAME.qml, which
+ * QGIS loads with NAME.shp by itself.
  *
  * The QML holds a graduated renderer, five classes from the TIN's own
  * values coloured yellow to red (ColorBrewer YlOrRd), the triangles' fills
@@ -24,7 +28,9 @@
  * repeated values leave fewer than three. ins_err is NULL for the starting
  * corners, the forced outline vertices and every vertex of a decimated
  * TIN: coalesce() maps it to -1, drawn grey in a class of its own, so no
- * vertex disappears.
+ * vertex disappears. The QML also names every field's title
+ * (field_docs.c) as QGIS's alias, which GDAL 3.6 would not pass on from
+ * gpkg_data_columns.
  *
  * Workload: one sort of the triangles' and vertices' errors (8 bytes
  * each), a QML of a few kilobytes per layer.

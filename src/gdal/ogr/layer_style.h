@@ -3,11 +3,13 @@
  * triangles read from one, the features' records, QGIS's default style,
  * safe output paths and the protection of the input's files.
  *
- * layer_style.h -- the default QGIS style of a GeoPackage's layers: the
+ * layer_style.h -- the default QGIS style of the TIN's layers: the
  * `layer_styles` table of QGIS's own convention (written by QGIS's OGR
  * provider when a user saves a style into the file, read when the layer is
- * opened) with one row per geometry layer, graduated colours on max_err for
- * triangles and on ins_err for vertices.
+ * opened) with one row per geometry layer (GeoPackage, PostgreSQL), or a
+ * .qml beside each layer's file; graduated colours on max_err for
+ * triangles (see-through fills) and on ins_err for vertices, the fields'
+ * titles as aliases.
  */
 #ifndef TERRATIN_LAYER_STYLE_H
 #define TERRATIN_LAYER_STYLE_H

@@ -41,8 +41,9 @@
  * Fields: Integer64 becomes Integer where the driver has no Integer64
  * (MapInfo); a layer that creates no fields (DXF's fixed set) gets the
  * features without attributes, warned once. STYLE=YES writes QGIS's
- * layer_styles table of a GeoPackage (layer_style.c) in the same
- * transaction. A GeoPackage gets every field's title and description in
+ * layer_styles table of a GeoPackage or a PostgreSQL database
+ * (layer_style.c) in the same transaction, or a .qml beside each layer's
+ * file (Shapefile, FlatGeobuf, GeoJSON) once the layers are written. A GeoPackage gets every field's title and description in
  * gpkg_data_columns (field_docs.c), with the height unit Z_UNIT.
  *
  * Spatial index: GPKG layers are created with SPATIAL_INDEX=NO (its R-tree
