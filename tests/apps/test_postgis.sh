@@ -12,7 +12,8 @@
 #  - QGIS's layer_styles table with a default style per geometry layer
 #    (catalog, schema, table, geometry column; the triangles' QML on
 #    max_err with see-through fills), one per table after -overwrite, in
-#    the -lco SCHEMA's name; QGIS opens the table with it (when
+#    the -lco SCHEMA's name; every column's description as its comment;
+#    QGIS opens the table with the style and the comments (when
 #    python3-qgis is installed);
 #  - existing tables refused without -overwrite (before the work, the old
 #    tables untouched), replaced with it; -lco SCHEMA=...;
@@ -151,6 +152,21 @@ check "layer_styles: the triangles' QML on max_err, see-through" \
           AND xpath_exists('//symbol[@type=\"fill\" and @alpha < 1]',
                            styleQML)")" = 1 ]
 
+uncommented() { # the columns of table $1 (schema public) without a comment
+  q "SELECT count(*) FROM pg_attribute WHERE attrelid = 'public.$1'::regclass
+     AND attnum > 0 AND NOT attisdropped AND attname NOT IN ('ogc_fid',
+     'wkb_geometry') AND col_description(attrelid, attnum) IS NULL"
+}
+for t in triangles vertices run_parameters; do
+  check "every column of $t described (COMMENT ON COLUMN)" \
+    [ "$(uncommented $t)" = 0 ]
+done
+check "max_err's comment and unit" \
+  [ "$(q "SELECT col_description('public.triangles'::regclass, attnum) FROM
+          pg_attribute WHERE attrelid = 'public.triangles'::regclass AND
+          attname = 'max_err'")" = \
+    "largest |TIN - DEM| of the samples in this triangle (z units)" ]
+
 # QGIS (when python3-qgis is installed) opens the table with that style
 if /usr/bin/python3 -c 'import qgis.core' >/dev/null 2>&1; then
   mkdir -m 700 "$W/xdg"
@@ -166,12 +182,13 @@ def main():
     layer = QgsVectorLayer(uri, "triangles", "postgres")
     r = layer.renderer() if layer.isValid() else None
     print(layer.isValid(), r.type() if r else None,
-          r.classAttribute() if r and r.type() == "graduatedSymbol" else None)
+          r.classAttribute() if r and r.type() == "graduatedSymbol" else None,
+          layer.fields().field("max_err").comment().startswith("largest"))
 main()
 app.exitQgis()
 EOF
   check "QGIS opens the triangles styled ($(cat qgis.txt))" \
-    [ "$(cat qgis.txt)" = "True graduatedSymbol max_err" ]
+    [ "$(cat qgis.txt)" = "True graduatedSymbol max_err True" ]
 else
   echo "SKIP: python3-qgis is not installed: QGIS reading layer_styles skipped"
 fi

@@ -17,7 +17,10 @@
  * is unique, so the titles of a layer differ. Heights and errors are in
  * the run's height unit, said in the description ("{z}" in the tables).
  *
- * Workload: a few dozen INSERTs through the driver's SQL.
+ * A PostgreSQL table gets the same descriptions as its columns' comments
+ * (COMMENT ON COLUMN), which QGIS shows as the fields' comments.
+ *
+ * Workload: a few dozen INSERTs or COMMENTs through the driver's SQL.
  */
 #include "gdal/ogr/field_docs.h"
 
@@ -222,8 +225,7 @@ static tt_status exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
     GDALDatasetReleaseResultSet(dst, rs);
   if (CPLGetLastErrorType() >= CE_Failure) {
     const char *m = CPLGetLastErrorMsg();
-    return tt__error(ctx, TT_ERR_IO, "cannot describe the fields "
-                     "(gpkg_data_columns): %s",
+    return tt__error(ctx, TT_ERR_IO, "cannot describe the fields: %s",
                      m && *m ? m : "no details from GDAL");
   }
   return TT_OK;
@@ -311,5 +313,75 @@ tt_status tt__field_docs_write_gpkg(tt_context *ctx, GDALDatasetH dst,
                    d ? d->description : NULL, z_unit);
   }
   CPLFree(table);
+  return s;
+}
+
+/* A PostgreSQL identifier in double quotes (doubled inside), CPLFree. */
+static char *identifier(const char *s)
+{
+  size_t n = 3;
+  for (const char *p = s; *p; p++)
+    n += *p == '"' ? 2 : 1;
+  char *q = CPLMalloc(n), *o = q;
+  *o++ = '"';
+  for (const char *p = s; *p; p++) {
+    *o++ = *p;
+    if (*p == '"')
+      *o++ = '"';
+  }
+  *o++ = '"';
+  *o = '\0';
+  return q;
+}
+
+static tt_status comment_column(tt_context *ctx, GDALDatasetH dst,
+                                const char *qualified, const char *column,
+                                const char *description, const char *z_unit)
+{
+  if (!description)
+    return TT_OK;
+  char *text = tt__field_doc_text(description, z_unit);
+  char *c = identifier(column), *d = literal(text);
+  char *sql = CPLStrdup(CPLSPrintf("COMMENT ON COLUMN %s.%s IS %s",
+                                   qualified, c, d));
+  tt_status s = exec(ctx, dst, sql);
+  CPLFree(sql);
+  CPLFree(d);
+  CPLFree(c);
+  CPLFree(text);
+  return s;
+}
+
+tt_status tt__field_docs_comment_pg(tt_context *ctx, GDALDatasetH dst,
+                                    const char *schema, const char *prefix,
+                                    unsigned layers, int n_vertex_fields,
+                                    const tt_run_field *fields,
+                                    size_t nfields, const char *z_unit)
+{
+  tt_status s = TT_OK;
+  static const char *const suffix[3] = {"triangles", "vertices",
+                                        "run_parameters"};
+  static const unsigned bit[3] = {TT__LAYER_TRIANGLES, TT__LAYER_VERTICES,
+                                  TT__LAYER_RUN_PARAMETERS};
+  for (int k = 0; k < 3 && s == TT_OK; k++) {
+    if (!(layers & bit[k]))
+      continue;
+    char *t = identifier(CPLSPrintf("%s%s", prefix, suffix[k]));
+    char *sch = schema && *schema ? identifier(schema) : NULL;
+    char *qualified = CPLStrdup(sch ? CPLSPrintf("%s.%s", sch, t) : t);
+    size_t n = k == 0 ? TT__TF_COUNT : k == 1 ? (size_t)n_vertex_fields
+                                              : nfields;
+    for (size_t i = 0; i < n && s == TT_OK; i++) {
+      const tt__field_doc *d = k == 0   ? &tt__triangle_docs[i]
+                               : k == 1 ? &tt__vertex_docs[i]
+                                        : tt__field_doc_run(fields[i].name);
+      const char *column = k == 2 ? fields[i].name : d->name;
+      s = comment_column(ctx, dst, qualified, column,
+                         d ? d->description : NULL, z_unit);
+    }
+    CPLFree(qualified);
+    CPLFree(sch);
+    CPLFree(t);
+  }
   return s;
 }

@@ -52,4 +52,17 @@ TT_HIDDEN tt_status tt__field_docs_write_gpkg(tt_context *ctx,
                                               size_t nfields,
                                               const char *z_unit);
 
+/* PostgreSQL, inside the write's transaction: the same descriptions as
+ * comments on the columns of the tables prefix + "triangles", ... in
+ * schema (NULL: the search path's). */
+TT_HIDDEN tt_status tt__field_docs_comment_pg(tt_context *ctx,
+                                              GDALDatasetH dst,
+                                              const char *schema,
+                                              const char *prefix,
+                                              unsigned layers,
+                                              int n_vertex_fields,
+                                              const tt_run_field *fields,
+                                              size_t nfields,
+                                              const char *z_unit);
+
 #endif /* TERRATIN_FIELD_DOCS_H */

@@ -864,6 +864,13 @@ static tt_status fill_and_commit(write_state *w, const tt_tin *tin,
     s = tt__style_insert_pg(w->ctx, w->dst, tin,
                             CSLFetchNameValue(w->lco, "SCHEMA"),
                             w->tri_layer, w->vtx_layer);
+  if (s == TT_OK && w->database &&
+      strcasecmp(w->drv_name, "PostgreSQL") == 0)
+    s = tt__field_docs_comment_pg(w->ctx, w->dst,
+                                  CSLFetchNameValue(w->lco, "SCHEMA"),
+                                  w->prefix, w->layers,
+                                  tt__records_vertex_fields(tin), fields,
+                                  nfields, w->z_unit);
   if (s == TT_OK && w->gpkg)
     s = tt__field_docs_write_gpkg(w->ctx, w->dst, w->prefix, w->layers,
                                   tt__records_vertex_fields(tin), fields,
