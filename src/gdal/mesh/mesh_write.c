@@ -471,18 +471,25 @@ static char *sidecar_path(const char *path, const char *suffix)
   return p;
 }
 
-/* 2DM has no CRS and MDAL reads none: the CRS goes beside it as a .prj
- * (WKT1 in ESRI's dialect, as a shapefile's), for whoever loads the mesh
- * by hand and sets its CRS. */
-static tt_status write_prj(tt_context *ctx, const char *prj_path,
-                           OGRSpatialReferenceH srs)
+/* 2DM has no CRS and MDAL reads none: the CRS goes beside path as a
+ * .prj (WKT1 in ESRI's dialect, as a shapefile's), for whoever loads the
+ * mesh by hand and sets its CRS. *out_path: the file written (malloc'd),
+ * NULL on failure. */
+static tt_status write_prj(tt_context *ctx, const char *path,
+                           OGRSpatialReferenceH srs, char **out_path)
 {
   const char *const opts[] = {"FORMAT=WKT1_ESRI", NULL};
   char *wkt = NULL;
+  char *prj_path = sidecar_path(path, PRJ_SUFFIX);
+  *out_path = NULL;
+  if (!prj_path)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
   if (OSRExportToWktEx(srs, &wkt, opts) != OGRERR_NONE || !wkt) {
     CPLFree(wkt);
-    return tt__error(ctx, TT_ERR_FORMAT, "%s: the CRS has no ESRI WKT "
-                     "form", prj_path);
+    tt_status st = tt__error(ctx, TT_ERR_FORMAT, "%s: the CRS has no ESRI "
+                             "WKT form", prj_path);
+    free(prj_path);
+    return st;
   }
   FILE *f = fopen(prj_path, "wb");
   tt_status st = TT_OK;
@@ -500,6 +507,10 @@ static tt_status write_prj(tt_context *ctx, const char *prj_path,
     }
   }
   CPLFree(wkt);
+  if (st == TT_OK)
+    *out_path = prj_path;
+  else
+    free(prj_path);
   return st;
 }
 
@@ -529,8 +540,8 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   FILE *f = NULL;
   FILE *dat[N_DATASETS] = {NULL};
   char *dat_path[N_DATASETS] = {NULL};
-  char *prj_path = NULL;
-  int made = 0, prj_made = 0;
+  char *prj_path = NULL; /* written: removed on a later failure */
+  int made = 0;
   const int ndat = fmt == TT_MESH_2DM ? N_DATASETS : 0;
   memset(&rec, 0, sizeof rec);
   if (!path || !tin || !tt_mesh_format_name(fmt))
@@ -640,15 +651,9 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   }
   if (st != TT_OK)
     goto done;
-  if (fmt == TT_MESH_2DM && rec.out_srs) {
-    if (!(prj_path = sidecar_path(path, PRJ_SUFFIX)))
-      st = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-    else
-      st = write_prj(ctx, prj_path, rec.out_srs);
-    if (st != TT_OK)
-      goto done;
-    prj_made = 1;
-  }
+  if (fmt == TT_MESH_2DM && rec.out_srs &&
+      (st = write_prj(ctx, path, rec.out_srs, &prj_path)) != TT_OK)
+    goto done;
   if (progress && !progress(1.0, NULL, progress_arg))
     st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
 
@@ -664,7 +669,7 @@ done:
   }
   if (st != TT_OK && made)
     remove(path);
-  if (st != TT_OK && prj_made)
+  if (st != TT_OK && prj_path)
     remove(prj_path);
   free(prj_path);
   tt__records_free(&rec);
