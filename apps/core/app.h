@@ -354,6 +354,9 @@ typedef struct app_simplify_report {
   /* what was written, as the user names it (tt__app_output_names): the
    * files, and the layers of a dataset of several (else NULL) */
   char **files, **layers;
+  /* 2DM: the .prj beside it that holds the CRS, which the format (and
+   * MDAL) cannot (one of files); NULL: none */
+  const char *crs_file;
 } app_simplify_report;
 
 /* --- the subcommands ----------------------------------------------------- */

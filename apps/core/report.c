@@ -360,6 +360,10 @@ static void say_output(app_run *r, const app_simplify_report *p)
     fprintf(r->out, "%s%s", i ? ", " : "", p->files[i]);
   if (nf > 3)
     fprintf(r->out, " and %zu files beside it", nf - 1);
+  /* 2DM has no place for a CRS, and QGIS's MDAL reads none */
+  if (p->crs_file)
+    fprintf(r->out, " (the CRS in %s: 2DM holds none, set it by hand in "
+            "QGIS)", p->crs_file);
   for (size_t i = 0; p->layers && p->layers[i]; i++)
     fprintf(r->out, "%s%s", i ? ", " : (p->layers[1] ? " (layers " :
                                                       " (layer "),

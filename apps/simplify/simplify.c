@@ -197,6 +197,10 @@ static void report(app_simplify_job *job)
   app_run *r = job->r;
   app_simplify_report *rep = &job->rep;
   tt__app_output_names(job, &rep->files, &rep->layers);
+  rep->crs_file = NULL;
+  int nf = CSLCount(rep->files);
+  if (job->mesh == TT_MESH_2DM && job->srs && nf > 1)
+    rep->crs_file = rep->files[nf - 1]; /* the last sidecar */
   if (job->s->json)
     tt__app_print_simplify_json(r, rep);
   else if (!job->s->quiet)
