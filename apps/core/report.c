@@ -162,6 +162,31 @@ void tt__json_null(app_json *j, const char *key)
   fputs("null", j->fp);
 }
 
+/* "estimate": what the quick pass predicted before the work, or null
+ * (a budget; apps/simplify/estimate.c). */
+static void print_estimate_json(app_json *j, const app_estimate *e)
+{
+  if (!e->done) {
+    tt__json_null(j, "estimate");
+    return;
+  }
+  tt__json_open(j, "estimate");
+  tt__json_num(j, "max_error", e->bound);
+  tt__json_bool(j, "max_error_default", e->bound_default);
+  tt__json_num(j, "vertices", round(e->vertices));
+  tt__json_num(j, "triangles", round(e->triangles));
+  tt__json_num(j, "valid_samples", round(e->valid));
+  tt__json_num(j, "share", e->share);
+  tt__json_num(j, "output_bytes", round(e->output_bytes));
+  tt__json_num(j, "memory_untiled", round(e->memory_whole));
+  tt__json_num(j, "max_error_5_percent", e->advice_bound);
+  tt__json_size(j, "windows", e->windows);
+  tt__json_size(j, "window_size", e->window_size);
+  tt__json_size(j, "sampled_cells", e->sampled_cells);
+  tt__json_num(j, "seconds", e->seconds);
+  tt__json_close(j);
+}
+
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
 {
   app_json j;
@@ -269,10 +294,16 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
     tt__json_size(&j, "threads", (size_t)p->tile_threads);
     tt__json_bool(&j, "automatic", p->auto_tiled);
     tt__json_size(&j, "memory_in_flight", p->tile_bytes);
+    if (p->mem_limit && p->mem_limit != SIZE_MAX)
+      tt__json_size(&j, "memory_limit", p->mem_limit);
+    else
+      tt__json_null(&j, "memory_limit");
+    tt__json_str(&j, "memory_limit_source", p->mem_source);
     tt__json_size(&j, "budget_passes", (size_t)p->budget_passes);
     tt__json_bool(&j, "streamed", p->streamed);
     tt__json_close(&j);
   }
+  print_estimate_json(&j, &p->estimate);
   tt__json_open(&j, "seconds");
   tt__json_num(&j, "read", p->t_read);
   tt__json_num(&j, "simplify", p->t_simplify);
@@ -333,13 +364,21 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
           p->t_srs_auto ? " (the only CRS the format holds)" : "",
           in->frame_name, zu, p->sum.seconds_mesh, p->t_write,
           p->driver ? p->driver : "?", p->t_total);
-  if (p->tiles) {
-    fprintf(r->out, "%s: %zu tiles of %zu cells on %d thread%s%s; the tiles "
+  if (p->tiles && p->auto_tiled) {
+    fprintf(r->out, "%s: tiled automatically: %zu tiles of %zu cells on %d "
+            "thread%s, memory limit %.1f MiB (%s); the tiles in flight hold "
+            "at most about %.0f MiB\n", shown, p->tiles, p->tile_size,
+            p->tile_threads, p->tile_threads == 1 ? "" : "s",
+            (double)p->mem_limit / 1048576.0,
+            p->mem_source ? p->mem_source : "?",
+            (double)p->tile_bytes / 1048576.0);
+  } else if (p->tiles) {
+    fprintf(r->out, "%s: %zu tiles of %zu cells on %d thread%s; the tiles "
             "in flight hold at most about %.0f MiB\n", shown, p->tiles,
             p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
-            p->auto_tiled ? " (chosen because the heights do not fit the "
-                            "memory limit)" : "",
             (double)p->tile_bytes / 1048576.0);
+  }
+  if (p->tiles) {
     if (p->budget_passes)
       fprintf(r->out, "%s: the budget is met at the bound %g, found from "
               "the tiles' curves (one pass) and %d run%s at a bound\n",

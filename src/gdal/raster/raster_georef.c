@@ -252,8 +252,7 @@ static tt_status set_ground_points(raster_read *r)
              "samples would need %s, more than %s (%s): keeping the "
              "affine frame %s", r->path, nx, ny,
              tt__format_bytes(need_s, sizeof need_s, with_points),
-             opt->max_memory_default ? "3/4 of this machine's physical "
-                                       "memory"
+             opt->max_memory_default ? opt->max_memory_source
                                      : "MAX_MEMORY",
              tt__format_bytes(max_s, sizeof max_s, opt->max_memory),
              r->frame_name);
