@@ -287,6 +287,11 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_bool(&j, "output_crs_automatic", p->t_srs_auto);
   tt__json_str(&j, "frame", p->info->frame_name);
   tt__json_size(&j, "warnings", r->msg.warnings);
+  if (p->mem_limit && p->mem_limit != SIZE_MAX)
+    tt__json_size(&j, "memory_limit", p->mem_limit);
+  else
+    tt__json_null(&j, "memory_limit");
+  tt__json_str(&j, "memory_limit_source", p->mem_source);
   if (p->tiles) {
     tt__json_open(&j, "tiling");
     tt__json_size(&j, "tiles", p->tiles);
@@ -294,11 +299,6 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
     tt__json_size(&j, "threads", (size_t)p->tile_threads);
     tt__json_bool(&j, "automatic", p->auto_tiled);
     tt__json_size(&j, "memory_in_flight", p->tile_bytes);
-    if (p->mem_limit && p->mem_limit != SIZE_MAX)
-      tt__json_size(&j, "memory_limit", p->mem_limit);
-    else
-      tt__json_null(&j, "memory_limit");
-    tt__json_str(&j, "memory_limit_source", p->mem_source);
     tt__json_size(&j, "budget_passes", (size_t)p->budget_passes);
     tt__json_bool(&j, "streamed", p->streamed);
     tt__json_close(&j);

@@ -20,7 +20,8 @@
  * The output's bytes are the vertices times what one costs in the format
  * (a GeoPackage: about 700 bytes a vertex with its two triangles, measured
  * on 12000^2 runs); the whole run's memory those of docs/cli.md's
- * *Limits* (4 bytes a sample for the heights, about 280 a vertex).
+ * *Limits* (4 bytes a sample for the heights, 20 with ground points, and
+ * about 280 a vertex, at the capacity of the last growth step: 1.5 x).
  * Accuracy: bench/estimate.sh prints predicted against actual on the DEMs
  * of ../shared/testdata.
  *
@@ -219,9 +220,11 @@ static void predict(app_simplify_job *job, const est_window *ws, size_t nw,
   e->output_bytes = e->vertices * (job->kind == APP_OUTPUT_MESH
                                        ? EST_MESH_BYTES
                                        : EST_OGR_BYTES);
+  /* the refinement holds its arrays at the capacity of its next growth
+   * step: up to half as much again */
   e->memory_whole = (double)job->width * (double)job->height *
                         (job->ground ? 20.0 : 4.0) +
-                    e->vertices * EST_RUN_BYTES;
+                    1.5 * e->vertices * EST_RUN_BYTES;
   /* the bound of about a 5 % TIN, from the same curves */
   app_curve *c = malloc(nw * sizeof *c);
   e->advice_bound = NAN;

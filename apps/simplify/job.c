@@ -121,6 +121,8 @@ tt_status tt__app_job_memory(app_simplify_job *job)
   job->mem_limit = s->max_memory ? s->max_memory
                                  : tt_memory_limit(&job->mem_source);
   job->ro.max_memory = job->mem_limit == SIZE_MAX ? 0 : job->mem_limit;
+  job->rep.mem_limit = job->mem_limit;
+  job->rep.mem_source = job->mem_source;
   /* Decimation does not count its memory as it goes (its start holds a
    * triangle per half sample): an explicit limit would be a promise it
    * cannot keep. Refused before anything is read. */

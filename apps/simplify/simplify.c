@@ -87,24 +87,9 @@ static tt_status choose_tiling(app_simplify_job *job)
   tt__app_job_threads(job);
   job->ground = tt__app_ground_points(job->band);
   job->tile_size = s->tile_size;
-  if (tt__app_estimate_wanted(job)) {
-    tt_status st = tt__app_estimate(job);
-    if (st != TT_OK)
-      return st;
-    tt__app_estimate_say(job);
-  }
-  /* the whole run's memory: the estimate's (the heights and its TIN),
-   * else a few bytes a sample */
-  const app_estimate *e = &job->rep.estimate;
-  int fits = e->done && !job->decimate
-                 ? e->memory_whole <= (double)limit
-                 : w * h <= limit / whole_bytes_per_sample(job);
-  if (job->tile_size || w <= 2 || h <= 2 || limit == SIZE_MAX || fits)
-    return TT_OK;
-  size_t tile = auto_tile_size(job);
-  if (w * h > TT_APP_AUTO_TILE_CELLS) {
-    if (w * h <= limit / sizeof(float))
-      return TT_OK; /* the heights fit: the whole run counts the rest */
+  if (!job->tile_size && limit != SIZE_MAX && w * h > TT_APP_AUTO_TILE_CELLS &&
+      w * h > limit / sizeof(float)) {
+    size_t tile = auto_tile_size(job);
     char need[32], lim[32];
     return tt__app_fail(job->r, TT_APP_EXIT_FAILURE, TT_ERR_LIMIT,
                         s->input, "the %zu x %zu heights need %s, more "
@@ -118,6 +103,23 @@ static tt_status choose_tiling(app_simplify_job *job)
                         job->mem_source, tile ? tile : 64,
                         (size_t)TT_APP_AUTO_TILE_CELLS);
   }
+  if (tt__app_estimate_wanted(job)) {
+    tt_status st = tt__app_estimate(job);
+    if (st != TT_OK)
+      return st;
+    tt__app_estimate_say(job);
+  }
+  /* the whole run's memory: the estimate's (the heights and its TIN, a
+   * quarter more for the estimate's own error), else a few bytes a
+   * sample */
+  const app_estimate *e = &job->rep.estimate;
+  int fits = e->done && !job->decimate
+                 ? 1.25 * e->memory_whole <= (double)limit
+                 : w * h <= limit / whole_bytes_per_sample(job);
+  if (job->tile_size || w <= 2 || h <= 2 || limit == SIZE_MAX || fits ||
+      w * h > TT_APP_AUTO_TILE_CELLS)
+    return TT_OK;
+  size_t tile = auto_tile_size(job);
   if (tile) {
     job->tile_size = tile;
     job->rep.auto_tiled = 1;
@@ -137,8 +139,6 @@ static tt_status run_tiled(app_simplify_job *job)
   size_t tile = job->tile_size;
   rep->ropt = &job->ro;
   rep->tile_size = tile;
-  rep->mem_limit = job->mem_limit;
-  rep->mem_source = job->mem_source;
   rep->tile_bytes = tt__app_tile_bytes(tile, job->width, job->height,
                                        job->workers, job->ground);
   if (job->decimate) /* a start of every sample: 48 bytes a sample more */
