@@ -5,8 +5,9 @@
  * over a sample of the DEM.
  *
  * The pass reads a few windows of the DEM at full resolution, spread on a
- * lattice over it (the tiles of a tiling of W cells, every k-th one each
- * way: at least 4, about 1/64 of the samples, at most some 2 M), and
+ * lattice over it (the tiles of a tiling of 256 cells -- fewer on a DEM
+ * where 4 of them would pass an eighth of it --, every k-th one each way:
+ * at least 4, about 1/64 of the samples, at most some 2 M), and
  * records each one's error-against-count curve (tt_tile_curve: the window
  * refined without its shared sides' vertices, as the inside of a whole
  * run is). A curve runs until its error is within the bound and it holds
@@ -83,7 +84,11 @@ static void lattice(size_t W, size_t H, size_t *out_n, size_t *out_ntx,
 {
   size_t small = W < H ? W : H;
   size_t n = EST_WINDOW;
-  while (n > 16 && n * 2 > small)
+  /* smaller windows on a small DEM, so the fewest of them still sample
+   * at most an eighth of it */
+  while (n > 16 && (n * 2 > small ||
+                    8.0 * EST_MIN_WINDOWS * (double)n * (double)n >
+                        (double)W * (double)H))
     n /= 2;
   size_t ntx = (W - 2) / n + 1, nty = (H - 2) / n + 1;
   double want = (double)W * (double)H / EST_SHARE;
@@ -318,7 +323,8 @@ void tt__app_estimate_say(app_simplify_job *job)
 {
   const app_estimate *e = &job->rep.estimate;
   app_run *r = job->r;
-  if (!e->done || (e->vertices <= 1e6 && e->output_bytes <= 1e9))
+  if (!e->done || job->s->quiet ||
+      (e->vertices <= 1e6 && e->output_bytes <= 1e9))
     return;
   char out[32], advice[160] = "";
   decimal_bytes(out, sizeof out, e->output_bytes);
