@@ -43,8 +43,10 @@ check "whole run: exit 0 ($(cat err.txt))" [ $? -eq 0 ]
 check "whole run: untiled" [ "$(jget whole.json tiling)" = None ]
 nv_whole=$(jget whole.json vertices)
 need=$(jget whole.json estimate.memory_untiled)
-check "whole run: the estimate predicts its vertices within 10 % ($(jget whole.json estimate.vertices) for $nv_whole)" \
-  python3 -c "import sys; sys.exit(abs($(jget whole.json estimate.vertices) / $nv_whole - 1) > 0.1)"
+# (a sample of 4 windows of 128^2: bench/estimate.sh measures 0.86 to
+# 1.58 on real DEMs; the goal is a factor of 2)
+check "whole run: the estimate predicts its vertices within 40 % ($(jget whole.json estimate.vertices) for $nv_whole)" \
+  python3 -c "import sys; sys.exit(not 0.7 < $(jget whole.json estimate.vertices) / $nv_whole < 1.4)"
 check "whole run: the estimate's memory is some 60 MB ($need)" \
   python3 -c "import sys; sys.exit(not 30e6 < $need < 120e6)"
 
@@ -81,13 +83,14 @@ nv_tiled=$(jget tiled.json vertices)
 check "tiled: about the whole run's vertices ($nv_tiled against $nv_whole)" \
   python3 -c "import sys; sys.exit(abs($nv_tiled / $nv_whole - 1) > 0.1)"
 
-# the default bound: the estimate says it is the default, near the run's
+# the default bound: the estimate says it is the default, from the sampled
+# heights' range (never wider than the DEM's: never a looser bound)
 "$T" simplify -q -json in/f.tif out/default.gpkg >default.json 2>err.txt
 check "default bound: exit 0 ($(cat err.txt))" [ $? -eq 0 ]
 check "default bound: the estimate's is the default" \
   [ "$(jget default.json estimate.max_error_default)" = True ]
-check "default bound: the estimate's within 25 % of the run's ($(jget default.json estimate.max_error), $(jget default.json limits.max_error))" \
-  python3 -c "import sys; sys.exit(abs($(jget default.json estimate.max_error) / $(jget default.json limits.max_error) - 1) > 0.25)"
+check "default bound: the estimate's at most the run's, within a factor of 2 ($(jget default.json estimate.max_error), $(jget default.json limits.max_error))" \
+  python3 -c "import sys; sys.exit(not 0.5 <= $(jget default.json estimate.max_error) / $(jget default.json limits.max_error) <= 1)"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
