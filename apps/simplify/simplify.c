@@ -46,10 +46,11 @@ static tt_status open_input(app_simplify_job *job)
 
 /* The bytes a whole run holds a sample, about: the heights and the
  * refinement's share (8), the ground points of a geographic or Web
- * Mercator DEM (16), decimation's start of every sample (48). */
+ * Mercator DEM (16), decimation's start of every sample (a vertex and two
+ * triangles a sample in the mesh: 150). */
 static size_t whole_bytes_per_sample(const app_simplify_job *job)
 {
-  return 8 + (job->ground ? 16 : 0) + (job->decimate ? 48 : 0);
+  return 8 + (job->ground ? 16 : 0) + (job->decimate ? 150 : 0);
 }
 
 /* The tiles of an automatic tiling: 1024 cells (a multiple of the block

@@ -5,9 +5,9 @@
 # the safety margin: src/base/memory.c) is tiled automatically, the
 # summary and the JSON say so with the limit, and the TIN keeps the same
 # bound (terratin eval measures it against the DEM) with about the same
-# vertices as the whole run without the limit; the estimate before the
-# work (JSON "estimate") predicts those vertices; without -max_error the
-# estimate's bound is the default one. A generated 1025^2 fault terrain
+# vertices as the whole run without the limit, by either method; the
+# estimate before the work (JSON "estimate") predicts those vertices;
+# without -max_error the estimate's bound is the default one. A generated 1025^2 fault terrain
 # keeps 13 % of its samples at -max_error 0.5: its whole run needs some
 # 60 MB, and the limit is set to 3/4 of that above what the
 # process maps at its start (measured first, from the JSON's
@@ -82,6 +82,13 @@ check "ulimit -v $kb, -json: max error within the bound" \
 nv_tiled=$(jget tiled.json vertices)
 check "tiled: about the whole run's vertices ($nv_tiled against $nv_whole)" \
   python3 -c "import sys; sys.exit(abs($nv_tiled / $nv_whole - 1) > 0.1)"
+
+# decimation too (its start holds every sample: about 150 bytes each)
+( ulimit -v "$kb"; "$T" simplify -q -json -method decimate -max_error 0.5 in/f.tif out/dec.gpkg >dec.json 2>err.txt )
+check "decimate, ulimit -v $kb: exit 0 ($(head -c 300 err.txt))" [ $? -eq 0 ]
+check "decimate, ulimit -v $kb: tiling.automatic" [ "$(jget dec.json tiling.automatic)" = True ]
+"$T" eval -q -max_error 0.5 in/f.tif out/dec.gpkg >/dev/null 2>err.txt
+check "decimate, tiled: every sample within the bound (eval exit $?: $(cat err.txt))" [ $? -eq 0 ]
 
 # the default bound: the estimate says it is the default, from the sampled
 # heights' range (never wider than the DEM's: never a looser bound)
