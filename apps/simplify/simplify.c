@@ -64,7 +64,10 @@ static size_t auto_tile_size(const app_simplify_job *job)
   size_t want = 1024;
   if (bw > 1 && bw <= 4096 && bw == bh)
     want = ((1024 + (size_t)bw - 1) / (size_t)bw) * (size_t)bw;
-  size_t per = job->decimate ? 80 : 32; /* tiled_tiles.c's, per sample */
+  /* tiled_tiles.c's bytes a sample; for decimation twice its figure
+   * (80): a tile's start of every sample, with the allocator's arenas of
+   * the worker threads, took more under ulimit -v */
+  size_t per = job->decimate ? 160 : 32;
   while (want > 64 && tt__app_tile_bytes(want, w, h, nth, job->ground) /
                               32 * per > limit / 2)
     want /= 2;
