@@ -251,7 +251,8 @@ int tt__app_estimate_wanted(const app_simplify_job *job)
   const tt_refine_options *ro = &job->ro;
   if (ro->max_points || ro->max_triangles || ro->percent > 0 ||
       tt__app_tiles_hook.save || tt__app_tiles_hook.load ||
-      job->width < 4 || job->height < 4)
+      job->width < 4 || job->height < 4 ||
+      strncmp(job->s->input, "/vsistdin/", 10) == 0) /* read once */
     return 0;
   /* always in the JSON; else only where it may say something: past a
    * million samples, or a DEM the whole run may not hold */
