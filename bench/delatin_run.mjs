@@ -1,19 +1,20 @@
 // delatin_run.mjs -- runs the npm package delatin on a DEM, for bench/run.sh.
 //
 //   node bench/delatin_run.mjs --delatin PATH/index.js --raw DEM.raw \
-//        --info DEM.info.json --max-error E --out TIN.geojsonl
+//        --info DEM.info.json --max-error E --out TIN.obj
 //
 // Node has no GeoTIFF reader, so run.sh exports the DEM with
 // `gdal_translate -of ENVI -ot Float32` (DEM.raw + DEM.hdr, row-major
-// float32) and its `gdalinfo -json` (size, geoTransform). This script reads
-// the raw samples, meshes them with `new Delatin(data, w, h).run(E)` and
-// writes the triangles as GeoJSON text sequence (one Polygon Z feature per
-// line) in the DEM's map coordinates, so `terratin eval` can measure them.
+// float32) and its `gdalinfo -json` (size). This script reads the raw
+// samples, meshes them with `new Delatin(data, w, h).run(E)` and writes
+// delatin's own result as it holds it, a Wavefront OBJ of its `coords`
+// (`v x y z`) and `triangles` (`f a b c`), with no georeferencing:
+// `terratin eval` reads it straight, in the DEM's pixel frame.
 //
-// Delatin's coordinates are sample indices: vertex (x, y) is column x, row y,
-// height data[y * width + x] (its heightAt()). terratin puts sample (c, r) at
-// the pixel centre, map = geotransform applied to (c + 0.5, r + 0.5); we do
-// the same here so both TINs are measured against the same samples.
+// Delatin's coordinates are sample indices: vertex (x, y) is column x, row y
+// counted down, height data[y * width + x] (its heightAt()). eval's pixel
+// frame counts rows up (as hmm's STL does), so run.sh measures the OBJ
+// with `-tin_frame pixel -tin_transform 1,-1,1,0,HEIGHT-1,0`.
 //
 // Prints one JSON object on stdout: vertices, triangles, delatin's own max
 // error, and seconds {read, mesh, write, total} from process.hrtime (total
@@ -70,7 +71,6 @@ async function main() {
   const { default: Delatin } = await import(pathToFileURL(path.resolve(opt.delatin)).href);
   const info = JSON.parse(fs.readFileSync(opt.info, 'utf8'));
   const [width, height] = info.size;
-  const gt = info.geoTransform;
   const maxError = Number(opt['max-error']);
   if (!(maxError >= 0)) throw new Error(`bad --max-error ${opt['max-error']}`);
   checkEnviHeader(opt.raw.replace(/\.[^./]*$/, '') + '.hdr', width, height);
@@ -102,34 +102,23 @@ async function main() {
   const { coords, triangles } = tin;
   const nv = coords.length >> 1;
   const nt = triangles.length / 3;
-  const mx = new Float64Array(nv);
-  const my = new Float64Array(nv);
-  const mz = new Float64Array(nv);
-  for (let i = 0; i < nv; i++) {
-    const px = coords[2 * i] + 0.5;
-    const py = coords[2 * i + 1] + 0.5;
-    mx[i] = gt[0] + px * gt[1] + py * gt[2];
-    my[i] = gt[3] + px * gt[4] + py * gt[5];
-    mz[i] = data[coords[2 * i + 1] * width + coords[2 * i]];
-  }
-  const pt = (i) => `[${mx[i]},${my[i]},${mz[i]}]`;
   const fd = fs.openSync(opt.out, 'w');
-  let chunk = [];
-  for (let t = 0; t < nt; t++) {
-    const a = triangles[3 * t];
-    let b = triangles[3 * t + 1];
-    let c = triangles[3 * t + 2];
-    // Counter-clockwise in map space, as RFC 7946 asks of exterior rings.
-    const cross = (mx[b] - mx[a]) * (my[c] - my[a]) - (my[b] - my[a]) * (mx[c] - mx[a]);
-    if (cross < 0) [b, c] = [c, b];
-    chunk.push(`{"type":"Feature","properties":{},"geometry":{"type":"Polygon",` +
-      `"coordinates":[[${pt(a)},${pt(b)},${pt(c)},${pt(a)}]]}}\n`);
-    if (chunk.length === 8192) {
-      fs.writeSync(fd, chunk.join(''));
-      chunk = [];
-    }
+  let chunk = [`# delatin ${nv} vertices, ${nt} triangles\n`];
+  const flush = () => {
+    fs.writeSync(fd, chunk.join(''));
+    chunk = [];
+  };
+  for (let i = 0; i < nv; i++) {
+    const x = coords[2 * i];
+    const y = coords[2 * i + 1];
+    chunk.push(`v ${x} ${y} ${data[y * width + x]}\n`);
+    if (chunk.length === 8192) flush();
   }
-  if (chunk.length) fs.writeSync(fd, chunk.join(''));
+  for (let t = 0; t < nt; t++) {
+    chunk.push(`f ${triangles[3 * t] + 1} ${triangles[3 * t + 1] + 1} ${triangles[3 * t + 2] + 1}\n`);
+    if (chunk.length === 8192) flush();
+  }
+  flush();
   fs.closeSync(fd);
   const tWrite = seconds(tWrite0);
 

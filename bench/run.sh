@@ -28,13 +28,17 @@
 #    commit 5ea6114 with its own Makefile (Debian's libglm-dev); without it
 #    the table has no hmm column.
 #  - delatin (npm, the JavaScript port of the same algorithm): from a raw
-#    Float32 copy of the DEM to a GeoJSON text sequence, timed inside node.
+#    Float32 copy of the DEM to an OBJ of its own coords and triangles (no
+#    georeferencing), timed inside node.
 #  - wall s: the whole process (start-up included) from date +%s%N; peak
 #    MiB: /usr/bin/time -f %M.
 #  - max error, RMSE: `terratin eval DEM TIN -json` over every valid
-#    sample, the same code for the three TINs (hmm's STL is put back on the
-#    DEM by bench/stl_to_geojsonl.py; its heights are 16-bit, so its error
-#    includes up to half a quantum of the PNG).
+#    sample, the same code for the three TINs, each read as its tool wrote
+#    it, with no converter: hmm's binary STL in the DEM's pixel frame
+#    (-stl_frame pixel) with its heights less zmin put back
+#    (-tin_transform 1,1,1,0,0,ZMIN; they are 16-bit, so its error includes
+#    up to half a quantum of the PNG), delatin's OBJ in the pixel frame
+#    with rows counted down (-tin_transform 1,-1,1,0,HEIGHT-1,0).
 # The peers' inputs (PNG, raw) come from bench/peer_input.py, untimed;
 # neither peer knows nodata, which is filled with the DEM's minimum for
 # them. Everything lands in bench/out/ (git-ignored); report.txt is the
@@ -59,7 +63,7 @@ quick=0
 for arg in "$@"; do
   case "$arg" in
     --quick) quick=1 ;;
-    -h|--help) sed -n '2,44p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,45p' "$0"; exit 0 ;;
     *) echo "bench: unknown argument '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -177,10 +181,10 @@ run_case() {
       measure "$c.hmm.r$r" "$HMM" -z "$zr" -e "$he" "$OUT/$c.png" "$OUT/$c.hmm.stl"
       hmm_json "$OUT/$c.hmm.r$r.out" >"$OUT/$c.hmm.r$r.json"
     fi
-    rm -f "$OUT/$c.delatin.geojsonl"
+    rm -f "$OUT/$c.delatin.obj"
     measure "$c.delatin.r$r" node bench/delatin_run.mjs --delatin "$DELATIN_JS" \
       --raw "$OUT/$c.raw" --info "$OUT/$c.info.json" --max-error "$e" \
-      --out "$OUT/$c.delatin.geojsonl"
+      --out "$OUT/$c.delatin.obj"
     cp "$OUT/$c.delatin.r$r.out" "$OUT/$c.delatin.r$r.json"
     for t in $tools; do
       printf '  %-9s mesh %s  wall %.3f s\n' "$t" \
@@ -196,10 +200,14 @@ run_case() {
 
   say "[$c] terratin eval of the TINs"
   "$TT" eval "$dem" "$OUT/$c.terratin.gpkg" -json >"$OUT/$c.terratin.eval.json"
-  "$TT" eval "$dem" "$OUT/$c.delatin.geojsonl" -json >"$OUT/$c.delatin.eval.json"
+  local zmin h1
+  zmin=$($PY -c "import json;print(repr(json.load(open('$OUT/$c.info.json'))['zmin']))")
+  h1=$($PY -c "import json;print(json.load(open('$OUT/$c.info.json'))['size'][1] - 1)")
+  "$TT" eval "$dem" "$OUT/$c.delatin.obj" -tin_frame pixel \
+    -tin_transform "1,-1,1,0,$h1,0" -json >"$OUT/$c.delatin.eval.json"
   if [ -n "$HMM" ]; then
-    $PY bench/stl_to_geojsonl.py "$OUT/$c.hmm.stl" "$OUT/$c.info.json" "$OUT/$c.hmm.geojsonl"
-    "$TT" eval "$dem" "$OUT/$c.hmm.geojsonl" -json >"$OUT/$c.hmm.eval.json"
+    "$TT" eval "$dem" "$OUT/$c.hmm.stl" -stl_frame pixel \
+      -tin_transform "1,1,1,0,0,$zmin" -json >"$OUT/$c.hmm.eval.json"
   fi
 }
 

@@ -196,6 +196,11 @@ typedef struct app_run {
   app_messages msg;
   app_phase prog;
   double t0;
+  /* the DEM under GDAL's input options (dem_view.c): the file's dataset
+   * the open view reads from, and the arguments that made the view (a
+   * tiled run's workers make their own from them); NULL: none */
+  GDALDatasetH dem_file;
+  char **view_args;
 } app_run;
 
 /* A datasource name of the run as it is shown: a connection string with
@@ -226,9 +231,36 @@ tt_status tt__app_fail_exists(app_run *r, const char *output);
 int tt__app_continue(app_run *r, double at);
 
 /* Opens a raster for reading and checks the band; on failure explains in
- * one line why and returns NULL. */
+ * one line why and returns NULL. With GDAL's input options (-srcwin,
+ * -projwin, -a_srs, -a_ullr) the dataset returned is the in-memory view
+ * of them over the file's (r->dem_file): close it with
+ * tt__app_close_raster(), and protect tt__app_raster_file()'s files. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
                                  GDALRasterBandH *out_band);
+/* Closes what tt__app_open_raster returned (NULL: nothing), and the file's
+ * dataset under a view. */
+void tt__app_close_raster(app_run *r, GDALDatasetH ds);
+/* The dataset of the DEM's file: r->dem_file under a view, else ds. */
+GDALDatasetH tt__app_raster_file(const app_run *r, GDALDatasetH ds);
+/* ropts with, under a view, the file's name (path) and driver for the
+ * read's messages and info (SOURCE_NAME, SOURCE_DRIVER). */
+char **tt__app_view_read_options(const app_run *r, char **ropts,
+                                 const char *path);
+
+/* dem_view.c: GDAL's input options on a DEM. Whether any applies. */
+int tt__app_view_wanted(const tt_app_settings *s);
+/* gdal_translate's arguments for the view of src (-of VRT, -srcwin with
+ * the window checked and clipped, -a_srs, -a_ullr); NULL with the reason
+ * in why (*out_usage: the options are at fault). A clipped window is
+ * told in warn ("" otherwise). The caller frees the list with
+ * CSLDestroy(). */
+char **tt__app_view_args(const tt_app_settings *s, GDALDatasetH src,
+                         int *out_usage, char *why, size_t size, char *warn,
+                         size_t warn_size);
+/* The in-memory VRT of src under args, or NULL with the reason in why.
+ * It reads from src, which must stay open until it is closed. */
+GDALDatasetH tt__app_view_open(GDALDatasetH src, char **args, char *why,
+                               size_t size);
 /* The read options of -srcnodata, -z_factor, -z_unit and -work_srs
  * (tt_gdal_read_grid's SRCNODATA, Z_FACTOR, Z_UNIT, WORK_SRS), for a
  * whole DEM (tt__app_read_dem adds MAX_MEMORY) and a tiled run's windows
@@ -254,6 +286,12 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
                           double *out_max);
 const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
 const char *tt__app_nonempty_or_null(const char *s);
+/* Why the heights were converted to metres, in the command's words ("the
+ * CRS is in metres", "asked by -z_to m"); "" when they were not. */
+const char *tt__app_z_unit_why(const tt_raster_info *info);
+/* Where the heights' unit was said: "band unit", "vertical CRS",
+ * "-z_unit", or "". */
+const char *tt__app_z_unit_source(const tt_raster_info *info);
 /* "2026-11-22T10:38:55Z" */
 void tt__app_iso8601_utc(char *buf, size_t size);
 /* The engine's thread count (tt_refine_options.threads): -threads, else
@@ -287,6 +325,8 @@ void tt__json_size(app_json *j, const char *key, size_t v);
 void tt__json_i64(app_json *j, const char *key, int64_t v);
 void tt__json_bool(app_json *j, const char *key, int v);
 void tt__json_null(app_json *j, const char *key);
+/* A list of strings (NULL-terminated; NULL: an empty list). */
+void tt__json_strs(app_json *j, const char *key, char *const *v);
 
 /* What simplify's estimate predicted before the work (apps/simplify/
  * estimate.c). */
@@ -309,7 +349,9 @@ typedef struct app_simplify_report {
   double zmin, zmax;
   const tt_refine_options *ropt;  /* the limits, for either method */
   const tt_decimate_options *dopt; /* -method decimate; else NULL */
-  int default_error;            /* max_error came from the 0.5% rule */
+  int default_error;            /* max_error is the default: twice the
+                                   mean step */
+  double step;                  /* the DEM's mean step, when default */
   tt_tin_summary sum;
   double t_read, t_simplify, t_write, t_total;
   /* tiled runs (tiled.c): the tiles, their size, the threads, whether
@@ -325,6 +367,9 @@ typedef struct app_simplify_report {
    * only (GPX: EPSG:4326, chosen by the dry run); NULL: the DEM's */
   const char *t_srs;
   int t_srs_auto;     /* t_srs was chosen for the format, not given */
+  /* what was written, as the user names it (tt__app_output_names): the
+   * files, and the layers of a dataset of several (else NULL) */
+  char **files, **layers;
 } app_simplify_report;
 
 /* --- the subcommands ----------------------------------------------------- */
@@ -335,6 +380,15 @@ tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
 tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+/* --formats (simplify/formats.c): the output formats simplify writes, each
+ * OGR driver judged by the dry run of its writer (ogr_output.c). */
+tt_status tt__app_formats(app_run *r);
+/* --help-general (help.c): the options of every command, as GDAL's
+ * utilities print them. */
+const char *tt__app_help_general(void);
+/* The help page of `terratin tiles SUB` (plan, run, merge; anything else:
+ * the overview of the three). */
+const char *tt__app_tiles_help(const char *sub);
 
 /* The dispatch table (run.c): one entry per command, which the parser
  * (the command word, how many positional words, where they go), the help
@@ -354,6 +408,9 @@ typedef struct tt__app_command_def {
 extern const tt__app_command_def tt__app_commands[];
 /* The entry of c, or NULL (no command, help, version). */
 const tt__app_command_def *tt__app_command_def_of(tt_app_command c);
+/* Which of the run's positional words path is (1 for the first), by the
+ * dispatch table; 0 when it is none of them (study's -terrain). */
+int tt__app_arg_number(const app_run *r, const char *path);
 /* raster_output.c, for rasterize and eval -error_raster: the raster
  * driver of -of, else
  * the one path's extension names (NULL path: GTiff), that can write a
@@ -388,5 +445,27 @@ GDALDatasetH tt__app_open_vector(app_run *r, const char *path);
 OGRLayerH tt__app_tin_layer(app_run *r, GDALDatasetH ds);
 /* Whether the layer declares a CRS that is not the DEM's (tin_input.c). */
 int tt__app_layer_in_other_crs(OGRLayerH layer, const tt_raster_info *info);
+
+/* tin_read.c, for eval: a TIN from a mesh file or an OGR layer, on the
+ * DEM's pixel-centre grid. */
+typedef struct app_tin {
+  GDALDatasetH ds;       /* the OGR dataset; NULL for a mesh file */
+  const char *format;    /* "STL", "PLY", ... or the OGR driver's name */
+  const char *layer;     /* the layer's name (ds owns it); NULL: a file */
+  double *xyz;           /* ntri triangles, corners in pixel space */
+  size_t ntri, rejected;
+  char *crs_wkt;         /* the CRS the TIN declares (malloc'd) or NULL */
+  char crs_name[128];    /* its name, when it was reprojected */
+  int pixel;             /* read in the DEM's pixel frame */
+  int reprojected;       /* reprojected from crs_wkt to the DEM's CRS */
+  int other_crs;         /* a CRS on a DEM without one: measured as is */
+} app_tin;
+/* Reads r->s->tin (its OGR dataset protected from outp, which may be
+ * NULL) into t, on the DEM of info and grid (whose heights settle an
+ * STL's frame when its extent does not). On failure (recorded) the caller still frees t with
+ * tt__app_tin_free. */
+tt_status tt__app_read_tin(app_run *r, const tt_raster_info *info,
+                           const tt_grid *grid, tt_output *outp, app_tin *t);
+void tt__app_tin_free(app_tin *t);
 
 #endif /* TERRATIN_APP_H */

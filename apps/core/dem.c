@@ -64,6 +64,63 @@ static int explain_missing_vsi(const char *path, char *why, size_t size)
   return 1;
 }
 
+/* The view of GDAL's input options over the opened file (dem_view.c),
+ * which becomes r->dem_file; NULL with the failure recorded (file closed).
+ * The arguments are kept for the workers of a tiled run. */
+static GDALDatasetH open_view(app_run *r, const char *path, GDALDatasetH ds)
+{
+  char why[TT_APP_MESSAGE_MAX], warn[TT_APP_MESSAGE_MAX];
+  int usage = 0;
+  const char *cmd = tt__app_command_name(r->s->command);
+  CSLDestroy(r->view_args);
+  r->view_args = tt__app_view_args(r->s, ds, &usage, why, sizeof why, warn,
+                                   sizeof warn);
+  if (!r->view_args) {
+    tt__app_fail(r, usage ? TT_APP_EXIT_USAGE : TT_APP_EXIT_FAILURE,
+                 usage ? TT_ERR_ARG : TT_ERR_DATA, NULL, "%s: %s (DEM %s)",
+                 cmd, why, path);
+    GDALClose(ds);
+    return NULL;
+  }
+  if (warn[0])
+    tt__app_warn(&r->msg, "%s: %s", path, warn);
+  GDALDatasetH view = tt__app_view_open(ds, r->view_args, why, sizeof why);
+  if (!view) {
+    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path, "%s", why);
+    GDALClose(ds);
+    return NULL;
+  }
+  r->dem_file = ds;
+  return view;
+}
+
+void tt__app_close_raster(app_run *r, GDALDatasetH ds)
+{
+  if (ds)
+    GDALClose(ds);
+  if (r->dem_file)
+    GDALClose(r->dem_file);
+  r->dem_file = NULL;
+}
+
+GDALDatasetH tt__app_raster_file(const app_run *r, GDALDatasetH ds)
+{
+  return r->dem_file ? r->dem_file : ds;
+}
+
+char **tt__app_view_read_options(const app_run *r, char **ropts,
+                                 const char *path)
+{
+  if (!r->dem_file)
+    return ropts;
+  GDALDriverH drv = GDALGetDatasetDriver(r->dem_file);
+  ropts = CSLSetNameValue(ropts, "SOURCE_NAME", path);
+  if (drv)
+    ropts = CSLSetNameValue(ropts, "SOURCE_DRIVER",
+                            GDALGetDriverShortName(drv));
+  return ropts;
+}
+
 /* Opens a raster for reading and checks the band; on failure explains in
  * one line why: missing, a folder, empty, a vector dataset, unreadable. */
 GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
@@ -110,9 +167,19 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
     CPLPopErrorHandler();
     if (vec) {
       GDALDriverH drv = GDALGetDatasetDriver(vec);
-      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
-               "is a vector dataset (%s), not a raster",
-               drv ? GDALGetDriverShortName(drv) : "?");
+      const char *dname = drv ? GDALGetDriverShortName(drv) : "?";
+      int k = tt__app_arg_number(r, path);
+      /* a positional word: which one, and what the command expects there
+       * (every command that reads a DEM takes it first) */
+      if (k)
+        tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, NULL,
+                     "%s: %s (argument %d) is a vector dataset (%s); the "
+                     "DEM (a raster) comes first",
+                     tt__app_command_name(r->s->command),
+                     tt__app_shown(r, path), k, dname);
+      else
+        tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+                     "is a vector dataset (%s), not a raster", dname);
       GDALClose(vec);
       return NULL;
     }
@@ -124,25 +191,27 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
                "not a raster format GDAL can read");
     return NULL;
   }
+  if (tt__app_view_wanted(r->s) && !(ds = open_view(r, path, ds)))
+    return NULL;
   int nbands = GDALGetRasterCount(ds);
   if (nbands < 1) {
     tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
              "has no raster band");
-    GDALClose(ds);
+    tt__app_close_raster(r, ds);
     return NULL;
   }
   if (band > nbands) {
     tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, path,
              "-b %d: the raster has %d band%s", band, nbands,
              nbands == 1 ? "" : "s");
-    GDALClose(ds);
+    tt__app_close_raster(r, ds);
     return NULL;
   }
   int w = GDALGetRasterXSize(ds), h = GDALGetRasterYSize(ds);
   if (w < 2 || h < 2) {
     tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, path,
              "raster is %dx%d; at least 2x2 samples are needed", w, h);
-    GDALClose(ds);
+    tt__app_close_raster(r, ds);
     return NULL;
   }
   *out_band = GDALGetRasterBand(ds, band);
@@ -246,8 +315,14 @@ char **tt__app_read_options(const tt_app_settings *s)
     tt__app_format_double(num, sizeof num, s->z_factor);
     ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
   }
+  /* -z_unit says what the heights are; -z_to whether they become metres
+   * (auto unless asked otherwise) */
   if (s->z_unit)
-    ropts = CSLSetNameValue(ropts, "Z_UNIT", s->z_unit);
+    ropts = CSLSetNameValue(ropts, "SRC_Z_UNIT", s->z_unit);
+  if (!s->z_to || strcmp(s->z_to, "auto") == 0)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", "auto");
+  else if (strcmp(s->z_to, "m") == 0)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", "m");
   if (s->work_srs)
     ropts = CSLSetNameValue(ropts, "WORK_SRS", s->work_srs);
   return ropts;
@@ -266,6 +341,7 @@ tt_status tt__app_read_dem(app_run *r, GDALRasterBandH band, const char *path,
   if (r->s->max_memory)
     ropts = CSLSetNameValue(ropts, "MAX_MEMORY",
                             CPLSPrintf("%zu", r->s->max_memory));
+  ropts = tt__app_view_read_options(r, ropts, path);
   r->msg.last[0] = '\0';
   tt_status st = tt_gdal_read_grid(r->ctx, band, ropts, progress,
                                    progress_arg, &grid, &info);
@@ -338,14 +414,16 @@ tt_status tt__app_read_dem_and_tin(app_run *r, tt_output *outp,
   GDALDatasetH src = tt__app_open_raster(r, s->input, s->band, &band);
   if (!src)
     return r->res->status;
-  tt_status st = tt_output_protect_dataset(r->ctx, outp, src, s->input);
+  tt_status st = tt_output_protect_dataset(r->ctx, outp,
+                                           tt__app_raster_file(r, src),
+                                           s->input);
   if (st != TT_OK) {
-    GDALClose(src);
+    tt__app_close_raster(r, src);
     return tt__app_fail_tt(r, st, s->output);
   }
   st = tt__app_read_dem(r, band, s->input, tt__app_phase_fn, &r->prog,
                         out_grid, out_info, out_valid);
-  GDALClose(src);
+  tt__app_close_raster(r, src);
   if (st != TT_OK)
     return st;
   *out_tds = tt__app_open_vector(r, s->tin);

@@ -21,6 +21,26 @@ _Static_assert(2 * TT_MAX_VERTICES == 2147483646,
 
 /* --- the names, as the engine (or the table) knows them ------------------ */
 
+/* Whether the value w is the name: case-insensitive, '-' as '_'. */
+static int name_matches_word(const char *w, const char *name)
+{
+  for (;; w++, name++) {
+    char a = *w, b = *name;
+    if (a >= 'A' && a <= 'Z')
+      a = (char)(a - 'A' + 'a');
+    if (b >= 'A' && b <= 'Z')
+      b = (char)(b - 'A' + 'a');
+    if (a == '-')
+      a = '_';
+    if (b == '-')
+      b = '_';
+    if (a != b)
+      return 0;
+    if (!a)
+      return 1;
+  }
+}
+
 static int name_criterion(tt_context *ctx, const char *w, void *out)
 {
   return tt_criterion_parse(ctx, w, out) == TT_OK;
@@ -87,13 +107,39 @@ static int name_seeding(tt_context *ctx, const char *w, void *out)
   return 0;
 }
 
-/* -z_unit: metres, the one unit heights are converted to. */
+/* -z_unit: the unit the heights are in. */
 static int name_z_unit(tt_context *ctx, const char *w, void *out)
 {
+  static const char *const units[] = {"m", "ft", "us-ft"};
   (void)ctx;
-  if (!tt__app_str_ieq(w, "m"))
+  for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+    if (name_matches_word(w, units[i])) {
+      *(const char **)out = units[i];
+      return 1;
+    }
+  return 0;
+}
+
+/* -z_to: whether the heights are converted to metres. */
+static int name_z_to(tt_context *ctx, const char *w, void *out)
+{
+  static const char *const modes[] = {"m", "native", "auto"};
+  (void)ctx;
+  for (size_t i = 0; i < sizeof modes / sizeof modes[0]; i++)
+    if (tt__app_str_ieq(w, modes[i])) {
+      *(const char **)out = modes[i];
+      return 1;
+    }
+  return 0;
+}
+
+/* -tin_frame (eval): the int tt_app_settings.tin_frame, 1 map, 2 pixel. */
+static int name_tin_frame(tt_context *ctx, const char *w, void *out)
+{
+  (void)ctx;
+  if (!tt__app_str_ieq(w, "map") && !tt__app_str_ieq(w, "pixel"))
     return 0;
-  *(const char **)out = "m";
+  *(int *)out = tt__app_str_ieq(w, "map") ? 1 : 2;
   return 1;
 }
 
@@ -107,6 +153,11 @@ static tt_status own_size(tt__app_opt_parse *p, const tt__app_opt_def *d,
                           const char *v, void *out);
 static tt_status own_layers(tt__app_opt_parse *p, const tt__app_opt_def *d,
                             const char *v, void *out);
+static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
+                         const char *v, void *out);
+static tt_status own_tin_transform(tt__app_opt_parse *p,
+                                   const tt__app_opt_def *d, const char *v,
+                                   void *out);
 
 /* --- the table ------------------------------------------------------------ */
 
@@ -157,6 +208,7 @@ static const tt__app_opt_def opt_defs[] = {
      .name_fn = name_repair,
      .known = "flip, local, lookahead, delaunay, auto"},
     {"-json", O_JSON, FOR_S | FOR_E | FOR_O | FOR_R, OPT_FLAG, AT(s.json)},
+    {"-verbose", O_VERBOSE, FOR_S, OPT_FLAG, AT(s.verbose)},
     {"-layer", O_LAYER, FOR_E | FOR_O | FOR_R, OPT_TEXT, AT(s.layer),
      .need = "needs a layer name"},
     {"-size", O_SIZE, FOR_G, OPT_OWN, .to = TO_SYNTH, .at = 0, /* nx, ny */
@@ -177,7 +229,9 @@ static const tt__app_opt_def opt_defs[] = {
      .hi = HUGE_VAL, .bad = "must be a finite number >= 0"},
     {"-seeding", O_SEEDING, FOR_G, OPT_NAME, SYNTH(seeding),
      .name_fn = name_seeding, .bad = "must be none, peak, valley or hybrid"},
-    {"-a_srs", O_A_SRS, FOR_G, OPT_TEXT, AT(s.srs), .need = CRS_NEEDED},
+    /* generate: the output's CRS; the DEM readers: the DEM's (dem_view.c) */
+    {"-a_srs", O_A_SRS, FOR_G | DEM_READERS, OPT_TEXT, AT(s.srs),
+     .need = CRS_NEEDED},
     {"-srcnodata", O_SRCNODATA, DEM_READERS, OPT_OWN, AT(s.srcnodata),
      .own_fn = own_srcnodata,
      .bad = "must be a finite decimal number or nan"},
@@ -187,7 +241,11 @@ static const tt__app_opt_def opt_defs[] = {
      .bad = "must be a finite non-zero number"},
     {"-z_unit", O_Z_UNIT, DEM_READERS, OPT_NAME, AT(s.z_unit),
      .name_fn = name_z_unit,
-     .bad = "must be m (heights in ft or us-ft converted to metres)"},
+     .bad = "must be ft, us-ft or m (the unit the heights are in; -z_to m "
+            "converts them to metres)"},
+    {"-z_to", O_Z_TO, DEM_READERS, OPT_NAME, AT(s.z_to), .name_fn = name_z_to,
+     .bad = "must be m (heights converted to metres), native (kept in their "
+            "unit) or auto (metres when the CRS is in metres or geographic)"},
     {"-work_srs", O_WORK_SRS, FOR_S, OPT_TEXT, AT(s.work_srs),
      .need = CRS_NEEDED},
     {"-t_srs", O_T_SRS, FOR_S, OPT_TEXT, AT(s.t_srs), .need = CRS_NEEDED},
@@ -254,14 +312,64 @@ static const tt__app_opt_def opt_defs[] = {
     {"-layers", O_LAYERS, FOR_S, OPT_OWN, AT(s.layers),
      .own_fn = own_layers},
     {"-nostyle", O_NOSTYLE, FOR_S, OPT_FLAG, AT(s.nostyle)},
+    /* GDAL's input options (dem_view.c); -s_srs as gdalwarp's: reading,
+     * the same as -a_srs; -a_nodata is -srcnodata's GDAL name */
+    {"-s_srs", O_S_SRS, DEM_READERS, OPT_TEXT, AT(s.srs), .need = CRS_NEEDED},
+    {"-a_nodata", O_A_NODATA, DEM_READERS, OPT_OWN, AT(s.srcnodata),
+     .own_fn = own_srcnodata,
+     .bad = "must be a finite decimal number or nan"},
+    {"-srcwin", O_SRCWIN, DEM_READERS, OPT_OWN, AT(s.srcwin),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs xoff yoff xsize ysize: integers, sizes >= 1"},
+    {"-projwin", O_PROJWIN, DEM_READERS, OPT_OWN, AT(s.projwin),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs ulx uly lrx lry: finite numbers, ulx < lrx, uly > lry"},
+    {"-projwin_srs", O_PROJWIN_SRS, DEM_READERS, OPT_TEXT,
+     AT(s.projwin_srs), .need = CRS_NEEDED},
+    {"-a_ullr", O_A_ULLR, DEM_READERS, OPT_OWN, AT(s.a_ullr),
+     .own_fn = own_box, .nwords = 4,
+     .bad = "needs ulx uly lrx lry: finite numbers, ulx != lrx, uly != lry"},
+    /* eval: the frame of a TIN file's coordinates, and an affine before */
+    {"-tin_frame", O_TIN_FRAME, FOR_E, OPT_NAME, AT(s.tin_frame),
+     .name_fn = name_tin_frame, .known = "map, pixel"},
+    {"-stl_frame", O_TIN_FRAME, FOR_E, OPT_NAME, AT(s.tin_frame),
+     .name_fn = name_tin_frame, .known = "map, pixel"},
+    {"-tin_transform", O_TIN_TRANSFORM, FOR_E, OPT_OWN, AT(s),
+     .own_fn = own_tin_transform,
+     .bad = "must be six comma-separated numbers sx,sy,sz,ox,oy,oz "
+            "(x' = sx x + ox, ...), sx, sy, sz non-zero"},
 };
 
 #define OPT_DEFS (sizeof opt_defs / sizeof opt_defs[0])
 
+/* Whether the word w spells the option name: case-insensitive, and '-'
+ * inside the name matches '_' (-max-error is -max_error); the leading dash
+ * is the option's, not a letter of its name. */
+static int name_matches(const char *w, const char *name)
+{
+  if (*w != '-' || *name != '-')
+    return 0;
+  for (w++, name++;; w++, name++) {
+    char a = *w, b = *name;
+    if (a >= 'A' && a <= 'Z')
+      a = (char)(a - 'A' + 'a');
+    if (b >= 'A' && b <= 'Z')
+      b = (char)(b - 'A' + 'a');
+    if (a == '-')
+      a = '_';
+    if (b == '-')
+      b = '_';
+    if (a != b)
+      return 0;
+    if (!a)
+      return 1;
+  }
+}
+
 const tt__app_opt_def *tt__app_find_opt(const char *w)
 {
   for (size_t i = 0; i < OPT_DEFS; i++)
-    if (tt__app_str_ieq(w, opt_defs[i].name))
+    if (name_matches(w, opt_defs[i].name))
       return &opt_defs[i];
   /* GDAL accepts --of as well as -of for its own options: do the same,
    * with exactly two dashes ("---of" is a typo, not an option). */
@@ -270,11 +378,73 @@ const tt__app_opt_def *tt__app_find_opt(const char *w)
   return NULL;
 }
 
+/* The optimal string alignment distance between a and b (Levenshtein's
+ * edits plus the swap of two neighbours: -max_erorr is one edit away),
+ * without regard to case, '-' as '_'; anything past 63 characters counts
+ * as far. */
+size_t tt__app_edit_distance(const char *a, const char *b)
+{
+  enum { MAXLEN = 63 };
+  char x[MAXLEN + 1], y[MAXLEN + 1];
+  size_t n = 0, m = 0;
+  for (; a[n] && n < MAXLEN; n++)
+    x[n] = a[n] == '-' ? '_' : (char)((a[n] >= 'A' && a[n] <= 'Z')
+                                          ? a[n] - 'A' + 'a' : a[n]);
+  for (; b[m] && m < MAXLEN; m++)
+    y[m] = b[m] == '-' ? '_' : (char)((b[m] >= 'A' && b[m] <= 'Z')
+                                          ? b[m] - 'A' + 'a' : b[m]);
+  if (a[n] || b[m])
+    return SIZE_MAX;
+  /* three rows of the dynamic programme: i-2, i-1, i */
+  size_t rows[3][MAXLEN + 1];
+  for (size_t j = 0; j <= m; j++)
+    rows[0][j] = j;
+  for (size_t i = 1; i <= n; i++) {
+    size_t *cur = rows[i % 3], *prev = rows[(i - 1) % 3],
+           *prev2 = rows[(i + 1) % 3];
+    cur[0] = i;
+    for (size_t j = 1; j <= m; j++) {
+      size_t cost = x[i - 1] != y[j - 1];
+      size_t best = prev[j - 1] + cost;
+      if (prev[j] + 1 < best)
+        best = prev[j] + 1;
+      if (cur[j - 1] + 1 < best)
+        best = cur[j - 1] + 1;
+      if (i > 1 && j > 1 && x[i - 1] == y[j - 2] && x[i - 2] == y[j - 1] &&
+          prev2[j - 2] + 1 < best)
+        best = prev2[j - 2] + 1;
+      cur[j] = best;
+    }
+  }
+  return rows[n % 3][m];
+}
+
+const char *tt__app_opt_suggest(const char *w, tt_app_command command)
+{
+  while (w[0] == '-' && w[1] == '-') /* --max-eror: as -max-eror */
+    w++;
+  size_t len = strlen(w), best = SIZE_MAX;
+  const char *name = NULL;
+  /* a third of the word's letters, at least 1, at most 3 */
+  size_t limit = len / 3 < 1 ? 1 : len / 3 > 3 ? 3 : len / 3;
+  for (size_t i = 0; i < OPT_DEFS; i++) {
+    if (!(opt_defs[i].commands & (1u << command)))
+      continue;
+    size_t d = tt__app_edit_distance(w, opt_defs[i].name);
+    if (d < best) { /* ties: the table's first, the more common option */
+      best = d;
+      name = opt_defs[i].name;
+    }
+  }
+  /* and fewer edits than half the letters: -x is no typo of -b */
+  return best <= limit && 2 * best < len - 1 ? name : NULL;
+}
+
 const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
                                        tt_app_command command)
 {
   for (size_t i = 0; i < OPT_DEFS; i++)
-    if (tt__app_str_ieq(d->name, opt_defs[i].name) &&
+    if (name_matches(d->name, opt_defs[i].name) &&
         (opt_defs[i].commands & (1u << command)))
       return &opt_defs[i];
   return NULL;
@@ -282,7 +452,9 @@ const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
 
 int tt__app_opt_takes_value(const tt__app_opt_def *d)
 {
-  return d->kind != OPT_FLAG;
+  if (d->kind == OPT_FLAG)
+    return 0;
+  return d->nwords ? (int)d->nwords : 1;
 }
 
 /* The option's name in the messages about its value: its first spelling. */
@@ -442,6 +614,45 @@ static tt_status own_threads(tt__app_opt_parse *p, const tt__app_opt_def *d,
   return st;
 }
 
+/* -srcwin, -projwin, -a_ullr: four numbers, the words joined by spaces.
+ * -srcwin's are samples (offsets may be negative: the window is clipped
+ * to the raster when read, as dem_view.c says), -projwin's a window
+ * whose upper left is above and left of its lower right, -a_ullr's any
+ * box of non-zero width and height. */
+static tt_status own_box(tt__app_opt_parse *p, const tt__app_opt_def *d,
+                         const char *v, void *out)
+{
+  tt_app_box *b = out;
+  double x[4];
+  char word[64];
+  const char *at = v;
+  for (int i = 0; i < 4; i++) {
+    const char *e = strchr(at, ' ');
+    size_t n = e ? (size_t)(e - at) : strlen(at);
+    if (n == 0 || n >= sizeof word || (i < 3) != (e != NULL))
+      return refuse(p, d, v);
+    memcpy(word, at, n);
+    word[n] = '\0';
+    if (!tt__app_parse_double(word, &x[i]))
+      return refuse(p, d, v);
+    at = e ? e + 1 : at + n;
+  }
+  if (d->id == O_SRCWIN) {
+    for (int i = 0; i < 4; i++)
+      if (x[i] != floor(x[i]) || fabs(x[i]) > (double)INT_MAX)
+        return refuse(p, d, v);
+    if (x[2] < 1 || x[3] < 1)
+      return refuse(p, d, v);
+  } else if (d->id == O_PROJWIN && !(x[0] < x[2] && x[1] > x[3])) {
+    return refuse(p, d, v);
+  } else if (d->id == O_A_ULLR && (x[0] == x[2] || x[1] == x[3])) {
+    return refuse(p, d, v);
+  }
+  b->set = 1;
+  memcpy(b->v, x, sizeof x);
+  return TT_OK;
+}
+
 /* -size N or NXxNY: out is the parameters (nx and ny). */
 static tt_status own_size(tt__app_opt_parse *p, const tt__app_opt_def *d,
                           const char *v, void *out)
@@ -508,5 +719,31 @@ tt_status tt__app_opt_apply(tt__app_opt_parse *p, const tt__app_opt_def *d,
   OPT_SET_GIVEN(p, d->id);
   if ((d->flags & OPT_DECIMATE) && !p->decimate_only)
     p->decimate_only = d->name;
+  return TT_OK;
+}
+
+/* -tin_transform sx,sy,sz,ox,oy,oz: out is the settings (the six numbers
+ * and the flag both go there). */
+static tt_status own_tin_transform(tt__app_opt_parse *p,
+                                   const tt__app_opt_def *d, const char *v,
+                                   void *out)
+{
+  tt_app_settings *s = out;
+  double t[6];
+  const char *at = v;
+  for (int k = 0; k < 6; k++) {
+    char word[64];
+    const char *comma = strchr(at, ',');
+    size_t n = comma ? (size_t)(comma - at) : strlen(at);
+    if ((comma == NULL) != (k == 5) || n == 0 || n >= sizeof word)
+      return refuse(p, d, v);
+    memcpy(word, at, n);
+    word[n] = '\0';
+    if (!tt__app_parse_double(word, &t[k]) || (k < 3 && t[k] == 0))
+      return refuse(p, d, v);
+    at = comma ? comma + 1 : at + n;
+  }
+  memcpy(s->tin_transform, t, sizeof t);
+  s->tin_transform_set = 1;
   return TT_OK;
 }

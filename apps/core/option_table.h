@@ -32,6 +32,10 @@ enum opt_id {
   O_SELECTION, O_ONEPASS, O_HOLE, O_THREADS, O_MAX_MEMORY, O_TERRAIN,
   O_CRITERIA, O_METHODS, O_OPTIMIZERS, O_ERROR_RASTER, O_CO,
   O_POINTS, O_PLOT, O_TIN_POINTS, O_LAYERS, O_NOSTYLE, O_TILE_SIZE,
+  O_VERBOSE,
+  O_S_SRS, O_A_NODATA, O_SRCWIN, O_PROJWIN, O_PROJWIN_SRS, O_A_ULLR,
+  O_TIN_FRAME, O_TIN_TRANSFORM,
+  O_Z_TO,
   O_COUNT
 };
 
@@ -122,16 +126,28 @@ struct tt__app_opt_def {
   /* OPT_OWN: TT_OK with the value at out, else the failure recorded */
   tt_status (*own_fn)(tt__app_opt_parse *p, const tt__app_opt_def *d,
                       const char *word, void *out);
+  /* The words of the value (0: one; -srcwin's four), which the parser
+   * joins with spaces into the one word the reader gets. */
+  unsigned nwords;
 };
 
-/* The option a word names (case-insensitive; "--of" as "-of"), or NULL.
+/* The option a word names (case-insensitive; "--of" as "-of"; '-' inside
+ * the name as '_': "-max-error"), or NULL.
  * An option spelt alike for several commands (-percent: a number for
  * simplify, a list for study) is found by its first entry. */
 const tt__app_opt_def *tt__app_find_opt(const char *w);
+/* The option of command nearest to the unknown word w (a typo: a few
+ * letters added, dropped, changed or swapped, '-' for '_', any case), for
+ * "did you mean"; NULL when none is close. */
+const char *tt__app_opt_suggest(const char *w, tt_app_command command);
+/* The edits (insert, delete, change, swap two neighbours) from a to b,
+ * without regard to case, '-' as '_'; SIZE_MAX past 63 characters. */
+size_t tt__app_edit_distance(const char *a, const char *b);
 /* The entry of d's spelling that command takes, or NULL. */
 const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
                                        tt_app_command command);
-/* Whether the option is followed by a value. */
+/* How many words of value follow the option: 0 (a flag), 1, or more
+ * (-srcwin xoff yoff xsize ysize: 4). */
 int tt__app_opt_takes_value(const tt__app_opt_def *d);
 
 /* Reads the value word v of option d (v is NULL for a flag) into its place

@@ -2,8 +2,9 @@
  * report.c -- apps/core/: the command's core, what every command's folder
  * shares. This file: what the command prints: a small JSON writer (one object;
  * strings escaped, invalid UTF-8 replaced by U+FFFD, non-finite numbers as
- * null, so the output always parses) and simplify's summary line and JSON
- * object. eval builds its JSON with the same writer.
+ * null, so the output always parses) and simplify's summary (three short
+ * lines: what went in, what came out, the error; -verbose adds how) and
+ * JSON object. eval builds its JSON with the same writer.
  */
 #include "app.h"
 
@@ -187,6 +188,18 @@ static void print_estimate_json(app_json *j, const app_estimate *e)
   tt__json_close(j);
 }
 
+void tt__json_strs(app_json *j, const char *key, char *const *v)
+{
+  json_key(j, key);
+  fputc('[', j->fp);
+  for (size_t i = 0; v && v[i]; i++) {
+    if (i)
+      fputs(", ", j->fp);
+    json_string(j->fp, v[i]);
+  }
+  fputc(']', j->fp);
+}
+
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
 {
   app_json j;
@@ -196,6 +209,8 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_str(&j, "input", tt__app_shown(r, r->s->input));
   tt__json_size(&j, "band", (size_t)r->s->band);
   tt__json_str(&j, "output", tt__app_shown(r, r->s->output));
+  tt__json_strs(&j, "files", p->files);
+  tt__json_strs(&j, "layers", p->layers);
   tt__json_str(&j, "format", p->driver);
   tt__json_str(&j, "method", p->dopt ? "decimate" : "insert");
   tt__json_str(&j, "criterion", tt_criterion_name(p->sum.criterion));
@@ -214,6 +229,8 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   if (ro->max_error >= 0) tt__json_num(&j, "max_error", ro->max_error);
   else tt__json_null(&j, "max_error");
   tt__json_bool(&j, "max_error_default", p->default_error);
+  if (p->default_error)
+    tt__json_num(&j, "mean_step", p->step);
   if (ro->max_points) tt__json_size(&j, "max_points", ro->max_points);
   else tt__json_null(&j, "max_points");
   if (ro->max_triangles) tt__json_size(&j, "max_triangles", ro->max_triangles);
@@ -276,7 +293,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_str(&j, "z_unit_declared",
                tt__app_nonempty_or_null(p->info->z_unit_declared));
   tt__json_str(&j, "z_unit_source",
-               tt__app_nonempty_or_null(p->info->z_unit_source));
+               tt__app_nonempty_or_null(tt__app_z_unit_source(p->info)));
+  tt__json_str(&j, "z_unit_conversion",
+               tt__app_nonempty_or_null(tt__app_z_unit_why(p->info)));
   tt__json_num(&j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
   tt__json_str(&j, "pixel_is",
                tt__app_nonempty_or_null(p->info->area_or_point));
@@ -316,92 +335,189 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_close(&j);
 }
 
-void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
+/* " (-max_points 2000, -percent 5)": the budget as it was given. */
+static void budget_words(const tt_refine_options *ro, char *buf, size_t size)
+{
+  size_t n = 0;
+  buf[0] = '\0';
+  if (ro->max_points && n < size)
+    n += (size_t)snprintf(buf + n, size - n, "%s-max_points %zu",
+                          n ? ", " : "", ro->max_points);
+  if (ro->max_triangles && n < size)
+    n += (size_t)snprintf(buf + n, size - n, "%s-max_triangles %zu",
+                          n ? ", " : "", ro->max_triangles);
+  if (ro->percent > 0 && n < size)
+    snprintf(buf + n, size - n, "%s-percent %g", n ? ", " : "", ro->percent);
+}
+
+/* What went in: the file, the band, its size, the CRS, the heights' unit. */
+static void say_input(app_run *r, const app_simplify_report *p)
+{
+  const tt_raster_info *in = p->info;
+  char valid[64], heights[200];
+  if (p->valid == p->cells)
+    snprintf(valid, sizeof valid, "all valid");
+  else
+    snprintf(valid, sizeof valid, "%zu valid", p->valid);
+  if (in->z_unit_factor != 1.0)
+    snprintf(heights, sizeof heights, "heights in %s, converted to %s (%s)",
+             in->z_unit_declared, tt__app_unit_or(in, "?"),
+             tt__app_z_unit_why(in));
+  else if (in->z_unit && *in->z_unit)
+    snprintf(heights, sizeof heights, "heights in %s", in->z_unit);
+  else
+    snprintf(heights, sizeof heights, "heights in unknown units");
+  if (in->z_factor != 1.0) {
+    size_t n = strlen(heights);
+    snprintf(heights + n, sizeof heights - n, ", times %g", in->z_factor);
+  }
+  const tt_app_settings *s = r->s;
+  fprintf(r->out, "input:  %s, band %d: %zu x %zu samples%s, %s; %s%s; %s\n",
+          tt__app_shown(r, s->input), s->band, in->width, in->height,
+          s->srcwin.set || s->projwin.set ? " (a window)" : "", valid,
+          in->crs_name && *in->crs_name ? in->crs_name : "no CRS",
+          s->srs ? " (given)" : "", heights);
+}
+
+/* What came out: the files (and layers) written, the TIN's size. */
+static void say_output(app_run *r, const app_simplify_report *p)
+{
+  fputs("output: ", r->out);
+  size_t nf = 0;
+  while (p->files && p->files[nf])
+    nf++;
+  /* a file and its many sidecars (2DM's datasets): the file, and a count */
+  for (size_t i = 0; i < nf && (nf <= 3 || i == 0); i++)
+    fprintf(r->out, "%s%s", i ? ", " : "", p->files[i]);
+  if (nf > 3)
+    fprintf(r->out, " and %zu files beside it", nf - 1);
+  for (size_t i = 0; p->layers && p->layers[i]; i++)
+    fprintf(r->out, "%s%s", i ? ", " : (p->layers[1] ? " (layers " :
+                                                      " (layer "),
+            p->layers[i]);
+  if (p->layers && p->layers[0])
+    fputc(')', r->out);
+  double share = p->valid ? 100.0 * (double)p->sum.vertices /
+                                (double)p->valid
+                          : 0.0;
+  fprintf(r->out, ": %zu vertices (%.2g%% of the valid samples), %zu "
+          "triangles", p->sum.vertices, share, p->sum.triangles);
+  /* nodata splits the TIN: the parts that share no edge */
+  if (p->sum.components > 1)
+    fprintf(r->out, " in %zu components", p->sum.components);
+  if (p->t_srs)
+    fprintf(r->out, ", in %s%s", p->t_srs,
+            p->t_srs_auto ? " (the only CRS the format holds)" : "");
+  if (p->tiles && p->auto_tiled)
+    fprintf(r->out, "; tiled automatically in %zu tiles, memory limit "
+            "%.1f MiB", p->tiles, (double)p->mem_limit / 1048576.0);
+  fprintf(r->out, "; %.1f s\n", p->t_total);
+}
+
+/* The guarantee: the largest error, against the bound that holds it, and
+ * the RMS; or what the budget gave. */
+static void say_error(app_run *r, const app_simplify_report *p)
 {
   const char *unit = tt__app_unit_or(p->info, "z units");
   const tt_refine_options *ro = p->ropt;
-  char lim[256] = "", num[40];
-  size_t n = 0;
-  if (ro->max_error >= 0) {
-    snprintf(num, sizeof num, "%.6g", ro->max_error);
-    n += (size_t)snprintf(lim + n, sizeof lim - n, "%smax_error %s %s%s",
-                          n ? ", " : "", num, unit,
-                          p->default_error ? " (default: 0.5% of the height "
-                                             "range)"
-                                           : "");
+  const tt_error_stats *e = &p->sum.errors;
+  char budget[160];
+  budget_words(ro, budget, sizeof budget);
+  fprintf(r->out, "error:  max %.4g %s", e->max_error, unit);
+  if (ro->max_error >= 0 && p->sum.stop_reason != TT_STOP_MAX_POINTS &&
+      p->sum.stop_reason != TT_STOP_MAX_TRIANGLES) {
+    if (p->default_error)
+      fprintf(r->out, ", within the default bound %g %s (twice the DEM's "
+              "mean step between samples, %.3g %s; -max_error sets it)",
+              ro->max_error, unit, p->step, unit);
+    else
+      fprintf(r->out, ", within the bound %g %s", ro->max_error, unit);
+  } else if (ro->max_error >= 0) {
+    fprintf(r->out, " (%s reached before the bound %g %s)", budget,
+            ro->max_error, unit);
+  } else {
+    fprintf(r->out, " (the budget %s)", budget);
   }
-  if (ro->max_points && n < sizeof lim)
-    n += (size_t)snprintf(lim + n, sizeof lim - n, "%smax_points %zu",
-                          n ? ", " : "", ro->max_points);
-  if (ro->max_triangles && n < sizeof lim)
-    n += (size_t)snprintf(lim + n, sizeof lim - n, "%smax_triangles %zu",
-                          n ? ", " : "", ro->max_triangles);
-  if (ro->percent > 0 && n < sizeof lim) {
-    snprintf(num, sizeof num, "%.6g", ro->percent);
-    snprintf(lim + n, sizeof lim - n, "%spercent %s", n ? ", " : "", num);
-  }
-  /* Where the numbers stand: CRS, working frame, height unit. */
-  const tt_raster_info *in = p->info;
-  char zu[160];
-  if (in->z_unit_factor != 1.0)
-    snprintf(zu, sizeof zu, "%s (from %s, x%.10g)", unit,
-             in->z_unit_declared, in->z_unit_factor);
-  else if (in->z_unit && *in->z_unit)
-    snprintf(zu, sizeof zu, "%s (%s)", unit, in->z_unit_source);
-  else
-    snprintf(zu, sizeof zu, "unknown");
-  const char *shown = tt__app_shown(r, r->s->output);
-  fprintf(r->out,
-          "%s: %zu cells, %zu valid samples -> %zu vertices, %zu triangles; "
-          "max error %.6g %s, RMS %.6g %s; limits: %s; stop: %s; CRS %s%s%s%s; "
-          "frame %s; z unit %s; mesh %.2f s, write %.2f s (%s); %.2f s\n",
-          shown, p->cells, p->valid, p->sum.vertices,
-          p->sum.triangles, p->sum.errors.max_error, unit,
-          p->sum.errors.rmse, unit, lim,
-          tt_stop_reason_name(p->sum.stop_reason),
-          in->crs_name && *in->crs_name ? in->crs_name : "none",
-          p->t_srs ? ", written in " : "", p->t_srs ? p->t_srs : "",
-          p->t_srs_auto ? " (the only CRS the format holds)" : "",
-          in->frame_name, zu, p->sum.seconds_mesh, p->t_write,
-          p->driver ? p->driver : "?", p->t_total);
-  if (p->tiles && p->auto_tiled) {
-    fprintf(r->out, "%s: tiled automatically: %zu tiles of %zu cells on %d "
-            "thread%s, memory limit %.1f MiB (%s); the tiles in flight hold "
-            "at most about %.0f MiB\n", shown, p->tiles, p->tile_size,
-            p->tile_threads, p->tile_threads == 1 ? "" : "s",
-            (double)p->mem_limit / 1048576.0,
-            p->mem_source ? p->mem_source : "?",
-            (double)p->tile_bytes / 1048576.0);
-  } else if (p->tiles) {
-    fprintf(r->out, "%s: %zu tiles of %zu cells on %d thread%s; the tiles "
-            "in flight hold at most about %.0f MiB\n", shown, p->tiles,
-            p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
-            (double)p->tile_bytes / 1048576.0);
-  }
-  if (p->tiles) {
-    if (p->budget_passes)
-      fprintf(r->out, "%s: the budget is met at the bound %g, found from "
-              "the tiles' curves (one pass) and %d run%s at a bound\n",
-              shown, p->ropt ? p->ropt->max_error : 0.0,
-              p->budget_passes, p->budget_passes == 1 ? "" : "s");
-  }
-  if (p->dopt)
+  fprintf(r->out, "; RMS %.4g %s\n", e->rmse, unit);
+  /* nodata outlines: what the TIN could not carry is said, not dropped */
+  size_t lone = e->samples - e->covered;
+  if (lone)
     fprintf(r->out,
-            "%s: decimated from %zu vertices: %zu removed in %zu %s\n",
-            shown, p->sum.start_vertices, p->sum.removed_vertices,
+            "note:   %zu valid sample%s amid nodata (in no cell with 3 "
+            "valid corners) cannot carry a triangle and %s left out\n",
+            lone, lone == 1 ? "" : "s", lone == 1 ? "is" : "are");
+}
+
+/* How the stop came, in words. */
+static const char *stop_words(tt_stop_reason why)
+{
+  switch (why) {
+  case TT_STOP_MAX_ERROR: return "every sample within the bound";
+  case TT_STOP_MAX_POINTS: return "the vertex budget reached";
+  case TT_STOP_MAX_TRIANGLES: return "the triangle budget reached";
+  case TT_STOP_EXHAUSTED: return "every sample exact";
+  default: return "not stopped";
+  }
+}
+
+/* -verbose: how the TIN was made, where its numbers stand, the time. */
+static void say_details(app_run *r, const app_simplify_report *p)
+{
+  const tt_raster_info *in = p->info;
+  FILE *o = r->out;
+  tt_repair rep = tt_repair_resolve(r->s->repair, p->sum.criterion);
+  fprintf(o, "method: %s, criterion %s, repair %s, optimize %s; stopped "
+          "with %s\n", p->dopt ? "decimate" : "insert",
+          tt_criterion_name(p->sum.criterion), tt_repair_name(rep),
+          tt_optimize_name(tt_optimize_resolve(r->s->optimize,
+                                               p->sum.criterion, rep)),
+          stop_words(p->sum.stop_reason));
+  if (p->dopt)
+    fprintf(o, "        decimated from %zu vertices: %zu removed in %zu "
+            "%s\n", p->sum.start_vertices, p->sum.removed_vertices,
             p->sum.rounds,
             p->dopt->selection == TT_SELECTION_SEQUENTIAL ? "steps"
                                                           : "rounds");
-  /* nodata outlines: what the TIN could not carry is said, not dropped */
-  size_t lone = p->sum.errors.samples - p->sum.errors.covered;
-  if (p->sum.components > 1)
-    fprintf(r->out, "%s: %zu separate pieces%s", shown, p->sum.components,
-            lone ? "; " : "\n");
-  else if (lone)
-    fprintf(r->out, "%s: ", shown);
-  if (lone)
-    fprintf(r->out,
-            "%zu valid sample%s amid nodata (in no cell with 3 valid "
-            "corners) cannot carry a triangle and %s left out\n",
-            lone, lone == 1 ? "" : "s", lone == 1 ? "is" : "are");
+  fprintf(o, "frame:  %s\n", in->frame_name);
+  fprintf(o, "heights: %.6g to %.6g %s", p->zmin, p->zmax,
+          tt__app_unit_or(in, "z units"));
+  const char *source = tt__app_z_unit_source(in);
+  int given = strcmp(source, "-z_unit") == 0;
+  if (in->z_unit_factor != 1.0)
+    fprintf(o, given ? " (%s %s times %.10g: %s)"
+                     : " (the %s's %s times %.10g: %s)",
+            source, in->z_unit_declared, in->z_unit_factor,
+            tt__app_z_unit_why(in));
+  else if (*source)
+    fprintf(o, given ? " (as %s says)" : " (the unit from the %s)", source);
+  fputc('\n', o);
+  if (p->tiles) {
+    char lim[200] = "";
+    if (p->auto_tiled)
+      snprintf(lim, sizeof lim, " (tiled automatically: the run does not "
+               "fit the memory limit of %.1f MiB, %s)",
+               (double)p->mem_limit / 1048576.0,
+               p->mem_source ? p->mem_source : "?");
+    fprintf(o, "tiles:  %zu tiles of %zu cells on %d thread%s%s; the tiles "
+            "in flight hold at most about %.0f MiB\n", p->tiles,
+            p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
+            lim, (double)p->tile_bytes / 1048576.0);
+    if (p->budget_passes)
+      fprintf(o, "        the budget is met at the bound %g, found from the "
+              "tiles' curves (one pass) and %d run%s at a bound\n",
+              p->ropt ? p->ropt->max_error : 0.0, p->budget_passes,
+              p->budget_passes == 1 ? "" : "s");
+  }
+  fprintf(o, "time:   read %.2f s, mesh %.2f s, write %.2f s (%s), total "
+          "%.2f s\n", p->t_read, p->sum.seconds_mesh, p->t_write,
+          p->driver ? p->driver : "?", p->t_total);
+}
+
+void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
+{
+  say_input(r, p);
+  say_output(r, p);
+  say_error(r, p);
+  if (r->s->verbose)
+    say_details(r, p);
 }

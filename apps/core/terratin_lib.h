@@ -53,7 +53,11 @@ typedef enum tt_app_command {
   TT_APP_EVAL,
   TT_APP_OPTIMIZE,           /* optimize DEM IN_TIN OUTPUT */
   TT_APP_STUDY,              /* study OUTDIR */
-  TT_APP_RASTERIZE           /* rasterize TIN DEM OUTPUT */
+  TT_APP_RASTERIZE,          /* rasterize DEM TIN OUTPUT */
+  TT_APP_FORMATS,            /* --formats: the output formats */
+  TT_APP_HELP_GENERAL,       /* --help-general: the options of every command */
+  TT_APP_TILES               /* a help topic only: `terratin tiles` runs
+                                through tt_app_tiles() */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
@@ -79,6 +83,12 @@ enum {
   TT_APP_LAYERS_ALL = 7u
 };
 
+/* Four numbers given to one option (-srcwin, -projwin, -a_ullr). */
+typedef struct tt_app_box {
+  int set;                   /* the option was given */
+  double v[4];               /* its values, in the option's order */
+} tt_app_box;
+
 typedef struct tt_app_settings {
   tt_app_command command;
   tt_app_command help_topic; /* TT_APP_HELP: TT_APP_NONE = top level */
@@ -87,6 +97,7 @@ typedef struct tt_app_settings {
   const char *const *config; /* --config pairs: KEY, VALUE, KEY, VALUE, NULL */
   int quiet;                 /* -q */
   int json;                  /* -json (simplify, eval) */
+  int verbose;               /* -verbose: the whole summary (simplify) */
   int overwrite;             /* -overwrite (simplify, generate) */
 
   /* simplify INPUT OUTPUT; eval INPUT TIN; generate TYPE OUTPUT */
@@ -98,11 +109,25 @@ typedef struct tt_app_settings {
                                 band's own mask (simplify, eval) */
   double z_factor;           /* -z_factor; default 1 (simplify, eval) */
   int z_factor_set;          /* -z_factor was given */
-  const char *z_unit;        /* -z_unit: "m" or NULL (simplify, eval) */
+  const char *z_unit;        /* -z_unit: the heights' unit, "m", "ft" or
+                                "us-ft"; NULL: as the file says */
+  const char *z_to;          /* -z_to: "m" (convert to metres), "native"
+                                (keep the unit) or "auto" (metres when the
+                                CRS is in metres or geographic); NULL:
+                                auto */
   const char *work_srs;      /* -work_srs: the working CRS; NULL: chosen
                                 from the DEM's CRS (simplify) */
   const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the
                                 DEM's (simplify) */
+  /* the DEM as GDAL's input options present it (dem_view.c): read
+   * through an in-memory VRT of the window, map coordinates unchanged */
+  tt_app_box srcwin;         /* -srcwin xoff yoff xsize ysize (samples) */
+  tt_app_box projwin;        /* -projwin ulx uly lrx lry */
+  const char *projwin_srs;   /* -projwin_srs: projwin's CRS; NULL: the
+                                DEM's */
+  tt_app_box a_ullr;         /* -a_ullr ulx uly lrx lry: the georeferenced
+                                bounds given to the (windowed) DEM */
+  int srs_is_s_srs;          /* the DEM's CRS (srs) was given as -s_srs */
 
   /* simplify; eval uses max_error as its threshold */
   double max_error;          /* -max_error; negative: not given */
@@ -143,10 +168,17 @@ typedef struct tt_app_settings {
 
   /* eval, optimize (which reads the TIN from tin and writes output) */
   const char *layer;         /* -layer; NULL: the triangles layer */
+  int tin_frame;             /* eval -tin_frame (-stl_frame): 0 auto (map;
+                                an STL off the DEM's extent: pixel), 1 map,
+                                2 pixel */
+  double tin_transform[6];   /* eval -tin_transform sx,sy,sz,ox,oy,oz */
+  int tin_transform_set;     /* -tin_transform was given */
 
   /* generate */
   tt_synth_options synth;    /* tt_synth_options_init(kind) + the flags */
-  const char *srs;           /* -a_srs; NULL: none */
+  const char *srs;           /* -a_srs (or -s_srs, DEM readers): the CRS
+                                given to the output (generate) or to the
+                                DEM read (the others); NULL: none */
 
   /* study OUTDIR (output); the lists are checked by the run (study.c) */
   const char *const *terrains; /* -terrain, in order: a DEM or a name */

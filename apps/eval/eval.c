@@ -1,8 +1,11 @@
 /*
  * eval.c -- apps/eval/: the eval command, a folder over the core
- * (apps/core/). `terratin eval DEM TIN`: read any layer of triangles (the
- * triangles layer of a terratin output, or any POLYGON Z layer), measure it
- * against the DEM's valid samples (tt_eval_triangles), print the errors, and
+ * (apps/core/). `terratin eval DEM TIN`: read a TIN from any file that
+ * holds one (a mesh file: STL, PLY, OBJ, 2DM, LandXML, UGRID; or an OGR
+ * layer of triangles: terratin's, any POLYGON Z, TIN or PolyhedralSurface
+ * layer, CSV WKT, DXF 3DFACE; core/tin_read.c), put it on the DEM (its
+ * frame, -tin_transform, reprojected from its CRS), measure it against
+ * the DEM's valid samples (tt_eval_triangles), print the errors, and
  * exit with code 3 when -max_error is exceeded. With -error_raster, also
  * write TIN - DEM on the DEM's grid (core/raster_output.c's writer), refused
  * before anything is read when it exists without -overwrite.
@@ -30,14 +33,11 @@ typedef struct eval_run {
   const tt_app_settings *s;
   tt_output *outp;         /* -error_raster's output, or NULL */
   GDALDriverH rdrv;        /* and its driver */
-  GDALDatasetH src, tds;   /* the DEM (while read), the TIN's dataset */
+  GDALDatasetH src;        /* the DEM, while read */
   tt_grid *grid;
   tt_raster_info *info;
   size_t valid;            /* the DEM's valid samples */
-  const char *lname;       /* the triangle layer's name (tds owns it) */
-  int other_crs;           /* the layer declares another CRS */
-  double *xyz;             /* ntri triangles, corners in pixel space */
-  size_t ntri, rejected;
+  app_tin tin;             /* the triangles, in pixel space */
   double *err;             /* -error_raster: TIN - DEM per cell */
   tt_eval_result ev;
   double t_read, t_eval, t_raster;
@@ -73,7 +73,9 @@ static tt_status read_dem(eval_run *e)
   if (!(e->src = tt__app_open_raster(r, s->input, s->band, &band)))
     return r->res->status;
   if (e->outp &&
-      (st = tt_output_protect_dataset(r->ctx, e->outp, e->src, s->input)) !=
+      (st = tt_output_protect_dataset(r->ctx, e->outp,
+                                      tt__app_raster_file(r, e->src),
+                                      s->input)) !=
           TT_OK)
     return tt__app_fail_tt(r, st, s->error_raster);
   /* No bar for eval, but the reading still polls for an interruption. */
@@ -82,7 +84,7 @@ static tt_status read_dem(eval_run *e)
                         &e->grid, &e->info, &e->valid);
   if (st != TT_OK)
     return st;
-  GDALClose(e->src);
+  tt__app_close_raster(r, e->src);
   e->src = NULL;
   e->t_read = tt__app_now() - r->t0;
   if (!tt__app_continue(r, 0.3))
@@ -90,49 +92,47 @@ static tt_status read_dem(eval_run *e)
   return TT_OK;
 }
 
-/* The triangles of the TIN's layer, in the DEM's pixel space. */
+/* The triangles of the TIN, in the DEM's pixel space. */
 static tt_status read_triangles(eval_run *e)
 {
   app_run *r = e->r;
   const tt_app_settings *s = e->s;
-  tt_status st;
-  if (!(e->tds = tt__app_open_vector(r, s->tin)))
-    return r->res->status;
-  if (e->outp &&
-      (st = tt_output_protect_dataset(r->ctx, e->outp, e->tds, s->tin)) !=
-          TT_OK)
-    return tt__app_fail_tt(r, st, s->error_raster);
-  OGRLayerH layer = tt__app_tin_layer(r, e->tds);
-  if (!layer)
-    return r->res->status;
-  e->lname = OGR_L_GetName(layer);
-
-  /* Triangles in another CRS would be measured in the wrong place. */
-  e->other_crs = tt__app_layer_in_other_crs(layer, e->info);
-
-  r->msg.last[0] = '\0';
-  st = tt_ogr_read_triangles(r->ctx, layer, e->info->gt, &e->xyz, &e->ntri,
-                             &e->rejected);
+  app_tin *t = &e->tin;
+  tt_status st = tt__app_read_tin(r, e->info, e->grid, e->outp, t);
   if (st != TT_OK)
-    return tt__app_fail_tt(r, st, s->tin);
+    return st;
   /* Map coordinates stored in a file carry round-off: a TIN vertex on a
    * grid sample comes back a few 1e-9 pixel away when pixels are tiny
    * next to the coordinates (lidar in degrees), and the boundary samples
    * would then fall outside every triangle. Put corners within 1e-6 pixel
    * of a sample centre back on it; no other corner moves. */
-  for (size_t i = 0; i < e->ntri * 9; i++) {
+  for (size_t i = 0; i < t->ntri * 9; i++) {
     if (i % 3 == 2)
       continue; /* z */
-    double rounded = floor(e->xyz[i] + 0.5);
-    if (fabs(e->xyz[i] - rounded) <= 1e-6)
-      e->xyz[i] = rounded;
+    double rounded = floor(t->xyz[i] + 0.5);
+    if (fabs(t->xyz[i] - rounded) <= 1e-6)
+      t->xyz[i] = rounded;
   }
-  if (e->ntri == 0)
+  if (t->ntri == 0)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, s->tin,
-                        "layer '%s' holds no triangles (%zu polygon%s "
-                        "rejected)", e->lname, e->rejected,
-                        e->rejected == 1 ? "" : "s");
+                        "%s%s%s holds no triangles (%zu %s%s rejected)",
+                        t->layer ? "layer '" : "the ",
+                        t->layer ? t->layer : t->format,
+                        t->layer ? "'" : " file", t->rejected,
+                        t->layer ? "polygon" : "face",
+                        t->rejected == 1 ? "" : "s");
   return TT_OK;
+}
+
+/* "layer 'NAME'" or "the STL file", for messages. */
+static const char *shown_layer(const eval_run *e, char *buf, size_t size)
+{
+  const app_tin *t = &e->tin;
+  if (t->layer)
+    snprintf(buf, size, "layer %s", t->layer);
+  else
+    snprintf(buf, size, "the %s file", t->format);
+  return buf;
 }
 
 /* The errors of the triangles at the DEM's valid samples (and, for
@@ -147,23 +147,24 @@ static tt_status measure(eval_run *e)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM,
                         s->error_raster, "out of memory for %zu x %zu errors",
                         info->width, info->height);
-  double t = tt__app_now();
-  tt_status st = tt_eval_triangles_raster(r->ctx, e->grid, e->ntri, e->xyz,
+  double t0 = tt__app_now();
+  const app_tin *t = &e->tin;
+  char shown[320];
+  tt_status st = tt_eval_triangles_raster(r->ctx, e->grid, t->ntri, t->xyz,
                                           &e->ev, e->err);
   if (st != TT_OK)
     return tt__app_fail_tt(r, st, s->tin);
-  e->t_eval = tt__app_now() - t;
+  e->t_eval = tt__app_now() - t0;
   if (e->ev.errors.covered == 0)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, s->tin,
-                        "no valid sample of %s lies in a triangle of layer "
-                        "'%s' (%s)", s->input, e->lname,
-                        e->other_crs ? "the layer is in another CRS"
-                                     : "another extent?");
-  if (e->other_crs)
-    tt__app_warn(&r->msg,
-                 "%s: layer '%s' is not in the CRS of %s; the error is "
-                 "measured as if it were",
-                 s->tin, e->lname, s->input);
+                        "no valid sample of %s lies in a triangle of %s "
+                        "(%s)", s->input, shown_layer(e, shown, sizeof shown),
+                        t->other_crs ? "the TIN has a CRS, the DEM none"
+                        : t->pixel   ? "another grid? -tin_frame pixel "
+                                       "takes x as the column, y as the "
+                                       "row counted up"
+                                     : "another extent? -tin_frame, "
+                                       "-tin_transform");
   if (e->ev.uncovered)
     tt__app_warn(&r->msg,
                  "%s: %zu of %zu valid samples lie in no triangle; their "
@@ -225,14 +226,18 @@ static void report_json(const eval_run *e)
   tt__json_str(&j, "dem", tt__app_shown(r, s->input));
   tt__json_size(&j, "band", (size_t)s->band);
   tt__json_str(&j, "tin", tt__app_shown(r, s->tin));
-  tt__json_str(&j, "layer", e->lname);
+  tt__json_str(&j, "layer", e->tin.layer);
+  tt__json_str(&j, "format", e->tin.format);
+  tt__json_str(&j, "frame", e->tin.pixel ? "pixel" : "map");
+  tt__json_bool(&j, "reprojected", e->tin.reprojected);
+  tt__json_str(&j, "tin_crs", e->tin.reprojected ? e->tin.crs_name : NULL);
   tt__json_size(&j, "cells", info->width * info->height);
   tt__json_size(&j, "valid_samples", er->samples);
   tt__json_size(&j, "covered", er->covered);
   tt__json_size(&j, "uncovered", e->ev.uncovered);
   tt__json_size(&j, "overlapped", e->ev.overlapped);
   tt__json_size(&j, "triangles", e->ev.triangles);
-  tt__json_size(&j, "rejected", e->rejected);
+  tt__json_size(&j, "rejected", e->tin.rejected);
   tt__json_size(&j, "degenerate", e->ev.degenerate);
   tt__json_num(&j, "max_error", er->max_error);
   if (er->max_col >= 0) {
@@ -276,16 +281,26 @@ static void report_text(const eval_run *e)
   const tt_error_stats *er = &e->ev.errors;
   const char *unit = tt__app_unit_or(info, "z units");
   FILE *o = e->r->out;
+  char shown[320];
   double mx, my;
   int pass = passes(e);
   max_error_at(e, &mx, &my);
   fprintf(o, "DEM: %s, band %d: %zux%zu = %zu cells, %zu valid samples\n",
           tt__app_shown(e->r, s->input), s->band, info->width, info->height,
           info->width * info->height, er->samples);
-  fprintf(o, "TIN: %s, layer %s: %zu triangles, %zu polygons rejected "
+  fprintf(o, "TIN: %s, %s: %zu triangles, %zu %s rejected "
              "(not triangles), %zu degenerate\n",
-          tt__app_shown(e->r, s->tin), e->lname, e->ev.triangles, e->rejected,
+          tt__app_shown(e->r, s->tin), shown_layer(e, shown, sizeof shown),
+          e->ev.triangles,
+          e->tin.rejected, e->tin.layer ? "polygons" : "faces",
           e->ev.degenerate);
+  if (e->tin.pixel || e->tin.reprojected || s->tin_transform_set)
+    fprintf(o, "TIN frame:       %s%s%s%s\n",
+            e->tin.pixel ? "the DEM's pixels (x column, y row up)"
+                         : "map coordinates",
+            s->tin_transform_set ? ", after -tin_transform" : "",
+            e->tin.reprojected ? ", reprojected from " : "",
+            e->tin.reprojected ? e->tin.crs_name : "");
   if (er->max_col >= 0)
     fprintf(o, "max error:       %.9g %s at column %lld, row %lld "
                "(x %.10g, y %.10g)\n",
@@ -351,11 +366,9 @@ tt_status tt__app_eval(app_run *r)
 
   tt_output_destroy(e.outp);
   free(e.err);
-  if (e.tds)
-    GDALClose(e.tds);
+  tt__app_tin_free(&e.tin);
   if (e.src)
-    GDALClose(e.src);
-  free(e.xyz);
+    tt__app_close_raster(r, e.src);
   tt_grid_destroy(e.grid);
   tt_raster_info_destroy(e.info);
   return st;

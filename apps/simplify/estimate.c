@@ -14,9 +14,8 @@
  * 5 % of its samples, whichever comes last. The vertices at the bound per
  * sampled cell, times the DEM's cells, predict the TIN; the curves also
  * give the bound that keeps about 5 % of the samples, for the advice.
- * Without -max_error the bound is the default's, from the sampled
- * heights' range (a range the sample misses makes it tighter: the count
- * is then over, never under).
+ * Without -max_error the bound is the default's (default_bound.c: twice
+ * the mean step), from the sampled windows' steps.
  *
  * The output's bytes are the vertices times what one costs in the format
  * (a GeoPackage: about 700 bytes a vertex with its two triangles, measured
@@ -105,31 +104,19 @@ static void lattice(size_t W, size_t H, size_t *out_n, size_t *out_ntx,
   *out_ky = side < nty ? side : nty;
 }
 
-/* The heights' range of a window. */
-static void window_range(const tt_grid *g, double *lo, double *hi)
-{
-  size_t nx = tt_grid_width(g), ny = tt_grid_height(g);
-  for (size_t y = 0; y < ny; y++)
-    for (size_t x = 0; x < nx; x++) {
-      double z = tt_grid_sample(g, x, y);
-      if (!isnan(z)) {
-        *lo = z < *lo ? z : *lo;
-        *hi = z > *hi ? z : *hi;
-      }
-    }
-}
-
 /* Reads the sampled windows (tile (i, j) of the lattice each), into
- * grids[] and tiles[]; their heights' range. The failure is recorded. */
+ * grids[] and tiles[]; their mean step (default_bound.c) into step. The
+ * failure is recorded. */
 static tt_status read_windows(app_simplify_job *job, tt_context *ctx,
                               size_t n, size_t ntx,
                               size_t nty, size_t kx, size_t ky,
-                              tt_grid **grids, tt_tile *tiles, double *lo,
-                              double *hi)
+                              tt_grid **grids, tt_tile *tiles,
+                              app_step *step)
 {
   app_run *r = job->r;
   size_t W = job->width, H = job->height;
-  char **base = tt__app_read_options(job->s);
+  char **base = tt__app_view_read_options(r, tt__app_read_options(job->s),
+                                          job->s->input);
   tt_status st = TT_OK;
   /* the read's warnings are the DEM's: the whole run says them (ctx has
    * no log) */
@@ -154,7 +141,7 @@ static tt_status read_windows(app_simplify_job *job, tt_context *ctx,
                              &grids[b * kx + a], NULL);
       CSLDestroy(ro);
       if (st == TT_OK)
-        window_range(grids[b * kx + a], lo, hi);
+        tt__app_step_of_grid(step, grids[b * kx + a]);
     }
   CPLPopErrorHandler();
   CSLDestroy(base);
@@ -274,18 +261,17 @@ tt_status tt__app_estimate(app_simplify_job *job)
   est_window *ws = calloc(nw, sizeof *ws);
   tt_context *ctx = tt_context_create();
   tt_status st = TT_OK;
-  double lo = INFINITY, hi = -INFINITY;
+  app_step step = {0};
   if (!grids || !tiles || !ws || !ctx)
     st = tt__app_fail(job->r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
                       "out of memory for the estimate");
   if (st == TT_OK)
-    st = read_windows(job, ctx, n, ntx, nty, kx, ky, grids, tiles, &lo,
-                      &hi);
+    st = read_windows(job, ctx, n, ntx, nty, kx, ky, grids, tiles, &step);
   if (st == TT_OK) {
     e->bound = job->ro.max_error;
     e->bound_default = e->bound < 0;
     if (e->bound_default)
-      e->bound = lo <= hi ? 0.005 * (hi - lo) : 0.0;
+      e->bound = tt__app_default_bound_of(&step);
     size_t cells = 0, valid = 0;
     st = run_curves(job, ctx, grids, tiles, nw, e->bound, ws, &cells,
                     &valid);

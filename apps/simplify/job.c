@@ -170,10 +170,10 @@ int tt__app_job_default_wanted(const app_simplify_job *job)
          !(ro->percent > 0);
 }
 
-void tt__app_job_default_bound(app_simplify_job *job, double zmin,
-                               double zmax)
+void tt__app_job_default_bound(app_simplify_job *job, const app_step *step)
 {
-  job->ro.max_error = 0.005 * (zmax - zmin);
+  job->rep.step = tt__app_step_mean(step);
+  job->ro.max_error = tt__app_default_bound_of(step);
   job->dopt.max_error = job->ro.max_error;
   job->rep.default_error = 1;
 }
@@ -184,7 +184,7 @@ void tt__app_job_free(app_simplify_job *job)
     GDALClose(job->dst);
   CPLSetThreadLocalConfigOption("OGR_SQLITE_JOURNAL", NULL);
   if (job->src)
-    GDALClose(job->src);
+    tt__app_close_raster(job->r, job->src);
   /* an unfinished streamed write undone, then the temporary files removed
    * unless committed */
   tt__app_stream_close(&job->so);

@@ -181,3 +181,82 @@ void tt__app_output_choose_stream(app_simplify_job *job)
   job->kind = APP_OUTPUT_STREAM;
   job->rep.streamed = 1;
 }
+
+/* The layers the output holds, under their written names (-nln first). */
+static char **layer_names(const app_simplify_job *job, const char *prefix,
+                          const char *const suffix[3])
+{
+  static const char *const names[] = {"triangles", "vertices",
+                                      "run_parameters"};
+  char **out = NULL;
+  for (unsigned i = 0; i < 3; i++)
+    if (job->s->layers & (1u << i))
+      out = CSLAddString(out, CPLSPrintf("%s%s%s%s", prefix, job->s->nln,
+                                         names[i], suffix ? suffix[i] : ""));
+  return out;
+}
+
+/* name added to list as messages show it: any password in it masked (a
+ * file named like a connection string, and the names made from it) */
+static char **add_shown(char **list, const app_run *r, const char *name)
+{
+  char buf[TT_APP_MESSAGE_MAX];
+  return CSLAddString(list, tt__app_secrets_mask(&r->msg.secrets,
+                                                 tt__app_shown(r, name), buf,
+                                                 sizeof buf));
+}
+
+void tt__app_output_names(const app_simplify_job *job, char ***out_files,
+                          char ***out_layers)
+{
+  const tt_app_settings *s = job->s;
+  char **files = NULL, **layers = NULL;
+  /* the names as every message shows them: a password never */
+  app_run *r = job->r;
+  if (job->kind == APP_OUTPUT_DATABASE) {
+    files = add_shown(files, r, job->shown);
+    layers = layer_names(job, "", NULL);
+  } else if (job->kind == APP_OUTPUT_MESH) {
+    files = add_shown(files, r, s->output);
+    /* the sidecars replace OUTPUT's extension (2DM's datasets) */
+    char *stem = CPLStrdup(CPLFormFilename(CPLGetPath(s->output),
+                                           CPLGetBasename(s->output), NULL));
+    for (const char *const *sc = tt_mesh_format_sidecars(job->mesh); *sc;
+         sc++)
+      files = add_shown(files, r, CPLSPrintf("%s%s", stem, *sc));
+    CPLFree(stem);
+  } else if (tt__app_str_ieq(job->drvname, "ESRI Shapefile")) {
+    /* files of their own beside OUTPUT: <name>_triangles.shp, ... */
+    static const char *const ext[3] = {".shp", ".shp", ".dbf"};
+    const char *slash = strrchr(s->output, '/');
+    char *dir = CPLStrdup(s->output);
+    dir[slash ? (size_t)(slash - s->output) + 1 : 0] = '\0';
+    char **names = layer_names(
+        job, CPLSPrintf("%s%s", dir, tt_output_layer_prefix(job->outp)),
+        ext);
+    CPLFree(dir);
+    for (size_t i = 0; names && names[i]; i++)
+      files = add_shown(files, r, names[i]);
+    CSLDestroy(names);
+  } else {
+    VSIStatBufL sb;
+    if (VSIStatL(s->output, &sb) == 0 && VSI_ISDIR(sb.st_mode)) {
+      /* a folder of a file per layer (FlatGeobuf, MapInfo) */
+      char **entries = VSIReadDir(s->output);
+      char **mine = layer_names(job, "", NULL);
+      for (size_t i = 0; entries && entries[i]; i++)
+        for (size_t k = 0; mine && mine[k]; k++)
+          if (strncmp(entries[i], mine[k], strlen(mine[k])) == 0 &&
+              entries[i][strlen(mine[k])] == '.')
+            files = add_shown(files, r,
+                              CPLFormFilename(s->output, entries[i], NULL));
+      CSLDestroy(entries);
+      CSLDestroy(mine);
+    } else {
+      files = add_shown(files, r, s->output);
+      layers = layer_names(job, "", NULL);
+    }
+  }
+  *out_files = files;
+  *out_layers = layers;
+}

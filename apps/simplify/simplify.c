@@ -20,6 +20,8 @@
 #include "simplify.h"
 #include "base/internal.h" /* tt__format_bytes */
 
+#include <cpl_string.h>
+
 #include <stdint.h>
 #include <string.h>
 
@@ -34,10 +36,18 @@ static tt_status open_input(app_simplify_job *job)
   job->src = tt__app_open_raster(r, s->input, s->band, &job->band);
   if (!job->src)
     return r->res->status;
+  /* a CRS to go from, said before any work: the way forward is -a_srs */
+  const char *needs = s->t_srs ? "-t_srs" : s->work_srs ? "-work_srs" : NULL;
+  if (needs && !GDALGetSpatialRef(job->src))
+    return tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: %s %s: the DEM %s has no CRS to transform "
+                        "from; give it one with -a_srs SRS", needs,
+                        s->t_srs ? s->t_srs : s->work_srs, s->input);
   job->width = (size_t)GDALGetRasterBandXSize(job->band);
   job->height = (size_t)GDALGetRasterBandYSize(job->band);
-  tt_status st = job->outp ? tt_output_protect_dataset(r->ctx, job->outp,
-                                                       job->src, s->input)
+  tt_status st = job->outp ? tt_output_protect_dataset(
+                                 r->ctx, job->outp,
+                                 tt__app_raster_file(r, job->src), s->input)
                            : TT_OK;
   if (st != TT_OK)
     tt__app_fail_tt(r, st, s->output);
@@ -164,7 +174,7 @@ static tt_status run_tiled(app_simplify_job *job)
   tt_status st = tt__app_simplify_tiled(job);
   if (st != TT_OK || (!job->tin && job->kind != APP_OUTPUT_STREAM))
     return st;
-  GDALClose(job->src);
+  tt__app_close_raster(job->r, job->src);
   job->src = NULL;
   rep->info = job->info;
   rep->driver = job->drvname;
@@ -185,8 +195,8 @@ static double read_share(const app_simplify_job *job)
   return job->ground ? 0.30 : 0.10;
 }
 
-/* The whole DEM read into a grid (0 - 10 %, or 30 %), for the default
- * bound its height range. */
+/* The whole DEM read into a grid (0 - 10 %, or 30 %), and its height
+ * range. */
 static tt_status read_whole(app_simplify_job *job)
 {
   app_run *r = job->r;
@@ -198,7 +208,7 @@ static tt_status read_whole(app_simplify_job *job)
                                   &job->info, &valid);
   if (st != TT_OK)
     return st;
-  GDALClose(job->src);
+  tt__app_close_raster(job->r, job->src);
   job->src = NULL;
   rep->info = job->info;
   rep->driver = job->drvname;
@@ -219,8 +229,11 @@ static tt_status run_whole(app_simplify_job *job)
   tt_status st = read_whole(job);
   if (st != TT_OK)
     return st;
-  if (tt__app_job_default_wanted(job))
-    tt__app_job_default_bound(job, rep->zmin, rep->zmax);
+  if (tt__app_job_default_wanted(job)) {
+    app_step step = {0};
+    tt__app_step_of_grid(&step, job->grid);
+    tt__app_job_default_bound(job, &step);
+  }
   tt__app_phase_set(&r->prog, read_share(job), 0.85);
   rep->ropt = &job->ro;
   if (job->decimate)
@@ -247,14 +260,19 @@ static tt_status run_whole(app_simplify_job *job)
   return TT_OK;
 }
 
-static void report(const app_simplify_job *job)
+static void report(app_simplify_job *job)
 {
   app_run *r = job->r;
+  app_simplify_report *rep = &job->rep;
+  tt__app_output_names(job, &rep->files, &rep->layers);
   if (job->s->json)
-    tt__app_print_simplify_json(r, &job->rep);
+    tt__app_print_simplify_json(r, rep);
   else if (!job->s->quiet)
-    tt__app_print_simplify_summary(r, &job->rep);
+    tt__app_print_simplify_summary(r, rep);
   fflush(r->out);
+  CSLDestroy(rep->files);
+  CSLDestroy(rep->layers);
+  rep->files = rep->layers = NULL;
 }
 
 tt_status tt__app_simplify(app_run *r)

@@ -8,7 +8,8 @@
  *   simplify.c      tt__app_simplify: the pipeline, the input, the
  *                   tiling's choice, the whole run and the tiled run
  *   job.c           the job from the settings: the method's options, the
- *                   memory, the threads, the default bound
+ *                   memory, the threads, the default bound set
+ *   default_bound.c the default bound: the DEM's mean step
  *   output.c        the output's choice (OGR file, database, mesh file,
  *                   streamed GeoPackage), its plan and writer options
  *   ogr_output.c    the OGR output's checks before any work (the dry run,
@@ -127,17 +128,42 @@ tt_status tt__app_job_memory(app_simplify_job *job);
 /* The engine's threads (-threads, GDAL_NUM_THREADS: tt__app_threads, which
  * may warn) into the options, and the workers of a tiled run. */
 void tt__app_job_threads(app_simplify_job *job);
+/* The DEM's mean step (default_bound.c): the sum of the absolute height
+ * differences of 4-neighbour valid samples, and their count. */
+typedef struct app_step {
+  double sum, comp; /* the sum, and its compensation (Neumaier) */
+  size_t pairs;
+} app_step;
+/* The pairs of g whose first sample lies in columns x0..x1 and rows
+ * y0..y1 and whose second lies at most at column xmax, row ymax, added
+ * to s (all in g's cells). */
+void tt__app_step_add(app_step *s, const tt_grid *g, size_t x0, size_t y0,
+                      size_t x1, size_t y1, size_t xmax, size_t ymax);
+/* All the pairs of g added to s. */
+void tt__app_step_of_grid(app_step *s, const tt_grid *g);
+/* s's pairs added to into (a tile's to the DEM's). */
+void tt__app_step_merge(app_step *into, const app_step *s);
+/* The mean absolute difference (0 without pairs). */
+double tt__app_step_mean(const app_step *s);
+/* The default bound: twice the mean step, two significant digits; 0 for
+ * a flat DEM or one without pairs. */
+double tt__app_default_bound_of(const app_step *s);
+
 /* Whether the bound is the default one (no -max_error, no budget), and
- * that bound set from the height range: 0.5 % of it. */
+ * that bound set from the DEM's step (tt__app_default_bound_of). */
 int tt__app_job_default_wanted(const app_simplify_job *job);
-void tt__app_job_default_bound(app_simplify_job *job, double zmin,
-                               double zmax);
+void tt__app_job_default_bound(app_simplify_job *job, const app_step *step);
 /* Closes and frees what the job holds; an unfinished output is removed. */
 void tt__app_job_free(app_simplify_job *job);
 
 /* output.c: the kind of output and its driver (-of, else OUTPUT's form),
  * the mesh formats' refusals of the OGR options. */
 tt_status tt__app_output_choose(app_simplify_job *job);
+/* What the run wrote, as the user names it: the files (a database: its
+ * name without password) and, for a dataset of several layers, the layers
+ * in it (else NULL); CSLDestroy both. */
+void tt__app_output_names(const app_simplify_job *job, char ***out_files,
+                          char ***out_layers);
 /* The output planned before any work: a database opened and checked, a
  * file's temporary name and sidecars, what is in the way refused. */
 tt_status tt__app_output_plan(app_simplify_job *job);
@@ -179,6 +205,15 @@ void tt__app_simplify_fields(const app_simplify_job *job,
  * error naming the -layers or OUTPUT form that works). */
 int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
                              char **dsco, char **wopts, char **auto_t_srs);
+/* ogr_output.c, for --formats: the dry run of drv (with the -dsco terratin
+ * adds) into a file named with extension ext ("" for a folder), on a TIN
+ * in UTM zone 33N, read back: TT_APP_LAYERS_ALL when it holds the three
+ * layers together as written, else 0, with *out_alone the layers it
+ * holds each alone (all three when together; 0: the driver cannot write
+ * the TIN faithfully) and *out_imposed 1 when it writes them in a CRS of
+ * its own (GPX: EPSG:4326). */
+unsigned tt__app_probe_format(GDALDriverH drv, const char *ext,
+                              unsigned *out_alone, int *out_imposed);
 /* ogr_readback.c: 1 when the dataset name, just written by drv with the
  * layers (TT_APP_LAYERS_* bits) of tin
  * (in tin_srs, NULL: none) reprojected to t_srs (NULL: none), reads back

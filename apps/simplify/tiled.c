@@ -22,8 +22,8 @@
  * again while the TIN passes the budget (tt__app_budget_passes decides,
  * docs/scale.md); streamed, a pass writes as if kept, and has its rows
  * dropped if it is not (at once when its counts pass the budget). Without
- * -max_error the bound is 0.5 % of the height range, as untiled (one more
- * pass over the tiles finds the range first).
+ * -max_error the bound is twice the DEM's mean step, as untiled (one more
+ * pass over the tiles finds the step and the height range first).
  *
  * GDAL's block cache (5 % of the memory by default) would keep every
  * block read, the whole DEM in the end: unless GDAL_CACHEMAX is set, it
@@ -245,7 +245,8 @@ static tt_status tiled_init(tiled *T)
    * -max_memory (the tiles in flight are bounded instead); what grows
    * with the TIN is held to -max_memory, or to the system's limit when
    * that chose the tiles */
-  T->ropts = tt__app_read_options(job->s);
+  T->ropts = tt__app_view_read_options(T->r, tt__app_read_options(job->s),
+                                       T->path);
   T->max_memory = job->s->max_memory ? job->s->max_memory
                   : job->rep.auto_tiled ? job->mem_limit
                                         : 0;
@@ -257,21 +258,23 @@ static tt_status tiled_init(tiled *T)
   T->zmin = calloc(T->ntiles, sizeof *T->zmin);
   T->zmax = calloc(T->ntiles, sizeof *T->zmax);
   T->valid = calloc(T->ntiles, sizeof *T->valid);
+  T->steps = calloc(T->ntiles, sizeof *T->steps);
   hold_cache(T);
   pthread_mutex_init(&T->lock, NULL);
   pthread_mutex_init(&T->gdal, NULL);
   pthread_cond_init(&T->cond, NULL);
   T->range_min = INFINITY;
   T->range_max = -INFINITY;
-  if (!T->pieces || !T->done || !T->zmin || !T->zmax || !T->valid)
+  if (!T->pieces || !T->done || !T->zmin || !T->zmax || !T->valid ||
+      !T->steps)
     return tt__app_fail(T->r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
                         "out of memory for %zu tiles", T->ntiles);
   return TT_OK;
 }
 
-/* The range of heights, which the default bound needs (no -max_error and
- * no budget; the report too): a pass over the tiles that only reads
- * them, then the bound set. */
+/* The DEM's step, which the default bound needs (no -max_error and no
+ * budget), and its range of heights (the report): a pass over the tiles
+ * that only reads them, then the bound set. */
 static tt_status height_range(tiled *T)
 {
   app_run *r = T->r;
@@ -286,17 +289,19 @@ static tt_status height_range(tiled *T)
   if (st != TT_OK)
     return st;
   size_t valid = 0;
+  app_step step = {0};
   for (size_t k = 0; k < T->ntiles; k++) {
     T->range_min = T->zmin[k] < T->range_min ? T->zmin[k] : T->range_min;
     T->range_max = T->zmax[k] > T->range_max ? T->zmax[k] : T->range_max;
     valid += T->valid[k];
+    tt__app_step_merge(&step, &T->steps[k]);
     T->done[k] = false;
   }
   if (valid == 0)
     return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, T->path,
                         "band %d has no valid samples (all nodata)",
                         r->s->band);
-  tt__app_job_default_bound(T->job, T->range_min, T->range_max);
+  tt__app_job_default_bound(T->job, &step);
   T->ro.max_error = T->job->ro.max_error;
   T->dec.max_error = T->job->ro.max_error;
   T->minmax_only = false;
@@ -402,6 +407,7 @@ static void tiled_free(tiled *T)
   free(T->pieces);
   free(T->done);
   free(T->zmin);
+  free(T->steps);
   free(T->zmax);
   free(T->valid);
   pthread_mutex_destroy(&T->lock);

@@ -38,6 +38,7 @@ typedef struct tiled {
   tt_tin **pieces;
   bool *done;
   double *zmin, *zmax;      /* per tile (pre-pass) */
+  app_step *steps;          /* per tile (pre-pass): its pairs' step */
   size_t *valid;            /* per tile: valid samples of its window */
   atomic_int stop;
   size_t failed;            /* the first tile that failed (ntiles: none) */

@@ -148,6 +148,12 @@ void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
     T->zmin[k] = lo;
     T->zmax[k] = hi;
     T->valid[k] = n;
+    /* the pairs whose first sample the tile owns (its last column and row
+     * are the next tile's, but for the DEM's own last ones) */
+    size_t x1 = t.col1 - (t.col1 + 1 < t.dem_width);
+    size_t y1 = t.row1 - (t.row1 + 1 < t.dem_height);
+    tt__app_step_add(&T->steps[k], win, t.col0 - c0, t.row0 - r0, x1 - c0,
+                     y1 - r0, t.col1 - c0, t.row1 - r0);
   } else if (st == TT_OK && T->curve_pass) {
     /* a budget's first pass: the tile's curve, its valid samples */
     size_t cells = (t.col1 - t.col0 + 1) * (t.row1 - t.row0 + 1);
@@ -200,9 +206,21 @@ static void *worker(void *arg)
                                                   GDAL_OF_READONLY, NULL,
                                                   NULL, NULL)
                                      : NULL;
-  GDALRasterBandH band = own ? GDALGetRasterBand(own,
-                                                 GDALGetBandNumber(T->band))
-                             : NULL;
+  /* under GDAL's input options, the worker's own view of its dataset,
+   * from the arguments the main thread checked (dem_view.c) */
+  GDALDatasetH view = NULL;
+  if (own && T->r->view_args) {
+    char why[TT_APP_MESSAGE_MAX];
+    view = tt__app_view_open(own, T->r->view_args, why, sizeof why);
+    if (!view) {
+      GDALClose(own);
+      own = NULL;
+    }
+  }
+  GDALDatasetH reads = view ? view : own;
+  GDALRasterBandH band = reads ? GDALGetRasterBand(reads,
+                                                   GDALGetBandNumber(T->band))
+                               : NULL;
   for (;;) {
     pthread_mutex_lock(&T->lock);
     while (!atomic_load(&T->stop) && T->next < T->ntiles &&
@@ -221,6 +239,8 @@ static void *worker(void *arg)
     }
     tt__app_tiled_run_tile(T, ctx, k, band);
   }
+  if (view)
+    GDALClose(view);
   if (own)
     GDALClose(own);
   CPLPopErrorHandler();

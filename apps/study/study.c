@@ -282,7 +282,7 @@ static int load_terrain(app_run *r, study_terrain *t)
 done:
   tt_raster_info_destroy(info);
   if (ds)
-    GDALClose(ds);
+    tt__app_close_raster(r, ds);
   return st == TT_OK;
 }
 

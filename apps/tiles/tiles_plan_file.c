@@ -202,7 +202,10 @@ static const enum opt_id plan_opts[] = {
     O_MAX_ERROR, O_TILE_SIZE, O_METHOD, O_START, O_IMPORTANCE, O_SELECTION,
     O_ONEPASS, O_HOLE, O_CRITERION, O_REPAIR, O_OPTIMIZE, O_SEED,
     O_ANNEAL_T0, O_ANNEAL_STAGES, O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R,
-    O_B, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS};
+    O_B, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT, O_Z_TO, O_WORK_SRS,
+    /* GDAL's input options: every tile reads the same window alike */
+    O_A_SRS, O_S_SRS, O_A_NODATA, O_SRCWIN, O_PROJWIN, O_PROJWIN_SRS,
+    O_A_ULLR};
 /* The output's: `tiles merge` takes them from its own command line. */
 static const enum opt_id output_opts[] = {
     O_OF, O_LCO, O_DSCO, O_NLN, O_LAYERS, O_NOSTYLE, O_OBJ_LOCAL, O_T_SRS};
@@ -255,6 +258,10 @@ static bool refuse_option(const char *who, const char *w,
     return REFUSE(res, TT_ERR_ARG, "%s: '%s' is not an option: a plan holds "
                   "-NAME [VALUE] pairs only (a word of its own would "
                   "become an input or output name)", who, w);
+  const char *near = d ? NULL : tt__app_opt_suggest(w, TT_APP_SIMPLIFY);
+  if (near)
+    return REFUSE(res, TT_ERR_ARG, "%s: unknown option '%s'; did you mean "
+                  "%s?", who, w, near);
   if (d && IN(budget_opts, d->id))
     return REFUSE(res, TT_ERR_ARG, "%s: %s is a budget: a plan needs "
                   "-tile_size N and -max_error E (each tile is simplified "
@@ -290,16 +297,19 @@ bool tt__tiles_plan_check_words(const char *who, char *const *words,
     const tt__app_opt_def *d = simplify_opt(words[i]);
     if (!d || !IN(plan_opts, d->id))
       return refuse_option(who, words[i], d, res);
-    if (!tt__app_opt_takes_value(d))
+    size_t nv = (size_t)tt__app_opt_takes_value(d);
+    if (!nv)
       continue;
-    if (i + 1 == n)
-      return REFUSE(res, TT_ERR_ARG, "%s: option %s needs a value", who,
-                    words[i]);
-    const char *v = words[++i];
-    if (d->id == O_WORK_SRS && !is_auth_code(v))
-      return REFUSE(res, TT_ERR_ARG, "%s: -work_srs '%s': a plan takes a "
+    if (i + nv >= n)
+      return REFUSE(res, TT_ERR_ARG, "%s: option %s needs %s", who,
+                    words[i], nv == 1 ? "a value" : "its values");
+    const char *opt = words[i], *v = words[i + 1];
+    i += nv;
+    if ((d->id == O_WORK_SRS || d->id == O_A_SRS || d->id == O_S_SRS ||
+         d->id == O_PROJWIN_SRS) && !is_auth_code(v))
+      return REFUSE(res, TT_ERR_ARG, "%s: %s '%s': a plan takes a "
                     "CRS as AUTHORITY:CODE only (e.g. EPSG:32633), never a "
-                    "file name, URL, WKT or PROJ string", who, v);
+                    "file name, URL, WKT or PROJ string", who, opt, v);
   }
   return true;
 }
@@ -492,7 +502,7 @@ static bool check_grid(const char *path, const tiles_plan *p,
 
 /* simplify's parser reads the options as `tiles run` will pass them: a
  * bound, the plan's tile size, no budget. *out_band: -b. */
-static bool check_line(const tiles_plan *p, int *out_band,
+static bool check_line(const tiles_plan *p, tt_app_options **out_o,
                        tt_app_result *res)
 {
   char **sv = CSLAddString(NULL, "simplify");
@@ -508,7 +518,6 @@ static bool check_line(const tiles_plan *p, int *out_band,
     return REFUSE(res, TT_ERR_ARG, "%s: its options: %s", p->path,
                   pr.message);
   const tt_app_settings *s = tt_app_options_settings(o);
-  *out_band = s->band;
   if (s->tile_size != p->tile_size)
     ok = REFUSE(res, TT_ERR_DATA, "%s: its options' -tile_size %zu is not "
                 "its \"tile_size\" %zu", p->path, s->tile_size,
@@ -516,7 +525,10 @@ static bool check_line(const tiles_plan *p, int *out_band,
   else if (s->max_error < 0)
     ok = REFUSE(res, TT_ERR_ARG, "%s: its options have no -max_error",
                 p->path);
-  tt_app_options_destroy(o);
+  if (ok)
+    *out_o = o;
+  else
+    tt_app_options_destroy(o);
   return ok;
 }
 
@@ -533,8 +545,10 @@ static bool dem_identity(const char *path, uint64_t *bytes, uint64_t *ns)
 
 /* The DEM: a file by its canonical path, unchanged since the plan, a
  * raster of the plan's size with the band. */
-static bool check_dem(const tiles_plan *p, int band, tt_app_result *res)
+static bool check_dem(const tiles_plan *p, const tt_app_settings *s,
+                      tt_app_result *res)
 {
+  int band = s->band;
   char *real = realpath(p->dem, NULL);
   uint64_t bytes = 0, ns = 0;
   bool ok = false;
@@ -564,8 +578,28 @@ static bool check_dem(const tiles_plan *p, int band, tt_app_result *res)
                        "raster GDAL can open", p->dem);
     return false;
   }
-  size_t W = (size_t)GDALGetRasterXSize(ds), H = (size_t)GDALGetRasterYSize(ds);
+  /* the size of the window GDAL's input options read (dem_view.c) */
+  GDALDatasetH view = NULL;
+  if (tt__app_view_wanted(s)) {
+    char why[TT_APP_MESSAGE_MAX], warn[TT_APP_MESSAGE_MAX];
+    int usage = 0;
+    char **args = tt__app_view_args(s, ds, &usage, why, sizeof why, warn,
+                                    sizeof warn);
+    if (args)
+      view = tt__app_view_open(ds, args, why, sizeof why);
+    CSLDestroy(args);
+    if (!view) {
+      GDALClose(ds);
+      return REFUSE(res, TT_ERR_DATA, "%s: its options on its DEM %s: %s",
+                    p->path, p->dem, why);
+    }
+  }
+  GDALDatasetH seen = view ? view : ds;
+  size_t W = (size_t)GDALGetRasterXSize(seen);
+  size_t H = (size_t)GDALGetRasterYSize(seen);
   int nbands = GDALGetRasterCount(ds);
+  if (view)
+    GDALClose(view);
   GDALClose(ds);
   if (W != p->width || H != p->height)
     return REFUSE(res, TT_ERR_DATA, "%s: its \"width\" and \"height\" are "
@@ -626,12 +660,14 @@ bool tt__tiles_plan_read(const char *path, tiles_plan *p, tt_app_result *res)
     return false;
   const char *t = (const char *)buf;
   size_t n = (size_t)len;
-  int band = 1;
+  tt_app_options *o = NULL;
   bool ok = check_sum(path, t, n, res) && parse_plan(path, t, n, p, res) &&
             check_grid(path, p, res) &&
             tt__tiles_plan_check_words(path, p->options, res) &&
-            check_line(p, &band, res) && check_dem(p, band, res) &&
+            check_line(p, &o, res) &&
+            check_dem(p, tt_app_options_settings(o), res) &&
             check_text(p, t, n, res);
+  tt_app_options_destroy(o);
   if (ok)
     p->hash = fnv1a(t, n);
   CPLFree(buf);

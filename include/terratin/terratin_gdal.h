@@ -56,6 +56,10 @@ typedef struct tt_raster_info {
   char *z_unit_source;    /* "band unit", "vertical CRS" or "" */
   double z_unit_factor;   /* Z_UNIT=m's factor (0.3048 for ft, 1200/3937
                              for us-ft), else 1 */
+  const char *z_unit_why; /* why the heights were converted to metres:
+                             "asked" (Z_UNIT=m), "the CRS is in metres" or
+                             "the CRS is geographic" (Z_UNIT=auto); "" when
+                             they were not (a static string) */
 } tt_raster_info;
 
 void tt_raster_info_destroy(tt_raster_info *info);
@@ -83,16 +87,23 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> or SRCNODATA=nan
  * (replaces the mask; compared with the raw values), MAX_MEMORY=<bytes>
  * (refuse grids whose samples need more; default 3/4 of physical memory),
- * Z_UNIT=m (heights declared in ft or us-ft -- band unit type, else the
- * vertical CRS -- are converted to metres: height = (raw * scale + offset)
- * * (unit factor * Z_FACTOR), in doubles in that order; an unknown unit is
- * refused unless Z_FACTOR is given, which then does the whole
- * conversion), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
+ * SRC_Z_UNIT=m|ft|us-ft (the unit the heights are in, over the band's
+ * unit type and the vertical CRS, which say it otherwise: z_unit_source
+ * "given"), Z_UNIT=m (heights in ft or us-ft -- SRC_Z_UNIT, else the band
+ * unit type, else the vertical CRS -- are converted to metres: height =
+ * (raw * scale + offset) * (unit factor * Z_FACTOR), in doubles in that
+ * order; an unknown unit is refused unless Z_FACTOR is given, which then
+ * does the whole conversion), Z_UNIT=auto (converted so when the CRS is
+ * projected in metres or geographic, kept when it is in feet or absent;
+ * an unknown unit is kept, never refused), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
  * the working frame), WINDOW=col,row,width,height (read those samples
  * only, for a tile: the grid's geotransform is that of its first sample,
  * its ground frame the whole raster's, a geographic or Web Mercator
  * raster's ground points those of the whole raster's samples, bit for bit,
- * a window of nodata only is no error, GDAL's cache is left alone).
+ * a window of nodata only is no error, GDAL's cache is left alone),
+ * SOURCE_NAME=<name> and SOURCE_DRIVER=<driver> (the raster's name in
+ * messages and info->path, its driver in info->driver, for a band of a
+ * view over a file, such as an in-memory VRT, which has neither).
  * The caller owns *out_grid and frees it with tt_grid_destroy(); the caller
  * owns *out_info (may be NULL) and frees it with tt_raster_info_destroy(). */
 tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
@@ -209,6 +220,42 @@ tt_status tt_ogr_read_triangles(tt_context *ctx, OGRLayerH layer,
                                 const double gt[6], double **out_xyz,
                                 size_t *out_ntriangles, size_t *out_rejected);
 
+/* The triangles of an OGR layer in the layer's own coordinates (x, y, z
+ * of each corner, 9 doubles per triangle), every geometry flattened to
+ * the triangles it holds: what tt_ogr_read_triangles accepts, from a
+ * layer of any declared type ("Unknown" included: CSV WKT, DXF 3DFACE,
+ * MULTIPATCH); a ring of more than 4 points counts once its consecutive
+ * repeats are dropped (a 3DFACE's fourth corner repeating its third).
+ * Rejected geometries are counted as there. The caller owns *out_xyz and
+ * frees it with free(). */
+tt_status tt_ogr_read_triangles_map(tt_context *ctx, OGRLayerH layer,
+                                    double **out_xyz,
+                                    size_t *out_ntriangles,
+                                    size_t *out_rejected);
+
+/* The frame of a TIN file's coordinates (tt_tin_to_pixels). */
+typedef enum tt_tin_frame {
+  TT_TIN_FRAME_MAP = 0, /* map coordinates, in the TIN's CRS */
+  TT_TIN_FRAME_PIXEL    /* the DEM's samples: x the column, y the row
+                           counted up from the last row (hmm's STL) */
+} tt_tin_frame;
+
+/* Puts ntriangles triangles (9 doubles each, as read) on a DEM's
+ * pixel-centre grid, in place, for tt_eval_triangles(): each corner's
+ * x, y, z first becomes transform[a] * v + transform[3 + a] (transform:
+ * sx sy sz ox oy oz; NULL: none); then in TT_TIN_FRAME_PIXEL the row is
+ * dem_height - 1 - y; in TT_TIN_FRAME_MAP x, y are reprojected from
+ * tin_crs to dem_crs (WKT or anything OSRSetFromUserInput takes, e.g.
+ * "EPSG:32610"; NULL or "" for either: none) when the two differ, in
+ * the traditional GIS axis order, heights untouched, and then put through
+ * the inverse of gt, less 0.5 (sample (c, r) at (c, r)).
+ * *out_reprojected (may be NULL) says whether they were reprojected. */
+tt_status tt_tin_to_pixels(tt_context *ctx, double *xyz, size_t ntriangles,
+                           tt_tin_frame frame, const double transform[6],
+                           size_t dem_height, const char *tin_crs,
+                           const char *dem_crs, const double gt[6],
+                           int *out_reprojected);
+
 /* Writes a grid as a single-band Float32 GeoTIFF (Float64 for a grid of
  * doubles; TILED=YES, COMPRESS=DEFLATE; nodata NaN only when the grid has
  * NaN), with the grid's geotransform and srs_wkt ("" or NULL for none).
@@ -285,6 +332,27 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
                         const tt_tin *tin, OGRSpatialReferenceH srs,
                         const char *t_srs, int local,
                         tt_progress_fn progress, void *progress_arg);
+
+/* The format of a TIN file that eval reads without OGR, from its first
+ * bytes (and the extension .stl or .obj, whose content says little):
+ * "STL" (binary or ASCII), "PLY" (ascii or binary), "OBJ", "2DM",
+ * "LandXML" or "UGRID" (a netCDF file with a 2-D mesh_topology); NULL for
+ * anything else (an OGR dataset, or no file). Static storage. */
+const char *tt_mesh_read_format(const char *path);
+
+/* Reads the TIN file path (a format tt_mesh_read_format names) as
+ * *out_ntriangles triangles of 9 doubles (x, y, z of each corner) in the
+ * file's coordinates: OBJ's "# origin X Y" added back, LandXML's
+ * northing, easting swapped to x, y. Faces of other than 3 corners (and
+ * LandXML's invisible ones) are counted in *out_rejected (may be NULL).
+ * *out_crs_wkt (may be NULL) is the CRS the file declares (PLY's "comment
+ * crs:", LandXML's CoordinateSystem, UGRID's crs_wkt), or NULL. TT_ERR_IO
+ * when the file cannot be read, TT_ERR_FORMAT with the line or face when
+ * it is damaged. The caller owns *out_xyz and *out_crs_wkt and frees them
+ * with free(). */
+tt_status tt_mesh_read(tt_context *ctx, const char *path,
+                       double **out_xyz, size_t *out_ntriangles,
+                       size_t *out_rejected, char **out_crs_wkt);
 
 /* ---------------------------------------------------------------------------
  * Safe output: never overwrite without permission, never leave a half-written

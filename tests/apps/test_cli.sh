@@ -316,7 +316,26 @@ run simplify -max_points 200 in/fault.tif out/p.gpkg
 check "progress: exit 0" [ "$rc" -eq 0 ]
 check "progress bar on stdout" \
   grep -q "^0\.\.\.10\.\.\.20\.\.\.30\.\.\.40\.\.\.50\.\.\.60\.\.\.70\.\.\.80\.\.\.90\.\.\.100 - done\.$" out.txt
-check "summary line" grep -q "12000 cells, 12000 valid samples -> 200 vertices, .* triangles; max error .*; .* s$" out.txt
+check "summary: the input" grep -q "^input:  in/fault.tif, band 1: 120 x 100 samples, all valid; WGS 84 / UTM zone 33N (EPSG:32633); heights in unknown units$" out.txt
+check "summary: the output" grep -q "^output: out/p.gpkg (layers triangles, vertices, run_parameters): 200 vertices (1.7% of the valid samples), [0-9]* triangles; [0-9.]* s$" out.txt
+check "summary: the error of the budget" grep -q "^error:  max [0-9.e+]* z units (the budget -max_points 200); RMS [0-9.e+]* z units$" out.txt
+check "summary: three lines after the bar" [ "$(grep -vc "^0\.\.\." out.txt)" -eq 3 ]
+run simplify -overwrite -verbose -max_points 200 in/fault.tif out/p.gpkg
+check "-verbose: the method, frame, heights and times" bash -c '
+grep -q "^method: insert, criterion delaunay, repair flip, optimize none; stopped with the vertex budget reached$" out.txt &&
+grep -q "^frame:  " out.txt && grep -q "^heights: .* to .* z units$" out.txt &&
+grep -q "^time:   read .* s, mesh .* s, write .* s (GPKG), total .* s$" out.txt'
+run simplify -overwrite -max_error 5 in/fault.tif out/p.shp
+check "summary: a Shapefile output names its files" grep -q "^output: out/p_triangles.shp, out/p_vertices.shp, out/p_run_parameters.dbf: " out.txt
+check "summary: the bound given" grep -q "^error:  max [0-9.]* z units, within the bound 5 z units; RMS " out.txt
+check "summary: the files exist" bash -c '[ -f out/p_triangles.shp ] && [ -f out/p_vertices.shp ] && [ -f out/p_run_parameters.dbf ]'
+run simplify -overwrite -json -max_error 5 in/fault.tif out/p.shp
+check "-json: files and layers" python3 -c '
+import json
+d = json.load(open("out.txt"))
+assert d["files"] == ["out/p_triangles.shp", "out/p_vertices.shp", "out/p_run_parameters.dbf"], d["files"]
+assert d["layers"] == [], d["layers"]'
+
 run simplify -q -overwrite -percent 1 in/fault.tif out/p.gpkg
 check "-q: exit 0" [ "$rc" -eq 0 ]
 check "-q: nothing on stdout" [ ! -s out.txt ]
@@ -334,16 +353,59 @@ run simplify -q -max_error 10 -overwrite in/fault.tif out/tin.gpkg
 check "-overwrite: exit 0" [ "$rc" -eq 0 ]
 check "-overwrite: file replaced" [ "$(count out/tin.gpkg vertices)" -lt "$before" ]
 
-# default limit: 0.5 % of the height range
-run simplify -json in/fault.tif out/default.gpkg
-check "default limit: exit 0" [ "$rc" -eq 0 ]
-check "default limit is 0.5% of the height range" python3 -c '
+# default limit: twice the mean step between 4-neighbour valid samples, to
+# two significant digits, computed here from the heights of a grid with a
+# nodata hole (pairs with a nodata end do not count)
+python3 - <<'PY'
+import math
+with open("step.asc", "w") as f:
+    f.write("ncols 37\nnrows 29\nxllcorner 0\nyllcorner 0\ncellsize 10\n"
+            "NODATA_value -9999\n")
+    for y in range(29):
+        row = []
+        for x in range(37):
+            hole = 10 <= x < 16 and 8 <= y < 13
+            z = 100 + 7.3 * math.sin(x / 3.1) * math.cos(y / 4.7) + 0.013 * x * y
+            row.append("-9999" if hole else "%.3f" % z)
+        f.write(" ".join(row) + "\n")
+PY
+run simplify -json step.asc out/default.gpkg
+check "default limit: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+check "default limit is twice the mean step" python3 -c '
 import json, sys
-d = json.load(sys.stdin)
+d = json.load(open("out.txt"))
+rows = [l.split() for l in open("step.asc")]
+nd = -9999.0
+z = [[float(v) for v in r] for r in rows[6:]]
+diffs = []
+for y, row in enumerate(z):
+    for x, v in enumerate(row):
+        if v == nd:
+            continue
+        if x + 1 < len(row) and row[x + 1] != nd:
+            diffs.append(abs(row[x + 1] - v))
+        if y + 1 < len(z) and z[y + 1][x] != nd:
+            diffs.append(abs(z[y + 1][x] - v))
+step = sum(diffs) / len(diffs)
 lim = d["limits"]["max_error"]
-assert d["limits"]["max_error_default"] is True
-assert abs(lim - 0.005 * (d["z_max"] - d["z_min"])) <= 1e-9 * abs(lim), d
-assert d["max_error"] <= lim' <out.txt
+assert d["valid_samples"] == 37 * 29 - 30, d
+assert d["limits"]["max_error_default"] is True, d["limits"]
+# the grid holds the heights as Float32 (AAIGrid reads decimals so)
+assert abs(d["limits"]["mean_step"] - step) <= 1e-6 * step, (d["limits"], step)
+assert lim == float("%.2g" % (2 * step)), (lim, step)
+assert d["max_error"] <= lim, d'
+cp out.txt default.json
+run simplify -json -tile_size 16 step.asc out/default_tiled.gpkg
+check "default limit: tiled, the same step and bound ($(cat err.txt))" python3 -c '
+import json
+u = json.load(open("default.json"))["limits"]
+d = json.load(open("out.txt"))
+t = d["limits"]
+assert d["tiling"]["tiles"] > 1, d.get("tiling")
+assert t["max_error_default"] is True, t
+assert abs(t["mean_step"] - u["mean_step"]) <= 1e-12 * u["mean_step"], (t, u)
+assert t["max_error"] == u["max_error"], (t, u)
+assert d["max_error"] <= t["max_error"], d' 
 run simplify in/flat.tif out/flat.gpkg
 check "flat DEM: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "flat DEM: two triangles" [ "$(count out/flat.gpkg triangles)" = 2 ]
@@ -477,9 +539,19 @@ assert d["uncovered"] == lone, (d, lone)
 assert d["covered"] + lone == d["valid_samples"] > 0, d' "${lone:-x}" <out.txt
 done
 if [ -n "$S" ] && [ -f "$S/usgs_dem_san_francisco/sanfranciscos.dem" ]; then
-  run simplify -max_points 500 "$S/usgs_dem_san_francisco/sanfranciscos.dem" \
-    real_ft.gpkg
-  check "the summary carries the z unit (ft)" grep -q "max error .* ft, RMS .* ft" out.txt
+  # heights in ft on a UTM grid: metres by default (-z_to auto), feet kept
+  # with -z_to native
+  run simplify -json -max_points 500 \
+    "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_m.gpkg
+  check "ft heights on UTM: metres, because the CRS is in metres" python3 -c '
+import json
+d = json.load(open("out.txt"))
+assert d["z_unit"] == "m" and d["z_unit_declared"] == "ft", d
+assert d["z_unit_conversion"] == "the CRS is in metres", d
+assert abs(d["z_multiplier"] - 0.3048) < 1e-15, d'
+  run simplify -z_to native -max_points 500 \
+    "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_ft.gpkg
+  check "the summary carries the z unit (ft)" bash -c 'grep -q "^input: .*; heights in ft$" out.txt && grep -q "^error:  max .* ft (.*); RMS .* ft$" out.txt'
 fi
 
 # --- georeferencing, units, output CRS, robustness (issue 3) ----------------
@@ -502,9 +574,12 @@ assert d["valid_samples"] == 138632, d'
      ogrinfo -q out/geo.gpkg run_parameters | grep -q "z_unit (String) = m" &&
      ogrinfo -q out/geo.gpkg run_parameters | grep -q "crs (String) = WGS 84" &&
      ogrinfo -q out/geo.gpkg run_parameters | grep -q "valid (Integer64) = 138632"'
-  run simplify -max_error 10 "$J" out/geo_line.gpkg
-  check "summary line: CRS, frame, z unit" grep -q \
-    "138632 valid samples -> .*; CRS WGS 84 (EPSG:4326); frame UTM zone 16N (EPSG:32616), per vertex; scale .* off over the whole DEM); z unit m (band unit); .* s$" out.txt
+  run simplify -verbose -max_error 10 "$J" out/geo_line.gpkg
+  check "summary: CRS and heights' unit" grep -q \
+    "^input:  .*jacksboro_fault_dem.tif, band 1: 403 x 344 samples, all valid; WGS 84 (EPSG:4326); heights in m$" out.txt
+  check "summary -verbose: frame, the unit's source" bash -c '
+grep -q "^frame:  UTM zone 16N (EPSG:32616), per vertex; scale .* off over the whole DEM)$" out.txt &&
+grep -q "^heights: 236 to 1076 m (the unit from the band unit)$" out.txt' 
   run simplify -q -max_error 10 -t_srs EPSG:32616 "$J" out/utm.gpkg
   check "-t_srs: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
   check "-t_srs: the layers are in UTM 16N" \
@@ -528,12 +603,13 @@ assert 700000 < x0 < 800000, eu'
   expect_failure "-work_srs geographic" 2 out simplify -work_srs EPSG:4326 "$J" out/x.gpkg
   expect_failure "-work_srs garbage" 2 out simplify -work_srs NOT_A_CRS "$J" out/x.gpkg
   expect_failure "-t_srs garbage" 2 out simplify -t_srs NOT_A_CRS "$J" out/x.gpkg
-  expect_failure "-z_unit ft" 2 out simplify -z_unit ft "$J" out/x.gpkg
+  expect_failure "-z_unit cm" 2 out simplify -z_unit cm "$J" out/x.gpkg
 fi
-expect_failure "-z_unit m, unknown unit" 1 out simplify -z_unit m in/fault.tif out/x.gpkg
-check "-z_unit m, unknown unit: says -z_factor" grep -q -- "-z_factor" err.txt
-run simplify -q -z_unit m -z_factor 0.5 in/fault.tif out/zf.gpkg
-check "-z_unit m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+expect_failure "-z_to m, unknown unit" 1 out simplify -z_to m in/fault.tif out/x.gpkg
+check "-z_to m, unknown unit: says -z_unit and -z_factor" \
+  grep -q -- "-z_unit ft|us-ft|m.*-z_factor" err.txt
+run simplify -q -z_to m -z_factor 0.5 in/fault.tif out/zf.gpkg
+check "-z_to m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 rm -f out/*
 expect_failure "-max_points 0" 2 out simplify -max_points 0 in/fault.tif out/x.gpkg
 expect_failure "-max_triangles 0" 2 out simplify -max_triangles 0 in/fault.tif out/x.gpkg
@@ -560,7 +636,7 @@ for c in simplify generate eval; do
   check "$c --help: exit 0 and its usage" \
     bash -c "[ $rc -eq 0 ] && grep -q '^Usage: terratin $c' out.txt"
 done
-check "simplify --help documents the default limit" grep -q "0.5%" <("$T" simplify --help)
+check "simplify --help documents the default limit" grep -q "twice the DEM's mean step" <("$T" simplify --help)
 run --version
 check "--version: exit 0" [ "$rc" -eq 0 ]
 check "--version: terratin, GDAL and PROJ" \

@@ -385,11 +385,11 @@ static void test_help_and_version(void)
   const char *ev = tt_app_help(TT_APP_EVAL);
   CHECK(strstr(top, "Exit codes") && strstr(top, "  3  eval"));
   CHECK(strstr(top, "--config KEY VALUE") && strstr(top, "--version"));
-  CHECK(strstr(sim, "0.5% of the DEM's valid") != NULL);
+  CHECK(strstr(sim, "twice the DEM's mean step") != NULL);
   static const char *const simplify_opts[] = {
       "-b ", "-max_error", "-max_points", "-max_triangles", "-percent",
       "-of ", "-lco", "-dsco", "-nln", "-overwrite", "-q ", "-criterion",
-      "-repair", "-optimize", "-json", "Exit codes"};
+      "-repair", "-optimize", "-json", "-verbose", "Exit codes"};
   for (size_t i = 0; i < sizeof simplify_opts / sizeof *simplify_opts; i++)
     if (!strstr(sim, simplify_opts[i]))
       TT_FAIL_("simplify help lacks %s", simplify_opts[i]);
@@ -523,13 +523,13 @@ static void test_eval(void)
   CHECK_USAGE("does not apply", "eval", "a", "b", "-overwrite");
   CHECK_USAGE("without -error_raster", "eval", "a", "b", "-co", "A=B");
   CHECK_USAGE("does not apply", "eval", "a", "b", "-of", "GTiff");
-  CHECK_USAGE("missing DEM and OUTPUT", "rasterize", "tin.gpkg");
-  CHECK_USAGE("missing OUTPUT", "rasterize", "tin.gpkg", "dem.tif");
+  CHECK_USAGE("missing TIN and OUTPUT", "rasterize", "dem.tif");
+  CHECK_USAGE("missing OUTPUT", "rasterize", "dem.tif", "tin.gpkg");
   CHECK_USAGE("-co expects NAME=VALUE", "rasterize", "a", "b", "c", "-co",
               "X");
   CHECK_USAGE("does not apply", "rasterize", "a", "b", "c", "-lco", "A=B");
   CHECK_USAGE("unexpected argument", "rasterize", "a", "b", "c", "d");
-  PARSE_OK(o, "rasterize", "t.gpkg", "d.tif", "o.tif", "-co", "A=1", "-co",
+  PARSE_OK(o, "rasterize", "d.tif", "t.gpkg", "o.tif", "-co", "A=1", "-co",
            "B=2", "-of", "AAIGrid", "-layer", "tri");
   s = tt_app_options_settings(o);
   CHECK(s && s->command == TT_APP_RASTERIZE && strcmp(s->tin, "t.gpkg") == 0 &&
@@ -544,6 +544,67 @@ static void test_eval(void)
   CHECK(s && s->overwrite && strcmp(s->error_raster, "e.tif") == 0);
   tt_app_options_destroy(o);
   CHECK_USAGE("does not apply", "eval", "a", "b", "-max_points", "5");
+}
+
+/* GDAL's input options (issue 27): four words for a window, each the
+ * commands that read a DEM take, one of each pair, the refusals. */
+static void test_input_options(void)
+{
+  tt_app_options *o = NULL;
+  const tt_app_settings *s;
+  PARSE_OK(o, "simplify", "-srcwin", "-5", "0", "100", "80", "-a_srs",
+           "EPSG:32633", "-a_ullr", "0", "100", "50", "0", "-a_nodata",
+           "-9999", "in.tif", "out.gpkg");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->srcwin.set && s->srcwin.v[0] == -5 && s->srcwin.v[1] == 0 &&
+        s->srcwin.v[2] == 100 && s->srcwin.v[3] == 80);
+  CHECK(s && !s->projwin.set && s->a_ullr.set && s->a_ullr.v[1] == 100 &&
+        s->a_ullr.v[2] == 50);
+  CHECK(s && strcmp(s->srs, "EPSG:32633") == 0 && !s->srs_is_s_srs);
+  CHECK(s && strcmp(s->srcnodata, "-9999") == 0);
+  CHECK(s && strcmp(s->input, "in.tif") == 0 &&
+        strcmp(s->output, "out.gpkg") == 0);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "eval", "-projwin", "1.5", "20", "3", "10.25", "-projwin_srs",
+           "EPSG:4326", "-s_srs", "EPSG:32633", "d.tif", "t.gpkg");
+  s = tt_app_options_settings(o);
+  CHECK(s && s->projwin.set && s->projwin.v[0] == 1.5 &&
+        s->projwin.v[3] == 10.25 && strcmp(s->projwin_srs, "EPSG:4326") == 0);
+  CHECK(s && s->srs_is_s_srs && strcmp(s->srs, "EPSG:32633") == 0);
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "rasterize", "t.gpkg", "d.tif", "o.tif", "-srcwin", "0", "0",
+           "2", "2");
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "optimize", "-a_srs", "EPSG:4326", "d.tif", "t.gpkg", "o.gpkg");
+  tt_app_options_destroy(o);
+  PARSE_OK(o, "study", "-terrain", "d.tif", "-srcwin", "0", "0", "9", "9",
+           "out");
+  tt_app_options_destroy(o);
+  CHECK_USAGE("-srcwin needs 4 values", "simplify", "a", "b", "-srcwin", "1",
+              "2", "3");
+  CHECK_USAGE("-srcwin needs xoff yoff xsize ysize", "simplify", "a", "b",
+              "-srcwin", "1", "2", "0", "3");
+  CHECK_USAGE("-srcwin needs xoff yoff xsize ysize", "simplify", "a", "b",
+              "-srcwin", "1", "2", "3.5", "3");
+  CHECK_USAGE("-srcwin needs xoff yoff xsize ysize", "simplify", "a", "b",
+              "-srcwin", "1 2", "3", "4", "5");
+  CHECK_USAGE("-projwin needs ulx uly lrx lry", "simplify", "a", "b",
+              "-projwin", "3", "10", "1", "20");
+  CHECK_USAGE("-a_ullr needs ulx uly lrx lry", "simplify", "a", "b",
+              "-a_ullr", "0", "5", "0", "0");
+  CHECK_USAGE("-a_srs and -s_srs", "simplify", "a", "b", "-a_srs", "EPSG:1",
+              "-s_srs", "EPSG:1");
+  CHECK_USAGE("-a_nodata and -srcnodata", "eval", "a", "b", "-a_nodata", "1",
+              "-srcnodata", "1");
+  CHECK_USAGE("-srcwin and -projwin", "simplify", "a", "b", "-srcwin", "0",
+              "0", "5", "5", "-projwin", "0", "5", "5", "0");
+  CHECK_USAGE("-projwin_srs is the CRS of -projwin", "simplify", "a", "b",
+              "-projwin_srs", "EPSG:4326");
+  CHECK_USAGE("-projwin with -a_ullr", "simplify", "a", "b", "-projwin", "0",
+              "5", "5", "0", "-a_ullr", "0", "5", "5", "0");
+  CHECK_USAGE("-a_nodata must be", "simplify", "a", "b", "-a_nodata", "x");
+  CHECK_USAGE("does not apply", "generate", "fault", "g.tif", "-srcwin", "0",
+              "0", "5", "5");
 }
 
 /* optimize DEM IN_TIN OUTPUT and the annealing options (issue 14). */
@@ -827,6 +888,7 @@ int main(void)
   TT_RUN(test_generate());
   TT_RUN(test_eval());
   TT_RUN(test_optimize());
+  TT_RUN(test_input_options());
   TT_RUN(test_progress_bar());
   TT_RUN(test_no_argv());
   TT_RUN(test_library_runs());

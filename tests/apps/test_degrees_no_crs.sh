@@ -3,7 +3,7 @@
 # longitude/latitude degrees but that carries no CRS ($TT_TERRATIN), issue
 # 26: the bundled Jacksboro DEM (3 arc-seconds) as an ESRI ASCII grid
 # without its .prj, as SRTM tiles travel. simplify warns once, loudly, with
-# the way out (a VRT with -a_srs), whole and tiled on two threads, and
+# the way out (-a_srs, or a VRT with it), whole and tiled on two threads, and
 # names the frame so in the summary and -json; the same grid with its .prj,
 # a synthetic terrain on the unit square and a DEM in pixel units get no
 # such warning. Prints "N passed, M failed"; exits 1 on any failure, 77
@@ -40,6 +40,8 @@ for how in whole tiled; do
   check "$how: one warning that it looks like degrees" \
     [ "$(grep -c 'has no CRS, but its geotransform looks like longitude/latitude degrees' err.txt)" = 1 ]
   check "$how: the warning gives the way out" grep -q -- "-a_srs EPSG:4326" err.txt
+  "$T" simplify "${opt[@]}" -q -a_srs EPSG:4326 srtm.asc ${how}_a.gpkg 2>err.txt
+  check "$how: with -a_srs EPSG:4326, no such warning" not grep -q "looks like" err.txt
   check "$how: -json names the frame" python3 -c '
 import json, sys
 d = json.load(open("out.json"))

@@ -8,7 +8,7 @@
 #  - a driver's warning names the user's output, not the temporary file,
 #    and is said once (-lco FOO=BAR: three lines naming ./.ttXXXXXXXX.gpkg);
 #  - the progress bar's line is ended before a warning or a failure line;
-#  - the summary says "N separate pieces" only for N > 1, and names lone
+#  - the summary says "in N components" only for N > 1, and names lone
 #    samples only when there are some;
 #  - eval -layer on a point layer says what the layer holds;
 #  - SIGINT during a long write (a 520,000-triangle Shapefile), once or
@@ -102,7 +102,7 @@ check "FlatGeobuf file with three layers: refused ($rc)" [ "$rc" -ne 0 ]
 check "a failure starts its own line ($(cut -c1-120 both.txt))" \
   [ "$(grep -c '.terratin:' both.txt)" -eq 0 ] && grep -q '^terratin: one.fgb' both.txt
 
-# --- pieces and lone samples -----------------------------------------------------
+# --- components and lone samples -----------------------------------------------------
 # two islands split by a nodata column, no lone sample
 {
   printf 'ncols 9\nnrows 5\nxllcorner 0\nyllcorner 0\ncellsize 10\n'
@@ -112,16 +112,16 @@ check "a failure starts its own line ($(cut -c1-120 both.txt))" \
   done
 } >two.asc
 "$T" simplify -max_error 0 two.asc two.gpkg >out.txt 2>&1
-check "two islands: 'two.gpkg: 2 separate pieces' ($(tail -1 out.txt))" \
-  grep -q '^two.gpkg: 2 separate pieces$' out.txt
+check "two islands: 'in 2 components' ($(grep ^output: out.txt))" \
+  grep -q '^output: two.gpkg .* triangles in 2 components; ' out.txt
 check "two islands: no '0 valid samples amid nodata'" [ "$(grep -c '[^0-9]0 valid samples amid' out.txt)" -eq 0 ]
 LUX=$SHARED/rspatial_terra/elev.tif
 if [ -n "$SHARED" ] && [ -f "$LUX" ]; then
   "$T" simplify "$LUX" lux.gpkg >out.txt 2>&1
-  check "Luxembourg: no '1 separate piece' ($(tail -1 out.txt))" \
-    [ "$(grep -c 'separate piece' out.txt)" -eq 0 ]
+  check "Luxembourg: no 'in 1 components' ($(grep ^output: out.txt))" \
+    [ "$(grep -c 'components' out.txt)" -eq 0 ]
   check "Luxembourg: the lone samples said" \
-    grep -q '^lux.gpkg: 3 valid samples amid nodata' out.txt
+    grep -q '^note:   3 valid samples amid nodata' out.txt
 else
   echo "note: $LUX is missing; the lone-sample summary case is skipped"
 fi

@@ -158,7 +158,7 @@ if (ulimit -v 600000 && "$T" --version >/dev/null 2>&1); then
   check "ulimit -v, a small DEM: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
   # a command that reads the whole DEM (simplify tiles it instead:
   # test_auto_tiling.sh)
-  ( ulimit -v 600000; "$T" rasterize -q out/u.gpkg in/huge.vrt out/x.tif >out.txt 2>err.txt ); rc=$?
+  ( ulimit -v 600000; "$T" rasterize -q in/huge.vrt out/u.gpkg out/x.tif >out.txt 2>err.txt ); rc=$?
   check "ulimit -v: exit 1 (got $rc)" [ "$rc" -eq 1 ]
   check "ulimit -v: names the limit and the size ($(cat err.txt))" \
     bash -c "grep -q 'ulimit -v' err.txt && grep -q '1.5 GiB' err.txt && [ \$(wc -l <err.txt) = 1 ]"

@@ -104,7 +104,7 @@ EOF
 # heights in <ele>
 run simplify -max_error 1 -layers vertices -overwrite dem.tif one/v2.gpx
 check "GPX: the summary names EPSG:4326" \
-  grep -q "written in EPSG:4326 (the only CRS the format holds)" out.txt
+  grep -q "^output: one/v2.gpx (layer vertices): .*, in EPSG:4326 (the only CRS the format holds); " out.txt
 check "GPX: heights in <ele>" grep -q "<ele>" one/v2.gpx
 python3 - one/v2.gpx <<'EOF' || fail "GPX: longitudes and latitudes, not UTM metres"
 import re, sys

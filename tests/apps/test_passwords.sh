@@ -155,7 +155,7 @@ for f in "password=s3cretpw.tif|password=***|s3cr,cretpw" \
   run eval "$name" "o$i.gpkg" -json
   check "eval -json $name: exit 0" test "$rc" = 0
   hidden "eval -json $name" "${pieces[@]}"
-  run rasterize "o$i.gpkg" "$name" "r$i.tif"
+  run rasterize "$name" "o$i.gpkg" "r$i.tif"
   check "rasterize $name: exit 0" test "$rc" = 0
   hidden "rasterize $name" "${pieces[@]}"
 done
@@ -163,7 +163,7 @@ done
 run simplify dem.tif "password=s3cretpw.gpkg"
 check "output password=s3cretpw.gpkg: exit 0" test "$rc" = 0
 check "output password=s3cretpw.gpkg: summary names password=***" \
-  grep -qF "password=***: " out.txt
+  grep -qF "output: password=*** (layers " out.txt
 hidden "output password=s3cretpw.gpkg" s3cr cretpw
 
 echo "$passed passed, $failed failed"

@@ -84,9 +84,7 @@ run simplify -q -max_error 2 -tile_size 64 -criterion minmax_angle -optimize loo
 check "fault, minmax_angle + lookahead: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 conforming "fault, minmax_angle" out/f.gpkg
 bounded "fault, minmax_angle" in/f.tif out/f.gpkg 2
-# the default bound (0.5 % of the range) is the untiled run's (on the
-# fault terrain: 3,800 vertices, where the fractal's would keep 87 % of
-# its samples)
+# the default bound (twice the mean step) is the untiled run's
 run simplify -q -json in/f.tif out/d.gpkg
 cp out.txt ud.json
 run simplify -q -json -tile_size 150 in/f.tif out/td.gpkg

@@ -563,7 +563,7 @@ static void test_feet(const char *path)
   }
 
   /* The command: the summary names m, the CRS, the frame, valid samples. */
-  char *argv[] = {"simplify", "-z_unit", "m", "-max_error", "1",
+  char *argv[] = {"simplify", "-verbose", "-z_to", "m", "-max_error", "1",
                   (char *)path, (char *)tmp_path("sf.gpkg"), "-overwrite",
                   NULL};
   tt_app_options *opts = NULL;
@@ -573,16 +573,19 @@ static void test_feet(const char *path)
   if (opts && out) {
     tt_app_options_set_streams(opts, out, stderr);
     CHECK_INT_EQ(tt_app_run(opts, &res), TT_OK);
-    char line[4096] = "";
+    char text[8192] = "";
     rewind(out);
-    if (!fgets(line, sizeof line, out))
-      line[0] = '\0';
-    printf("summary: %s", line);
-    CHECK(strstr(line, "max error") && strstr(line, " m, RMS "));
-    CHECK(strstr(line, "valid samples") != NULL);
-    CHECK(strstr(line, "CRS unnamed (like EPSG:26710)") != NULL);
-    CHECK(strstr(line, "frame geotransform") != NULL);
-    CHECK(strstr(line, "z unit m (from ft, x0.3048)") != NULL);
+    size_t n = fread(text, 1, sizeof text - 1, out);
+    text[n] = '\0';
+    printf("summary:\n%s", text);
+    CHECK(strstr(text, "\nerror:  max ") && strstr(text, " m, within the "
+                                                        "bound 1 m; RMS "));
+    CHECK(strstr(text, "valid;") != NULL);
+    CHECK(strstr(text, "; unnamed (like EPSG:26710); heights in ft, "
+                       "converted to m (asked by -z_to m)\n") != NULL);
+    CHECK(strstr(text, "\nframe:  geotransform") != NULL);
+    CHECK(strstr(text, "(the band unit's ft times 0.3048: asked by -z_to "
+                       "m)") != NULL);
   }
   if (out)
     fclose(out);

@@ -185,30 +185,58 @@ static tt_status read_scale_offset(raster_read *r)
   return TT_OK;
 }
 
-/* The height unit, and Z_UNIT=m's conversion (before Z_FACTOR): r->conv
- * is the options with Z_FACTOR times the unit's factor. */
+/* Why Z_UNIT=auto converts heights to metres: the CRS's horizontal unit
+ * is the metre, or degrees (whose ground is measured in metres); NULL
+ * when it keeps them (a CRS in feet, none). */
+static const char *auto_reason(OGRSpatialReferenceH srs)
+{
+  if (!srs)
+    return NULL;
+  if (OSRIsGeographic(srs))
+    return "the CRS is geographic";
+  if (OSRIsProjected(srs) && fabs(OSRGetLinearUnits(srs, NULL) - 1.0) < 1e-12)
+    return "the CRS is in metres";
+  return NULL;
+}
+
+/* The height unit, and Z_UNIT=m's or auto's conversion (before Z_FACTOR):
+ * r->conv is the options with Z_FACTOR times the unit's factor. */
 static tt_status read_z_unit(raster_read *r)
 {
   const read_options *opt = &r->opt;
-  r->unit_source = declared_z_unit(r->band, r->srs, r->unit_declared,
-                                   sizeof r->unit_declared);
+  if (opt->src_z_unit) {
+    snprintf(r->unit_declared, sizeof r->unit_declared, "%s",
+             opt->src_z_unit);
+    r->unit_source = "given";
+  } else {
+    r->unit_source = declared_z_unit(r->band, r->srs, r->unit_declared,
+                                     sizeof r->unit_declared);
+  }
   const char *unit_declared = r->unit_declared;
   const char *unit_short = unit_short_name(unit_declared);
   r->unit_factor = 1.0;
+  r->unit_why = "";
   r->unit_out = unit_short ? unit_short : unit_declared;
-  if (opt->z_unit_m) {
+  const char *why = opt->z_unit_m ? "asked"
+                    : opt->z_unit_auto && unit_short &&
+                            strcmp(unit_short, "m") != 0
+                        ? auto_reason(r->srs)
+                        : NULL;
+  if (why) {
     if (unit_short) {
       r->unit_factor = unit_metres(unit_short);
     } else if (!opt->has_z_factor) {
       return tt__error(r->ctx, TT_ERR_DATA, "%s: heights cannot be "
-                       "converted to metres (Z_UNIT=m, -z_unit m): the "
-                       "height unit is %s%s%s; give the factor to metres as "
-                       "Z_FACTOR (-z_factor)", r->path,
+                       "converted to metres (asked by Z_UNIT=m, -z_to m): "
+                       "the height unit is %s%s%s; declare it as SRC_Z_UNIT "
+                       "(-z_unit ft|us-ft|m) or give the factor to metres "
+                       "as Z_FACTOR (-z_factor)", r->path,
                        unit_declared[0] ? "\"" : "unknown (no band unit, no "
                        "vertical CRS)", unit_declared,
                        unit_declared[0] ? "\", which is not m, ft or us-ft"
                                         : "");
     }
+    r->unit_why = r->unit_factor != 1.0 ? why : "";
     r->unit_out = "m";
   }
   r->conv = *opt; /* what the scan multiplies by */
@@ -364,8 +392,9 @@ tt_status tt__raster_check_degrees(raster_read *r)
              "longitude/latitude degrees (x %.6g to %.6g, y %.6g to %.6g, "
              "pixels of %.3g): slopes, angles and areas are measured as if "
              "those were the heights' units, which is wrong on the ground; "
-             "give it its CRS, e.g. gdal_translate -of VRT -a_srs "
-             "EPSG:4326 %s dem.vrt, and simplify dem.vrt", r->path, ext[0],
+             "give it its CRS: terratin's -a_srs EPSG:4326, or "
+             "gdal_translate -of VRT -a_srs EPSG:4326 %s dem.vrt", r->path,
+             ext[0],
              ext[1], ext[2], ext[3], hypot(r->gt[1], r->gt[4]), r->path);
     snprintf(r->frame_name, sizeof r->frame_name, "geotransform (no CRS; "
              "its coordinates look like degrees, measured as map units)");

@@ -118,6 +118,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->z_factor = 1.0;
   opt->has_z_factor = 0;
   opt->z_unit_m = 0;
+  opt->z_unit_auto = 0;
+  opt->src_z_unit = NULL;
   opt->work_srs = NULL;
   opt->has_srcnodata = 0;
   opt->srcnodata_is_nan = 0;
@@ -128,6 +130,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->srcnodata_mag = 0;
   opt->max_memory = 0;
   opt->has_window = 0;
+  opt->source_name = NULL;
+  opt->source_driver = NULL;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
     char *key = NULL;
@@ -148,11 +152,25 @@ static tt_status parse_options(tt_context *ctx, char **options,
         opt->has_z_factor = 1;
       }
     } else if (strcasecmp(key, "Z_UNIT") == 0) {
-      if (strcasecmp(value, "m") != 0)
-        s = tt__error(ctx, TT_ERR_ARG, "Z_UNIT must be m (heights in ft or "
-                      "us-ft converted to metres), got \"%s\"", value);
-      else
+      if (strcasecmp(value, "m") == 0)
         opt->z_unit_m = 1;
+      else if (strcasecmp(value, "auto") == 0)
+        opt->z_unit_auto = 1;
+      else
+        s = tt__error(ctx, TT_ERR_ARG, "Z_UNIT must be m (heights in ft or "
+                      "us-ft converted to metres) or auto (the same when "
+                      "the CRS is in metres or geographic), got \"%s\"",
+                      value);
+    } else if (strcasecmp(key, "SRC_Z_UNIT") == 0) {
+      static const char *const units[] = {"m", "ft", "us-ft"};
+      opt->src_z_unit = NULL;
+      for (int k = 0; k < 3; k++)
+        if (strcasecmp(value, units[k]) == 0 ||
+            (k == 2 && strcasecmp(value, "us_ft") == 0))
+          opt->src_z_unit = units[k];
+      if (!opt->src_z_unit)
+        s = tt__error(ctx, TT_ERR_ARG, "SRC_Z_UNIT must be m, ft or us-ft "
+                      "(the unit the heights are in), got \"%s\"", value);
     } else if (strcasecmp(key, "WORK_SRS") == 0) {
       if (!*value)
         s = tt__error(ctx, TT_ERR_ARG, "WORK_SRS needs a CRS");
@@ -191,10 +209,14 @@ static tt_status parse_options(tt_context *ctx, char **options,
           opt->win[k] = (size_t)w[k];
         opt->has_window = 1;
       }
+    } else if (strcasecmp(key, "SOURCE_NAME") == 0) {
+      opt->source_name = value;
+    } else if (strcasecmp(key, "SOURCE_DRIVER") == 0) {
+      opt->source_driver = value;
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
                     "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS, "
-                    "WINDOW)", key);
+                    "WINDOW, SOURCE_NAME, SOURCE_DRIVER)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -334,7 +356,10 @@ static tt_status fill_info(raster_read *r)
   GDALDatasetH ds = r->ds;
   info->path = tt__raster_dup_str(r->path);
   GDALDriverH drv = ds ? GDALGetDatasetDriver(ds) : NULL;
-  info->driver = tt__raster_dup_str(drv ? GDALGetDriverShortName(drv) : "");
+  info->driver = tt__raster_dup_str(
+      r->opt.source_driver ? r->opt.source_driver
+      : drv               ? GDALGetDriverShortName(drv)
+                          : "");
   info->band = GDALGetBandNumber(r->band);
   info->width = r->nx;
   info->height = r->ny;
@@ -346,6 +371,7 @@ static tt_status fill_info(raster_read *r)
   info->z_unit_declared = tt__raster_dup_str(r->unit_declared);
   info->z_unit_source = tt__raster_dup_str(r->unit_source);
   info->z_unit_factor = r->unit_factor;
+  info->z_unit_why = r->unit_why ? r->unit_why : "";
   info->scale = r->scale;
   info->offset = r->offset;
   info->z_factor = r->opt.z_factor;
@@ -391,6 +417,8 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   tt_status s = parse_options(ctx, options, &r.opt);
   if (s != TT_OK)
     goto done;
+  if (r.opt.source_name && *r.opt.source_name)
+    r.path = r.opt.source_name;
   s = check_band_type(&r);
   if (s != TT_OK)
     goto done;

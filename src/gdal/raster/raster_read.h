@@ -29,6 +29,9 @@ typedef struct read_options {
   double z_factor;
   int has_z_factor;      /* Z_FACTOR was given */
   int z_unit_m;          /* Z_UNIT=m: convert ft and us-ft to metres */
+  int z_unit_auto;       /* Z_UNIT=auto: the same when the CRS is in
+                            metres or geographic */
+  const char *src_z_unit; /* SRC_Z_UNIT: "m", "ft" or "us-ft", NULL */
   const char *work_srs;  /* WORK_SRS, NULL: chosen here (points into the
                             options list) */
   int has_srcnodata;
@@ -43,6 +46,8 @@ typedef struct read_options {
   const char *max_memory_source; /* which limit that is (tt_memory_limit) */
   int has_window;        /* WINDOW=col,row,width,height: a tile's window */
   size_t win[4];
+  const char *source_name;   /* SOURCE_NAME, SOURCE_DRIVER: what a view's */
+  const char *source_driver; /* band is read from; NULL: its dataset's */
 } read_options;
 
 /* Where the raw values of a band of rows are: in the grid itself (bands
@@ -87,6 +92,7 @@ typedef struct raster_read {
   const char *unit_source;  /* where it was declared ("band unit", ...) */
   const char *unit_out;     /* the unit of the grid's heights */
   double unit_factor;       /* Z_UNIT=m's factor, else 1 */
+  const char *unit_why;     /* why the heights were converted, "" */
   read_options conv;        /* what the scan multiplies by: Z_FACTOR times
                                unit_factor */
   char frame_name[512];
