@@ -328,6 +328,19 @@ void tt__json_null(app_json *j, const char *key);
 /* A list of strings (NULL-terminated; NULL: an empty list). */
 void tt__json_strs(app_json *j, const char *key, char *const *v);
 
+/* What simplify's estimate predicted before the work (apps/simplify/
+ * estimate.c). */
+typedef struct app_estimate {
+  int done;                  /* the pass ran */
+  double bound;              /* the bound it predicts for */
+  int bound_default;         /* ... the default one, from the sample */
+  size_t windows, window_size, sampled_cells, sampled_valid;
+  double valid, vertices, triangles, share; /* the DEM's, predicted */
+  double output_bytes, memory_whole;        /* bytes */
+  double advice_bound;       /* the bound of about a 5 % TIN, or NaN */
+  double seconds;
+} app_estimate;
+
 /* What simplify reports, as text or JSON (report.c). */
 typedef struct app_simplify_report {
   const tt_raster_info *info;
@@ -345,6 +358,9 @@ typedef struct app_simplify_report {
    * the memory limit chose tiling, the bytes the tiles in flight hold */
   size_t tiles, tile_size, tile_bytes;
   int tile_threads, auto_tiled;
+  size_t mem_limit;            /* the memory limit the tiling was held to */
+  const char *mem_source;      /* what set it (-max_memory, the system) */
+  app_estimate estimate;       /* done: the estimate ran */
   int budget_passes;  /* tiled runs to a budget: the runs at a bound */
   int streamed;       /* the GeoPackage written as the tiles merged */
   /* the CRS the layers are written in: -t_srs, or the one a format takes

@@ -163,6 +163,31 @@ void tt__json_null(app_json *j, const char *key)
   fputs("null", j->fp);
 }
 
+/* "estimate": what the quick pass predicted before the work, or null
+ * (a budget; apps/simplify/estimate.c). */
+static void print_estimate_json(app_json *j, const app_estimate *e)
+{
+  if (!e->done) {
+    tt__json_null(j, "estimate");
+    return;
+  }
+  tt__json_open(j, "estimate");
+  tt__json_num(j, "max_error", e->bound);
+  tt__json_bool(j, "max_error_default", e->bound_default);
+  tt__json_num(j, "vertices", round(e->vertices));
+  tt__json_num(j, "triangles", round(e->triangles));
+  tt__json_num(j, "valid_samples", round(e->valid));
+  tt__json_num(j, "share", e->share);
+  tt__json_num(j, "output_bytes", round(e->output_bytes));
+  tt__json_num(j, "memory_untiled", round(e->memory_whole));
+  tt__json_num(j, "max_error_5_percent", e->advice_bound);
+  tt__json_size(j, "windows", e->windows);
+  tt__json_size(j, "window_size", e->window_size);
+  tt__json_size(j, "sampled_cells", e->sampled_cells);
+  tt__json_num(j, "seconds", e->seconds);
+  tt__json_close(j);
+}
+
 void tt__json_strs(app_json *j, const char *key, char *const *v)
 {
   json_key(j, key);
@@ -281,6 +306,11 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_bool(&j, "output_crs_automatic", p->t_srs_auto);
   tt__json_str(&j, "frame", p->info->frame_name);
   tt__json_size(&j, "warnings", r->msg.warnings);
+  if (p->mem_limit && p->mem_limit != SIZE_MAX)
+    tt__json_size(&j, "memory_limit", p->mem_limit);
+  else
+    tt__json_null(&j, "memory_limit");
+  tt__json_str(&j, "memory_limit_source", p->mem_source);
   if (p->tiles) {
     tt__json_open(&j, "tiling");
     tt__json_size(&j, "tiles", p->tiles);
@@ -292,6 +322,7 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
     tt__json_bool(&j, "streamed", p->streamed);
     tt__json_close(&j);
   }
+  print_estimate_json(&j, &p->estimate);
   tt__json_open(&j, "seconds");
   tt__json_num(&j, "read", p->t_read);
   tt__json_num(&j, "simplify", p->t_simplify);
@@ -382,8 +413,8 @@ static void say_output(app_run *r, const app_simplify_report *p)
     fprintf(r->out, ", in %s%s", p->t_srs,
             p->t_srs_auto ? " (the only CRS the format holds)" : "");
   if (p->tiles && p->auto_tiled)
-    fprintf(r->out, "; tiled automatically in %zu tiles (the DEM does not "
-            "fit the memory)", p->tiles);
+    fprintf(r->out, "; tiled automatically in %zu tiles, memory limit "
+            "%.1f MiB", p->tiles, (double)p->mem_limit / 1048576.0);
   fprintf(r->out, "; %.1f s\n", p->t_total);
 }
 
@@ -465,12 +496,16 @@ static void say_details(app_run *r, const app_simplify_report *p)
     fprintf(o, given ? " (as %s says)" : " (the unit from the %s)", source);
   fputc('\n', o);
   if (p->tiles) {
+    char lim[200] = "";
+    if (p->auto_tiled)
+      snprintf(lim, sizeof lim, " (tiled automatically: the run does not "
+               "fit the memory limit of %.1f MiB, %s)",
+               (double)p->mem_limit / 1048576.0,
+               p->mem_source ? p->mem_source : "?");
     fprintf(o, "tiles:  %zu tiles of %zu cells on %d thread%s%s; the tiles "
             "in flight hold at most about %.0f MiB\n", p->tiles,
             p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
-            p->auto_tiled ? " (chosen because the heights do not fit the "
-                            "memory limit)" : "",
-            (double)p->tile_bytes / 1048576.0);
+            lim, (double)p->tile_bytes / 1048576.0);
     if (p->budget_passes)
       fprintf(o, "        the budget is met at the bound %g, found from the "
               "tiles' curves (one pass) and %d run%s at a bound\n",

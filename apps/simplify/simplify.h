@@ -21,6 +21,7 @@
  *   tiled_budget.c  a budget in tiles: the curves and the bound
  *   tiled_tiles.c   a tile's curve, its samples, the tiles' memory
  *   tiled_stream.c  a tiled run's GeoPackage written as the tiles merge
+ *   estimate.c      what a bound will make, from a sample of the DEM
  */
 #ifndef TT_APP_SIMPLIFY_H
 #define TT_APP_SIMPLIFY_H
@@ -109,6 +110,10 @@ struct app_simplify_job {
   tt_tin *tin;                /* NULL when streamed */
   app_simplify_report rep;
 };
+
+/* The most samples a DEM may have to be tiled without -tile_size (4.3
+ * G, a 65536^2 DEM: some ten minutes of tiles here; docs/scale.md). */
+#define TT_APP_AUTO_TILE_CELLS ((size_t)1 << 32)
 
 /* job.c: the job of r's settings (nothing is opened yet): the method's
  * options, OUTPUT's shown name. */
@@ -300,6 +305,18 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
                                 size_t valid, const tt_refine_options *ro,
                                 const app_budget_pass *p, double *out_bound,
                                 int *out_passes);
+/* tiled_budget.c: the vertices a curve's tile has at bound e. */
+size_t tt__app_curve_count_at(const app_curve *c, double e);
+
+/* estimate.c: whether the run is estimated before its work (always for
+ * -json; a DEM past a million samples, or one the whole run may not
+ * hold; never for a budget or a tile of `tiles run`), the estimate into
+ * job->rep.estimate (the failure recorded), and its line on stderr when
+ * the TIN passes a million vertices or its output 1 GB. */
+int tt__app_estimate_wanted(const app_simplify_job *job);
+tt_status tt__app_estimate(app_simplify_job *job);
+void tt__app_estimate_say(app_simplify_job *job);
+
 /* tiled_stream.c: whether a tiled run into a file of drvname streams
  * (GPKG, unless TERRATIN_TILE_STREAM=NO), and the sink of job's. */
 int tt__app_stream_wanted(const char *drvname);

@@ -619,6 +619,7 @@ expect_failure "-max_points absurd" 2 out simplify -max_points 99999999999999999
 gdal_translate -q -of VRT -outsize 100000 100000 in/fault.tif in/huge.vrt
 expect_failure "100k x 100k raster" 1 out simplify in/huge.vrt out/x.gpkg
 check "100k x 100k: says how much memory (37.3 GiB)" grep -q "need 37.3 GiB" err.txt
+check "100k x 100k: names -tile_size" grep -q -- "-tile_size 1024 runs it in tiles" err.txt
 # GCPs only, no geotransform
 gdal_translate -q -of VRT -gcp 0 0 10 10 -gcp 100 0 20 10 -gcp 0 100 10 0 \
   in/fault.tif in/gcp.vrt

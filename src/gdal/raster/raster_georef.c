@@ -262,6 +262,12 @@ tt_status tt__raster_georef(raster_read *r)
   return s;
 }
 
+/* The ground points' progress, onto the read's. */
+static int ground_progress(double complete, const char *message, void *arg)
+{
+  return tt__raster_progress(arg, complete, message);
+}
+
 /* Longitude/latitude and Web Mercator: every sample projected into a
  * conformal frame (georef_conformal.c) over the affine frame just set,
  * which stays only when that fails (with a warning) or when the ground
@@ -280,8 +286,7 @@ static tt_status set_ground_points(raster_read *r)
              "samples would need %s, more than %s (%s): keeping the "
              "affine frame %s", r->path, nx, ny,
              tt__format_bytes(need_s, sizeof need_s, with_points),
-             opt->max_memory_default ? "3/4 of this machine's physical "
-                                       "memory"
+             opt->max_memory_default ? opt->max_memory_source
                                      : "MAX_MEMORY",
              tt__format_bytes(max_s, sizeof max_s, opt->max_memory),
              r->frame_name);
@@ -289,13 +294,22 @@ static tt_status set_ground_points(raster_read *r)
   }
   char conformal_name[512];
   /* a window (a tile) gets the whole raster's frame and the ground points
-   * of its samples as the whole raster has them */
+   * of its samples as the whole raster has them; projecting them takes
+   * some ten times the scan (0.35 against 0.035 us a sample, a 12000^2
+   * VRT): 0 - 0.8 of the read's progress */
+  r->prog_lo = 0.0;
+  r->prog_hi = 0.8;
   tt_status s = tt__georef_ground_points(ctx, r->srs, opt->work_srs, r->gt,
                                          (size_t)r->xsize, (size_t)r->ysize,
                                          r->wx, r->wy, r->grid,
-                                         conformal_name,
+                                         r->progress ? ground_progress : NULL,
+                                         r, conformal_name,
                                          sizeof conformal_name,
                                          &r->frame_scale_error);
+  r->prog_lo = 0.8;
+  r->prog_hi = 1.0;
+  if (s == TT_ERR_INTERRUPTED)
+    return tt__error(ctx, s, "%s: read interrupted", r->path);
   if (s == TT_OK) {
     snprintf(r->frame_name, sizeof r->frame_name, "%s", conformal_name);
   } else if (s != TT_ERR_ARG) {

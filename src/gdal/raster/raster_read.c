@@ -407,6 +407,8 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   r.band = band;
   r.progress = progress;
   r.progress_arg = progress_arg;
+  r.prog_lo = 0.0;
+  r.prog_hi = 1.0;
   r.ds = GDALGetBandDataset(band);
   r.path = r.ds ? GDALGetDescription(r.ds) : "";
   if (!r.path || !*r.path)

@@ -72,6 +72,9 @@ typedef struct raster_read {
   const char *path;         /* its name, for messages */
   tt_progress_fn progress;
   void *progress_arg;
+  double prog_lo, prog_hi;  /* the stage's share of the read's progress:
+                               the ground points' (0 - 0.8, when made),
+                               then the scan's */
   read_options opt;         /* as given */
   /* the band (raster_read.c) */
   GDALDataType dtype;
@@ -130,6 +133,16 @@ static inline tt_status tt__raster_with_path(tt_context *ctx, tt_status s,
   char msg[TT_ERRMSG_MAX];
   snprintf(msg, sizeof msg, "%s", ctx->errmsg);
   return tt__error(ctx, s, "%s: %s", path, msg);
+}
+
+/* The read's progress at fraction f of the current stage (prog_lo ..
+ * prog_hi); 0 when the run is to stop. */
+static inline int tt__raster_progress(raster_read *r, double f,
+                                      const char *what)
+{
+  return !r->progress ||
+         r->progress(r->prog_lo + (r->prog_hi - r->prog_lo) * f, what,
+                     r->progress_arg);
 }
 
 /* --- the georeferencing (raster_georef.c) --------------------------------
