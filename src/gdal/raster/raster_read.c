@@ -130,6 +130,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->has_window = 0;
   opt->source_name = NULL;
   opt->source_driver = NULL;
+  opt->fill_max = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
     char *key = NULL;
@@ -193,6 +194,15 @@ static tt_status parse_options(tt_context *ctx, char **options,
           opt->win[k] = (size_t)w[k];
         opt->has_window = 1;
       }
+    } else if (strcasecmp(key, "FILL_NODATA") == 0) {
+      unsigned long long k;
+      char tail;
+      if (sscanf(value, "%llu%c", &k, &tail) != 1 || k < 1 ||
+          *value == '-' || k > (unsigned long long)INT32_MAX)
+        s = tt__error(ctx, TT_ERR_ARG, "FILL_NODATA must be a number of "
+                      "samples from 1 to %d, got \"%s\"", INT32_MAX, value);
+      else
+        opt->fill_max = (size_t)k;
     } else if (strcasecmp(key, "SOURCE_NAME") == 0) {
       opt->source_name = value;
     } else if (strcasecmp(key, "SOURCE_DRIVER") == 0) {
@@ -200,7 +210,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
                     "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS, "
-                    "WINDOW, SOURCE_NAME, SOURCE_DRIVER)", key);
+                    "WINDOW, FILL_NODATA, SOURCE_NAME, SOURCE_DRIVER)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -348,6 +358,9 @@ static tt_status fill_info(raster_read *r)
   info->width = r->nx;
   info->height = r->ny;
   info->valid_samples = r->valid;
+  info->filled_samples = r->filled_samples;
+  info->filled_voids = r->filled_voids;
+  info->fill_max = r->opt.fill_max;
   info->nodata_samples = r->nx * r->ny - r->valid;
   memcpy(info->gt, r->gt, sizeof r->gt);
   info->has_geotransform = r->has_gt;
@@ -390,6 +403,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   r.band = band;
   r.progress = progress;
   r.progress_arg = progress_arg;
+  r.options = options;
   r.ds = GDALGetBandDataset(band);
   r.path = r.ds ? GDALGetDescription(r.ds) : "";
   if (!r.path || !*r.path)
@@ -416,6 +430,9 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   if (s != TT_OK)
     goto done;
   s = tt__raster_scan(&r);
+  if (s != TT_OK)
+    goto done;
+  s = tt__raster_fill(&r);
   if (s != TT_OK)
     goto done;
   s = tt__raster_check_degrees(&r);
