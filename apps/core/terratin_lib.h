@@ -106,6 +106,8 @@ typedef struct tt_app_settings {
   double z_factor;           /* -z_factor; default 1 (simplify, eval) */
   int z_factor_set;          /* -z_factor was given */
   const char *z_unit;        /* -z_unit: "m" or NULL (simplify, eval) */
+  size_t fill_nodata;        /* -fill_nodata: voids of at most this many
+                                samples filled; 0: none (simplify, eval) */
   const char *work_srs;      /* -work_srs: the working CRS; NULL: chosen
                                 from the DEM's CRS (simplify) */
   const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the

@@ -254,6 +254,8 @@ static tt_status tiled_init(tiled *T)
   T->zmin = calloc(T->ntiles, sizeof *T->zmin);
   T->zmax = calloc(T->ntiles, sizeof *T->zmax);
   T->valid = calloc(T->ntiles, sizeof *T->valid);
+  T->filled = calloc(T->ntiles, sizeof *T->filled);
+  T->voids = calloc(T->ntiles, sizeof *T->voids);
   T->steps = calloc(T->ntiles, sizeof *T->steps);
   hold_cache(T);
   pthread_mutex_init(&T->lock, NULL);
@@ -262,7 +264,7 @@ static tt_status tiled_init(tiled *T)
   T->range_min = INFINITY;
   T->range_max = -INFINITY;
   if (!T->pieces || !T->done || !T->zmin || !T->zmax || !T->valid ||
-      !T->steps)
+      !T->steps || !T->filled || !T->voids)
     return tt__app_fail(T->r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
                         "out of memory for %zu tiles", T->ntiles);
   return TT_OK;
@@ -364,6 +366,11 @@ static void finish(tiled *T)
     T->info->height = T->H;
     T->info->valid_samples = sum.valid_samples;
     T->info->nodata_samples = T->W * T->H - sum.valid_samples;
+    T->info->filled_samples = T->info->filled_voids = 0;
+    for (size_t k = 0; k < T->ntiles; k++) {
+      T->info->filled_samples += T->filled[k];
+      T->info->filled_voids += T->voids[k];
+    }
   }
   double zmin = T->range_min, zmax = T->range_max;
   if (!(zmin <= zmax) && T->sink) {
@@ -406,6 +413,8 @@ static void tiled_free(tiled *T)
   free(T->steps);
   free(T->zmax);
   free(T->valid);
+  free(T->filled);
+  free(T->voids);
   pthread_mutex_destroy(&T->lock);
   pthread_mutex_destroy(&T->gdal);
   pthread_cond_destroy(&T->cond);

@@ -59,7 +59,8 @@ typedef struct tt_raster_info {
   size_t fill_max;        /* FILL_NODATA's K, 0 when not given */
   size_t filled_samples;  /* nodata samples filled (counted valid) */
   size_t filled_voids;    /* the voids they make up (a window: those whose
-                             first sample, in row-major order, it holds) */
+                             first sample, in row-major order, it holds;
+                             both within FILL_OWNED when given) */
 } tt_raster_info;
 
 void tt_raster_info_destroy(tt_raster_info *info);
@@ -103,7 +104,9 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * larger side + 1 and no smoothing, each void from its own neighbourhood
  * so that a window, which reads a margin of 2K + 2 samples for it, fills
  * exactly as the whole raster does; filled heights take the grid's
- * precision; info->filled_samples and filled_voids count them),
+ * precision; info->filled_samples and filled_voids count them, within
+ * FILL_OWNED=col,row,width,height when given: a tile's own samples, so
+ * that the tiles' counts add up),
  * SOURCE_NAME=<name> and SOURCE_DRIVER=<driver> (the raster's name in
  * messages and info->path, its driver in info->driver, for a band of a
  * view over a file, such as an in-memory VRT, which has neither).

@@ -240,18 +240,28 @@ static tt_status fill_void_in_window(raster_read *r, const fill_src *f,
   tt_status s = fill_one(r, f, v, *zbuf);
   if (s != TT_OK)
     return s;
-  size_t inside = 0;
+  /* the samples counted: FILL_OWNED's, else the window's (source
+   * coordinates) */
+  size_t ox0 = wx0, oy0 = wy0, ox1 = wx1, oy1 = wy1;
+  if (r->opt.has_fill_own) {
+    ox0 = r->opt.fill_own[0] - f->x0;
+    oy0 = r->opt.fill_own[1] - f->y0;
+    ox1 = ox0 + r->opt.fill_own[2];
+    oy1 = oy0 + r->opt.fill_own[3];
+  }
+  size_t inside = 0, owned = 0;
   for (size_t q = 0; q < v->n; q++) {
     const size_t c = v->cell[q] % f->nx, row = v->cell[q] / f->nx;
     if (c < wx0 || c >= wx1 || row < wy0 || row >= wy1 || isnan((*zbuf)[q]))
       continue;
     store(r->grid, c - wx0, row - wy0, (*zbuf)[q]);
     inside++;
+    owned += c >= ox0 && c < ox1 && row >= oy0 && row < oy1;
   }
   const size_t sc = seed % f->nx, sr = seed / f->nx;
-  if (inside && sc >= wx0 && sc < wx1 && sr >= wy0 && sr < wy1)
+  if (inside && sc >= ox0 && sc < ox1 && sr >= oy0 && sr < oy1)
     r->filled_voids++;
-  r->filled_samples += inside;
+  r->filled_samples += owned;
   r->valid += inside;
   return TT_OK;
 }

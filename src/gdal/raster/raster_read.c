@@ -131,6 +131,7 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->source_name = NULL;
   opt->source_driver = NULL;
   opt->fill_max = 0;
+  opt->has_fill_own = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
     char *key = NULL;
@@ -203,6 +204,18 @@ static tt_status parse_options(tt_context *ctx, char **options,
                       "samples from 1 to %d, got \"%s\"", INT32_MAX, value);
       else
         opt->fill_max = (size_t)k;
+    } else if (strcasecmp(key, "FILL_OWNED") == 0) {
+      unsigned long long w[4];
+      char tail;
+      if (sscanf(value, "%llu,%llu,%llu,%llu%c", &w[0], &w[1], &w[2], &w[3],
+                 &tail) != 4)
+        s = tt__error(ctx, TT_ERR_ARG, "FILL_OWNED must be col,row,width,"
+                      "height, got \"%s\"", value);
+      else {
+        for (int k = 0; k < 4; k++)
+          opt->fill_own[k] = (size_t)w[k];
+        opt->has_fill_own = 1;
+      }
     } else if (strcasecmp(key, "SOURCE_NAME") == 0) {
       opt->source_name = value;
     } else if (strcasecmp(key, "SOURCE_DRIVER") == 0) {
@@ -210,7 +223,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
                     "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS, "
-                    "WINDOW, FILL_NODATA, SOURCE_NAME, SOURCE_DRIVER)", key);
+                    "WINDOW, FILL_NODATA, FILL_OWNED, SOURCE_NAME, "
+                    "SOURCE_DRIVER)", key);
     }
     CPLFree(key);
     if (s != TT_OK)

@@ -47,6 +47,10 @@ typedef struct read_options {
   const char *source_driver; /* band is read from; NULL: its dataset's */
   size_t fill_max;       /* FILL_NODATA=K: voids of <= K samples filled;
                             0: none */
+  int has_fill_own;      /* FILL_OWNED=col,row,width,height: the samples
+                            whose fills are counted (a tile's own part of
+                            its window); else the window's */
+  size_t fill_own[4];
 } read_options;
 
 /* Where the raw values of a band of rows are: in the grid itself (bands
