@@ -1,5 +1,5 @@
 /*
- * test_fill_nodata.c -- tt_gdal_read_grid's FILL_NODATA=K on an in-memory
+ * test_raster_fill.c -- tt_gdal_read_grid's FILL_NODATA=K on an in-memory
  * Float32 DEM of 90 x 70 samples (a smooth surface, nodata -9999) with
  * small voids (a sample, a 3 x 2 block, an L of 5, a 10-sample bar), a
  * lake of 113 samples and a void on the raster's edge: the small voids
