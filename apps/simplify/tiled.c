@@ -178,6 +178,16 @@ static tt_status tiled_size(tiled *T, app_simplify_job *job)
     return tt__app_fail(T->r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, T->path,
                         "raster is %zu x %zu pixels: at least 2 x 2 are "
                         "needed to make a triangle", T->W, T->H);
+  /* -fill_nodata K: every tile reads a margin of 2K + 2 samples to fill
+   * the voids across its border as the whole DEM does; a quarter of a
+   * tile keeps that read within about 4 tiles' heights */
+  const size_t fill = job->s->fill_nodata;
+  if (fill && fill > T->N / 4)
+    return tt__app_fail(T->r, TT_APP_EXIT_USAGE, TT_ERR_ARG, "-fill_nodata",
+                        "%zu in tiles of %zu: a tile reads a margin of %zu "
+                        "samples for it; at most %zu (a quarter of the "
+                        "tile size) in a tiled run, or larger tiles "
+                        "(-tile_size)", fill, T->N, 2 * fill + 2, T->N / 4);
   T->ntx = (T->W - 2) / T->N + 1;
   T->nty = (T->H - 2) / T->N + 1;
   T->ntiles = T->ntx * T->nty;

@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # test_fill_nodata.sh -- simplify -fill_nodata K ($TT_TERRATIN, issue 29) on
 # a 120 x 100 ESRI ASCII grid written here: a smooth surface with four
-# small voids (1, 6, 5 and 10 samples, the last crossing the tile border
-# at column 64), a lake of 441 samples and a 2-sample void on the left
-# edge. -fill_nodata 20 fills the 22 samples of the four voids (summary
-# note, -json counts), the lake and the edge void stay holes (no vertex in
-# them); the TIN is within the bound of the filled DEM (eval -fill_nodata:
-# every valid sample covered); whole and tiled (streamed GeoPackage, a
-# merged Shapefile, 2 threads), inserted and decimated, count the same and,
-# at -max_error 0, give the filled samples the same heights; bad values
-# are refused in one line. Prints "N passed, M failed"; exits 1 on any
+# small voids (1, 6, 5 and 10 samples, the last crossing the border of
+# tiles of 40 at row 40), a lake of 441 samples and a 2-sample void on the
+# left edge. -fill_nodata 10 fills the 22 samples of the four voids
+# (summary note, -json counts), the lake and the edge void stay holes (no
+# vertex in them); the TIN is within the bound of the filled DEM (eval
+# -fill_nodata: every valid sample covered); whole and tiled (streamed
+# GeoPackage, a merged Shapefile, 2 threads), inserted and decimated,
+# count the same and, at -max_error 0, give the filled samples the same
+# heights; bad values, and a K above a quarter of the tile size, are
+# refused in one line. Prints "N passed, M failed"; exits 1 on any
 # failure, 77 when a tool is missing.
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/../apps/tt_check.sh" || exit 1
@@ -89,15 +90,15 @@ EDGE="col = 0 AND row BETWEEN 50 AND 51"
 
 # --- whole, inserted: counts, the note, holes kept, the bound -------------
 "$T" simplify -q -max_error 0.5 dem.asc plain.gpkg -json >plain.json
-"$T" simplify -max_error 0.5 -fill_nodata 20 dem.asc whole.gpkg \
+"$T" simplify -max_error 0.5 -fill_nodata 10 dem.asc whole.gpkg \
   >whole.txt 2>&1
-"$T" simplify -q -max_error 0.5 -fill_nodata 20 dem.asc whole.gpkg \
+"$T" simplify -q -max_error 0.5 -fill_nodata 10 dem.asc whole.gpkg \
   -overwrite -json >whole.json
 check "the summary's note" \
-  grep -q "^note:   22 nodata samples in 4 voids filled (-fill_nodata 20); the bound holds on the filled grid" whole.txt
+  grep -q "^note:   22 nodata samples in 4 voids filled (-fill_nodata 10); the bound holds on the filled grid" whole.txt
 check "-json filled_samples" [ "$(field whole.json filled_samples)" = 22 ]
 check "-json filled_voids" [ "$(field whole.json filled_voids)" = 4 ]
-check "-json fill_nodata" [ "$(field whole.json fill_nodata)" = 20 ]
+check "-json fill_nodata" [ "$(field whole.json fill_nodata)" = 10 ]
 check "without -fill_nodata: null, none filled" \
   [ "$(field plain.json fill_nodata)" = None -a "$(field plain.json filled_samples)" = 0 ]
 check "the valid samples gain the filled ones" \
@@ -106,7 +107,7 @@ check "no vertex in the lake" [ "$(count_where whole.gpkg "$LAKE")" = 0 ]
 check "no vertex in the edge void" [ "$(count_where whole.gpkg "$EDGE")" = 0 ]
 check "without -fill_nodata no vertex in the small voids" \
   [ "$(count_where plain.gpkg "$SMALL")" = 0 ]
-"$T" eval -fill_nodata 20 -max_error 0.5 -json dem.asc whole.gpkg >eval.json
+"$T" eval -fill_nodata 10 -max_error 0.5 -json dem.asc whole.gpkg >eval.json
 check "eval against the filled DEM: within the bound" \
   [ "$(field eval.json pass)" = True ]
 check "eval: every sample of the filled DEM covered" \
@@ -122,34 +123,34 @@ check "-fill_nodata 9: no vertex in the bar" \
   [ "$(count_where k9.gpkg "col BETWEEN 62 AND 66 AND row BETWEEN 40 AND 41")" = 0 ]
 
 # --- tiled and decimated: the same counts, the same filled heights --------
-"$T" simplify -q -max_error 0 -fill_nodata 20 dem.asc exact.gpkg
+"$T" simplify -q -max_error 0 -fill_nodata 10 dem.asc exact.gpkg
 heights exact.gpkg vertices >exact.txt
 check "at -max_error 0 the filled samples are vertices" \
   [ "$(count_where exact.gpkg "$SMALL")" -gt 15 ]
 i=0
-for run in "-tile_size 32" "-tile_size 32 -threads 2" \
-           "-tile_size 16 -of ESRI_Shapefile" "-method decimate" \
-           "-method decimate -tile_size 32"; do
+for run in "-tile_size 40" "-tile_size 40 -threads 2" \
+           "-tile_size 40 -of ESRI_Shapefile" "-method decimate" \
+           "-method decimate -tile_size 40"; do
   i=$((i + 1))
   out=t$i.gpkg
   if [[ $run == *Shapefile* ]]; then
     out=t${i}_triangles.shp
-    "$T" simplify -q -max_error 0.5 -fill_nodata 20 -tile_size 16 \
+    "$T" simplify -q -max_error 0.5 -fill_nodata 10 -tile_size 40 \
       -of "ESRI Shapefile" dem.asc t$i -json >t$i.json
   else
     # shellcheck disable=SC2086
-    "$T" simplify -q -max_error 0.5 -fill_nodata 20 $run dem.asc "$out" \
+    "$T" simplify -q -max_error 0.5 -fill_nodata 10 $run dem.asc "$out" \
       -json >t$i.json
   fi
   check "$run: 22 samples in 4 voids" \
     [ "$(field t$i.json filled_samples)" = 22 -a "$(field t$i.json filled_voids)" = 4 ]
-  "$T" eval -fill_nodata 20 -max_error 0.5 -json dem.asc "$out" >e$i.json
+  "$T" eval -fill_nodata 10 -max_error 0.5 -json dem.asc "$out" >e$i.json
   check "$run: within the bound of the filled DEM, all covered" \
     [ "$(field e$i.json pass)" = True -a "$(field e$i.json covered)" = "$(field whole.json valid_samples)" ]
 done
-for run in "-tile_size 32" "-tile_size 16 -threads 2" "-method decimate -tile_size 32"; do
+for run in "-tile_size 40" "-tile_size 40 -threads 2" "-method decimate -tile_size 40"; do
   # shellcheck disable=SC2086
-  "$T" simplify -q -max_error 0 -fill_nodata 20 $run dem.asc x.gpkg -overwrite
+  "$T" simplify -q -max_error 0 -fill_nodata 10 $run dem.asc x.gpkg -overwrite
   heights x.gpkg vertices >x.txt
   check "$run at -max_error 0: the filled heights of the whole run" \
     same_filled exact.txt x.txt
@@ -164,6 +165,13 @@ for bad in 0 -1 x 1.5; do
     grep -qx "terratin: simplify: -fill_nodata must be a number of samples from 1 to 2147483647, got '$bad'" err.txt
   check "-fill_nodata $bad: nothing written" not test -e bad.gpkg
 done
+
+"$T" simplify -q -fill_nodata 11 -tile_size 40 dem.asc bad.gpkg 2>err.txt
+rc=$?
+check "-fill_nodata 11 in tiles of 40: exit 2" [ $rc = 2 ]
+check "-fill_nodata 11 in tiles of 40: one line" \
+  grep -qx "terratin: -fill_nodata: 11 in tiles of 40: a tile reads a margin of 24 samples for it; at most 10 (a quarter of the tile size) in a tiled run, or larger tiles (-tile_size)" err.txt
+check "-fill_nodata 11 in tiles of 40: nothing written" not test -e bad.gpkg
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
