@@ -1,4 +1,7 @@
 /*
+ * src/gdal/raster/ -- the rasters: a band read into a grid, a grid written
+ * as a GeoTIFF.
+ *
  * raster_fill.c -- FILL_NODATA=K of tt_gdal_read_grid: the nodata voids of
  * at most K samples filled by GDAL's GDALFillNodata (inverse distance
  * weighting, as gdal_fillnodata -md D, no smoothing) before anything is
