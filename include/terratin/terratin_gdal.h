@@ -103,8 +103,8 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * GDALFillNodata, inverse distance with a search distance of the void's
  * larger side + 1 and no smoothing, each void from its own neighbourhood
  * so that a window, which reads a margin of 2K + 2 samples for it, fills
- * exactly as the whole raster does; filled heights take the grid's
- * precision; info->filled_samples and filled_voids count them, within
+ * exactly as the whole raster does; filled heights are rounded to
+ * floats; info->filled_samples and filled_voids count them, within
  * FILL_OWNED=col,row,width,height when given: a tile's own samples, so
  * that the tiles' counts add up),
  * SOURCE_NAME=<name> and SOURCE_DRIVER=<driver> (the raster's name in

@@ -7,8 +7,9 @@
  * values GDAL's GDALFillNodata gives the whole raster for that void's
  * search distance (gdal_fillnodata -md D); the lake, the edge void and the
  * voids above K stay nodata; every window (tiles of 16 and 23, a window
- * cutting a void) fills its samples bit for bit as the whole read; the
- * counts, FILL_OWNED's and the bad values.
+ * cutting a void) fills its samples bit for bit as the whole read, a
+ * window of floats too as a whole read of doubles; the counts,
+ * FILL_OWNED's and the bad values.
  */
 #include "terratin/terratin_gdal.h"
 #include "tt_test.h"
@@ -200,6 +201,44 @@ static void test_windows(GDALDatasetH ds, const tt_grid *whole, int side)
   CHECK_INT_EQ(voids, 4);
 }
 
+/* A Float64 band with a height that is no float: the whole read holds
+ * doubles, a window without that height floats; the filled samples agree
+ * (rounded to floats in both). */
+static void test_precision(void)
+{
+  static double zd[NX * NY];
+  for (int i = 0; i < NX * NY; i++)
+    zd[i] = dem[i];
+  zd[65 * NX + 85] = 100.1;
+  GDALDatasetH ds = GDALCreate(GDALGetDriverByName("MEM"), "f64", NX, NY,
+                               1, GDT_Float64, NULL);
+  GDALRasterBandH b = GDALGetRasterBand(ds, 1);
+  GDALSetRasterNoDataValue(b, NODATA);
+  CHECK(GDALRasterIO(b, GF_Write, 0, 0, NX, NY, zd, NX, NY, GDT_Float64, 0,
+                     0) == CE_None);
+  char **o = CSLSetNameValue(NULL, "FILL_NODATA", "10");
+  tt_grid *whole = read_grid(ds, o, NULL);
+  o = CSLSetNameValue(o, "WINDOW", "20,10,45,40");
+  tt_grid *win = read_grid(ds, o, NULL);
+  CSLDestroy(o);
+  if (whole && win) {
+    CHECK(tt_grid_precision(whole) == TT_PRECISION_FLOAT64);
+    CHECK(tt_grid_precision(win) == TT_PRECISION_FLOAT32);
+    size_t filled = 0;
+    for (int r = 10; r < 50; r++)
+      for (int c = 20; c < 65; c++)
+        if (is_void(c, r) && !in_lake(c, r)) {
+          CHECK(tt_grid_sample(win, c - 20, r - 10) ==
+                tt_grid_sample(whole, c, r));
+          filled++;
+        }
+    CHECK_INT_EQ(filled, 6 + 10);
+  }
+  tt_grid_destroy(whole);
+  tt_grid_destroy(win);
+  GDALClose(ds);
+}
+
 static void test_bad_values(GDALDatasetH ds)
 {
   const char *bad[] = {"0", "-3", "x", "2.5", "99999999999"};
@@ -229,6 +268,7 @@ int main(void)
     TT_RUN(test_windows(ds, whole, 23));
     TT_RUN(test_windows(ds, whole, 61));
   }
+  TT_RUN(test_precision());
   TT_RUN(test_bad_values(ds));
   tt_grid_destroy(whole);
   GDALClose(ds);

@@ -26,9 +26,10 @@
  * untiled run's. A void counts in the window that holds its first sample
  * in row-major order, so the windows' counts add up to the raster's.
  *
- * Filled heights are GDAL's doubles stored at the grid's precision: a
- * grid of floats keeps floats (the made-up heights rounded to the nearest
- * float, relative 6e-8) rather than doubling its memory.
+ * Filled heights are GDAL's doubles rounded to the nearest float
+ * (relative 6e-8; they are made up) in a grid of floats and of doubles
+ * alike: a grid of floats stays one rather than doubling its memory, and
+ * a tile whose grid holds floats fills as the whole raster's of doubles.
  *
  * Memory: a byte per sample of the (margin) grid to mark visited nodata,
  * and the samples of the largest patch met (8 bytes each); the copies are
@@ -208,15 +209,15 @@ done:
   return s;
 }
 
-/* Stores height h at window sample (c, row) of the read's grid, at the
- * grid's precision. */
+/* Stores height h, rounded to a float, at window sample (c, row) of the
+ * read's grid. */
 static void store(tt_grid *g, size_t c, size_t row, double h)
 {
   float *z = tt_grid_heights(g);
   double *zd = tt_grid_heights_f64(g);
   const size_t i = row * tt_grid_width(g) + c;
   if (zd)
-    zd[i] = h;
+    zd[i] = (double)(float)h;
   else
     z[i] = (float)h;
 }
