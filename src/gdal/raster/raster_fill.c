@@ -32,8 +32,9 @@
  * a tile whose grid holds floats fills as the whole raster's of doubles.
  *
  * Memory: a byte per sample of the (margin) grid to mark visited nodata,
- * and the samples of the largest patch met (8 bytes each); the copies are
- * a void's neighbourhood, a few times its size.
+ * and 8 bytes a sample of the search's queue: every sample of a void of
+ * at most K, the frontier only of a larger one (a sea); the copies are a
+ * void's neighbourhood, a few times its size.
  */
 #include "gdal/raster/raster_read.h"
 
@@ -54,8 +55,10 @@ typedef struct fill_src {
 
 /* A void found: its samples (indices into the source grid) and box. */
 typedef struct fill_void {
-  size_t *cell;
+  size_t *cell;         /* every sample while it may be filled; then the
+                           search's frontier only */
   size_t n, cap;
+  size_t count;         /* its samples */
   size_t cmin, cmax, rmin, rmax;
   int edge;             /* touches the source's edge */
 } fill_void;
@@ -105,11 +108,14 @@ static int push(fill_void *v, size_t i)
   return 1;
 }
 
-/* The 4-connected nodata patch of seed, breadth first; seen marks it. */
+/* The 4-connected nodata patch of seed, breadth first; seen marks it.
+ * Once it has more than max samples it will not be filled: the samples
+ * searched are dropped, so that a sea holds its frontier only. */
 static int collect(const fill_src *f, unsigned char *seen, size_t seed,
-                   fill_void *v)
+                   size_t max, fill_void *v)
 {
   v->n = 0;
+  v->count = 1;
   v->edge = 0;
   v->cmin = v->rmin = SIZE_MAX;
   v->cmax = v->rmax = 0;
@@ -117,6 +123,11 @@ static int collect(const fill_src *f, unsigned char *seen, size_t seed,
   if (!push(v, seed))
     return 0;
   for (size_t q = 0; q < v->n; q++) {
+    if (v->count > max && q >= 4096 && q >= v->n - q) {
+      memmove(v->cell, v->cell + q, (v->n - q) * sizeof *v->cell);
+      v->n -= q;
+      q = 0;
+    }
     const size_t i = v->cell[q], c = i % f->nx, r = i / f->nx;
     v->cmin = c < v->cmin ? c : v->cmin;
     v->cmax = c > v->cmax ? c : v->cmax;
@@ -133,6 +144,7 @@ static int collect(const fill_src *f, unsigned char *seen, size_t seed,
     for (int j = 0; j < k; j++)
       if (!seen[nb[j]] && isnan(src_height(f, nb[j]))) {
         seen[nb[j]] = 1;
+        v->count++;
         if (!push(v, nb[j]))
           return 0;
       }
@@ -230,7 +242,7 @@ static tt_status fill_void_in_window(raster_read *r, const fill_src *f,
 {
   const size_t wx0 = r->wx - f->x0, wy0 = r->wy - f->y0;
   const size_t wx1 = wx0 + r->nx, wy1 = wy0 + r->ny;
-  if (v->n > r->opt.fill_max || v->edge)
+  if (v->count > r->opt.fill_max || v->edge)
     return TT_OK;
   if (v->cmax < wx0 || v->cmin >= wx1 || v->rmax < wy0 || v->rmin >= wy1)
     return TT_OK; /* outside the window (a margin's) */
@@ -296,7 +308,7 @@ tt_status tt__raster_fill(raster_read *r)
   for (size_t i = 0; s == TT_OK && i < f.nx * f.ny; i++) {
     if (seen[i] || !isnan(src_height(&f, i)))
       continue;
-    if (!collect(&f, seen, i, &v))
+    if (!collect(&f, seen, i, r->opt.fill_max, &v))
       s = tt__error(r->ctx, TT_ERR_NOMEM, "out of memory");
     else
       s = fill_void_in_window(r, &f, &v, i, &zbuf, &zcap);
