@@ -261,7 +261,8 @@ char **tt__app_view_args(const tt_app_settings *s, GDALDatasetH src,
  * It reads from src, which must stay open until it is closed. */
 GDALDatasetH tt__app_view_open(GDALDatasetH src, char **args, char *why,
                                size_t size);
-/* The read options of -srcnodata, -z_factor, -z_unit and -work_srs
+/* The read options of -srcnodata, -z_factor, -z_unit, -work_srs and
+ * -fill_nodata (FILL_NODATA)
  * (tt_gdal_read_grid's SRCNODATA, Z_FACTOR, Z_UNIT, WORK_SRS), for a
  * whole DEM (tt__app_read_dem adds MAX_MEMORY) and a tiled run's windows
  * alike. The caller frees the list with CSLDestroy(). */

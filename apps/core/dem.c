@@ -325,6 +325,9 @@ char **tt__app_read_options(const tt_app_settings *s)
     ropts = CSLSetNameValue(ropts, "Z_UNIT", "m");
   if (s->work_srs)
     ropts = CSLSetNameValue(ropts, "WORK_SRS", s->work_srs);
+  if (s->fill_nodata)
+    ropts = CSLSetNameValue(ropts, "FILL_NODATA",
+                            CPLSPrintf("%zu", s->fill_nodata));
   return ropts;
 }
 

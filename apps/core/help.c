@@ -115,6 +115,7 @@ static const char help_simplify[] =
     "           [-hole minangle|circumradius|dp]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
     "           [-z_to m|native|auto]\n"
+    "           [-fill_nodata MAXCELLS]\n"
     INPUT_USAGE
     "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
@@ -151,6 +152,13 @@ static const char help_simplify[] =
     "  -b BAND           band of INPUT to read (default 1)\n"
     "  -srcnodata VALUE  height to treat as nodata, a number or nan\n"
     "                    (default: the band's nodata value and mask)\n"
+    "  -fill_nodata MAXCELLS  fill the nodata voids of at most MAXCELLS\n"
+    "                    samples (4-connected, not touching the raster's\n"
+    "                    edge) with GDAL's GDALFillNodata (inverse\n"
+    "                    distance, search distance the void's larger side\n"
+    "                    + 1, no smoothing) before meshing; larger ones\n"
+    "                    (lakes, the sea) stay holes. The bound holds on\n"
+    "                    the filled DEM (eval -fill_nodata measures it)\n"
     INPUT_HELP
     "  -z_factor F       multiply heights by F, e.g. 0.3048 for feet to\n"
     "                    metres (default 1; after the band's scale/offset)\n"
@@ -324,6 +332,7 @@ static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
     "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
     "           [-z_to m|native|auto] [-json] [-q]\n"
+    "           [-fill_nodata MAXCELLS]\n"
     INPUT_USAGE
     "           [-tin_frame map|pixel] [-tin_transform SX,SY,SZ,OX,OY,OZ]\n"
     "           [-max_memory SIZE] [-error_raster OUT.tif [-co NAME=VALUE]...\n"
@@ -345,6 +354,8 @@ static const char help_eval[] =
     "Options:\n"
     "  -b BAND         band of DEM to read (default 1)\n"
     "  -srcnodata V    height to treat as nodata, a number or nan\n"
+    "  -fill_nodata MAXCELLS  the DEM's small voids filled (as given to\n"
+    "                  simplify): measure a TIN against the filled DEM\n"
     "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
     "                  the DEM as simplify reads it (the TIN's window)\n"
     "  -z_factor F     multiply heights by F (as given to simplify)\n"

@@ -288,6 +288,10 @@ static const tt__app_opt_def opt_defs[] = {
      .bad = "must be a size of at least 1 byte: bytes, or a number with K, "
             "M, G or T (e.g. 500M, 2G)",
      .unit = "bytes"},
+    {"-fill_nodata", O_FILL_NODATA, FOR_S | FOR_E, OPT_SIZE,
+     AT(s.fill_nodata), .min = 1, .max = INT32_MAX,
+     .bad = "must be a number of samples from 1 to 2147483647",
+     .unit = "samples"},
     {"-tile_size", O_TILE_SIZE, FOR_S, OPT_SIZE, AT(s.tile_size), .min = 16,
      .max = 65536, .bad = "must be 16 to 65536 cells"},
     {"-terrain", O_TERRAIN, FOR_T, OPT_LIST, AT(terrains), .flags = OPT_HINT,

@@ -223,6 +223,15 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_size(&j, "height", p->info->height);
   tt__json_size(&j, "cells", p->cells);
   tt__json_size(&j, "valid_samples", p->valid);
+  if (p->info->fill_max) {
+    tt__json_size(&j, "fill_nodata", p->info->fill_max);
+    tt__json_size(&j, "filled_samples", p->info->filled_samples);
+    tt__json_size(&j, "filled_voids", p->info->filled_voids);
+  } else {
+    tt__json_null(&j, "fill_nodata");
+    tt__json_size(&j, "filled_samples", 0);
+    tt__json_size(&j, "filled_voids", 0);
+  }
   tt__json_num(&j, "z_min", p->zmin);
   tt__json_num(&j, "z_max", p->zmax);
   tt__json_open(&j, "limits");
@@ -377,6 +386,12 @@ static void say_input(app_run *r, const app_simplify_report *p)
           s->srcwin.set || s->projwin.set ? " (a window)" : "", valid,
           in->crs_name && *in->crs_name ? in->crs_name : "no CRS",
           s->srs ? " (given)" : "", heights);
+  if (in->fill_max)
+    fprintf(r->out, "note:   %zu nodata sample%s in %zu void%s filled "
+            "(-fill_nodata %zu); the bound holds on the filled grid\n",
+            in->filled_samples, in->filled_samples == 1 ? "" : "s",
+            in->filled_voids, in->filled_voids == 1 ? "" : "s",
+            in->fill_max);
 }
 
 /* What came out: the files (and layers) written, the TIN's size. */

@@ -115,6 +115,8 @@ typedef struct tt_app_settings {
                                 (keep the unit) or "auto" (metres when the
                                 CRS is in metres or geographic); NULL:
                                 auto */
+  size_t fill_nodata;        /* -fill_nodata: voids of at most this many
+                                samples filled; 0: none (simplify, eval) */
   const char *work_srs;      /* -work_srs: the working CRS; NULL: chosen
                                 from the DEM's CRS (simplify) */
   const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the

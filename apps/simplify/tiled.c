@@ -178,6 +178,16 @@ static tt_status tiled_size(tiled *T, app_simplify_job *job)
     return tt__app_fail(T->r, TT_APP_EXIT_FAILURE, TT_ERR_DATA, T->path,
                         "raster is %zu x %zu pixels: at least 2 x 2 are "
                         "needed to make a triangle", T->W, T->H);
+  /* -fill_nodata K: every tile reads a margin of 2K + 2 samples to fill
+   * the voids across its border as the whole DEM does; a quarter of a
+   * tile keeps that read within about 4 tiles' heights */
+  const size_t fill = job->s->fill_nodata;
+  if (fill && fill > T->N / 4)
+    return tt__app_fail(T->r, TT_APP_EXIT_USAGE, TT_ERR_ARG, "-fill_nodata",
+                        "%zu in tiles of %zu: a tile reads a margin of %zu "
+                        "samples for it; at most %zu (a quarter of the "
+                        "tile size) in a tiled run, or larger tiles "
+                        "(-tile_size)", fill, T->N, 2 * fill + 2, T->N / 4);
   T->ntx = (T->W - 2) / T->N + 1;
   T->nty = (T->H - 2) / T->N + 1;
   T->ntiles = T->ntx * T->nty;
@@ -258,6 +268,8 @@ static tt_status tiled_init(tiled *T)
   T->zmin = calloc(T->ntiles, sizeof *T->zmin);
   T->zmax = calloc(T->ntiles, sizeof *T->zmax);
   T->valid = calloc(T->ntiles, sizeof *T->valid);
+  T->filled = calloc(T->ntiles, sizeof *T->filled);
+  T->voids = calloc(T->ntiles, sizeof *T->voids);
   T->steps = calloc(T->ntiles, sizeof *T->steps);
   hold_cache(T);
   pthread_mutex_init(&T->lock, NULL);
@@ -266,7 +278,7 @@ static tt_status tiled_init(tiled *T)
   T->range_min = INFINITY;
   T->range_max = -INFINITY;
   if (!T->pieces || !T->done || !T->zmin || !T->zmax || !T->valid ||
-      !T->steps)
+      !T->steps || !T->filled || !T->voids)
     return tt__app_fail(T->r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, NULL,
                         "out of memory for %zu tiles", T->ntiles);
   return TT_OK;
@@ -368,6 +380,11 @@ static void finish(tiled *T)
     T->info->height = T->H;
     T->info->valid_samples = sum.valid_samples;
     T->info->nodata_samples = T->W * T->H - sum.valid_samples;
+    T->info->filled_samples = T->info->filled_voids = 0;
+    for (size_t k = 0; k < T->ntiles; k++) {
+      T->info->filled_samples += T->filled[k];
+      T->info->filled_voids += T->voids[k];
+    }
   }
   double zmin = T->range_min, zmax = T->range_max;
   if (!(zmin <= zmax) && T->sink) {
@@ -410,6 +427,8 @@ static void tiled_free(tiled *T)
   free(T->steps);
   free(T->zmax);
   free(T->valid);
+  free(T->filled);
+  free(T->voids);
   pthread_mutex_destroy(&T->lock);
   pthread_mutex_destroy(&T->gdal);
   pthread_cond_destroy(&T->cond);

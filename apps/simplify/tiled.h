@@ -40,6 +40,8 @@ typedef struct tiled {
   double *zmin, *zmax;      /* per tile (pre-pass) */
   app_step *steps;          /* per tile (pre-pass): its pairs' step */
   size_t *valid;            /* per tile: valid samples of its window */
+  size_t *filled, *voids;   /* per tile: the samples it owns that
+                               -fill_nodata filled, the voids they start */
   atomic_int stop;
   size_t failed;            /* the first tile that failed (ntiles: none) */
   tt_status fail_status;

@@ -94,6 +94,15 @@ void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
   char **ro = CSLDuplicate(T->ropts);
   ro = CSLSetNameValue(ro, "WINDOW", CPLSPrintf("%zu,%zu,%zu,%zu", c0, r0,
                                                 w, h));
+  /* -fill_nodata's counts: the samples the tile owns (its last column and
+   * row are the next tile's, but for the DEM's own last ones) */
+  if (CSLFetchNameValue(ro, "FILL_NODATA")) {
+    size_t x1 = t.col1 - (t.col1 + 1 < t.dem_width);
+    size_t y1 = t.row1 - (t.row1 + 1 < t.dem_height);
+    ro = CSLSetNameValue(ro, "FILL_OWNED",
+                         CPLSPrintf("%zu,%zu,%zu,%zu", t.col0, t.row0,
+                                    x1 - t.col0 + 1, y1 - t.row0 + 1));
+  }
   tt_grid *win = NULL;
   tt_raster_info *info = NULL;
   tt_status st = TT_OK;
@@ -111,6 +120,10 @@ void tt__app_tiled_run_tile(tiled *T, tt_context *ctx, size_t k,
     pthread_mutex_unlock(&T->gdal);
   }
   CSLDestroy(ro);
+  if (st == TT_OK && info) {
+    T->filled[k] = info->filled_samples;
+    T->voids[k] = info->filled_voids;
+  }
   if (say) {
     tt_context_set_log(ctx, NULL, NULL);
     T->tile0_read = true;

@@ -60,6 +60,11 @@ typedef struct tt_raster_info {
                              "asked" (Z_UNIT=m), "the CRS is in metres" or
                              "the CRS is geographic" (Z_UNIT=auto); "" when
                              they were not (a static string) */
+  size_t fill_max;        /* FILL_NODATA's K, 0 when not given */
+  size_t filled_samples;  /* nodata samples filled (counted valid) */
+  size_t filled_voids;    /* the voids they make up (a window: those whose
+                             first sample, in row-major order, it holds;
+                             both within FILL_OWNED when given) */
 } tt_raster_info;
 
 void tt_raster_info_destroy(tt_raster_info *info);
@@ -101,6 +106,15 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * its ground frame the whole raster's, a geographic or Web Mercator
  * raster's ground points those of the whole raster's samples, bit for bit,
  * a window of nodata only is no error, GDAL's cache is left alone),
+ * FILL_NODATA=<K> (the voids -- 4-connected patches of nodata -- of at
+ * most K samples that do not touch the raster's edge filled by GDAL's
+ * GDALFillNodata, inverse distance with a search distance of the void's
+ * larger side + 1 and no smoothing, each void from its own neighbourhood
+ * so that a window, which reads a margin of 2K + 2 samples for it, fills
+ * exactly as the whole raster does; filled heights are rounded to
+ * floats; info->filled_samples and filled_voids count them, within
+ * FILL_OWNED=col,row,width,height when given: a tile's own samples, so
+ * that the tiles' counts add up),
  * SOURCE_NAME=<name> and SOURCE_DRIVER=<driver> (the raster's name in
  * messages and info->path, its driver in info->driver, for a band of a
  * view over a file, such as an in-memory VRT, which has neither).

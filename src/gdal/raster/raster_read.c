@@ -132,6 +132,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->has_window = 0;
   opt->source_name = NULL;
   opt->source_driver = NULL;
+  opt->fill_max = 0;
+  opt->has_fill_own = 0;
   int has_max_memory = 0;
   for (char **o = options; o && *o; o++) {
     char *key = NULL;
@@ -209,6 +211,27 @@ static tt_status parse_options(tt_context *ctx, char **options,
           opt->win[k] = (size_t)w[k];
         opt->has_window = 1;
       }
+    } else if (strcasecmp(key, "FILL_NODATA") == 0) {
+      unsigned long long k;
+      char tail;
+      if (sscanf(value, "%llu%c", &k, &tail) != 1 || k < 1 ||
+          *value == '-' || k > (unsigned long long)INT32_MAX)
+        s = tt__error(ctx, TT_ERR_ARG, "FILL_NODATA must be a number of "
+                      "samples from 1 to %d, got \"%s\"", INT32_MAX, value);
+      else
+        opt->fill_max = (size_t)k;
+    } else if (strcasecmp(key, "FILL_OWNED") == 0) {
+      unsigned long long w[4];
+      char tail;
+      if (sscanf(value, "%llu,%llu,%llu,%llu%c", &w[0], &w[1], &w[2], &w[3],
+                 &tail) != 4)
+        s = tt__error(ctx, TT_ERR_ARG, "FILL_OWNED must be col,row,width,"
+                      "height, got \"%s\"", value);
+      else {
+        for (int k = 0; k < 4; k++)
+          opt->fill_own[k] = (size_t)w[k];
+        opt->has_fill_own = 1;
+      }
     } else if (strcasecmp(key, "SOURCE_NAME") == 0) {
       opt->source_name = value;
     } else if (strcasecmp(key, "SOURCE_DRIVER") == 0) {
@@ -216,7 +239,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
     } else {
       s = tt__error(ctx, TT_ERR_ARG, "unknown read option \"%s\" (known: "
                     "Z_FACTOR, Z_UNIT, SRCNODATA, MAX_MEMORY, WORK_SRS, "
-                    "WINDOW, SOURCE_NAME, SOURCE_DRIVER)", key);
+                    "WINDOW, FILL_NODATA, FILL_OWNED, SOURCE_NAME, "
+                    "SOURCE_DRIVER)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -364,6 +388,9 @@ static tt_status fill_info(raster_read *r)
   info->width = r->nx;
   info->height = r->ny;
   info->valid_samples = r->valid;
+  info->filled_samples = r->filled_samples;
+  info->filled_voids = r->filled_voids;
+  info->fill_max = r->opt.fill_max;
   info->nodata_samples = r->nx * r->ny - r->valid;
   memcpy(info->gt, r->gt, sizeof r->gt);
   info->has_geotransform = r->has_gt;
@@ -409,6 +436,7 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   r.progress_arg = progress_arg;
   r.prog_lo = 0.0;
   r.prog_hi = 1.0;
+  r.options = options;
   r.ds = GDALGetBandDataset(band);
   r.path = r.ds ? GDALGetDescription(r.ds) : "";
   if (!r.path || !*r.path)
@@ -435,6 +463,9 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   if (s != TT_OK)
     goto done;
   s = tt__raster_scan(&r);
+  if (s != TT_OK)
+    goto done;
+  s = tt__raster_fill(&r);
   if (s != TT_OK)
     goto done;
   s = tt__raster_check_degrees(&r);

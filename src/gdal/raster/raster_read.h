@@ -48,6 +48,12 @@ typedef struct read_options {
   size_t win[4];
   const char *source_name;   /* SOURCE_NAME, SOURCE_DRIVER: what a view's */
   const char *source_driver; /* band is read from; NULL: its dataset's */
+  size_t fill_max;       /* FILL_NODATA=K: voids of <= K samples filled;
+                            0: none */
+  int has_fill_own;      /* FILL_OWNED=col,row,width,height: the samples
+                            whose fills are counted (a tile's own part of
+                            its window); else the window's */
+  size_t fill_own[4];
 } read_options;
 
 /* Where the raw values of a band of rows are: in the grid itself (bands
@@ -105,7 +111,11 @@ typedef struct raster_read {
   size_t step;              /* rows read at once */
   int cache_changed;        /* GDAL's cache limit lowered for the read */
   GIntBig old_cache_max;
-  size_t valid;             /* valid samples met */
+  size_t valid;             /* valid samples met (and filled) */
+  /* the voids filled (raster_fill.c) */
+  char **options;           /* the read's options, for the margin's read */
+  size_t filled_samples;    /* the window's samples filled */
+  size_t filled_voids;      /* voids whose first sample is the window's */
   /* what the read makes */
   tt_grid *grid;
   tt_raster_info *info;
@@ -165,6 +175,12 @@ TT_HIDDEN tt_status tt__raster_check_degrees(raster_read *r);
  * tt__raster_scan_end: GDAL's cache limit given back, the buffers freed
  * (on success and failure alike, once). */
 TT_HIDDEN tt_status tt__raster_scan(raster_read *r);
+
+/* --- the voids filled (raster_fill.c) ------------------------------------
+ * FILL_NODATA=K: the nodata voids of at most K samples not touching the
+ * raster's edge filled with GDALFillNodata, after the scan; r->valid,
+ * filled_samples and filled_voids count them. */
+TT_HIDDEN tt_status tt__raster_fill(raster_read *r);
 TT_HIDDEN void tt__raster_scan_end(raster_read *r);
 
 #endif /* TT_RASTER_READ_H */
