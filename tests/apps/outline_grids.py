@@ -2,13 +2,14 @@
 """outline_grids.py -- nodata patterns for the lean outline's tests, and the
 exact check of a TIN against one (pure python3, no GDAL bindings).
 
-  outline_grids.py make PATTERN OUT.asc [SIZE] [SEED]
+  outline_grids.py make PATTERN OUT.asc [SIZE] [SEED] [SPARSITY]
       writes an ESRI ASCII grid (cell size 1, upper left corner at (0, 0):
       sample (c, r) at (c + 0.5, -r - 0.5)) of smooth heights with the
       nodata PATTERN: coast (three straight coastlines of slopes 0.37, 1
       and 2.6), checker (a checkerboard block, one-sample valid and nodata
       lines, lone samples), border (holes and notches touching every side
-      and corner), noise (seeded random nodata blobs: hundreds of patches).
+      and corner), noise (seeded random nodata blobs, one per SPARSITY
+      samples, default 60: hundreds of patches on 96 x 96).
   outline_grids.py check GRID.asc TIN
       reads the TIN's triangles (ogr2ogr to CSV) and prints one JSON line:
       valid samples, the samples of the old domain (a valid corner of a
@@ -31,7 +32,7 @@ def height(c, r):
     return 100 + 30 * math.sin(c * 0.11) * math.cos(r * 0.07) + 0.05 * c * r % 7
 
 
-def pattern(name, nx, ny, seed):
+def pattern(name, nx, ny, seed, sparsity=60):
     valid = [[True] * nx for _ in range(ny)]
 
     def hole(c, r):
@@ -84,7 +85,7 @@ def pattern(name, nx, ny, seed):
                 hole(c, r)
     elif name == "noise":
         rng = random.Random(seed)
-        for _ in range(nx * ny // 60):
+        for _ in range(nx * ny // sparsity):
             c, r = rng.randrange(nx), rng.randrange(ny)
             rad = rng.choice((0, 0, 0, 1, 1, 2, 3))
             for dr in range(-rad, rad + 1):
@@ -96,9 +97,9 @@ def pattern(name, nx, ny, seed):
     return valid
 
 
-def make(name, out, size, seed):
+def make(name, out, size, seed, sparsity):
     nx = ny = size
-    valid = pattern(name, nx, ny, seed)
+    valid = pattern(name, nx, ny, seed, sparsity)
     with open(out, "w") as f:
         f.write("ncols %d\nnrows %d\nxllcorner 0\nyllcorner %d\n"
                 "cellsize 1\nNODATA_value %d\n" % (nx, ny, -ny, NODATA))
@@ -180,7 +181,7 @@ if __name__ == "__main__":
     a = sys.argv[1:]
     if len(a) >= 3 and a[0] == "make":
         make(a[1], a[2], int(a[3]) if len(a) > 3 else 96,
-             int(a[4]) if len(a) > 4 else 1)
+             int(a[4]) if len(a) > 4 else 1, int(a[5]) if len(a) > 5 else 60)
     elif len(a) == 3 and a[0] == "check":
         sys.exit(check(a[1], a[2]))
     else:
