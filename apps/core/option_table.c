@@ -248,6 +248,8 @@ static const tt__app_opt_def opt_defs[] = {
      .bad = "must be a size of at least 1 byte: bytes, or a number with K, "
             "M, G or T (e.g. 500M, 2G)",
      .unit = "bytes"},
+    {"-min_patch", O_MIN_PATCH, FOR_S, OPT_SIZE, AT(s.min_patch), .min = 1,
+     .max = SIZE_MAX, .bad = AT_LEAST_1, .unit = "samples"},
     {"-tile_size", O_TILE_SIZE, FOR_S, OPT_SIZE, AT(s.tile_size), .min = 16,
      .max = 65536, .bad = "must be 16 to 65536 cells"},
     {"-terrain", O_TERRAIN, FOR_T, OPT_LIST, AT(terrains), .flags = OPT_HINT,

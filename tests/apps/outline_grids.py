@@ -10,14 +10,16 @@ exact check of a TIN against one (pure python3, no GDAL bindings).
       lines, lone samples), border (holes and notches touching every side
       and corner), noise (seeded random nodata blobs, one per SPARSITY
       samples, default 60: hundreds of patches on 96 x 96).
-  outline_grids.py check GRID.asc TIN
+  outline_grids.py check GRID.asc TIN [MIN_PATCH]
       reads the TIN's triangles (ogr2ogr to CSV) and prints one JSON line:
       valid samples, the samples of the old domain (a valid corner of a
       cell with three or four valid corners), how many of those no
       triangle covers (missing), nodata samples a triangle covers (its
       closed interior: nodata_covered), and the covered valid samples.
       Exit 1 when missing or nodata_covered is not 0. Exact: integer
-      barycentric signs.
+      barycentric signs. With MIN_PATCH, the valid patches (4-connected)
+      of fewer samples are nodata first, and counted (dropped_samples,
+      dropped_patches).
 """
 import json
 import math
@@ -134,9 +136,35 @@ def triangles(tin):
     return tris
 
 
-def check(grid, tin):
+def drop_patches(valid, nx, ny, min_patch):
+    seen = [[False] * nx for _ in range(ny)]
+    samples = patches = 0
+    for r0 in range(ny):
+        for c0 in range(nx):
+            if seen[r0][c0] or not valid[r0][c0]:
+                continue
+            seen[r0][c0] = True
+            stack, patch = [(c0, r0)], []
+            while stack:
+                c, r = stack.pop()
+                patch.append((c, r))
+                for cc, rr in ((c - 1, r), (c + 1, r), (c, r - 1), (c, r + 1)):
+                    if (0 <= cc < nx and 0 <= rr < ny and valid[rr][cc] and
+                            not seen[rr][cc]):
+                        seen[rr][cc] = True
+                        stack.append((cc, rr))
+            if len(patch) < min_patch:
+                for c, r in patch:
+                    valid[r][c] = False
+                samples += len(patch)
+                patches += 1
+    return samples, patches
+
+
+def check(grid, tin, min_patch=0):
     valid = read_grid(grid)
     ny, nx = len(valid), len(valid[0])
+    dropped = drop_patches(valid, nx, ny, min_patch)
 
     def ok(c, r):
         return 0 <= c < nx and 0 <= r < ny and valid[r][c]
@@ -171,6 +199,7 @@ def check(grid, tin):
     out = {"valid": sum(map(sum, valid)), "domain": len(domain),
            "covered": len(covered), "missing": len(missing),
            "nodata_covered": len(nodata_covered),
+           "dropped_samples": dropped[0], "dropped_patches": dropped[1],
            "first_missing": missing[:3],
            "first_nodata_covered": sorted(nodata_covered)[:3]}
     print(json.dumps(out))
@@ -182,7 +211,7 @@ if __name__ == "__main__":
     if len(a) >= 3 and a[0] == "make":
         make(a[1], a[2], int(a[3]) if len(a) > 3 else 96,
              int(a[4]) if len(a) > 4 else 1, int(a[5]) if len(a) > 5 else 60)
-    elif len(a) == 3 and a[0] == "check":
-        sys.exit(check(a[1], a[2]))
+    elif len(a) in (3, 4) and a[0] == "check":
+        sys.exit(check(a[1], a[2], int(a[3]) if len(a) > 3 else 0))
     else:
         sys.exit(__doc__)

@@ -10,7 +10,11 @@
 #    triangles, for insertion, decimation from a greedy start, and tiles;
 #  - the count: the coastlines force at most a third of the vertices the
 #    old outline forced (56 at c5bf8c1, the cell-step outline);
-#  - covered_samples in -json is the old domain's count.
+#  - covered_samples in -json is the old domain's count;
+#  - -min_patch 5 drops the 4-connected valid patches of fewer than 5
+#    samples (the checkerboard's, the lone samples), counted in -json and
+#    the summary as python counts them, and the TIN stays exact on the
+#    grid without them; a tiled run refuses it.
 # Prints "N passed, M failed"; exits 1 on any failure, 77 (skip) when a tool
 # is missing.
 set -u
@@ -37,9 +41,10 @@ jget() { # jget FILE KEY
   python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])' "$1" "$2"
 }
 
-# exact WHAT GRID TIN: the python check passes (its line is kept in chk.json)
+# exact WHAT GRID TIN [MIN_PATCH]: the python check passes (its line is
+# kept in chk.json)
 exact() {
-  python3 "$G" check "$2" "$3" >chk.json 2>chk.err
+  python3 "$G" check "$2" "$3" ${4:-} >chk.json 2>chk.err
   local rc=$?
   check "$1: every domain sample covered, no nodata covered ($(cat chk.json chk.err))" \
     [ $rc -eq 0 ]
@@ -76,6 +81,29 @@ python3 "$G" make noise big.asc 200 7
 rc=$?
 check "noise 200: exits 0 ($(cat err.txt))" [ $rc -eq 0 ]
 exact "noise 200, -percent 15" big.asc big.gpkg
+
+# -min_patch
+"$T" simplify -q -json -max_error 1 -min_patch 5 checker.asc mp.gpkg >mp.json 2>err.txt
+rc=$?
+check "-min_patch 5: exits 0 ($(cat err.txt))" [ $rc -eq 0 ]
+exact "-min_patch 5" checker.asc mp.gpkg 5
+mp() { python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["min_patch"][sys.argv[2]])' mp.json "$1"; }
+check "-min_patch 5: dropped samples $(mp dropped_samples) = python's $(jget chk.json dropped_samples)" \
+  [ "$(mp dropped_samples)" = "$(jget chk.json dropped_samples)" ]
+check "-min_patch 5: dropped patches $(mp dropped_patches) = python's $(jget chk.json dropped_patches)" \
+  [ "$(mp dropped_patches)" = "$(jget chk.json dropped_patches)" ]
+check "-min_patch 5: some dropped" [ "$(mp dropped_samples)" -gt 300 ]
+check "-min_patch 5: valid_samples less the dropped" \
+  [ "$(jget mp.json valid_samples)" -eq $(($(jget chk.json valid))) ]
+"$T" simplify -max_error 1 -min_patch 5 -overwrite checker.asc mp.gpkg >mp.txt 2>&1
+check "-min_patch 5: the summary's note ($(grep min_patch mp.txt))" \
+  grep -q "^note:   $(mp dropped_samples) valid samples in $(mp dropped_patches) patches of fewer than 5 samples dropped (-min_patch)" mp.txt
+"$T" simplify -q -max_error 1 -min_patch 5 -tile_size 32 checker.asc mpt.gpkg 2>err.txt
+rc=$?
+check "-min_patch with tiles: refused, exit 2 ($rc: $(cat err.txt))" [ $rc -eq 2 ]
+check "-min_patch with tiles: one line naming the option" \
+  grep -q "^terratin: -min_patch: a tiled run" err.txt
+check "-min_patch with tiles: nothing written" [ ! -e mpt.gpkg ]
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
