@@ -7,19 +7,24 @@
  * valid corners when one is nodata, nothing otherwise. Its
  * outline is made of unit lattice segments: the long side of every
  * three-valid cell, and every axis edge between two valid samples that
- * exactly one of its two cells carries. Straight runs of the outline are
- * merged (the samples between lie on the merged edge, so they stay
- * covered); the corners become vertices of a Delaunay triangulation of the
- * valid samples' convex hull, and every run is then recovered as a
- * constrained edge by flips (Sloan 1993: the edges crossing the segment are
- * flipped until the segment appears; each queued edge is kept by its two
- * vertices, since flips rewrite half-edge slots). Finally the triangles
- * outside D are deleted: with the outline in the mesh, each triangle lies
- * wholly inside or wholly outside D. Refinement then only splits triangles
- * and flips unconstrained inner edges, so the TIN never leaves D, and a
- * valid sample stays uncovered exactly when no valid cell part holds it.
+ * exactly one of its two cells carries. The TIN follows not that outline
+ * but a lean polygon P that separates the same samples with fewer
+ * vertices (see "the lean outline" below): P holds D and adds only regions
+ * without samples. P's vertices are inserted into a Delaunay triangulation
+ * of the valid samples' convex hull, and each of its segments is then
+ * recovered as a constrained edge by flips (Sloan 1993: the edges crossing
+ * the segment are flipped until the segment appears; each queued edge is
+ * kept by its two vertices, since flips rewrite half-edge slots). Finally
+ * the triangles outside P are deleted: with P in the mesh, each triangle
+ * lies wholly on one side, told by the segments' orientation. Refinement
+ * then only splits triangles and flips unconstrained inner edges, so the
+ * TIN never leaves P, and a valid sample stays uncovered exactly when no
+ * valid cell part holds it.
  *
- * Memory: one byte per sample (outline directions) while building.
+ * Memory: three bytes per sample (outline directions, traced steps, kept
+ * vertices) while building, and the current chain's corners. Time: linear
+ * in the samples, and in the outline's corners times the 128 one segment
+ * may replace.
  *
  * Part of src/mesh/, the mesh stage: the half-edge mesh, the samples a
  * triangle owns, the nodata domain.
