@@ -283,6 +283,11 @@ tt_status tt__app_read_dem_and_tin(app_run *r, tt_output *outp,
                                    tt_raster_info **out_info,
                                    size_t *out_valid, GDALDatasetH *out_tds,
                                    OGRLayerH *out_layer);
+/* -min_patch (min_patch.c): the valid patches (4-connected) of fewer than
+ * min samples become nodata; the samples and patches dropped. False when
+ * out of memory. */
+bool tt__app_drop_patches(tt_grid *g, size_t min, size_t *out_samples,
+                          size_t *out_patches);
 void tt__app_height_range(const tt_grid *grid, double *out_min,
                           double *out_max);
 const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
@@ -347,6 +352,7 @@ typedef struct app_simplify_report {
   const tt_raster_info *info;
   const char *driver;
   size_t cells, valid;
+  size_t min_patch, dropped_samples, dropped_patches; /* -min_patch */
   double zmin, zmax;
   const tt_refine_options *ropt;  /* the limits, for either method */
   const tt_decimate_options *dopt; /* -method decimate; else NULL */

@@ -292,6 +292,8 @@ static const tt__app_opt_def opt_defs[] = {
      AT(s.fill_nodata), .min = 1, .max = INT32_MAX,
      .bad = "must be a number of samples from 1 to 2147483647",
      .unit = "samples"},
+    {"-min_patch", O_MIN_PATCH, FOR_S, OPT_SIZE, AT(s.min_patch), .min = 1,
+     .max = SIZE_MAX, .bad = AT_LEAST_1, .unit = "samples"},
     {"-tile_size", O_TILE_SIZE, FOR_S, OPT_SIZE, AT(s.tile_size), .min = 16,
      .max = 65536, .bad = "must be 16 to 65536 cells"},
     {"-terrain", O_TERRAIN, FOR_T, OPT_LIST, AT(terrains), .flags = OPT_HINT,

@@ -37,6 +37,7 @@ enum opt_id {
   O_TIN_FRAME, O_TIN_TRANSFORM,
   O_Z_TO,
   O_FILL_NODATA,
+  O_MIN_PATCH,
   O_COUNT
 };
 

@@ -281,6 +281,13 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_size(&j, "lone_samples", e->samples - e->covered);
   tt__json_size(&j, "components", p->sum.components);
   tt__json_size(&j, "forced_vertices", p->sum.forced_vertices);
+  if (p->min_patch) {
+    tt__json_open(&j, "min_patch");
+    tt__json_size(&j, "samples", p->min_patch);
+    tt__json_size(&j, "dropped_patches", p->dropped_patches);
+    tt__json_size(&j, "dropped_samples", p->dropped_samples);
+    tt__json_close(&j);
+  }
   tt__json_num(&j, "max_error", e->max_error);
   tt__json_num(&j, "rmse", e->rmse);
   tt__json_num(&j, "mean_abs_error", e->mean_abs);
@@ -465,6 +472,12 @@ static void say_error(app_run *r, const app_simplify_report *p)
             "note:   %zu valid sample%s amid nodata (in no cell with 3 "
             "valid corners) cannot carry a triangle and %s left out\n",
             lone, lone == 1 ? "" : "s", lone == 1 ? "is" : "are");
+  if (p->dropped_patches)
+    fprintf(r->out,
+            "note:   %zu valid sample%s in %zu patch%s of fewer than %zu "
+            "samples dropped (-min_patch)\n", p->dropped_samples,
+            p->dropped_samples == 1 ? "" : "s", p->dropped_patches,
+            p->dropped_patches == 1 ? "" : "es", p->min_patch);
 }
 
 /* How the stop came, in words. */

@@ -164,6 +164,8 @@ typedef struct tt_app_settings {
                                 given (GDAL_NUM_THREADS, else automatic) */
   size_t max_memory;         /* -max_memory in bytes (simplify, eval); 0:
                                 not given (the system's limit) */
+  size_t min_patch;          /* -min_patch N (simplify): valid patches of
+                                fewer samples dropped; 0: none */
   size_t tile_size;          /* -tile_size N (simplify): tiles of N cells
                                 (docs/scale.md); 0: untiled unless the
                                 heights do not fit the memory limit */

@@ -213,6 +213,12 @@ static tt_status read_whole(app_simplify_job *job)
   rep->info = job->info;
   rep->driver = job->drvname;
   rep->cells = tt_grid_width(job->grid) * tt_grid_height(job->grid);
+  rep->min_patch = job->s->min_patch;
+  if (!tt__app_drop_patches(job->grid, job->s->min_patch,
+                            &rep->dropped_samples, &rep->dropped_patches))
+    return tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, job->s->input,
+                        "out of memory for -min_patch");
+  valid -= rep->dropped_samples;
   rep->valid = valid;
   tt__app_height_range(job->grid, &rep->zmin, &rep->zmax);
   rep->t_read = tt__app_now() - r->t0;
@@ -299,6 +305,11 @@ tt_status tt__app_simplify(app_run *r)
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
   if (st == TT_OK)
     st = choose_tiling(&job);
+  if (st == TT_OK && job.tile_size && r->s->min_patch)
+    st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, "-min_patch",
+                      "a tiled run (-tile_size, or tiles chosen by the "
+                      "memory limit) cannot count patches across its "
+                      "tiles: run untiled");
   if (st == TT_OK)
     st = job.tile_size ? run_tiled(&job) : run_whole(&job);
   /* nothing to write: one tile of `tiles run`, handed to its hook */

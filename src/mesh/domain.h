@@ -18,9 +18,10 @@ typedef bool (*tt__domain_add_vertex)(void *arg, int32_t col, int32_t row,
                                       int32_t *out_v);
 
 /* m holds a triangulation of the valid samples' convex hull. Inserts the
- * corners of the domain's outline, recovers its straight runs as
+ * vertices of the domain's lean outline (a polygon holding the valid
+ * domain and no nodata sample, see domain.c), recovers its segments as
  * constrained edges, restores the criterion elsewhere, and deletes the
- * triangles outside the domain. */
+ * triangles outside it. */
 TT_HIDDEN tt_status tt__domain_build(tt_context *ctx, tt__mesh *m,
                                      const tt_grid *g,
                                      const tt__criterion_vt *crit,
