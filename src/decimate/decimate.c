@@ -879,6 +879,31 @@ static tt_status decimate(tt_context *ctx, const tt_grid *grid,
                                                      : run_independent(&r);
   if (status != TT_OK)
     goto done;
+  /* Every limit is exact: a budget the start cannot come down to (the
+   * vertices `all`'s cell-by-cell outline keeps, more than the lean
+   * outline the check above counts), unless the bound stopped the run
+   * first, is refused, not passed with exit 0. */
+  if (r.reason != TT_STOP_MAX_ERROR &&
+      ((r.target_v && d->nvert > r.target_v) ||
+       (r.target_t && d->m.nlive > r.target_t))) {
+    status = tt__error(ctx, TT_ERR_LIMIT, "the %s limit %zu%s is below the "
+                       "%zu %s this start cannot remove (the nodata "
+                       "outline's cell corners); ask for at least %zu, or "
+                       "start from -start greedy, which follows the lean "
+                       "outline", r.target_v && d->nvert > r.target_v
+                                      ? "point" : "triangle",
+                       r.target_v && d->nvert > r.target_v ? r.target_v
+                                                           : r.target_t,
+                       opt->percent > 0 && r.target_v != opt->max_points
+                           ? " (from the percentage)" : "",
+                       r.target_v && d->nvert > r.target_v ? d->nvert
+                                                           : d->m.nlive,
+                       r.target_v && d->nvert > r.target_v ? "vertices"
+                                                           : "triangles",
+                       r.target_v && d->nvert > r.target_v ? d->nvert
+                                                           : d->m.nlive);
+    goto done;
+  }
   /* the final pass keeps the bound (or the worst error left) */
   double bound = d->max_error >= 0 ? d->max_error : worst_error(d);
   tt_optimize mode = tt_optimize_resolve(opt->optimize, opt->criterion,

@@ -111,13 +111,27 @@ if [ -n "$need" ]; then
   expect_failure "decimate -max_points $((need - 1))" 2 "ask for at least $need" \
     simplify -q -method decimate -max_points $((need - 1)) in/hole.asc out/x.gpkg
   rm -f out/*
-  for n in "$need" $((need + 40)); do
+  # -start all keeps the cell corners of its outline, more than the lean
+  # outline refinement needs: a budget between the two is refused after
+  # the run (exit 2, nothing written), naming its own count
+  expect_failure "decimate -max_points $need (start all)" 2 "ask for at least" \
+    simplify -q -method decimate -max_points "$need" in/hole.asc out/x.gpkg
+  need_all=$(sed -n 's/.*ask for at least \([0-9]*\).*/\1/p' err.txt)
+  check "decimate: the refusal names the start's count ($need_all)" [ -n "$need_all" ]
+  rm -f out/*
+  for n in "$need_all" $((need_all + 40)); do
     run simplify -q -json -method decimate -max_points "$n" in/hole.asc out/d.gpkg
     check "decimate -max_points $n: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
     check "decimate -max_points $n: $n vertices" \
       [ "$(json_get out.txt vertices 2>/dev/null)" = "$n" ]
     rm -f out/*
   done
+  # -start greedy follows the lean outline: the refinement's count holds
+  run simplify -q -json -method decimate -start greedy -max_points "$need" in/hole.asc out/d.gpkg
+  check "decimate -start greedy -max_points $need: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+  check "decimate -start greedy -max_points $need: $need vertices" \
+    [ "$(json_get out.txt vertices 2>/dev/null)" = "$need" ]
+  rm -f out/*
 fi
 # a lone valid sample on the hull (a corner amid nodata) is in no triangle
 # and not written: the budget counts the TIN's vertices, so -max_points N
