@@ -166,6 +166,8 @@ static tt_status run_whole(app_simplify_job *job)
     tt__app_step_of_grid(&step, job->grid);
     tt__app_job_default_bound(job, &step);
   }
+  if (s->breaklines && (st = tt__app_breaklines(job)) != TT_OK)
+    return st;
   tt__app_phase_set(&r->prog, 0.10, 0.85);
   rep->ropt = &job->ro;
   if (job->decimate)
@@ -227,7 +229,14 @@ tt_status tt__app_simplify(app_run *r)
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
   if (st == TT_OK) {
     choose_tiling(&job);
-    st = job.tile_size ? run_tiled(&job) : run_whole(&job);
+    if (r->s->breaklines && (job.tile_size || job.decimate))
+      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                        "simplify: -breaklines: not yet with %s",
+                        job.decimate ? "-method decimate"
+                                     : "a tiled run (-tile_size, or "
+                                       "-max_memory choosing tiles)");
+    else
+      st = job.tile_size ? run_tiled(&job) : run_whole(&job);
   }
   /* nothing to write: one tile of `tiles run`, handed to its hook */
   int made = job.tin || job.kind == APP_OUTPUT_STREAM;
