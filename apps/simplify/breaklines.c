@@ -12,7 +12,7 @@
  * lines are split there. Each piece between such samples is simplified by
  * Douglas-Peucker on its profile (heights against the position along the
  * simplified segment), exactly: every chain sample is within the bound of
- * its segment, and a segment is kept only when every cell of its bounding
+ * its segment in height and within one sample step of it in the plane, and a segment is kept only when every cell of its bounding
  * box is valid, so it never crosses the nodata outline. Simplified
  * segments that cross each other are split again (back towards the unit
  * steps, which never cross) until none does. Refinement then keeps the
@@ -264,7 +264,9 @@ static bool shared(const int64_t *sorted, size_t n, int64_t s)
 
 /* The sample of chain samples i < k < j farthest from segment i - j in
  * height (heights interpolated at each sample's projection on it), and
- * that distance; i + 1 == j: -1. */
+ * that distance; i + 1 == j: -1. A sample farther than one sample step
+ * from the segment in the plane counts as infinitely far: a line keeps
+ * its path, not only its profile. */
 static size_t worst(const tracer *T, size_t i, size_t j, double *out_err)
 {
   const int64_t *s = T->c.s;
@@ -277,7 +279,10 @@ static size_t worst(const tracer *T, size_t i, size_t j, double *out_err)
     double t = len2 > 0 ? (((double)sx(T, s[k]) - xi) * dx +
                            ((double)sy(T, s[k]) - yi) * dy) / len2 : 0;
     t = t < 0 ? 0 : t > 1 ? 1 : t;
-    double e = fabs(sz(T, s[k]) - (zi + t * dz));
+    double ex = (double)sx(T, s[k]) - (xi + t * dx);
+    double ey = (double)sy(T, s[k]) - (yi + t * dy);
+    double e = ex * ex + ey * ey > 1.0 ? HUGE_VAL
+                                       : fabs(sz(T, s[k]) - (zi + t * dz));
     if (e > *out_err) {
       *out_err = e;
       at = k;
