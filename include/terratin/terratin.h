@@ -592,6 +592,9 @@ typedef struct tt_triangle_info {
                              (+y), [0,360); NaN when flat */
   double min_angle_deg;   /* in the ground frame */
   double max_angle_deg;
+  /* Bit k (1, 2, 4) set when edge v[k] -> v[(k + 1) % 3] lies on one of
+   * the run's breaklines (tt_breaklines); 0 without breaklines. */
+  unsigned constrained;
 } tt_triangle_info;
 
 /* index < count, else TT_ERR_ARG (the context may be NULL here). */

@@ -20,6 +20,8 @@
  */
 #include "mesh/breaklines.h"
 
+#include "base/predicates.h"
+
 #include <math.h>
 #include <stdlib.h>
 
@@ -66,6 +68,57 @@ oom:
   return -1;
 }
 
+static void flag_edge(tt__mesh *m, int32_t e)
+{
+  m->eflag[e] |= TT__EDGE_CONSTRAINED | TT__EDGE_BREAKLINE;
+  if (m->twin[e] >= 0)
+    m->eflag[m->twin[e]] |= TT__EDGE_CONSTRAINED | TT__EDGE_BREAKLINE;
+}
+
+/* Whether vertex c lies on segment pb, strictly after p (c == b too). */
+static bool ahead(const tt__mesh *m, int32_t p, int32_t b, int32_t c)
+{
+  const tt__mesh_vertex *P = &m->v[p], *B = &m->v[b], *C = &m->v[c];
+  if (tt__orient_i(P->c, P->r, B->c, B->r, C->c, C->r) != 0)
+    return false;
+  int64_t dx = B->c - P->c, dy = B->r - P->r;
+  int64_t t = (int64_t)(C->c - P->c) * dx + (int64_t)(C->r - P->r) * dy;
+  return t > 0 && t <= dx * dx + dy * dy;
+}
+
+/* Flags the recovered edges from a to b (split at the vertices on the
+ * segment) as a breakline's. False when out of memory or when the chain
+ * of edges is not there (then the recovery failed). */
+static bool flag_segment(tt__mesh *m, int32_t a, int32_t b, int32_t **ring,
+                         int *cap)
+{
+  int32_t p = a;
+  size_t guard = 0;
+  while (p != b) {
+    int n = tt__mesh_star(m, p, *ring, NULL, *cap, &(bool){false});
+    if (n > *cap) {
+      int32_t *r = realloc(*ring, (size_t)n * sizeof *r);
+      if (!r)
+        return false;
+      *ring = r;
+      *cap = n;
+      n = tt__mesh_star(m, p, *ring, NULL, *cap, &(bool){false});
+    }
+    int32_t q = -1;
+    for (int i = 0; i < n && q < 0; i++)
+      if (ahead(m, p, b, (*ring)[i]))
+        q = (*ring)[i];
+    int32_t e = q >= 0 ? tt__mesh_find_edge(m, p, q) : -1;
+    if (e < 0)
+      e = q >= 0 ? tt__mesh_find_edge(m, q, p) : -1;
+    if (e < 0 || ++guard > m->nv)
+      return false;
+    flag_edge(m, e);
+    p = q;
+  }
+  return true;
+}
+
 tt_status tt__breaklines_insert(tt_context *ctx, tt__mesh *m,
                                 const tt_grid *g, const tt_breaklines *bl,
                                 const tt__criterion_vt *crit,
@@ -75,6 +128,8 @@ tt_status tt__breaklines_insert(tt_context *ctx, tt__mesh *m,
                                 void *add_arg)
 {
   tt_status status = TT_OK;
+  int32_t *ring = NULL;
+  int ringcap = 0;
   int32_t *vid = malloc((2 * bl->n + 1) * sizeof *vid);
   if (!vid)
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory for %zu breakline "
@@ -110,11 +165,21 @@ tt_status tt__breaklines_insert(tt_context *ctx, tt__mesh *m,
       goto done;
     }
   }
-  /* 3. the criterion restored around the constrained edges */
+  /* 3. each segment's edges flagged as a breakline's, once all are in
+   *    (a later recovery may split an earlier segment at a vertex) */
+  for (size_t i = 0; i < bl->n; i++)
+    if (vid[2 * i] != vid[2 * i + 1] &&
+        !flag_segment(m, vid[2 * i], vid[2 * i + 1], &ring, &ringcap)) {
+      status = tt__error(ctx, TT_ERR_INTERNAL, "a recovered breakline "
+                         "segment is not a chain of mesh edges");
+      goto done;
+    }
+  /* 4. the criterion restored around the constrained edges */
   if (tt__swap_all(m, crit, env, stack) < 0)
     status = tt__error(ctx, TT_ERR_NOMEM, "out of memory while inserting "
                        "the breaklines");
 done:
   free(vid);
+  free(ring);
   return status;
 }

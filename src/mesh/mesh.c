@@ -844,7 +844,7 @@ bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots, int nold,
     for (int h = 0; h < nhalf; h++) {
       int32_t x = tris[h / 3][h % 3], y = tris[h / 3][(h % 3 + 1) % 3];
       if ((x == a && y == b) || (x == b && y == a)) {
-        iflag[h] = TT__EDGE_CONSTRAINED;
+        iflag[h] = m->eflag[icons[i]]; /* breakline bit included */
         kept = true;
       }
     }
