@@ -4,8 +4,12 @@ TIN of GPKG (read with sqlite3) follows each line of LINES (a GeoJSON of
 LineStrings in the DEM's map units; the DEM's grid: upper-left corner X0,
 YTOP, square cells of CELL, NX x NY samples): a path of TIN edges from the
 vertex at the line's first sample on the grid to the one at its last,
-every edge within 1.5 samples of the line all along. Prints one JSON
-object per line; exits 1 when some line has no such path."""
+every edge within 1.5 samples of the line all along. When GPKG has a
+breaklines layer (a TIN made with -breaklines), the path may take only
+its edges, and the layer must be exactly the edges the triangles'
+constrained field flags, each an edge of the TIN flagged on both sides.
+Prints one JSON object per line; exits 1 when some line has no such path
+or the layer and the flags disagree."""
 import json
 import math
 import sqlite3
@@ -31,12 +35,32 @@ def main():
     db = sqlite3.connect(gpkg)
     verts = {vid: (c, r) for vid, c, r in
              db.execute("select vertex_id, col, row from vertices")}
+    tables = {r[0] for r in db.execute(
+        "select name from sqlite_master where type = 'table'")}
+    layer = "breaklines" in tables
     adj = {}
-    for a, b, c in db.execute("select v0, v1, v2 from triangles"):
-        for p, q in ((a, b), (b, c), (c, a)):
-            adj.setdefault(p, set()).add(q)
-            adj.setdefault(q, set()).add(p)
+    sides, flagged = {}, {}
+    cols = "v0, v1, v2" + (", constrained" if layer else ", 0")
+    for a, b, c, k in db.execute("select %s from triangles" % cols):
+        for i, (p, q) in enumerate(((a, b), (b, c), (c, a))):
+            e = (min(p, q), max(p, q))
+            sides[e] = sides.get(e, 0) + 1
+            flagged[e] = flagged.get(e, 0) + ((k >> i) & 1)
     bad = 0
+    if layer:
+        edges = {(min(a, b), max(a, b)) for a, b in
+                 db.execute("select v0, v1 from breaklines")}
+        flags = {e for e, n in flagged.items() if n}
+        both = all(flagged[e] == sides[e] for e in flags)
+        agree = edges == flags and both
+        print(json.dumps({"breakline_edges": len(edges),
+                          "flags_agree": agree}))
+        bad += not agree
+    else:
+        edges = set(sides)
+    for p, q in edges:
+        adj.setdefault(p, set()).add(q)
+        adj.setdefault(q, set()).add(p)
     for feat in json.load(open(lines))["features"]:
         pts = [((x - x0) / cell - 0.5, (ytop - y) / cell - 0.5)
                for x, y in feat["geometry"]["coordinates"]]

@@ -3,9 +3,11 @@
 # ($TT_TERRATIN), on a synthetic valley (120 x 100 samples of 10 m, UTM
 # 17N) with a meandering stream and a straight road across it (a GeoJSON
 # written here):
-#  - each line is followed by a path of TIN edges from its first sample on
-#    the grid to its last (tests/apps/breakline_path.py), where without
-#    -breaklines the road is not;
+#  - each line is followed by a path of the breaklines layer's edges from
+#    its first sample on the grid to its last, and that layer is exactly
+#    the edges the triangles' constrained field flags
+#    (tests/apps/breakline_path.py); without -breaklines the road is not
+#    followed even by the TIN's edges, and there is no such layer or field;
 #  - so it stays under every optimiser (-optimize local, lookahead,
 #    anneal): they never flip a breakline's edge;
 #  - the bound holds by `terratin eval`, and the TIN is conforming
@@ -28,7 +30,7 @@ if [ -z "$T" ] || [ ! -x "$T" ]; then
   echo "SKIP: TT_TERRATIN is not set or not executable"
   exit 77
 fi
-for tool in gdal_translate python3; do
+for tool in gdal_translate ogrinfo python3; do
   if ! command -v "$tool" >/dev/null 2>&1; then
     echo "SKIP: $tool is missing"
     exit 77
@@ -101,6 +103,13 @@ if follows plain.gpkg road.geojson; then
 else
   pass
 fi
+
+check "a TIN without breaklines has no breaklines layer" \
+  sh -c "! ogrinfo -q plain.gpkg breaklines >/dev/null 2>&1"
+check "nor a constrained field" \
+  sh -c "! ogrinfo -so plain.gpkg triangles | grep -q constrained"
+check "a TIN with breaklines has both" \
+  sh -c "ogrinfo -so bl.gpkg triangles | grep -q 'constrained: Integer'"
 
 # no optimiser flips a breakline's edge
 for o in local lookahead anneal; do
