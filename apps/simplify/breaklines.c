@@ -577,13 +577,15 @@ tt_status tt__app_breaklines(app_simplify_job *job)
   st = trace_layer(r, &T, l, ct, inv, &lines, &cut);
   if (st != TT_OK)
     goto done;
-  double bound = job->ro.max_error > 0 ? job->ro.max_error : 0;
+  double e = job->decimate ? job->dopt.max_error : job->ro.max_error;
+  double bound = e > 0 ? e : 0;
   if (!chains_to_segments(&T, bound, &job->bl_ends, &job->ro.breaklines.n)) {
     st = tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_NOMEM, s->breaklines,
                       "out of memory simplifying the breaklines");
     goto done;
   }
   job->ro.breaklines.ends = job->bl_ends;
+  job->dopt.breaklines = job->ro.breaklines;
   job->rep.breaklines = lines;
   job->rep.breakline_segments = job->ro.breaklines.n;
   if (cut)

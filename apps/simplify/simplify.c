@@ -229,12 +229,10 @@ tt_status tt__app_simplify(app_run *r)
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
   if (st == TT_OK) {
     choose_tiling(&job);
-    if (r->s->breaklines && (job.tile_size || job.decimate))
+    if (r->s->breaklines && job.tile_size)
       st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                        "simplify: -breaklines: not yet with %s",
-                        job.decimate ? "-method decimate"
-                                     : "a tiled run (-tile_size, or "
-                                       "-max_memory choosing tiles)");
+                        "simplify: -breaklines: not yet with a tiled run "
+                        "(-tile_size, or -max_memory choosing tiles)");
     else
       st = job.tile_size ? run_tiled(&job) : run_whole(&job);
   }

@@ -687,6 +687,9 @@ typedef struct tt_decimate_options {
    * every sample (decimation keeps no running sums). NULL: none. */
   tt_step_fn step;
   void *step_arg;
+  /* Edges the TIN must have (tt_breaklines): made constrained edges of
+   * the start (every start); their vertices are never removed. */
+  tt_breaklines breaklines;
 } tt_decimate_options;
 
 /* Default: no limit at all (set one), Delaunay, start all, importance

@@ -75,6 +75,17 @@ static void flag_edge(tt__mesh *m, int32_t e)
     m->eflag[m->twin[e]] |= TT__EDGE_CONSTRAINED | TT__EDGE_BREAKLINE;
 }
 
+bool tt__breaklines_flag(tt__mesh *m, int32_t a, int32_t b)
+{
+  int32_t e = tt__mesh_find_edge(m, a, b);
+  if (e < 0)
+    e = tt__mesh_find_edge(m, b, a);
+  if (e < 0)
+    return false;
+  flag_edge(m, e);
+  return true;
+}
+
 /* Whether vertex c lies on segment pb, strictly after p (c == b too). */
 static bool ahead(const tt__mesh *m, int32_t p, int32_t b, int32_t c)
 {
@@ -86,6 +97,49 @@ static bool ahead(const tt__mesh *m, int32_t p, int32_t b, int32_t c)
   return t > 0 && t <= dx * dx + dy * dy;
 }
 
+/* The ring of p's star into *ring (grown); -1 when p is in no triangle,
+ * -2 when out of memory. */
+static int star_ring(const tt__mesh *m, int32_t p, int32_t **ring, int *cap)
+{
+  bool closed;
+  int n = tt__mesh_star(m, p, *ring, NULL, *cap, &closed);
+  if (n > *cap) {
+    int32_t *r = realloc(*ring, (size_t)n * sizeof *r);
+    if (!r)
+      return -2;
+    *ring = r;
+    *cap = n;
+    n = tt__mesh_star(m, p, *ring, NULL, *cap, &closed);
+  }
+  return n;
+}
+
+/* Recovers segment ab: step by step along the vertices on it that are
+ * neighbours already (the outline's recovery finds those inside a star,
+ * not those across the boundary, where a line along the grid's edge
+ * meets them), then the rest by flips. */
+static bool recover_line(tt__mesh *m, int32_t a, int32_t b, int32_t **ring,
+                         int *cap, bool *ok)
+{
+  int32_t p = a;
+  *ok = true;
+  while (p != b && *ok) {
+    int n = star_ring(m, p, ring, cap);
+    if (n == -2)
+      return false;
+    int32_t q = -1;
+    for (int i = 0; i < n && q < 0; i++)
+      if (ahead(m, p, b, (*ring)[i]))
+        q = (*ring)[i];
+    if (q < 0)
+      return tt__domain_recover_segment(m, p, b, ok);
+    if (!tt__domain_recover_segment(m, p, q, ok))
+      return false;
+    p = q;
+  }
+  return true;
+}
+
 /* Flags the recovered edges from a to b (split at the vertices on the
  * segment) as a breakline's. False when out of memory or when the chain
  * of edges is not there (then the recovery failed). */
@@ -95,15 +149,9 @@ static bool flag_segment(tt__mesh *m, int32_t a, int32_t b, int32_t **ring,
   int32_t p = a;
   size_t guard = 0;
   while (p != b) {
-    int n = tt__mesh_star(m, p, *ring, NULL, *cap, &(bool){false});
-    if (n > *cap) {
-      int32_t *r = realloc(*ring, (size_t)n * sizeof *r);
-      if (!r)
-        return false;
-      *ring = r;
-      *cap = n;
-      n = tt__mesh_star(m, p, *ring, NULL, *cap, &(bool){false});
-    }
+    int n = star_ring(m, p, ring, cap);
+    if (n == -2)
+      return false;
     int32_t q = -1;
     for (int i = 0; i < n && q < 0; i++)
       if (ahead(m, p, b, (*ring)[i]))
@@ -149,7 +197,8 @@ tt_status tt__breaklines_insert(tt_context *ctx, tt__mesh *m,
     bool ok = true;
     if (vid[2 * i] == vid[2 * i + 1])
       continue; /* a segment of one sample: nothing to recover */
-    if (!tt__domain_recover_segment(m, vid[2 * i], vid[2 * i + 1], &ok)) {
+    if (!recover_line(m, vid[2 * i], vid[2 * i + 1], &ring, &ringcap,
+                      &ok)) {
       status = tt__error(ctx, TT_ERR_NOMEM, "out of memory while "
                          "recovering the breaklines");
       goto done;

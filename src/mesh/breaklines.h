@@ -26,4 +26,8 @@ TT_HIDDEN tt_status tt__breaklines_insert(tt_context *ctx, tt__mesh *m,
                                           tt__domain_add_vertex add_vertex,
                                           void *add_arg);
 
+/* Flags the edge between vertices a and b (either direction; none: false)
+ * as a constrained edge on a breakline, both half-edges. */
+TT_HIDDEN bool tt__breaklines_flag(tt__mesh *m, int32_t a, int32_t b);
+
 #endif /* TT_BREAKLINES_H */

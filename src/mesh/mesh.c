@@ -397,8 +397,8 @@ bool tt__mesh_split_edge(tt__mesh *m, int32_t e, int32_t p,
     out_opposite[2] = 3 * u;
     out_opposite[3] = 3 * u1 + 2;
   } else {
-    link(m, 3 * t + 1, -1, 0);
-    link(m, 3 * t1 + 1, -1, 0);
+    link(m, 3 * t + 1, -1, f_ab); /* the halves keep its flags */
+    link(m, 3 * t1 + 1, -1, f_ab);
     out_opposite[2] = out_opposite[3] = -1;
   }
   return true;

@@ -16,7 +16,8 @@
 #    nodata hole are clipped there and the run still holds the bound;
 #  - -breaklines_where picks features, -breaklines_layer a layer; a missing
 #    file, layer or bad filter fails on one line naming it, nothing written;
-#    tiled runs and -method decimate are refused (not yet);
+#    tiled runs are refused (not yet);
+#  - -method decimate (-start all, greedy) keeps the lines and the bound;
 #  - the Jacksboro fault DEM (testdata/) with a line drawn across it in
 #    longitude/latitude.
 # Prints "N passed, M failed"; exits 1 on any failure, 77 (skip) when a tool
@@ -120,6 +121,17 @@ for o in local lookahead anneal; do
   check "-optimize $o keeps the bound" bound valley.tif opt_$o.gpkg 1
 done
 
+# decimation, from every sample and from the greedy start
+for st in all greedy; do
+  "$T" simplify valley.tif dec_$st.gpkg -max_error 1 -method decimate \
+    -start $st -breaklines lines.geojson -q 2>/dev/null
+  check "-method decimate -start $st runs" test $? -eq 0
+  check "-method decimate -start $st keeps the lines" \
+    follows dec_$st.gpkg lines.geojson
+  check "-method decimate -start $st keeps the bound" \
+    bound valley.tif dec_$st.gpkg 1
+done
+
 # the filter and the layer
 "$T" simplify valley.tif road.gpkg -max_error 1 -breaklines lines.geojson \
   -breaklines_where "kind = 'road'" -breaklines_layer lines -q 2>warn2.txt
@@ -154,9 +166,6 @@ check "a bad filter fails naming the option" \
 check "a tiled run is refused" \
   fails f4.gpkg "not yet with a tiled run" -breaklines lines.geojson \
   -tile_size 64
-check "decimation is refused" \
-  fails f5.gpkg "not yet with -method decimate" -breaklines lines.geojson \
-  -method decimate
 
 # a real DEM: the Jacksboro fault (geographic), a line drawn across it
 J="$HERE/../../testdata/jacksboro_fault_dem.tif"
