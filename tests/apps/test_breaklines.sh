@@ -18,6 +18,7 @@
 #    file, layer or bad filter fails on one line naming it, nothing written;
 #    tiled runs are refused (not yet);
 #  - -method decimate (-start all, greedy) keeps the lines and the bound;
+#  - LandXML carries the same edges in Surface/SourceData/Breaklines;
 #  - the Jacksboro fault DEM (testdata/) with a line drawn across it in
 #    longitude/latitude.
 # Prints "N passed, M failed"; exits 1 on any failure, 77 (skip) when a tool
@@ -131,6 +132,36 @@ for st in all greedy; do
   check "-method decimate -start $st keeps the bound" \
     bound valley.tif dec_$st.gpkg 1
 done
+
+# LandXML: the same edges in Surface/SourceData/Breaklines, before the
+# Definition as the schema orders them, chained into polylines
+"$T" simplify valley.tif bl.xml -max_error 1 -breaklines lines.geojson -q \
+  2>/dev/null
+check "a LandXML output with breaklines runs" test $? -eq 0
+landxml_lines() {
+  python3 - "$1" "$2" <<'PYEOF'
+import sqlite3, sys, xml.etree.ElementTree as ET
+ns = {"l": "http://www.landxml.org/schema/LandXML-1.2"}
+s = ET.parse(sys.argv[1]).getroot().find("l:Surfaces/l:Surface", ns)
+kids = [c.tag.split("}")[1] for c in s]
+pts = {}
+for p in s.findall("l:Definition/l:Pnts/l:P", ns):
+    pts[tuple(round(float(t), 6) for t in p.text.split())] = int(p.get("id"))
+edges = set()
+for b in s.findall("l:SourceData/l:Breaklines/l:Breakline", ns):
+    t = [float(x) for x in b.find("l:PntList3D", ns).text.split()]
+    ids = [pts[tuple(round(v, 6) for v in t[i:i + 3])]
+           for i in range(0, len(t), 3)]
+    edges |= {(min(a, b) - 1, max(a, b) - 1) for a, b in zip(ids, ids[1:])}
+db = sqlite3.connect(sys.argv[2])
+gpkg = {(min(a, b), max(a, b)) for a, b in
+        db.execute("select v0, v1 from breaklines")}
+sys.exit(0 if kids == ["SourceData", "Definition"] and edges == gpkg and
+         edges else 1)
+PYEOF
+}
+check "the LandXML breaklines are the GeoPackage's edges" \
+  landxml_lines bl.xml bl.gpkg
 
 # the filter and the layer
 "$T" simplify valley.tif road.gpkg -max_error 1 -breaklines lines.geojson \
