@@ -113,6 +113,18 @@ check "nor a constrained field" \
 check "a TIN with breaklines has both" \
   sh -c "ogrinfo -so bl.gpkg triangles | grep -q 'constrained: Integer'"
 
+"$T" simplify valley.tif sum.gpkg -max_error 1 -breaklines lines.geojson \
+  >sum.txt 2>/dev/null
+check "the summary names the breaklines layer" \
+  grep -q "layers triangles, vertices, run_parameters, breaklines" sum.txt
+check "the summary counts the lines" grep -q "^lines:  2 breaklines read" sum.txt
+"$T" simplify valley.tif sum.json.gpkg -max_error 1 -json \
+  -breaklines lines.geojson >sum.json 2>/dev/null
+check "the JSON counts the lines" python3 -c "
+import json, sys
+b = json.load(open('sum.json'))['breaklines']
+sys.exit(0 if b['lines'] == 2 and b['segments'] > 2 else 1)"
+
 # no optimiser flips a breakline's edge
 for o in local lookahead anneal; do
   "$T" simplify valley.tif opt_$o.gpkg -max_error 1 -optimize $o \
