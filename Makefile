@@ -88,5 +88,11 @@ study: build
 doc-tables: build
 	bench/doc_tables.py --update --tier long $(BUILD)/terratin
 
+# The QGIS plugin (qgis/terratin/, docs/qgis.md) as the zip QGIS's
+# "Install from ZIP" takes.
+.PHONY: qgis-plugin
+qgis-plugin:
+	python3 tools/qgis_plugin_zip.py $(BUILD)/terratin-qgis.zip
+
 clean:
 	rm -rf $(BUILD) $(BUILD_SAN) demo-out

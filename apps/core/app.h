@@ -286,6 +286,12 @@ void tt__app_height_range(const tt_grid *grid, double *out_min,
                           double *out_max);
 const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt);
 const char *tt__app_nonempty_or_null(const char *s);
+/* Why the heights were converted to metres, in the command's words ("the
+ * CRS is in metres", "asked by -z_to m"); "" when they were not. */
+const char *tt__app_z_unit_why(const tt_raster_info *info);
+/* Where the heights' unit was said: "band unit", "vertical CRS",
+ * "-z_unit", or "". */
+const char *tt__app_z_unit_source(const tt_raster_info *info);
 /* "2026-11-22T10:38:55Z" */
 void tt__app_iso8601_utc(char *buf, size_t size);
 /* The engine's thread count (tt_refine_options.threads): -threads, else
@@ -322,6 +328,19 @@ void tt__json_null(app_json *j, const char *key);
 /* A list of strings (NULL-terminated; NULL: an empty list). */
 void tt__json_strs(app_json *j, const char *key, char *const *v);
 
+/* What simplify's estimate predicted before the work (apps/simplify/
+ * estimate.c). */
+typedef struct app_estimate {
+  int done;                  /* the pass ran */
+  double bound;              /* the bound it predicts for */
+  int bound_default;         /* ... the default one, from the sample */
+  size_t windows, window_size, sampled_cells, sampled_valid;
+  double valid, vertices, triangles, share; /* the DEM's, predicted */
+  double output_bytes, memory_whole;        /* bytes */
+  double advice_bound;       /* the bound of about a 5 % TIN, or NaN */
+  double seconds;
+} app_estimate;
+
 /* What simplify reports, as text or JSON (report.c). */
 typedef struct app_simplify_report {
   const tt_raster_info *info;
@@ -339,6 +358,9 @@ typedef struct app_simplify_report {
    * the memory limit chose tiling, the bytes the tiles in flight hold */
   size_t tiles, tile_size, tile_bytes;
   int tile_threads, auto_tiled;
+  size_t mem_limit;            /* the memory limit the tiling was held to */
+  const char *mem_source;      /* what set it (-max_memory, the system) */
+  app_estimate estimate;       /* done: the estimate ran */
   int budget_passes;  /* tiled runs to a budget: the runs at a bound */
   int streamed;       /* the GeoPackage written as the tiles merged */
   /* the CRS the layers are written in: -t_srs, or the one a format takes
@@ -351,6 +373,9 @@ typedef struct app_simplify_report {
   /* what was written, as the user names it (tt__app_output_names): the
    * files, and the layers of a dataset of several (else NULL) */
   char **files, **layers;
+  /* 2DM: the .prj beside it that holds the CRS, which the format (and
+   * MDAL) cannot (one of files); NULL: none */
+  const char *crs_file;
 } app_simplify_report;
 
 /* --- the subcommands ----------------------------------------------------- */
@@ -361,6 +386,15 @@ tt_status tt__app_eval(app_run *r);      /* eval.c */
 tt_status tt__app_optimize(app_run *r);  /* optimize.c */
 tt_status tt__app_study(app_run *r);     /* study.c */
 tt_status tt__app_rasterize(app_run *r); /* rasterize.c */
+/* --formats (simplify/formats.c): the output formats simplify writes, each
+ * OGR driver judged by the dry run of its writer (ogr_output.c). */
+tt_status tt__app_formats(app_run *r);
+/* --help-general (help.c): the options of every command, as GDAL's
+ * utilities print them. */
+const char *tt__app_help_general(void);
+/* The help page of `terratin tiles SUB` (plan, run, merge; anything else:
+ * the overview of the three). */
+const char *tt__app_tiles_help(const char *sub);
 
 /* The dispatch table (run.c): one entry per command, which the parser
  * (the command word, how many positional words, where they go), the help
@@ -380,6 +414,9 @@ typedef struct tt__app_command_def {
 extern const tt__app_command_def tt__app_commands[];
 /* The entry of c, or NULL (no command, help, version). */
 const tt__app_command_def *tt__app_command_def_of(tt_app_command c);
+/* Which of the run's positional words path is (1 for the first), by the
+ * dispatch table; 0 when it is none of them (study's -terrain). */
+int tt__app_arg_number(const app_run *r, const char *path);
 /* raster_output.c, for rasterize and eval -error_raster: the raster
  * driver of -of, else
  * the one path's extension names (NULL path: GTiff), that can write a

@@ -167,9 +167,19 @@ GDALDatasetH tt__app_open_raster(app_run *r, const char *path, int band,
     CPLPopErrorHandler();
     if (vec) {
       GDALDriverH drv = GDALGetDatasetDriver(vec);
-      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
-               "is a vector dataset (%s), not a raster",
-               drv ? GDALGetDriverShortName(drv) : "?");
+      const char *dname = drv ? GDALGetDriverShortName(drv) : "?";
+      int k = tt__app_arg_number(r, path);
+      /* a positional word: which one, and what the command expects there
+       * (every command that reads a DEM takes it first) */
+      if (k)
+        tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, NULL,
+                     "%s: %s (argument %d) is a vector dataset (%s); the "
+                     "DEM (a raster) comes first",
+                     tt__app_command_name(r->s->command),
+                     tt__app_shown(r, path), k, dname);
+      else
+        tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+                     "is a vector dataset (%s), not a raster", dname);
       GDALClose(vec);
       return NULL;
     }
@@ -305,8 +315,14 @@ char **tt__app_read_options(const tt_app_settings *s)
     tt__app_format_double(num, sizeof num, s->z_factor);
     ropts = CSLSetNameValue(ropts, "Z_FACTOR", num);
   }
+  /* -z_unit says what the heights are; -z_to whether they become metres
+   * (auto unless asked otherwise) */
   if (s->z_unit)
-    ropts = CSLSetNameValue(ropts, "Z_UNIT", s->z_unit);
+    ropts = CSLSetNameValue(ropts, "SRC_Z_UNIT", s->z_unit);
+  if (!s->z_to || strcmp(s->z_to, "auto") == 0)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", "auto");
+  else if (strcmp(s->z_to, "m") == 0)
+    ropts = CSLSetNameValue(ropts, "Z_UNIT", "m");
   if (s->work_srs)
     ropts = CSLSetNameValue(ropts, "WORK_SRS", s->work_srs);
   return ropts;

@@ -6,9 +6,39 @@
  */
 #include "app.h"
 
+/* The options of every command: the top help and --help-general. */
+#define GENERAL_OPTIONS                                                       \
+  "  --help              this help, or the help of COMMAND (also -h,\n"      \
+  "                      'terratin help COMMAND')\n"                         \
+  "  --help-general      these options of every command\n"                   \
+  "  --version           terratin, GDAL and PROJ versions\n"                 \
+  "  --formats           the output formats -of accepts: the OGR drivers\n"  \
+  "                      terratin can write, the databases, the mesh formats\n"\
+  "  --config KEY VALUE  set a GDAL configuration option before anything is\n"\
+  "                      opened (repeatable; KEY=VALUE also accepted)\n"     \
+  "  --debug on|off      GDAL debug messages on stderr (CPL_DEBUG; also\n"   \
+  "                      yes|no|true|false|1|0)\n"                           \
+  "  -q, -quiet          no progress bar, no summary line (every command but\n" \
+  "                      tiles run, which prints nothing)\n"
+
+static const char help_general[] =
+    "Generic terratin options (every command takes them, before or after\n"
+    "the command word):\n"
+    GENERAL_OPTIONS
+    "\n"
+    "Option names and named values are matched without regard to case, and\n"
+    "'-' matches '_' in them (-max-error is -max_error); --opt is -opt.\n"
+    "A mistyped option is refused with the nearest option of the command\n"
+    "('did you mean -max_error?').\n";
+
+const char *tt__app_help_general(void)
+{
+  return help_general;
+}
+
 static const char help_top[] =
     "Usage: terratin COMMAND [options] ARGUMENTS...\n"
-    "       terratin --help | --version\n"
+    "       terratin --help | --help-general | --version | --formats\n"
     "\n"
     "Turns a DEM into a TIN (triangulated irregular network) whose vertices\n"
     "are grid samples, and measures triangle layers against DEMs.\n"
@@ -23,15 +53,11 @@ static const char help_top[] =
     "  tiles      plan, run and merge a tiled run as separate jobs (clusters)\n"
     "\n"
     "Options of every command:\n"
-    "  --help              this help, or the help of COMMAND\n"
-    "  --version           terratin, GDAL and PROJ versions\n"
-    "  --config KEY VALUE  set a GDAL configuration option before anything is\n"
-    "                      opened (repeatable; KEY=VALUE also accepted)\n"
-    "  --debug on|off      GDAL debug messages on stderr (CPL_DEBUG; also\n"
-    "                      yes|no|true|false|1|0)\n"
+    GENERAL_OPTIONS
     "\n"
     "Option names and named values (criteria, modes, TYPE) are matched\n"
-    "without regard to case; numbers are decimal (no hex, inf or nan).\n"
+    "without regard to case, '-' as '_'; numbers are decimal (no hex, inf\n"
+    "or nan).\n"
     "\n"
     "Exit codes:\n"
     "  0  success\n"
@@ -87,7 +113,8 @@ static const char help_simplify[] =
     "           [-importance degree|hdh|abh|volume|drop|error]\n"
     "           [-selection independent|sequential] [-onepass]\n"
     "           [-hole minangle|circumradius|dp]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
+    "           [-z_to m|native|auto]\n"
     INPUT_USAGE
     "           [-work_srs SRS] [-t_srs SRS]\n"
     "           [-breaklines LINES [-breaklines_layer L]\n"
@@ -129,12 +156,17 @@ static const char help_simplify[] =
     INPUT_HELP
     "  -z_factor F       multiply heights by F, e.g. 0.3048 for feet to\n"
     "                    metres (default 1; after the band's scale/offset)\n"
-    "  -z_unit m         heights declared in ft or us-ft (band unit, else\n"
-    "                    vertical CRS) converted to metres. Combined:\n"
-    "                    z = (raw * scale + offset) * unit factor * F; with\n"
-    "                    an unknown unit it needs -z_factor, which then is\n"
-    "                    the whole conversion. Errors and -max_error are in\n"
-    "                    the output z unit, which the summary names\n"
+    "  -z_unit U         the unit the heights are in: ft, us-ft or m (default:\n"
+    "                    the band's unit, else the vertical CRS's)\n"
+    "  -z_to MODE        auto (default): heights in ft or us-ft converted to\n"
+    "                    metres when the CRS is in metres or geographic,\n"
+    "                    kept when it is in feet or absent; m: converted\n"
+    "                    to metres whatever the CRS (an unknown unit then\n"
+    "                    needs -z_unit or -z_factor, which is then the\n"
+    "                    whole conversion); native: kept in their unit.\n"
+    "                    z = (raw * scale + offset) * unit factor * F.\n"
+    "                    Errors and -max_error are in the output z unit,\n"
+    "                    which the summary names with the reason\n"
     "  -work_srs SRS     conformal projected CRS in metres that measures\n"
     "                    angles, areas and the Delaunay test (default: a\n"
     "                    conformal frame for the extent, every sample\n"
@@ -214,7 +246,9 @@ static const char help_simplify[] =
     "  -layers LIST      the layers to write: triangles,vertices,\n"
     "                    run_parameters or any subset (default: all); one\n"
     "                    layer for GeoJSON, FlatGeobuf, GPX files\n"
-    "  -nostyle          no QGIS default style (layer_styles) in a GPKG\n"
+    "  -nostyle          no QGIS default style (layer_styles in a GPKG or\n"
+    "                    PostgreSQL, a .qml beside Shapefile, FlatGeobuf,\n"
+    "                    GeoJSON files)\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
     "  -q                quiet: no progress bar, no summary\n"
     "  -json             print one JSON object with the results instead of\n"
@@ -226,14 +260,16 @@ static const char help_simplify[] =
     "                    else all CPUs for a million samples or more)\n"
     "  -max_memory SIZE  memory the run may hold: heights, mesh and the TIN\n"
     "                    (bytes, or 500M, 2G, ...; default: the smallest of\n"
-    "                    3/4 of physical memory, the cgroup's limit and\n"
-    "                    ulimit -v). A run that would pass it stops with\n"
-    "                    the phase and the size, and writes nothing\n"
+    "                    MemAvailable, the cgroup's limit and ulimit -v,\n"
+    "                    less a margin). A run that would pass it stops\n"
+    "                    with the phase and the size, and writes nothing\n"
     "  -tile_size N      read and simplify the DEM in tiles of N cells\n"
     "                    (>= 16) sharing their borders, one tile a thread,\n"
     "                    merged into one conforming TIN within -max_error;\n"
-    "                    chosen by itself when the DEM does not fit\n"
-    "                    -max_memory. -method decimate keeps the borders'\n"
+    "                    chosen by itself when the run does not fit the\n"
+    "                    memory limit (-max_memory or the system's), as a\n"
+    "                    quick estimate before the work says (JSON\n"
+    "                    estimate). -method decimate keeps the borders'\n"
     "                    vertices; -max_points, -max_triangles, -percent\n"
     "                    become the one bound that meets them, found by a\n"
     "                    first pass over the tiles (never more than the\n"
@@ -297,7 +333,8 @@ static const char help_generate[] =
 
 static const char help_eval[] =
     "Usage: terratin eval DEM TIN [-b BAND] [-layer NAME] [-max_error E]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m] [-json] [-q]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit ft|us-ft|m]\n"
+    "           [-z_to m|native|auto] [-json] [-q]\n"
     INPUT_USAGE
     "           [-tin_frame map|pixel] [-tin_transform SX,SY,SZ,OX,OY,OZ]\n"
     "           [-max_memory SIZE] [-error_raster OUT.tif [-co NAME=VALUE]...\n"
@@ -322,7 +359,8 @@ static const char help_eval[] =
     "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
     "                  the DEM as simplify reads it (the TIN's window)\n"
     "  -z_factor F     multiply heights by F (as given to simplify)\n"
-    "  -z_unit m       ft or us-ft heights to metres (as given to simplify)\n"
+    "  -z_unit U, -z_to MODE  the heights' unit, and whether they become\n"
+    "                  metres (as given to simplify)\n"
     "  -layer NAME     layer to measure (default: a layer named 'triangles'\n"
     "                  or ending in '_triangles', else the first polygon\n"
     "                  layer)\n"
@@ -365,7 +403,7 @@ static const char help_optimize[] =
     "           [-optimize local|lookahead|anneal|edge_insertion]\n"
     "           [-max_error E] [-anneal_t0 T] [-anneal_stages K]\n"
     "           [-anneal_swaps S] [-anneal_good G] [-anneal_r R] [-seed N]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit U] [-z_to MODE]\n"
     "           [-of FORMAT] [-dsco NAME=VALUE]... [-lco NAME=VALUE]...\n"
     "           [-nln PREFIX] [-overwrite] [-q] [-json]\n"
     "\n"
@@ -388,7 +426,7 @@ static const char help_optimize[] =
     "                    the input TIN's own max error, which thus never\n"
     "                    grows)\n"
     ANNEAL_HELP
-    "  -b, -srcnodata, -z_factor, -z_unit   as simplify\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -z_to   as simplify\n"
     "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
     "                    the DEM, as simplify\n"
     "  -of, -dsco, -lco, -nln, -overwrite, -q, -json   as simplify\n"
@@ -408,7 +446,8 @@ static const char help_study[] =
     "           [-percent P,P,...] [-start all|greedy|greedy:N]\n"
     "           [-points N]\n"
     "           [-importance NAME] [-b BAND] [-srcnodata VALUE]\n"
-    "           [-z_factor F] [-z_unit m] [-threads N] [-overwrite] [-q]\n"
+    "           [-z_factor F] [-z_unit U] [-z_to MODE] [-threads N]\n"
+    "           [-overwrite] [-q]\n"
     "           [-tin_points N] [-plot]\n"
     "\n"
     "Runs every terrain x method x optimiser x checkpoint x criterion as\n"
@@ -458,7 +497,7 @@ static const char help_study[] =
     "                    study's 500), per round for decimation; alone, no\n"
     "                    -percent checkpoints\n"
     "  -start, -importance   decimation's, as simplify\n"
-    "  -b, -srcnodata, -z_factor, -z_unit, -threads   as simplify\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -z_to, -threads   as simplify\n"
     "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
     "                    every DEM file, as simplify\n"
     "  -overwrite        write into an OUTDIR that is not empty\n"
@@ -481,8 +520,8 @@ static const char help_study[] =
     "      delaunay,minmax_angle,l2 -methods insert,decimate out/\n";
 
 static const char help_rasterize[] =
-    "Usage: terratin rasterize TIN DEM OUTPUT [-layer NAME] [-b BAND]\n"
-    "           [-srcnodata VALUE] [-z_factor F] [-z_unit m]\n"
+    "Usage: terratin rasterize DEM TIN OUTPUT [-layer NAME] [-b BAND]\n"
+    "           [-srcnodata VALUE] [-z_factor F] [-z_unit U] [-z_to MODE]\n"
     "           [-of FORMAT] [-co NAME=VALUE]... [-max_memory SIZE]\n"
     "           [-overwrite] [-q] [-json]\n"
     "\n"
@@ -498,7 +537,8 @@ static const char help_rasterize[] =
     "  -of FORMAT        a GDAL raster driver (default: the one OUTPUT's\n"
     "                    extension names, else GTiff: tiled, DEFLATE)\n"
     "  -co NAME=VALUE    creation option of the driver (repeatable)\n"
-    "  -b, -srcnodata, -z_factor, -z_unit, -max_memory   the DEM, as eval\n"
+    "  -b, -srcnodata, -z_factor, -z_unit, -z_to, -max_memory   the DEM,\n"
+    "                    as eval\n"
     "  -a_srs, -s_srs, -a_nodata, -a_ullr, -srcwin, -projwin, -projwin_srs\n"
     "                    the DEM, as simplify (OUTPUT on the window's grid)\n"
     "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
@@ -508,8 +548,136 @@ static const char help_rasterize[] =
     "stopped by signal N (130 Ctrl-C, 143 SIGTERM; nothing left behind).\n"
     "\n"
     "Example:\n"
-    "  terratin rasterize tin.gpkg dem.tif tin.tif\n"
+    "  terratin rasterize dem.tif tin.gpkg tin.tif\n"
     "  terratin eval dem.tif tin.gpkg -error_raster diff.tif  (TIN - DEM)\n";
+
+/* The tiles commands: the overview and a page per subcommand. */
+#define TILES_USAGE                                                          \
+  "Usage: terratin tiles plan DEM PLAN.json -max_error E -tile_size N\n"      \
+  "           [options that shape the TIN] [-overwrite] [-q]\n"               \
+  "       terratin tiles run PLAN.json TILE_ID [-overwrite]\n"                \
+  "       terratin tiles merge PLAN.json OUTPUT [-overwrite] [-q] [-json]\n"  \
+  "           [-of FORMAT] [-lco ...] [-dsco ...] [-nln PREFIX] [-layers L]\n"\
+  "           [-nostyle] [-obj_local] [-t_srs SRS]\n"
+
+#define TILES_CARRIED                                                        \
+  "A plan carries the options that shape the TIN only: -max_error,\n"         \
+  "-tile_size, -method, -start, -importance, -selection, -onepass, -hole,\n"  \
+  "-criterion, -repair, -optimize, -seed, -anneal_*, -b, -srcnodata,\n"       \
+  "-z_factor, -z_unit, -z_to, -work_srs AUTHORITY:CODE, and the DEM's\n"    \
+  "window and georeferencing: -srcwin, -projwin, -a_ullr, -a_nodata,\n"      \
+  "-a_srs, -s_srs, -projwin_srs (CRSs as AUTHORITY:CODE). The output's\n"    \
+  "options (-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs)\n" \
+  "go to merge. run and merge refuse a plan that is truncated, edited (its\n" \
+  "checksum), or whose fields or options are not what plan writes.\n"
+
+#define TILES_EXIT                                                           \
+  "\n"                                                                        \
+  "Exit codes: 0 success, 1 processing failure (a missing or stale piece,\n"  \
+  "a changed DEM), 2 usage error (an option a plan may not carry, a bad\n"    \
+  "plan), 128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM; nothing left\n" \
+  "behind).\n"
+
+static const char help_tiles[] =
+    TILES_USAGE
+    "\n"
+    "A tiled run (simplify -tile_size) as independent jobs, for a cluster:\n"
+    "  plan   checks simplify's options (-tile_size and -max_error needed),\n"
+    "         writes PLAN.json (the DEM's path, size and time, the tiles and\n"
+    "         their windows, the options, a closing checksum) and makes the\n"
+    "         folder PLAN.json.tiles\n"
+    "  run    simplifies tile TILE_ID (0 .. tiles-1) alone (-method insert\n"
+    "         or decimate), on one thread, and\n"
+    "         writes its piece PLAN.json.tiles/TILE_ID.ttp\n"
+    "  merge  joins every piece into OUTPUT as simplify writes it: the same\n"
+    "         triangles and vertices as simplify -tile_size with the plan's\n"
+    "         options; a missing or stale piece, or a changed DEM, is refused\n"
+    TILES_CARRIED
+    "Each job can run on any machine that sees the same paths; the borders\n"
+    "of neighbouring tiles are computed alike by both. tools/tt_dask.py runs\n"
+    "the jobs on Dask distributed; docs/scale.md shows Slurm too.\n"
+    "\n"
+    "Run 'terratin tiles plan|run|merge --help' for the page of each.\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles plan dem.tif plan.json -max_error 0.5 -tile_size 1024\n"
+    "  for i in $(seq 0 15); do terratin tiles run plan.json $i; done\n"
+    "  terratin tiles merge plan.json tin.gpkg\n";
+
+static const char help_tiles_plan[] =
+    "Usage: terratin tiles plan DEM PLAN.json -max_error E -tile_size N\n"
+    "           [options that shape the TIN] [-overwrite] [-q]\n"
+    "\n"
+    "Checks simplify's options with simplify's parser and writes PLAN.json:\n"
+    "the DEM's absolute path, size in bytes and modification time, its\n"
+    "width and height, the tiles (each tile's columns, rows and the window\n"
+    "it reads), the options as words and a closing checksum; makes the\n"
+    "folder PLAN.json.tiles for the pieces. No budget (-max_points,\n"
+    "-max_triangles, -percent): its bound needs a pass over every tile\n"
+    "first, which simplify -tile_size makes.\n"
+    "\n"
+    TILES_CARRIED
+    "\n"
+    "Options:\n"
+    "  -max_error E      every sample within E of the TIN (needed)\n"
+    "  -tile_size N      tiles of N cells, 16 to 65536 (needed)\n"
+    "  -overwrite        replace PLAN.json when it exists\n"
+    "  -q                no summary line\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles plan dem.tif plan.json -max_error 0.5 -tile_size 1024\n";
+
+static const char help_tiles_run[] =
+    "Usage: terratin tiles run PLAN.json TILE_ID [-overwrite]\n"
+    "\n"
+    "Simplifies tile TILE_ID (0 to tiles - 1, row-major) of the plan alone,\n"
+    "on one thread, by the plan's method, and writes its piece\n"
+    "PLAN.json.tiles/TILE_ID.ttp (the piece's arrays, the plan's hash and\n"
+    "the tile id, a checksum) through a temporary name and a rename. The\n"
+    "DEM must be the one planned (same size and modification time).\n"
+    "\n"
+    "Options:\n"
+    "  -overwrite        replace the piece when it exists (default: keep it)\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles run plan.json 7\n";
+
+static const char help_tiles_merge[] =
+    "Usage: terratin tiles merge PLAN.json OUTPUT [-overwrite] [-q] [-json]\n"
+    "           [-of FORMAT] [-lco NAME=VALUE]... [-dsco NAME=VALUE]...\n"
+    "           [-nln PREFIX] [-layers LIST] [-nostyle] [-obj_local]\n"
+    "           [-t_srs SRS]\n"
+    "\n"
+    "Joins every piece of the plan in tile order and writes OUTPUT as\n"
+    "simplify writes it (temporary name, rename, nothing left behind on a\n"
+    "failure): the triangles and vertices of simplify -tile_size with the\n"
+    "plan's options. A missing piece (counted, the first named), a piece of\n"
+    "another plan or tile, a damaged one, or a changed DEM is refused\n"
+    "before anything is written.\n"
+    "\n"
+    "Options: the output options of simplify (see 'terratin simplify\n"
+    "--help'): -of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local,\n"
+    "-t_srs; and\n"
+    "  -overwrite        replace OUTPUT when it exists (default: refuse)\n"
+    "  -q, -json         no summary; one JSON object instead of it\n"
+    TILES_EXIT
+    "\n"
+    "Example:\n"
+    "  terratin tiles merge plan.json tin.gpkg -nln dem_\n";
+
+const char *tt__app_tiles_help(const char *sub)
+{
+  if (sub && tt__app_str_ieq(sub, "plan"))
+    return help_tiles_plan;
+  if (sub && tt__app_str_ieq(sub, "run"))
+    return help_tiles_run;
+  if (sub && tt__app_str_ieq(sub, "merge"))
+    return help_tiles_merge;
+  return help_tiles;
+}
 
 const char *tt_app_help(tt_app_command topic)
 {
@@ -520,6 +688,7 @@ const char *tt_app_help(tt_app_command topic)
   case TT_APP_OPTIMIZE: return help_optimize;
   case TT_APP_STUDY: return help_study;
   case TT_APP_RASTERIZE: return help_rasterize;
+  case TT_APP_TILES: return help_tiles;
   default: return help_top;
   }
 }

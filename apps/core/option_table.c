@@ -21,6 +21,26 @@ _Static_assert(2 * TT_MAX_VERTICES == 2147483646,
 
 /* --- the names, as the engine (or the table) knows them ------------------ */
 
+/* Whether the value w is the name: case-insensitive, '-' as '_'. */
+static int name_matches_word(const char *w, const char *name)
+{
+  for (;; w++, name++) {
+    char a = *w, b = *name;
+    if (a >= 'A' && a <= 'Z')
+      a = (char)(a - 'A' + 'a');
+    if (b >= 'A' && b <= 'Z')
+      b = (char)(b - 'A' + 'a');
+    if (a == '-')
+      a = '_';
+    if (b == '-')
+      b = '_';
+    if (a != b)
+      return 0;
+    if (!a)
+      return 1;
+  }
+}
+
 static int name_criterion(tt_context *ctx, const char *w, void *out)
 {
   return tt_criterion_parse(ctx, w, out) == TT_OK;
@@ -87,14 +107,30 @@ static int name_seeding(tt_context *ctx, const char *w, void *out)
   return 0;
 }
 
-/* -z_unit: metres, the one unit heights are converted to. */
+/* -z_unit: the unit the heights are in. */
 static int name_z_unit(tt_context *ctx, const char *w, void *out)
 {
+  static const char *const units[] = {"m", "ft", "us-ft"};
   (void)ctx;
-  if (!tt__app_str_ieq(w, "m"))
-    return 0;
-  *(const char **)out = "m";
-  return 1;
+  for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+    if (name_matches_word(w, units[i])) {
+      *(const char **)out = units[i];
+      return 1;
+    }
+  return 0;
+}
+
+/* -z_to: whether the heights are converted to metres. */
+static int name_z_to(tt_context *ctx, const char *w, void *out)
+{
+  static const char *const modes[] = {"m", "native", "auto"};
+  (void)ctx;
+  for (size_t i = 0; i < sizeof modes / sizeof modes[0]; i++)
+    if (tt__app_str_ieq(w, modes[i])) {
+      *(const char **)out = modes[i];
+      return 1;
+    }
+  return 0;
 }
 
 /* -tin_frame (eval): the int tt_app_settings.tin_frame, 1 map, 2 pixel. */
@@ -205,7 +241,11 @@ static const tt__app_opt_def opt_defs[] = {
      .bad = "must be a finite non-zero number"},
     {"-z_unit", O_Z_UNIT, DEM_READERS, OPT_NAME, AT(s.z_unit),
      .name_fn = name_z_unit,
-     .bad = "must be m (heights in ft or us-ft converted to metres)"},
+     .bad = "must be ft, us-ft or m (the unit the heights are in; -z_to m "
+            "converts them to metres)"},
+    {"-z_to", O_Z_TO, DEM_READERS, OPT_NAME, AT(s.z_to), .name_fn = name_z_to,
+     .bad = "must be m (heights converted to metres), native (kept in their "
+            "unit) or auto (metres when the CRS is in metres or geographic)"},
     {"-work_srs", O_WORK_SRS, FOR_S, OPT_TEXT, AT(s.work_srs),
      .need = CRS_NEEDED},
     {"-t_srs", O_T_SRS, FOR_S, OPT_TEXT, AT(s.t_srs), .need = CRS_NEEDED},
@@ -307,10 +347,34 @@ static const tt__app_opt_def opt_defs[] = {
 
 #define OPT_DEFS (sizeof opt_defs / sizeof opt_defs[0])
 
+/* Whether the word w spells the option name: case-insensitive, and '-'
+ * inside the name matches '_' (-max-error is -max_error); the leading dash
+ * is the option's, not a letter of its name. */
+static int name_matches(const char *w, const char *name)
+{
+  if (*w != '-' || *name != '-')
+    return 0;
+  for (w++, name++;; w++, name++) {
+    char a = *w, b = *name;
+    if (a >= 'A' && a <= 'Z')
+      a = (char)(a - 'A' + 'a');
+    if (b >= 'A' && b <= 'Z')
+      b = (char)(b - 'A' + 'a');
+    if (a == '-')
+      a = '_';
+    if (b == '-')
+      b = '_';
+    if (a != b)
+      return 0;
+    if (!a)
+      return 1;
+  }
+}
+
 const tt__app_opt_def *tt__app_find_opt(const char *w)
 {
   for (size_t i = 0; i < OPT_DEFS; i++)
-    if (tt__app_str_ieq(w, opt_defs[i].name))
+    if (name_matches(w, opt_defs[i].name))
       return &opt_defs[i];
   /* GDAL accepts --of as well as -of for its own options: do the same,
    * with exactly two dashes ("---of" is a typo, not an option). */
@@ -319,11 +383,73 @@ const tt__app_opt_def *tt__app_find_opt(const char *w)
   return NULL;
 }
 
+/* The optimal string alignment distance between a and b (Levenshtein's
+ * edits plus the swap of two neighbours: -max_erorr is one edit away),
+ * without regard to case, '-' as '_'; anything past 63 characters counts
+ * as far. */
+size_t tt__app_edit_distance(const char *a, const char *b)
+{
+  enum { MAXLEN = 63 };
+  char x[MAXLEN + 1], y[MAXLEN + 1];
+  size_t n = 0, m = 0;
+  for (; a[n] && n < MAXLEN; n++)
+    x[n] = a[n] == '-' ? '_' : (char)((a[n] >= 'A' && a[n] <= 'Z')
+                                          ? a[n] - 'A' + 'a' : a[n]);
+  for (; b[m] && m < MAXLEN; m++)
+    y[m] = b[m] == '-' ? '_' : (char)((b[m] >= 'A' && b[m] <= 'Z')
+                                          ? b[m] - 'A' + 'a' : b[m]);
+  if (a[n] || b[m])
+    return SIZE_MAX;
+  /* three rows of the dynamic programme: i-2, i-1, i */
+  size_t rows[3][MAXLEN + 1];
+  for (size_t j = 0; j <= m; j++)
+    rows[0][j] = j;
+  for (size_t i = 1; i <= n; i++) {
+    size_t *cur = rows[i % 3], *prev = rows[(i - 1) % 3],
+           *prev2 = rows[(i + 1) % 3];
+    cur[0] = i;
+    for (size_t j = 1; j <= m; j++) {
+      size_t cost = x[i - 1] != y[j - 1];
+      size_t best = prev[j - 1] + cost;
+      if (prev[j] + 1 < best)
+        best = prev[j] + 1;
+      if (cur[j - 1] + 1 < best)
+        best = cur[j - 1] + 1;
+      if (i > 1 && j > 1 && x[i - 1] == y[j - 2] && x[i - 2] == y[j - 1] &&
+          prev2[j - 2] + 1 < best)
+        best = prev2[j - 2] + 1;
+      cur[j] = best;
+    }
+  }
+  return rows[n % 3][m];
+}
+
+const char *tt__app_opt_suggest(const char *w, tt_app_command command)
+{
+  while (w[0] == '-' && w[1] == '-') /* --max-eror: as -max-eror */
+    w++;
+  size_t len = strlen(w), best = SIZE_MAX;
+  const char *name = NULL;
+  /* a third of the word's letters, at least 1, at most 3 */
+  size_t limit = len / 3 < 1 ? 1 : len / 3 > 3 ? 3 : len / 3;
+  for (size_t i = 0; i < OPT_DEFS; i++) {
+    if (!(opt_defs[i].commands & (1u << command)))
+      continue;
+    size_t d = tt__app_edit_distance(w, opt_defs[i].name);
+    if (d < best) { /* ties: the table's first, the more common option */
+      best = d;
+      name = opt_defs[i].name;
+    }
+  }
+  /* and fewer edits than half the letters: -x is no typo of -b */
+  return best <= limit && 2 * best < len - 1 ? name : NULL;
+}
+
 const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
                                        tt_app_command command)
 {
   for (size_t i = 0; i < OPT_DEFS; i++)
-    if (tt__app_str_ieq(d->name, opt_defs[i].name) &&
+    if (name_matches(d->name, opt_defs[i].name) &&
         (opt_defs[i].commands & (1u << command)))
       return &opt_defs[i];
   return NULL;

@@ -35,6 +35,7 @@ enum opt_id {
   O_VERBOSE,
   O_S_SRS, O_A_NODATA, O_SRCWIN, O_PROJWIN, O_PROJWIN_SRS, O_A_ULLR,
   O_TIN_FRAME, O_TIN_TRANSFORM,
+  O_Z_TO,
   O_BREAKLINES, O_BREAKLINES_LAYER, O_BREAKLINES_WHERE,
   O_COUNT
 };
@@ -131,10 +132,18 @@ struct tt__app_opt_def {
   unsigned nwords;
 };
 
-/* The option a word names (case-insensitive; "--of" as "-of"), or NULL.
+/* The option a word names (case-insensitive; "--of" as "-of"; '-' inside
+ * the name as '_': "-max-error"), or NULL.
  * An option spelt alike for several commands (-percent: a number for
  * simplify, a list for study) is found by its first entry. */
 const tt__app_opt_def *tt__app_find_opt(const char *w);
+/* The option of command nearest to the unknown word w (a typo: a few
+ * letters added, dropped, changed or swapped, '-' for '_', any case), for
+ * "did you mean"; NULL when none is close. */
+const char *tt__app_opt_suggest(const char *w, tt_app_command command);
+/* The edits (insert, delete, change, swap two neighbours) from a to b,
+ * without regard to case, '-' as '_'; SIZE_MAX past 63 characters. */
+size_t tt__app_edit_distance(const char *a, const char *b);
 /* The entry of d's spelling that command takes, or NULL. */
 const tt__app_opt_def *tt__app_opt_for(const tt__app_opt_def *d,
                                        tt_app_command command);

@@ -62,13 +62,15 @@ static tt_app_options *new_options(void)
   return o;
 }
 
-/* --help and --version win over anything else on the line, even over an
- * error earlier in it, as in GDAL's utilities: a user who asks for help
- * gets it. The command word, if any, picks the help page. 1 when the line
- * asks for either (the command set to TT_APP_HELP or TT_APP_VERSION). */
+/* --help, --help-general, --version and --formats win over anything else
+ * on the line, even over an error earlier in it, as in GDAL's utilities: a
+ * user who asks for help gets it. The command word, if any, picks the help
+ * page. 1 when the line asks for one (the command set to TT_APP_HELP,
+ * TT_APP_HELP_GENERAL, TT_APP_VERSION or TT_APP_FORMATS, in that order of
+ * precedence). */
 static int asks_help_or_version(tt_app_settings *s, char **argv)
 {
-  int want_help = 0, want_version = 0;
+  int want_help = 0, want_version = 0, want_general = 0, want_formats = 0;
   tt_app_command first_cmd = TT_APP_NONE;
   for (size_t i = 0; argv[i]; i++) {
     const char *w = argv[i];
@@ -76,9 +78,17 @@ static int asks_help_or_version(tt_app_settings *s, char **argv)
       want_help = 1;
     else if (tt__app_str_ieq(w, "--version"))
       want_version = 1;
+    else if (tt__app_str_ieq(w, "--help-general"))
+      want_general = 1;
+    else if (tt__app_str_ieq(w, "--formats"))
+      want_formats = 1;
     else if (first_cmd == TT_APP_NONE && w[0] != '-') {
       if (tt__app_str_ieq(w, "help")) {
         want_help = 1;
+        continue;
+      }
+      if (tt__app_str_ieq(w, "tiles")) { /* `terratin help tiles` */
+        first_cmd = TT_APP_TILES;
         continue;
       }
       if ((first_cmd = command_named(w)) == TT_APP_NONE)
@@ -96,10 +106,14 @@ static int asks_help_or_version(tt_app_settings *s, char **argv)
   if (want_help) {
     s->command = TT_APP_HELP;
     s->help_topic = first_cmd;
+  } else if (want_general) {
+    s->command = TT_APP_HELP_GENERAL;
   } else if (want_version) {
     s->command = TT_APP_VERSION;
+  } else if (want_formats) {
+    s->command = TT_APP_FORMATS;
   }
-  return want_help || want_version;
+  return want_help || want_general || want_version || want_formats;
 }
 
 /* --- the words, one at a time --------------------------------------------- */
@@ -156,17 +170,42 @@ static tt_status read_debug(tt__app_opt_parse *p, char **argv, size_t *i)
   return TT_OK;
 }
 
+/* The command nearest to a mistyped word (two edits at most), or NULL. */
+static const char *command_suggest(const char *w)
+{
+  const char *names[16];
+  size_t n = 0, best = 3;
+  const char *name = NULL;
+  for (const tt__app_command_def *d = tt__app_commands; d->name && n < 15;
+       d++)
+    names[n++] = d->name;
+  names[n++] = "tiles"; /* dispatched by main() before the parser */
+  for (size_t i = 0; i < n; i++) {
+    size_t e = tt__app_edit_distance(w, names[i]);
+    if (e < best && 2 * e < strlen(w)) {
+      best = e;
+      name = names[i];
+    }
+  }
+  return name;
+}
+
 static tt_status read_command(tt__app_opt_parse *p, const char *w)
 {
   if (w[0] == '-' && w[1] != '\0')
     return OPT_USAGE(p, "unknown option '%s' before the command; expected "
-                     "simplify, generate, eval, optimize, study or rasterize "
-                     "(see 'terratin --help')", w);
+                     "simplify, generate, eval, optimize, study, rasterize "
+                     "or tiles (see 'terratin --help')", w);
   tt_app_command c = command_named(w);
-  if (c == TT_APP_NONE)
+  if (c == TT_APP_NONE) {
+    const char *near = command_suggest(w);
+    if (near)
+      return OPT_USAGE(p, "unknown command '%s'; did you mean %s? (see "
+                       "'terratin --help')", w, near);
     return OPT_USAGE(p, "unknown command '%s'; expected simplify, generate, "
-                     "eval, optimize, study or rasterize (see 'terratin "
-                     "--help')", w);
+                     "eval, optimize, study, rasterize or tiles (see "
+                     "'terratin --help')", w);
+  }
   p->o->s.command = c;
   p->cmdname = tt__app_command_name(c);
   snprintf(p->hint, sizeof p->hint, " (see 'terratin %s --help')",
@@ -187,8 +226,13 @@ static tt_status read_option(tt__app_opt_parse *p, char **argv, size_t *i)
   const char *w = argv[*i], *v = NULL;
   char joined[512]; /* the words of a value of several (-srcwin's four) */
   const tt__app_opt_def *d = tt__app_find_opt(w), *mine;
-  if (!d)
+  if (!d) {
+    const char *near = tt__app_opt_suggest(w, p->o->s.command);
+    if (near)
+      return OPT_USAGE(p, "%s: unknown option '%s'; did you mean %s?%s",
+                       p->cmdname, w, near, p->hint);
     return OPT_USAGE(p, "%s: unknown option '%s'%s", p->cmdname, w, p->hint);
+  }
   if (!(mine = tt__app_opt_for(d, p->o->s.command)))
     return OPT_USAGE(p, "%s: option %s does not apply to this command%s",
                      p->cmdname, d->name, p->hint);
@@ -248,6 +292,21 @@ static tt_status read_words(tt__app_opt_parse *p, char **argv)
       st = read_option(p, argv, &i);
     else
       st = read_positional(p, w);
+  }
+  return st;
+}
+
+/* --formats: only the global options count (--config GDAL_SKIP=... hides
+ * a driver from the list as from a run); the other words are ignored, as
+ * GDAL's utilities ignore them beside --formats. */
+static tt_status read_global_words(tt__app_opt_parse *p, char **argv)
+{
+  tt_status st = TT_OK;
+  for (size_t i = 0; argv[i] && st == TT_OK; i++) {
+    if (tt__app_str_ieq(argv[i], "--config"))
+      st = read_config(p, argv, &i);
+    else if (tt__app_str_ieq(argv[i], "--debug"))
+      st = read_debug(p, argv, &i);
   }
   return st;
 }
@@ -343,8 +402,8 @@ static tt_status check_rasterize(tt__app_opt_parse *p)
 {
   if (p->npos < 3)
     return OPT_USAGE(p, "rasterize: missing %s%s",
-                     p->npos == 0   ? "TIN, DEM and OUTPUT"
-                     : p->npos == 1 ? "DEM and OUTPUT"
+                     p->npos == 0   ? "DEM, TIN and OUTPUT"
+                     : p->npos == 1 ? "TIN and OUTPUT"
                                     : "OUTPUT",
                      p->hint);
   return keep_positional(p);
@@ -456,7 +515,8 @@ static tt_status check_line(tt__app_opt_parse *p)
   switch (s->command) {
   case TT_APP_NONE:
     return OPT_USAGE(p, "missing command: simplify, generate, eval, "
-                     "optimize, study or rasterize (see 'terratin --help')");
+                     "optimize, study, rasterize or tiles (see 'terratin "
+                     "--help')");
   case TT_APP_SIMPLIFY: return check_simplify(p);
   case TT_APP_STUDY: return check_study(p);
   case TT_APP_EVAL: return check_eval(p);
@@ -501,6 +561,8 @@ tt_status tt_app_options_new(char **argv, tt_app_options **out_options,
   else if (!asks_help_or_version(&p.o->s, argv) &&
            (st = read_words(&p, argv)) == TT_OK)
     st = check_line(&p);
+  else if (p.o->s.command == TT_APP_FORMATS)
+    st = read_global_words(&p, argv);
 
   if (p.o)
     publish_lists(p.o);

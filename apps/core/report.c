@@ -163,6 +163,31 @@ void tt__json_null(app_json *j, const char *key)
   fputs("null", j->fp);
 }
 
+/* "estimate": what the quick pass predicted before the work, or null
+ * (a budget; apps/simplify/estimate.c). */
+static void print_estimate_json(app_json *j, const app_estimate *e)
+{
+  if (!e->done) {
+    tt__json_null(j, "estimate");
+    return;
+  }
+  tt__json_open(j, "estimate");
+  tt__json_num(j, "max_error", e->bound);
+  tt__json_bool(j, "max_error_default", e->bound_default);
+  tt__json_num(j, "vertices", round(e->vertices));
+  tt__json_num(j, "triangles", round(e->triangles));
+  tt__json_num(j, "valid_samples", round(e->valid));
+  tt__json_num(j, "share", e->share);
+  tt__json_num(j, "output_bytes", round(e->output_bytes));
+  tt__json_num(j, "memory_untiled", round(e->memory_whole));
+  tt__json_num(j, "max_error_5_percent", e->advice_bound);
+  tt__json_size(j, "windows", e->windows);
+  tt__json_size(j, "window_size", e->window_size);
+  tt__json_size(j, "sampled_cells", e->sampled_cells);
+  tt__json_num(j, "seconds", e->seconds);
+  tt__json_close(j);
+}
+
 void tt__json_strs(app_json *j, const char *key, char *const *v)
 {
   json_key(j, key);
@@ -268,7 +293,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_str(&j, "z_unit_declared",
                tt__app_nonempty_or_null(p->info->z_unit_declared));
   tt__json_str(&j, "z_unit_source",
-               tt__app_nonempty_or_null(p->info->z_unit_source));
+               tt__app_nonempty_or_null(tt__app_z_unit_source(p->info)));
+  tt__json_str(&j, "z_unit_conversion",
+               tt__app_nonempty_or_null(tt__app_z_unit_why(p->info)));
   tt__json_num(&j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
   tt__json_str(&j, "pixel_is",
                tt__app_nonempty_or_null(p->info->area_or_point));
@@ -279,6 +306,11 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   tt__json_bool(&j, "output_crs_automatic", p->t_srs_auto);
   tt__json_str(&j, "frame", p->info->frame_name);
   tt__json_size(&j, "warnings", r->msg.warnings);
+  if (p->mem_limit && p->mem_limit != SIZE_MAX)
+    tt__json_size(&j, "memory_limit", p->mem_limit);
+  else
+    tt__json_null(&j, "memory_limit");
+  tt__json_str(&j, "memory_limit_source", p->mem_source);
   if (p->breaklines) {
     tt__json_open(&j, "breaklines");
     tt__json_size(&j, "lines", p->breaklines);
@@ -296,6 +328,7 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
     tt__json_bool(&j, "streamed", p->streamed);
     tt__json_close(&j);
   }
+  print_estimate_json(&j, &p->estimate);
   tt__json_open(&j, "seconds");
   tt__json_num(&j, "read", p->t_read);
   tt__json_num(&j, "simplify", p->t_simplify);
@@ -327,14 +360,15 @@ static void budget_words(const tt_refine_options *ro, char *buf, size_t size)
 static void say_input(app_run *r, const app_simplify_report *p)
 {
   const tt_raster_info *in = p->info;
-  char valid[64], heights[160];
+  char valid[64], heights[200];
   if (p->valid == p->cells)
     snprintf(valid, sizeof valid, "all valid");
   else
     snprintf(valid, sizeof valid, "%zu valid", p->valid);
   if (in->z_unit_factor != 1.0)
-    snprintf(heights, sizeof heights, "heights in %s, converted to %s",
-             in->z_unit_declared, tt__app_unit_or(in, "?"));
+    snprintf(heights, sizeof heights, "heights in %s, converted to %s (%s)",
+             in->z_unit_declared, tt__app_unit_or(in, "?"),
+             tt__app_z_unit_why(in));
   else if (in->z_unit && *in->z_unit)
     snprintf(heights, sizeof heights, "heights in %s", in->z_unit);
   else
@@ -363,6 +397,10 @@ static void say_output(app_run *r, const app_simplify_report *p)
     fprintf(r->out, "%s%s", i ? ", " : "", p->files[i]);
   if (nf > 3)
     fprintf(r->out, " and %zu files beside it", nf - 1);
+  /* 2DM has no place for a CRS, and QGIS's MDAL reads none */
+  if (p->crs_file)
+    fprintf(r->out, " (the CRS in %s: 2DM holds none, set it by hand in "
+            "QGIS)", p->crs_file);
   for (size_t i = 0; p->layers && p->layers[i]; i++)
     fprintf(r->out, "%s%s", i ? ", " : (p->layers[1] ? " (layers " :
                                                       " (layer "),
@@ -381,8 +419,8 @@ static void say_output(app_run *r, const app_simplify_report *p)
     fprintf(r->out, ", in %s%s", p->t_srs,
             p->t_srs_auto ? " (the only CRS the format holds)" : "");
   if (p->tiles && p->auto_tiled)
-    fprintf(r->out, "; tiled automatically in %zu tiles (the DEM does not "
-            "fit the memory)", p->tiles);
+    fprintf(r->out, "; tiled automatically in %zu tiles, memory limit "
+            "%.1f MiB", p->tiles, (double)p->mem_limit / 1048576.0);
   fprintf(r->out, "; %.1f s\n", p->t_total);
 }
 
@@ -453,19 +491,27 @@ static void say_details(app_run *r, const app_simplify_report *p)
   fprintf(o, "frame:  %s\n", in->frame_name);
   fprintf(o, "heights: %.6g to %.6g %s", p->zmin, p->zmax,
           tt__app_unit_or(in, "z units"));
+  const char *source = tt__app_z_unit_source(in);
+  int given = strcmp(source, "-z_unit") == 0;
   if (in->z_unit_factor != 1.0)
-    fprintf(o, " (the %s's %s times %.10g)", in->z_unit_source,
-            in->z_unit_declared, in->z_unit_factor);
-  else if (in->z_unit_source && *in->z_unit_source)
-    fprintf(o, " (the unit from the %s)", in->z_unit_source);
+    fprintf(o, given ? " (%s %s times %.10g: %s)"
+                     : " (the %s's %s times %.10g: %s)",
+            source, in->z_unit_declared, in->z_unit_factor,
+            tt__app_z_unit_why(in));
+  else if (*source)
+    fprintf(o, given ? " (as %s says)" : " (the unit from the %s)", source);
   fputc('\n', o);
   if (p->tiles) {
+    char lim[200] = "";
+    if (p->auto_tiled)
+      snprintf(lim, sizeof lim, " (tiled automatically: the run does not "
+               "fit the memory limit of %.1f MiB, %s)",
+               (double)p->mem_limit / 1048576.0,
+               p->mem_source ? p->mem_source : "?");
     fprintf(o, "tiles:  %zu tiles of %zu cells on %d thread%s%s; the tiles "
             "in flight hold at most about %.0f MiB\n", p->tiles,
             p->tile_size, p->tile_threads, p->tile_threads == 1 ? "" : "s",
-            p->auto_tiled ? " (chosen because the heights do not fit the "
-                            "memory limit)" : "",
-            (double)p->tile_bytes / 1048576.0);
+            lim, (double)p->tile_bytes / 1048576.0);
     if (p->budget_passes)
       fprintf(o, "        the budget is met at the bound %g, found from the "
               "tiles' curves (one pass) and %d run%s at a bound\n",

@@ -410,6 +410,20 @@ const char *tt__app_unit_or(const tt_raster_info *info, const char *dflt)
   return info && info->z_unit && *info->z_unit ? info->z_unit : dflt;
 }
 
+const char *tt__app_z_unit_why(const tt_raster_info *info)
+{
+  const char *why = info ? info->z_unit_why : NULL;
+  if (!why || !*why)
+    return "";
+  return strcmp(why, "asked") == 0 ? "asked by -z_to m" : why;
+}
+
+const char *tt__app_z_unit_source(const tt_raster_info *info)
+{
+  const char *src = info && info->z_unit_source ? info->z_unit_source : "";
+  return strcmp(src, "given") == 0 ? "-z_unit" : src;
+}
+
 const char *tt__app_nonempty_or_null(const char *s)
 {
   return s && *s ? s : NULL;
@@ -630,7 +644,8 @@ const tt__app_command_def tt__app_commands[] = {
     {"optimize", TT_APP_OPTIMIZE, 3, {POS(input), POS(tin), POS(output)},
      tt__app_optimize},
     {"study", TT_APP_STUDY, 1, {POS(output), NONE, NONE}, tt__app_study},
-    {"rasterize", TT_APP_RASTERIZE, 3, {POS(tin), POS(input), POS(output)},
+    /* rasterize.c also takes the old order TIN DEM OUTPUT, with a note */
+    {"rasterize", TT_APP_RASTERIZE, 3, {POS(input), POS(tin), POS(output)},
      tt__app_rasterize},
     {NULL, TT_APP_NONE, 0, {NONE, NONE, NONE}, NULL}};
 
@@ -640,6 +655,23 @@ const tt__app_command_def *tt__app_command_def_of(tt_app_command c)
     if (d->command == c)
       return d;
   return NULL;
+}
+
+int tt__app_arg_number(const app_run *r, const char *path)
+{
+  const tt__app_command_def *d = tt__app_command_def_of(r->s->command);
+  /* the setting itself first (eval a.tif a.tif: the TIN is the second),
+   * then any word spelt alike */
+  for (int same = 0; same < 2; same++)
+    for (size_t k = 0; d && path && k < d->npos; k++) {
+      if (d->pos[k] == TT_APP_POS_NONE)
+        continue;
+      const char *w =
+          *(const char *const *)((const char *)r->s + d->pos[k]);
+      if (w && (same ? strcmp(w, path) == 0 : w == path))
+        return (int)k + 1;
+    }
+  return 0;
 }
 
 tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
@@ -672,15 +704,20 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
     fflush(r.out);
     return TT_OK;
   }
+  if (o->s.command == TT_APP_HELP_GENERAL) {
+    fputs(tt__app_help_general(), r.out);
+    fflush(r.out);
+    return TT_OK;
+  }
   if (o->s.command == TT_APP_VERSION) {
     print_version(r.out);
     fflush(r.out);
     return TT_OK;
   }
-  if (!cmd) {
+  if (!cmd && o->s.command != TT_APP_FORMATS) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                        "missing command: simplify, generate, eval, optimize, "
-                       "study or rasterize");
+                       "study, rasterize or tiles");
     return TT_ERR_ARG;
   }
 
@@ -720,7 +757,8 @@ tt_status tt_app_run(const tt_app_options *o, tt_app_result *out_result)
   tt_context_set_log(r.ctx, on_engine_warning, &r.msg);
   remove_stale(&r);
 
-  st = cmd->run(&r);
+  /* --formats: the drivers as this run would see them (after --config) */
+  st = cmd ? cmd->run(&r) : tt__app_formats(&r);
 done:
   tt__app_close_raster(&r, NULL);
   CSLDestroy(r.view_args);

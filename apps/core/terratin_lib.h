@@ -53,7 +53,11 @@ typedef enum tt_app_command {
   TT_APP_EVAL,
   TT_APP_OPTIMIZE,           /* optimize DEM IN_TIN OUTPUT */
   TT_APP_STUDY,              /* study OUTDIR */
-  TT_APP_RASTERIZE           /* rasterize TIN DEM OUTPUT */
+  TT_APP_RASTERIZE,          /* rasterize DEM TIN OUTPUT */
+  TT_APP_FORMATS,            /* --formats: the output formats */
+  TT_APP_HELP_GENERAL,       /* --help-general: the options of every command */
+  TT_APP_TILES               /* a help topic only: `terratin tiles` runs
+                                through tt_app_tiles() */
 } tt_app_command;
 
 #define TT_APP_MESSAGE_MAX 1024
@@ -105,7 +109,12 @@ typedef struct tt_app_settings {
                                 band's own mask (simplify, eval) */
   double z_factor;           /* -z_factor; default 1 (simplify, eval) */
   int z_factor_set;          /* -z_factor was given */
-  const char *z_unit;        /* -z_unit: "m" or NULL (simplify, eval) */
+  const char *z_unit;        /* -z_unit: the heights' unit, "m", "ft" or
+                                "us-ft"; NULL: as the file says */
+  const char *z_to;          /* -z_to: "m" (convert to metres), "native"
+                                (keep the unit) or "auto" (metres when the
+                                CRS is in metres or geographic); NULL:
+                                auto */
   const char *work_srs;      /* -work_srs: the working CRS; NULL: chosen
                                 from the DEM's CRS (simplify) */
   const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the

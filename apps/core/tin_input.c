@@ -113,8 +113,16 @@ GDALDatasetH tt__app_open_vector(app_run *r, const char *path)
   CPLPopErrorHandler();
   if (ras) {
     GDALClose(ras);
-    tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
-             "is a raster, not a vector dataset of triangles");
+    int k = tt__app_arg_number(r, path);
+    if (k)
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, NULL,
+                   "%s: %s (argument %d) is a raster; the TIN (a vector "
+                   "dataset of triangles) comes after the DEM",
+                   tt__app_command_name(r->s->command),
+                   tt__app_shown(r, path), k);
+    else
+      tt__app_fail(r, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT, path,
+                   "is a raster, not a vector dataset of triangles");
     return NULL;
   }
   if (r->msg.last[0] && !strstr(r->msg.last, "not recognized"))

@@ -237,6 +237,8 @@ static tt_status write_output(optimize_run *p)
   CPLFree(prefix);
   for (size_t i = 0; s->lco[i]; i++)
     p->wopts = CSLAddNameValue(p->wopts, "LCO", s->lco[i]);
+  /* the heights' unit, for the fields' descriptions */
+  p->wopts = CSLSetNameValue(p->wopts, "Z_UNIT", p->info->z_unit);
   tt_status st = tt_ogr_write_tin(r->ctx, p->dst, p->tin, p->srs, fields,
                                   sizeof fields / sizeof fields[0], p->wopts,
                                   tt__app_phase_fn, &r->prog);

@@ -1,6 +1,8 @@
 /*
  * rasterize.c -- apps/rasterize/: the rasterize command, a folder over the core
- * (apps/core/). `terratin rasterize TIN DEM OUTPUT`: a layer of triangles (read
+ * (apps/core/). `terratin rasterize DEM TIN OUTPUT` (the DEM first, as for
+ * eval and optimize; the old order TIN DEM OUTPUT is recognised by opening
+ * the words, and taken with a note): a layer of triangles (read
  * as eval reads it) drawn on the DEM's grid, each sample centre in a triangle
  * given the triangle's linear interpolation of its corners' heights, NaN (the
  * band's nodata) outside the TIN, written by the raster writer it shares with
@@ -28,9 +30,48 @@
 #include <string.h>
 #include <strings.h>
 
-tt_status tt__app_rasterize(app_run *r)
+/* Whether GDAL opens path as a dataset of that kind (GDAL_OF_RASTER or
+ * GDAL_OF_VECTOR), quietly. */
+static int opens_as(app_run *r, const char *path, unsigned kind)
+{
+  tt__app_quiet_push(&r->msg);
+  GDALDatasetH ds =
+      GDALOpenEx(path, kind | GDAL_OF_READONLY, NULL, NULL, NULL);
+  CPLPopErrorHandler();
+  if (ds)
+    GDALClose(ds);
+  return ds != NULL;
+}
+
+/* The old order, TIN DEM OUTPUT, is still taken: when the first word is
+ * no raster but a vector dataset and the second a raster, the two are
+ * swapped (in *swapped, which r->s then points to) with a one-line note
+ * on stderr. Returns the run's settings (r->s). */
+static const tt_app_settings *take_old_order(app_run *r,
+                                             tt_app_settings *swapped)
 {
   const tt_app_settings *s = r->s;
+  if (opens_as(r, s->input, GDAL_OF_RASTER) ||
+      !opens_as(r, s->input, GDAL_OF_VECTOR) ||
+      !opens_as(r, s->tin, GDAL_OF_RASTER))
+    return r->s;
+  *swapped = *s;
+  swapped->input = s->tin;
+  swapped->tin = s->input;
+  r->s = swapped;
+  tt_app_term_progress_break(r->msg.bar);
+  fprintf(r->err, "terratin: rasterize: note: TIN DEM OUTPUT is the old "
+          "order of the arguments, taken as DEM TIN OUTPUT; write "
+          "'terratin rasterize %s %s %s'\n", tt__app_shown(r, s->tin),
+          tt__app_shown(r, s->input), tt__app_shown(r, s->output));
+  fflush(r->err);
+  return r->s;
+}
+
+tt_status tt__app_rasterize(app_run *r)
+{
+  tt_app_settings swapped;
+  const tt_app_settings *s = take_old_order(r, &swapped);
   tt_status st = TT_OK;
   tt_output *outp = NULL;
   GDALDatasetH tds = NULL;

@@ -21,7 +21,11 @@
 
 #include <stdint.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 /* The decimation options of the command: ro's limits, criterion and
  * passes, and the -start, -importance, -selection, -onepass, -hole. */
@@ -112,8 +116,24 @@ tt_status tt__app_job_check(app_simplify_job *job)
   return TT_OK;
 }
 
+/* Under ulimit -v (RLIMIT_AS) every thread's malloc arena counts: glibc
+ * reserves 64 MiB of address space for each, and a realloc that its full
+ * arena cannot hold fails rather than move to another, so that the worker
+ * threads of a tiled run failed at random (1 run in 16 at 90 MB of room,
+ * test_auto_tiling.sh) with memory to spare. One arena then, for the
+ * process: the threads share it. */
+static void one_arena_under_rlimit_as(void)
+{
+#ifdef __GLIBC__
+  struct rlimit rl;
+  if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+    mallopt(M_ARENA_MAX, 1);
+#endif
+}
+
 tt_status tt__app_job_memory(app_simplify_job *job)
 {
+  one_arena_under_rlimit_as();
   const tt_app_settings *s = job->s;
   /* -max_memory, else what the system allows, asked before the DEM is
    * read (the heights count against it) */
@@ -121,6 +141,8 @@ tt_status tt__app_job_memory(app_simplify_job *job)
   job->mem_limit = s->max_memory ? s->max_memory
                                  : tt_memory_limit(&job->mem_source);
   job->ro.max_memory = job->mem_limit == SIZE_MAX ? 0 : job->mem_limit;
+  job->rep.mem_limit = job->mem_limit;
+  job->rep.mem_source = job->mem_source;
   /* Decimation does not count its memory as it goes (its start holds a
    * triangle per half sample): an explicit limit would be a promise it
    * cannot keep. Refused before anything is read. */

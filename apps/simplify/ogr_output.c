@@ -447,6 +447,53 @@ done:
   return ok;
 }
 
+unsigned tt__app_probe_format(GDALDriverH drv, const char *ext,
+                              unsigned *out_alone, int *out_imposed)
+{
+  /* a DEM of 30 m cells in UTM zone 33N, as the dry run of a run sees it;
+   * all three layers first, then each alone */
+  static const double gt[6] = {500000, 30, 0, 5000000, 0, -30};
+  static const unsigned masks[] = {TT_APP_LAYERS_ALL, 1u, 2u, 4u};
+  static const char *const none[] = {NULL};
+  probe p;
+  unsigned held = 0, together = 0;
+  *out_imposed = 0;
+  memset(&p, 0, sizeof p);
+  tt_context *ctx = tt_context_create();
+  p.drv = drv;
+  p.ext = ext;
+  p.tol_xy = 1e-6 * gt[1];
+  p.dsco = tt__app_output_dsco(GDALGetDriverShortName(drv), none);
+  p.srs = OSRNewSpatialReference(NULL);
+  if (p.srs && OSRImportFromEPSG(p.srs, 32633) == OGRERR_NONE)
+    OSRSetAxisMappingStrategy(p.srs, OAMS_TRADITIONAL_GIS_ORDER);
+  p.tin = ctx && p.srs ? probe_tin(ctx, gt) : NULL;
+  for (size_t i = 0; p.tin && i < sizeof masks / sizeof masks[0]; i++) {
+    int k = probe_run(&p, masks[i], ext);
+    char *crs = NULL;
+    if (k == 1 && p.lossy && p.imposed &&
+        (crs = in_own_crs(&p, masks[i])) != NULL) {
+      *out_imposed = 1; /* written in the driver's own CRS (GPX) */
+      p.lossy = 0;
+      CPLFree(crs);
+    }
+    if (k == 1 && !p.lossy && i == 0) {
+      held = together = TT_APP_LAYERS_ALL;
+      break;
+    }
+    if (k == 1 && !p.lossy)
+      held |= masks[i];
+  }
+  *out_alone = held;
+  CPLFree(p.imposed);
+  tt_tin_destroy(p.tin);
+  tt_context_destroy(ctx);
+  if (p.srs)
+    OSRDestroySpatialReference(p.srs);
+  CSLDestroy(p.dsco);
+  return together;
+}
+
 /* ===========================================================================
  * Databases
  * ========================================================================= */

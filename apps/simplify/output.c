@@ -85,6 +85,28 @@ static tt_status check_shapefile_names(app_simplify_job *job)
   return st;
 }
 
+/* The formats that get QGIS's default style: a layer_styles table
+ * (GPKG, PostgreSQL) or a .qml file beside each layer's file. */
+static int styled(const char *drvname)
+{
+  static const char *const names[] = {"GPKG", "PostgreSQL", "ESRI Shapefile",
+                                      "FlatGeobuf", "GeoJSON"};
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+    if (tt__app_str_ieq(drvname, names[i]))
+      return 1;
+  return 0;
+}
+
+/* FlatGeobuf and GeoJSON in one file: its style is OUTPUT's name with
+ * .qml, written and renamed with it (a FlatGeobuf folder holds its layers'
+ * styles itself). */
+static int qml_sidecar(const app_simplify_job *job)
+{
+  return !job->s->nostyle && *CPLGetExtension(job->s->output) &&
+         (tt__app_str_ieq(job->drvname, "FlatGeobuf") ||
+          tt__app_str_ieq(job->drvname, "GeoJSON"));
+}
+
 tt_status tt__app_output_plan(app_simplify_job *job)
 {
   app_run *r = job->r;
@@ -110,6 +132,8 @@ tt_status tt__app_output_plan(app_simplify_job *job)
   for (const char *const *sc = tt_mesh_format_sidecars(job->mesh);
        st == TT_OK && *sc; sc++)
     st = tt_output_add_sidecar(r->ctx, job->outp, *sc);
+  if (st == TT_OK && qml_sidecar(job))
+    st = tt_output_add_sidecar(r->ctx, job->outp, ".qml");
   if (st == TT_OK && !s->overwrite && s->nln[0] &&
       tt__app_str_ieq(job->drvname, "ESRI Shapefile")) {
     tt_status nst = check_shapefile_names(job);
@@ -143,7 +167,7 @@ tt_status tt__app_output_options(app_simplify_job *job)
   job->wopts = CSLSetNameValue(job->wopts, "LAYERS",
                                tt__app_layer_list(s->layers, list,
                                                   sizeof list));
-  if (!s->nostyle && tt__app_str_ieq(job->drvname, "GPKG"))
+  if (!s->nostyle && styled(job->drvname))
     job->wopts = CSLSetNameValue(job->wopts, "STYLE", "YES");
   int database = job->kind == APP_OUTPUT_DATABASE;
   if (database && s->overwrite)
@@ -222,12 +246,14 @@ void tt__app_output_names(const app_simplify_job *job, char ***out_files,
     layers = layer_names(job, "", NULL);
   } else if (job->kind == APP_OUTPUT_MESH) {
     files = add_shown(files, r, s->output);
-    /* the sidecars replace OUTPUT's extension (2DM's datasets) */
+    /* the sidecars replace OUTPUT's extension (2DM's datasets; its .prj,
+     * last, when the TIN has a CRS) */
     char *stem = CPLStrdup(CPLFormFilename(CPLGetPath(s->output),
                                            CPLGetBasename(s->output), NULL));
     for (const char *const *sc = tt_mesh_format_sidecars(job->mesh); *sc;
          sc++)
-      files = add_shown(files, r, CPLSPrintf("%s%s", stem, *sc));
+      if (job->srs || strcmp(*sc, ".prj") != 0)
+        files = add_shown(files, r, CPLSPrintf("%s%s", stem, *sc));
     CPLFree(stem);
   } else if (tt__app_str_ieq(job->drvname, "ESRI Shapefile")) {
     /* files of their own beside OUTPUT: <name>_triangles.shp, ... */

@@ -9,17 +9,20 @@
  * (tiled.c) -- then written and committed (write.c), and the summary or
  * JSON printed (apps/core/report.c).
  *
- * Progress: read 0 - 10 %, simplify 10 - 85 % (a tiled run reads as it
- * goes: 0 - 85 %), write 85 - 100 %.
+ * Progress: read 0 - 10 % (0 - 30 % with ground points: 0 - 24 % projecting
+ * them, then the scan), simplify to 85 % (a tiled run reads as it goes:
+ * 0 - 85 %), write 85 - 100 %.
  *
  * Invariants: the input is never written; an existing output is replaced
  * only with -overwrite and only once the new one is complete; a failure or
  * an interruption at any phase leaves nothing behind (tt__app_job_free).
  */
 #include "simplify.h"
+#include "base/internal.h" /* tt__format_bytes */
 
 #include <cpl_string.h>
 
+#include <stdint.h>
 #include <string.h>
 
 /* The DEM opened (its band checked), and every file it is read from (the
@@ -51,37 +54,92 @@ static tt_status open_input(app_simplify_job *job)
   return st;
 }
 
-/* Tiles (tiled.c, docs/scale.md): asked for, or because the run (about
- * 8 bytes a sample) would not fit -max_memory (insertion only:
- * decimation refuses -max_memory); a budget becomes a bound. Without
- * -max_memory a DEM past the system's limit is refused as before (the
- * message names the limit): tiling a huge raster for minutes is for the
- * user to ask. */
-static void choose_tiling(app_simplify_job *job)
+/* The bytes a whole run holds a sample, about: the heights and the
+ * refinement's share (8), the ground points of a geographic or Web
+ * Mercator DEM (16), decimation's start of every sample (a vertex and two
+ * triangles a sample in the mesh: 150). */
+static size_t whole_bytes_per_sample(const app_simplify_job *job)
+{
+  return 8 + (job->ground ? 16 : 0) + (job->decimate ? 150 : 0);
+}
+
+/* The tiles of an automatic tiling: 1024 cells (a multiple of the block
+ * size), halved until those in flight hold half the limit; 0 when even
+ * tiles of 64 do not fit (the whole run then says why). */
+static size_t auto_tile_size(const app_simplify_job *job)
+{
+  size_t w = job->width, h = job->height, limit = job->mem_limit;
+  int bw = 0, bh = 0, nth = job->workers;
+  GDALGetBlockSize(job->band, &bw, &bh);
+  size_t want = 1024;
+  if (bw > 1 && bw <= 4096 && bw == bh)
+    want = ((1024 + (size_t)bw - 1) / (size_t)bw) * (size_t)bw;
+  /* tiled_tiles.c's bytes a sample; for decimation twice its figure
+   * (80): a tile's start of every sample, with the allocator's arenas of
+   * the worker threads, took more under ulimit -v */
+  size_t per = job->decimate ? 160 : 32;
+  while (want > 64 && tt__app_tile_bytes(want, w, h, nth, job->ground) /
+                              32 * per > limit / 2)
+    want /= 2;
+  if (tt__app_tile_bytes(want, w, h, nth, job->ground) / 32 * per >
+      limit / 2)
+    return 0;
+  return want;
+}
+
+/* Tiles (tiled.c, docs/scale.md): asked for (-tile_size), or chosen when
+ * the whole run would not fit the memory limit (-max_memory, else what
+ * the system allows: tt_memory_limit), for either method, as the
+ * estimate says (its heights and TIN, estimate.c) or, without one, a few
+ * bytes a sample; a budget becomes a bound. A DEM of more than TT_APP_AUTO_TILE_CELLS samples is
+ * not tiled unasked (such a run takes an hour or more): when its heights
+ * do not fit either, it is refused here, before anything is read, naming
+ * -tile_size. The failure is recorded. */
+static tt_status choose_tiling(app_simplify_job *job)
 {
   const tt_app_settings *s = job->s;
   size_t w = job->width, h = job->height, limit = job->mem_limit;
   tt__app_job_threads(job);
   job->ground = tt__app_ground_points(job->band);
   job->tile_size = s->tile_size;
-  if (job->tile_size || job->decimate || !s->max_memory || w <= 2 ||
-      h <= 2 || w * h <= limit / 8)
-    return;
-  /* about 8 bytes a sample untiled: tiles of 1024 (a multiple of the
-   * block size), halved until those in flight hold half the limit;
-   * when even tiles of 64 do not fit, the untiled run says why */
-  int bw = 0, bh = 0, nth = job->workers;
-  GDALGetBlockSize(job->band, &bw, &bh);
-  size_t want = 1024;
-  if (bw > 1 && bw <= 4096 && bw == bh)
-    want = ((1024 + (size_t)bw - 1) / (size_t)bw) * (size_t)bw;
-  while (want > 64 &&
-         tt__app_tile_bytes(want, w, h, nth, job->ground) > limit / 2)
-    want /= 2;
-  if (tt__app_tile_bytes(want, w, h, nth, job->ground) <= limit / 2) {
-    job->tile_size = want;
+  if (!job->tile_size && limit != SIZE_MAX && w * h > TT_APP_AUTO_TILE_CELLS &&
+      w * h > limit / sizeof(float)) {
+    size_t tile = auto_tile_size(job);
+    char need[32], lim[32];
+    return tt__app_fail(job->r, TT_APP_EXIT_FAILURE, TT_ERR_LIMIT,
+                        s->input, "the %zu x %zu heights need %s, more "
+                        "than the memory limit of %s (%s); refused before "
+                        "reading: -tile_size %zu runs it in tiles (a DEM "
+                        "of more than %zu samples is tiled only when "
+                        "asked)", w, h,
+                        tt__format_bytes(need, sizeof need,
+                                         (uint64_t)w * h * sizeof(float)),
+                        tt__format_bytes(lim, sizeof lim, limit),
+                        job->mem_source, tile ? tile : 64,
+                        (size_t)TT_APP_AUTO_TILE_CELLS);
+  }
+  if (tt__app_estimate_wanted(job)) {
+    tt_status st = tt__app_estimate(job);
+    if (st != TT_OK)
+      return st;
+    tt__app_estimate_say(job);
+  }
+  /* the whole run's memory: the estimate's (the heights and its TIN, a
+   * quarter more for the estimate's own error), else a few bytes a
+   * sample */
+  const app_estimate *e = &job->rep.estimate;
+  int fits = e->done && !job->decimate
+                 ? 1.25 * e->memory_whole <= (double)limit
+                 : w * h <= limit / whole_bytes_per_sample(job);
+  if (job->tile_size || w <= 2 || h <= 2 || limit == SIZE_MAX || fits ||
+      w * h > TT_APP_AUTO_TILE_CELLS)
+    return TT_OK;
+  size_t tile = auto_tile_size(job);
+  if (tile) {
+    job->tile_size = tile;
     job->rep.auto_tiled = 1;
   }
+  return TT_OK;
 }
 
 /* The tiled run (tiled.c): the tiles in flight checked against
@@ -129,12 +187,22 @@ static tt_status run_tiled(app_simplify_job *job)
   return TT_OK;
 }
 
-/* The whole DEM read into a grid (0 - 10 %), and its height range. */
+/* The read's share of a whole run's progress: 10 %, 30 % for a DEM
+ * whose samples are all projected to ground points as they are read
+ * (raster_georef.c: ten times the scan's time). */
+static double read_share(const app_simplify_job *job)
+{
+  return job->ground ? 0.30 : 0.10;
+}
+
+/* The whole DEM read into a grid (0 - 10 %, or 30 %), and its height
+ * range. */
 static tt_status read_whole(app_simplify_job *job)
 {
   app_run *r = job->r;
   app_simplify_report *rep = &job->rep;
   size_t valid = 0;
+  tt__app_phase_set(&r->prog, 0.0, read_share(job));
   tt_status st = tt__app_read_dem(r, job->band, job->s->input,
                                   tt__app_phase_fn, &r->prog, &job->grid,
                                   &job->info, &valid);
@@ -168,7 +236,7 @@ static tt_status run_whole(app_simplify_job *job)
   }
   if (s->breaklines && (st = tt__app_breaklines(job)) != TT_OK)
     return st;
-  tt__app_phase_set(&r->prog, 0.10, 0.85);
+  tt__app_phase_set(&r->prog, read_share(job), 0.85);
   rep->ropt = &job->ro;
   if (job->decimate)
     rep->dopt = &job->dopt;
@@ -199,6 +267,10 @@ static void report(app_simplify_job *job)
   app_run *r = job->r;
   app_simplify_report *rep = &job->rep;
   tt__app_output_names(job, &rep->files, &rep->layers);
+  rep->crs_file = NULL;
+  int nf = CSLCount(rep->files);
+  if (job->mesh == TT_MESH_2DM && job->srs && nf > 1)
+    rep->crs_file = rep->files[nf - 1]; /* the last sidecar */
   if (job->s->json)
     tt__app_print_simplify_json(r, rep);
   else if (!job->s->quiet)
@@ -227,15 +299,15 @@ tt_status tt__app_simplify(app_run *r)
     st = tt__app_output_options(&job);
   if (st == TT_OK && !tt__app_continue(r, 0.0))
     st = tt__app_fail_tt(r, TT_ERR_INTERRUPTED, r->s->output);
-  if (st == TT_OK) {
-    choose_tiling(&job);
-    if (r->s->breaklines && job.tile_size)
-      st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
-                        "simplify: -breaklines: not yet with a tiled run "
-                        "(-tile_size, or -max_memory choosing tiles)");
-    else
-      st = job.tile_size ? run_tiled(&job) : run_whole(&job);
-  }
+  if (st == TT_OK)
+    st = choose_tiling(&job);
+  if (st == TT_OK && r->s->breaklines && job.tile_size)
+    st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                      "simplify: -breaklines: not yet with a tiled run "
+                      "(-tile_size, or a DEM tiled automatically for "
+                      "memory)");
+  if (st == TT_OK)
+    st = job.tile_size ? run_tiled(&job) : run_whole(&job);
   /* nothing to write: one tile of `tiles run`, handed to its hook */
   int made = job.tin || job.kind == APP_OUTPUT_STREAM;
   if (st == TT_OK && made)

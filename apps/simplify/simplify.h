@@ -23,6 +23,7 @@
  *   tiled_budget.c  a budget in tiles: the curves and the bound
  *   tiled_tiles.c   a tile's curve, its samples, the tiles' memory
  *   tiled_stream.c  a tiled run's GeoPackage written as the tiles merge
+ *   estimate.c      what a bound will make, from a sample of the DEM
  */
 #ifndef TT_APP_SIMPLIFY_H
 #define TT_APP_SIMPLIFY_H
@@ -112,6 +113,10 @@ struct app_simplify_job {
   int64_t *bl_ends;           /* -breaklines: ro.breaklines's ends (free) */
   app_simplify_report rep;
 };
+
+/* The most samples a DEM may have to be tiled without -tile_size (4.3
+ * G, a 65536^2 DEM: some ten minutes of tiles here; docs/scale.md). */
+#define TT_APP_AUTO_TILE_CELLS ((size_t)1 << 32)
 
 /* job.c: the job of r's settings (nothing is opened yet): the method's
  * options, OUTPUT's shown name. */
@@ -208,6 +213,15 @@ void tt__app_simplify_fields(const app_simplify_job *job,
  * error naming the -layers or OUTPUT form that works). */
 int tt__app_check_ogr_output(app_run *r, GDALDriverH drv, GDALDatasetH src,
                              char **dsco, char **wopts, char **auto_t_srs);
+/* ogr_output.c, for --formats: the dry run of drv (with the -dsco terratin
+ * adds) into a file named with extension ext ("" for a folder), on a TIN
+ * in UTM zone 33N, read back: TT_APP_LAYERS_ALL when it holds the three
+ * layers together as written, else 0, with *out_alone the layers it
+ * holds each alone (all three when together; 0: the driver cannot write
+ * the TIN faithfully) and *out_imposed 1 when it writes them in a CRS of
+ * its own (GPX: EPSG:4326). */
+unsigned tt__app_probe_format(GDALDriverH drv, const char *ext,
+                              unsigned *out_alone, int *out_imposed);
 /* ogr_readback.c: 1 when the dataset name, just written by drv with the
  * layers (TT_APP_LAYERS_* bits) of tin
  * (in tin_srs, NULL: none) reprojected to t_srs (NULL: none), reads back
@@ -299,6 +313,18 @@ tt_status tt__app_budget_passes(app_run *r, const char *path,
                                 size_t valid, const tt_refine_options *ro,
                                 const app_budget_pass *p, double *out_bound,
                                 int *out_passes);
+/* tiled_budget.c: the vertices a curve's tile has at bound e. */
+size_t tt__app_curve_count_at(const app_curve *c, double e);
+
+/* estimate.c: whether the run is estimated before its work (always for
+ * -json; a DEM past a million samples, or one the whole run may not
+ * hold; never for a budget or a tile of `tiles run`), the estimate into
+ * job->rep.estimate (the failure recorded), and its line on stderr when
+ * the TIN passes a million vertices or its output 1 GB. */
+int tt__app_estimate_wanted(const app_simplify_job *job);
+tt_status tt__app_estimate(app_simplify_job *job);
+void tt__app_estimate_say(app_simplify_job *job);
+
 /* tiled_stream.c: whether a tiled run into a file of drvname streams
  * (GPKG, unless TERRATIN_TILE_STREAM=NO), and the sink of job's. */
 int tt__app_stream_wanted(const char *drvname);

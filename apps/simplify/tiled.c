@@ -242,10 +242,14 @@ static tt_status tiled_init(tiled *T)
 {
   const app_simplify_job *job = T->job;
   /* every window's read options but its WINDOW: a whole DEM's, but
-   * -max_memory (the tiles in flight are bounded instead) */
+   * -max_memory (the tiles in flight are bounded instead); what grows
+   * with the TIN is held to -max_memory, or to the system's limit when
+   * that chose the tiles */
   T->ropts = tt__app_view_read_options(T->r, tt__app_read_options(job->s),
                                        T->path);
-  T->max_memory = job->s->max_memory;
+  T->max_memory = job->s->max_memory ? job->s->max_memory
+                  : job->rep.auto_tiled ? job->mem_limit
+                                        : 0;
   T->inflight_bytes = tt__app_tile_bytes(T->N, T->W, T->H, T->nthreads,
                                          job->ground);
   tile_options(T);

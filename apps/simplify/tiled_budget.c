@@ -79,7 +79,7 @@ void tt__app_curve_free(app_curve *c)
 
 /* The vertices a tile has when refined to e: its first point at or below
  * e; past its end (a curve cut at its insertions), its last. */
-static size_t count_at(const app_curve *c, double e)
+size_t tt__app_curve_count_at(const app_curve *c, double e)
 {
   if (c->n == 0)
     return 0;
@@ -98,7 +98,7 @@ static size_t sum_at(const app_curve *c, size_t n, double e)
 {
   size_t s = 0;
   for (size_t k = 0; k < n; k++)
-    s += count_at(&c[k], e);
+    s += tt__app_curve_count_at(&c[k], e);
   return s;
 }
 

@@ -82,6 +82,7 @@ static tt_status stream_open(tt_app_tile_sink *sink,
   job->rep.info = info;
   app_run_fields f;
   tt__app_simplify_fields(job, &f);
+  job->wopts = CSLSetNameValue(job->wopts, "Z_UNIT", info->z_unit);
   job->wopts = CSLSetNameValue(job->wopts, "ROWS", "DEFERRED");
   job->wopts = CSLSetNameValue(job->wopts, "JOURNAL", "MEMORY");
   job->wopts = CSLSetNameValue(job->wopts, "PAGES", "YES");

@@ -289,9 +289,10 @@ static tt_status stream_piece(tiled *T, size_t k)
              "%zu, at %zu vertices written and %zu waiting for their last "
              "tile: the writer's records take %zu MiB, with the tiles in "
              "flight (%zu MiB) more than the memory limit of %zu MiB "
-             "(-max_memory); nothing written", k + 1, T->ntiles, nv,
+             "(%s); nothing written", k + 1, T->ntiles, nv,
              tt__tin_stream_pending(T->stream), bytes >> 20,
-             T->inflight_bytes >> 20, T->max_memory >> 20);
+             T->inflight_bytes >> 20, T->max_memory >> 20,
+             T->job->mem_source);
     return TT_ERR_NOMEM;
   }
   return TT_OK;
@@ -371,9 +372,10 @@ tt_status tt__app_tiled_run_all(tiled *T, tt_tin_merger *merger)
         snprintf(T->merge_msg, sizeof T->merge_msg, "while merging tile %zu "
                  "of %zu, at %zu vertices and %zu triangles: the TIN's "
                  "records take %zu MiB, with the tiles in flight (%zu MiB) "
-                 "more than the memory limit of %zu MiB (-max_memory); "
-                 "nothing written", k + 1, T->ntiles, nv, ntri, bytes >> 20,
-                 T->inflight_bytes >> 20, T->max_memory >> 20);
+                 "more than the memory limit of %zu MiB (%s); nothing "
+                 "written", k + 1, T->ntiles, nv, ntri, bytes >> 20,
+                 T->inflight_bytes >> 20, T->max_memory >> 20,
+                 T->job->mem_source);
         break;
       }
     }

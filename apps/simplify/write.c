@@ -155,6 +155,9 @@ static tt_status write_ogr(app_simplify_job *job)
                         r->msg.last[0] ? r->msg.last : "unknown reason");
   app_run_fields f;
   tt__app_simplify_fields(job, &f);
+  /* the heights' unit, for the fields' descriptions */
+  job->wopts = CSLSetNameValue(job->wopts, "Z_UNIT",
+                               job->info ? job->info->z_unit : NULL);
   const int direct_rows = tt__app_str_ieq(job->drvname, "GPKG");
   if (direct_rows)
     defer_rows(job);

@@ -453,6 +453,7 @@ static void write_runs(app_run *r, FILE *fp, const study_terrain *ts,
       tt__json_str(&j, "srcnodata", s->srcnodata);
       tt__json_num(&j, "z_factor", s->z_factor);
       tt__json_str(&j, "z_unit", s->z_unit);
+      tt__json_str(&j, "z_to", s->z_to ? s->z_to : "auto");
     }
     tt__json_close(&j);
   }

@@ -12,6 +12,7 @@
  * before anything is written.
  */
 #include "tiles.h"
+#include "option_table.h"
 
 #include <cpl_conv.h>
 #include <cpl_string.h>
@@ -60,15 +61,27 @@ void tt__tiles_merge(char **argv, tt_progress_fn fn, void *arg,
       extra = CSLAddString(extra, argv[i]);
       extra = CSLAddString(extra, argv[++i]);
     } else if (argv[i][0] == '-' && argv[i][1]) {
+      /* a typo of one of merge's options: the nearest (simplify's
+       * table), when merge takes it */
+      const char *near = tt__app_opt_suggest(argv[i], TT_APP_SIMPLIFY);
+      if (near && tt__tiles_output_option(near) < 0 &&
+          !tt__app_str_ieq(near, "-overwrite") &&
+          !tt__app_str_ieq(near, "-q") && !tt__app_str_ieq(near, "-json"))
+        near = NULL;
       if (out_opt == 1)
         tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                            "tiles merge: option %s needs a value", argv[i]);
+      else if (near)
+        tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                           "tiles merge: unknown option '%s'; did you mean "
+                           "%s? (see 'terratin tiles merge --help')",
+                           argv[i], near);
       else
         tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                           "tiles merge: unknown option %s (usage: terratin "
-                           "tiles merge PLAN.json OUT.gpkg [-overwrite] [-q] "
-                           "[-json] [-of, -lco, -dsco, -nln, -layers, "
-                           "-nostyle, -obj_local, -t_srs])", argv[i]);
+                           "tiles merge: unknown option %s (see 'terratin "
+                           "tiles merge --help': -overwrite, -q, -json, "
+                           "-of, -lco, -dsco, -nln, -layers, -nostyle, "
+                           "-obj_local, -t_srs)", argv[i]);
       CSLDestroy(extra);
       return;
     } else if (!plan)
@@ -84,7 +97,8 @@ void tt__tiles_merge(char **argv, tt_progress_fn fn, void *arg,
   }
   if (!plan || !out) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                       "tiles merge: PLAN.json and OUT.gpkg are needed");
+                       "tiles merge: PLAN.json and OUTPUT are needed (see "
+                       "'terratin tiles merge --help')");
     CSLDestroy(extra);
     return;
   }

@@ -33,37 +33,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#define PLAN_USAGE                                                          \
-  "usage: terratin tiles plan DEM PLAN.json [-overwrite] [-q] -max_error E " \
-  "-tile_size N [options that shape the TIN]\n"                            \
-  "       terratin tiles run PLAN.json TILE_ID [-overwrite]\n"              \
-  "       terratin tiles merge PLAN.json OUT.gpkg [-overwrite] [-q] [-json] " \
-  "[output options]"
-
-#define PLAN_HELP                                                           \
-  "A tiled run (simplify -tile_size) as independent jobs, for a cluster:\n" \
-  "  plan   checks simplify's options (-tile_size and -max_error needed),\n"\
-  "         writes PLAN.json (the DEM's path, size and time, the tiles and\n"\
-  "         their windows, the options, a closing checksum) and makes the\n"\
-  "         folder PLAN.json.tiles\n"                                       \
-  "  run    simplifies tile TILE_ID (0 .. tiles-1) alone (-method insert\n"\
-  "         or decimate), on one thread, and\n"                            \
-  "         writes its piece PLAN.json.tiles/TILE_ID.ttp\n"                 \
-  "  merge  joins every piece into OUT as simplify writes it: the same\n"   \
-  "         triangles and vertices as simplify -tile_size with the plan's\n"\
-  "         options; a missing or stale piece, or a changed DEM, is refused\n"\
-  "A plan carries the options that shape the TIN only: -max_error,\n"       \
-  "-tile_size, -method, -start, -importance, -selection, -onepass, -hole,\n"\
-  "-criterion, -repair, -optimize, -seed, -anneal_*, -b, -srcnodata,\n"     \
-  "-z_factor, -z_unit, -work_srs AUTHORITY:CODE, and the DEM's window and\n"\
-  "georeferencing: -srcwin, -projwin, -a_ullr, -a_nodata, -a_srs, -s_srs,\n"\
-  "-projwin_srs (CRSs as AUTHORITY:CODE). The output's options\n"           \
-  "(-of, -lco, -dsco, -nln, -layers, -nostyle, -obj_local, -t_srs) go to\n" \
-  "merge. run and merge refuse a plan that is truncated, edited (its\n"     \
-  "checksum), or whose fields or options are not what plan writes.\n"       \
-  "Each job can run on any machine that sees the same paths; the borders\n" \
-  "of neighbouring tiles are computed alike by both. tools/tt_dask.py runs\n"\
-  "the jobs on Dask distributed; docs/scale.md shows Slurm too.\n"
+/* Where a usage error of the tiles commands points (help.c has the pages). */
+#define SEE_PLAN_HELP " (see 'terratin tiles plan --help')"
 
 static bool has_control(const char *s)
 {
@@ -119,15 +90,15 @@ static bool read_words(plan_job *j, char **argv, tt_app_result *res)
       j->plan = w;
     else {
       tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                         "tiles plan: unexpected argument %s\n%s", w,
-                         PLAN_USAGE);
+                         "tiles plan: unexpected argument '%s'" SEE_PLAN_HELP,
+                         w);
       return false;
     }
   }
   if (!j->dem || !j->plan) {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                       "tiles plan: DEM and PLAN.json are needed\n%s",
-                       PLAN_USAGE);
+                       "tiles plan: DEM and PLAN.json are needed"
+                       SEE_PLAN_HELP);
     return false;
   }
   return tt__tiles_plan_check_words("tiles plan", j->p.options, res);
@@ -186,6 +157,19 @@ static bool open_dem(plan_job *j, tt_app_result *res)
   }
   j->ds = GDALOpenEx(j->p.dem, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL,
                      NULL, NULL);
+  GDALDatasetH vec = j->ds ? NULL
+                           : GDALOpenEx(j->p.dem,
+                                        GDAL_OF_VECTOR | GDAL_OF_READONLY,
+                                        NULL, NULL, NULL);
+  if (vec) { /* the words swapped, or a TIN for the DEM */
+    GDALDriverH drv = GDALGetDatasetDriver(vec);
+    tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_FORMAT,
+                       "tiles plan: %s (argument 1) is a vector dataset "
+                       "(%s); the DEM (a raster) comes first", j->dem,
+                       drv ? GDALGetDriverShortName(drv) : "?");
+    GDALClose(vec);
+    return false;
+  }
   if (!j->ds || s->band > GDALGetRasterCount(j->ds)) {
     tt__app_result_set(res, TT_APP_EXIT_FAILURE, TT_ERR_IO,
                        "%s: %s", j->dem, j->ds ? "no such band (-b)"
@@ -325,11 +309,29 @@ void tt__tiles_simplify(const tiles_plan *p, const char *const *extra,
   memset(&tt__app_tiles_hook, 0, sizeof tt__app_tiles_hook);
 }
 
+/* Whether the words ask for help: --help, -help, -h or -? anywhere, which
+ * wins over the rest of the line as for the other commands. */
+static bool asks_help(char **argv)
+{
+  for (size_t i = 0; argv[i]; i++)
+    if (tt__app_str_ieq(argv[i], "--help") ||
+        tt__app_str_ieq(argv[i], "-help") || tt__app_str_ieq(argv[i], "-h") ||
+        tt__app_str_ieq(argv[i], "-?"))
+      return true;
+  return false;
+}
+
 void tt_app_tiles(char **argv, tt_progress_fn fn, void *arg,
                   tt_app_result *res)
 {
   memset(res, 0, sizeof *res);
   const char *sub = argv[0];
+  if (asks_help(argv)) {
+    fputs(tt__app_tiles_help(sub), stdout);
+    fflush(stdout);
+    tt__app_result_ok(res);
+    return;
+  }
   GDALAllRegister();
   tt__app_quiet_push(NULL); /* the messages are ours; debug lines pass */
   if (sub && strcmp(sub, "plan") == 0)
@@ -338,11 +340,9 @@ void tt_app_tiles(char **argv, tt_progress_fn fn, void *arg,
     tt__tiles_run(argv + 1, fn, arg, res);
   else if (sub && strcmp(sub, "merge") == 0)
     tt__tiles_merge(argv + 1, fn, arg, res);
-  else if (sub && (strcmp(sub, "-h") == 0 || strcmp(sub, "--help") == 0)) {
-    printf("%s\n\n%s", PLAN_USAGE, PLAN_HELP);
-    tt__app_result_ok(res);
-  } else
+  else
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                       "tiles: plan, run or merge is needed\n%s", PLAN_USAGE);
+                       "tiles: plan, run or merge is needed (see 'terratin "
+                       "tiles --help')");
   CPLPopErrorHandler();
 }

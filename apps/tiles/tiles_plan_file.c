@@ -202,7 +202,7 @@ static const enum opt_id plan_opts[] = {
     O_MAX_ERROR, O_TILE_SIZE, O_METHOD, O_START, O_IMPORTANCE, O_SELECTION,
     O_ONEPASS, O_HOLE, O_CRITERION, O_REPAIR, O_OPTIMIZE, O_SEED,
     O_ANNEAL_T0, O_ANNEAL_STAGES, O_ANNEAL_SWAPS, O_ANNEAL_GOOD, O_ANNEAL_R,
-    O_B, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT, O_WORK_SRS,
+    O_B, O_SRCNODATA, O_Z_FACTOR, O_Z_UNIT, O_Z_TO, O_WORK_SRS,
     /* GDAL's input options: every tile reads the same window alike */
     O_A_SRS, O_S_SRS, O_A_NODATA, O_SRCWIN, O_PROJWIN, O_PROJWIN_SRS,
     O_A_ULLR};
@@ -258,6 +258,10 @@ static bool refuse_option(const char *who, const char *w,
     return REFUSE(res, TT_ERR_ARG, "%s: '%s' is not an option: a plan holds "
                   "-NAME [VALUE] pairs only (a word of its own would "
                   "become an input or output name)", who, w);
+  const char *near = d ? NULL : tt__app_opt_suggest(w, TT_APP_SIMPLIFY);
+  if (near)
+    return REFUSE(res, TT_ERR_ARG, "%s: unknown option '%s'; did you mean "
+                  "%s?", who, w, near);
   if (d && IN(budget_opts, d->id))
     return REFUSE(res, TT_ERR_ARG, "%s: %s is a budget: a plan needs "
                   "-tile_size N and -max_error E (each tile is simplified "

@@ -8,6 +8,7 @@
  * piece is whole or absent.
  */
 #include "tiles.h"
+#include "option_table.h"
 
 #include <cpl_conv.h>
 #include <cpl_string.h>
@@ -68,10 +69,17 @@ void tt__tiles_run(char **argv, tt_progress_fn fn, void *arg,
   for (size_t i = 0; argv[i]; i++) {
     if (tt__app_str_ieq(argv[i], "-overwrite"))
       a.overwrite = 1;
-    else if (argv[i][0] == '-' && argv[i][1]) {
+    else if (argv[i][0] == '-' && argv[i][1] &&
+             tt__app_edit_distance(argv[i], "-overwrite") <= 2) {
       tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
-                         "tiles run: unknown option %s (usage: terratin "
-                         "tiles run PLAN.json TILE_ID [-overwrite])", argv[i]);
+                         "tiles run: unknown option '%s'; did you mean "
+                         "-overwrite? (see 'terratin tiles run --help')",
+                         argv[i]);
+      return;
+    } else if (argv[i][0] == '-' && argv[i][1]) {
+      tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
+                         "tiles run: unknown option %s (see 'terratin "
+                         "tiles run --help': -overwrite only)", argv[i]);
       return;
     } else if (!plan)
       plan = argv[i];
@@ -89,7 +97,8 @@ void tt__tiles_run(char **argv, tt_progress_fn fn, void *arg,
   if (!plan || !id || !*id || *e || errno || id[0] == '-') {
     tt__app_result_set(res, TT_APP_EXIT_USAGE, TT_ERR_ARG,
                        "tiles run: PLAN.json and a TILE_ID (a whole number "
-                       "from 0) are needed");
+                       "from 0) are needed (see 'terratin tiles run "
+                       "--help')");
     return;
   }
   tiles_plan p;

@@ -424,11 +424,13 @@ typedef struct tt_refine_options {
 void tt_refine_options_init(tt_refine_options *opt);
 
 /* The bytes this process may still use as the system says: the smallest
- * of 3/4 of physical memory, its cgroup's limit less the group's use (v2
+ * of the physical memory available (MemAvailable; without it 3/4 of
+ * physical memory), its cgroup's limit less the group's use (v2
  * memory.max, v1 memory.limit_in_bytes) and its address-space limit
- * (ulimit -v, RLIMIT_AS) less what is mapped already. *out_source (may be
- * NULL) names the one that decided, a static string. SIZE_MAX when the
- * system says nothing. */
+ * (ulimit -v, RLIMIT_AS) less what is mapped already, less a safety margin
+ * (an eighth and 32 MiB; half of a room under 64 MiB) for what no run
+ * counts. *out_source (may be NULL) names the one that decided, a static
+ * string. SIZE_MAX when the system says nothing. */
 size_t tt_memory_limit(const char **out_source);
 
 /* Copies text into buf (size bytes, always terminated), shortening every

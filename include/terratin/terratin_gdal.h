@@ -56,6 +56,10 @@ typedef struct tt_raster_info {
   char *z_unit_source;    /* "band unit", "vertical CRS" or "" */
   double z_unit_factor;   /* Z_UNIT=m's factor (0.3048 for ft, 1200/3937
                              for us-ft), else 1 */
+  const char *z_unit_why; /* why the heights were converted to metres:
+                             "asked" (Z_UNIT=m), "the CRS is in metres" or
+                             "the CRS is geographic" (Z_UNIT=auto); "" when
+                             they were not (a static string) */
 } tt_raster_info;
 
 void tt_raster_info_destroy(tt_raster_info *info);
@@ -83,11 +87,15 @@ void tt_raster_info_destroy(tt_raster_info *info);
  * Options: Z_FACTOR=<f> (default 1), SRCNODATA=<v> or SRCNODATA=nan
  * (replaces the mask; compared with the raw values), MAX_MEMORY=<bytes>
  * (refuse grids whose samples need more; default 3/4 of physical memory),
- * Z_UNIT=m (heights declared in ft or us-ft -- band unit type, else the
- * vertical CRS -- are converted to metres: height = (raw * scale + offset)
- * * (unit factor * Z_FACTOR), in doubles in that order; an unknown unit is
- * refused unless Z_FACTOR is given, which then does the whole
- * conversion), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
+ * SRC_Z_UNIT=m|ft|us-ft (the unit the heights are in, over the band's
+ * unit type and the vertical CRS, which say it otherwise: z_unit_source
+ * "given"), Z_UNIT=m (heights in ft or us-ft -- SRC_Z_UNIT, else the band
+ * unit type, else the vertical CRS -- are converted to metres: height =
+ * (raw * scale + offset) * (unit factor * Z_FACTOR), in doubles in that
+ * order; an unknown unit is refused unless Z_FACTOR is given, which then
+ * does the whole conversion), Z_UNIT=auto (converted so when the CRS is
+ * projected in metres or geographic, kept when it is in feet or absent;
+ * an unknown unit is kept, never refused), WORK_SRS=<CRS> (any OSRSetFromUserInput form, projected:
  * the working frame), WINDOW=col,row,width,height (read those samples
  * only, for a tile: the grid's geotransform is that of its first sample,
  * its ground frame the whole raster's, a geographic or Web Mercator
@@ -146,9 +154,14 @@ typedef struct tt_run_field {
  * other than GPKG and SQLite: PostgreSQL) gets its tables made inside the
  * transaction, so that a rollback or a lost connection leaves none;
  * OVERWRITE=YES drops the dataset's layers of those names first (inside
- * that transaction; LCO=SCHEMA=<s> looks for s.<name>). STYLE=YES (GPKG):
- * QGIS's layer_styles table with a default graduated style for each
- * geometry layer. Integer64 fields become Integer for drivers without them
+ * that transaction; LCO=SCHEMA=<s> looks for s.<name>). STYLE=YES:
+ * QGIS's default graduated style for each geometry layer, as rows of the
+ * layer_styles table (GPKG; PostgreSQL, the table made when missing) or a
+ * .qml file beside each layer's file (Shapefile, FlatGeobuf, GeoJSON: the
+ * caller's tt_output registers a single file's OUTPUT.qml as a sidecar).
+ * A GPKG gets every field's title and description in gpkg_data_columns
+ * (the schema extension), the errors' unit Z_UNIT=<unit> ("z units" when
+ * absent). Integer64 fields become Integer for drivers without them
  * (MapInfo); a layer that cannot create fields (DXF) is written without
  * attributes, with one warning. */
 tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
@@ -303,8 +316,9 @@ tt_mesh_format tt_mesh_format_from_path(const char *path);
 /* "2DM", "PLY", "OBJ", "LandXML", "UGRID", "DXF"; NULL for TT_MESH_NONE. */
 const char *tt_mesh_format_name(tt_mesh_format fmt);
 /* The files a format writes beside OUTPUT, as suffixes that replace its
- * extension (2DM: "_ins_err.dat", ..., "_n_samples_els.dat", its datasets;
- * the others: none), NULL-terminated; static storage. */
+ * extension (2DM: "_ins_err.dat", ..., "_n_samples_els.dat", its datasets,
+ * and ".prj", its CRS when it has one; the others: none),
+ * NULL-terminated; static storage. */
 const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt);
 
 /* Writes tin to the file path (create or truncate: give it the temporary
@@ -316,7 +330,8 @@ const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt);
  * Surface name, OBJ object; NULL: "TIN"). local (OBJ only): vertices
  * relative to the centre of the extent rounded to whole units, which a
  * comment line `# origin X Y` gives. 2DM's datasets are written beside
- * path under the names tt_mesh_format_sidecars() gives; PLY's header names
+ * path under the names tt_mesh_format_sidecars() gives, and its CRS (when
+ * there is one) as PATH's stem + ".prj" in ESRI's WKT1; PLY's header names
  * the CRS ("comment crs:WKT"). progress may stop the write
  * (TT_ERR_INTERRUPTED). On any failure the files written are removed. */
 tt_status tt_mesh_write(tt_context *ctx, const char *path,

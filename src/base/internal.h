@@ -124,8 +124,8 @@ TT_HIDDEN void tt__metric_from_frame(const double a[4], tt__metric *out);
 TT_HIDDEN bool tt__name_equal(const char *a, const char *b);
 
 /* tt_memory_limit() with its inputs given (memory.c; the tests pass a
- * folder holding proc/self/cgroup and sys/fs/cgroup/... as root, "" is the
- * real system): phys_bytes of physical memory (0: unknown), an address-space
+ * folder holding proc/meminfo, proc/self/cgroup and sys/fs/cgroup/... as
+ * root, "" is the real system): phys_bytes of physical memory (0: unknown), an address-space
  * limit as_limit (0: none) of which as_used is mapped already. */
 TT_HIDDEN size_t tt__memory_limit_at(const char *root, uint64_t phys_bytes,
                                      uint64_t as_limit, uint64_t as_used,

@@ -5,11 +5,17 @@
  * A process can be stopped short of physical memory by its control group
  * (cgroup v2 memory.max, v1 memory.limit_in_bytes: the kernel's OOM killer
  * ends it, no malloc ever fails) or by its address-space limit (ulimit -v,
- * RLIMIT_AS: malloc fails). The limit is the smallest of three quarters of
- * physical memory, the cgroup's limit less what the group already uses,
- * and the address-space limit less what the process has already mapped
- * (libraries, thread stacks), so that a refusal comes with a size and a
- * reason instead of a kill.
+ * RLIMIT_AS: malloc fails), and by what the machine has free. The room is
+ * the smallest of the physical memory available for new work (MemAvailable
+ * of /proc/meminfo: free memory and the page cache that can be dropped;
+ * without it, 3/4 of physical memory), the cgroup's limit less what the
+ * group already uses, and the address-space limit less what the process
+ * has already mapped (libraries, thread stacks). The limit is that room
+ * less a safety margin (MEMORY_MARGIN: an eighth of it and 32 MiB, or half
+ * of a room under 64 MiB) for what no run counts -- GDAL's block cache, the
+ * output driver's buffers, the arenas and stacks of the worker threads --
+ * so that a refusal or the choice of tiles comes with a size and a reason
+ * instead of a kill.
  *
  * Linux files are read when present; elsewhere only sysconf and getrlimit
  * answer. Nothing is cached: callers ask once per run.
@@ -23,6 +29,32 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <unistd.h>
+
+/* The room less the safety margin (see the top of the file). */
+static uint64_t less_margin(uint64_t room)
+{
+  const uint64_t mib = (uint64_t)1 << 20;
+  if (room == UINT64_MAX)
+    return room;
+  if (room < 64 * mib)
+    return room / 2 ? room / 2 : 1;
+  return room - room / 8 - 32 * mib;
+}
+
+/* MemAvailable of a /proc/meminfo, in bytes; 0 when absent. */
+static uint64_t mem_available(const char *path)
+{
+  FILE *f = fopen(path, "r");
+  if (!f)
+    return 0;
+  char line[256];
+  unsigned long long kb = 0;
+  int found = 0;
+  while (!found && fgets(line, sizeof line, f))
+    found = sscanf(line, "MemAvailable: %llu kB", &kb) == 1;
+  fclose(f);
+  return found ? (uint64_t)kb * 1024 : 0;
+}
 
 /* Reads the first unsigned number of a file; 0 when absent, unreadable or
  * "max" (cgroup v2's word for no limit). */
@@ -115,7 +147,13 @@ size_t tt__memory_limit_at(const char *root, uint64_t phys_bytes,
 {
   uint64_t best = UINT64_MAX;
   const char *source = "no limit known";
-  if (phys_bytes) {
+  char meminfo[512];
+  snprintf(meminfo, sizeof meminfo, "%s/proc/meminfo", root);
+  uint64_t avail = mem_available(meminfo);
+  if (avail) {
+    best = avail;
+    source = "the physical memory available (MemAvailable)";
+  } else if (phys_bytes) {
     best = phys_bytes / 4 * 3;
     source = "3/4 of this machine's physical memory";
   }
@@ -134,6 +172,7 @@ size_t tt__memory_limit_at(const char *root, uint64_t phys_bytes,
   }
   if (out_source)
     *out_source = source;
+  best = less_margin(best);
   return best >= (uint64_t)SIZE_MAX ? SIZE_MAX : (size_t)best;
 }
 

@@ -539,9 +539,19 @@ assert d["uncovered"] == lone, (d, lone)
 assert d["covered"] + lone == d["valid_samples"] > 0, d' "${lone:-x}" <out.txt
 done
 if [ -n "$S" ] && [ -f "$S/usgs_dem_san_francisco/sanfranciscos.dem" ]; then
-  run simplify -max_points 500 "$S/usgs_dem_san_francisco/sanfranciscos.dem" \
-    real_ft.gpkg
-  check "the summary carries the z unit (ft)" bash -c 'grep -q "^input: .*; heights in ft$" out.txt && grep -q "^error:  max .* ft (.*); RMS .* ft$" out.txt' 
+  # heights in ft on a UTM grid: metres by default (-z_to auto), feet kept
+  # with -z_to native
+  run simplify -json -max_points 500 \
+    "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_m.gpkg
+  check "ft heights on UTM: metres, because the CRS is in metres" python3 -c '
+import json
+d = json.load(open("out.txt"))
+assert d["z_unit"] == "m" and d["z_unit_declared"] == "ft", d
+assert d["z_unit_conversion"] == "the CRS is in metres", d
+assert abs(d["z_multiplier"] - 0.3048) < 1e-15, d'
+  run simplify -z_to native -max_points 500 \
+    "$S/usgs_dem_san_francisco/sanfranciscos.dem" real_ft.gpkg
+  check "the summary carries the z unit (ft)" bash -c 'grep -q "^input: .*; heights in ft$" out.txt && grep -q "^error:  max .* ft (.*); RMS .* ft$" out.txt'
 fi
 
 # --- georeferencing, units, output CRS, robustness (issue 3) ----------------
@@ -593,12 +603,13 @@ assert 700000 < x0 < 800000, eu'
   expect_failure "-work_srs geographic" 2 out simplify -work_srs EPSG:4326 "$J" out/x.gpkg
   expect_failure "-work_srs garbage" 2 out simplify -work_srs NOT_A_CRS "$J" out/x.gpkg
   expect_failure "-t_srs garbage" 2 out simplify -t_srs NOT_A_CRS "$J" out/x.gpkg
-  expect_failure "-z_unit ft" 2 out simplify -z_unit ft "$J" out/x.gpkg
+  expect_failure "-z_unit cm" 2 out simplify -z_unit cm "$J" out/x.gpkg
 fi
-expect_failure "-z_unit m, unknown unit" 1 out simplify -z_unit m in/fault.tif out/x.gpkg
-check "-z_unit m, unknown unit: says -z_factor" grep -q -- "-z_factor" err.txt
-run simplify -q -z_unit m -z_factor 0.5 in/fault.tif out/zf.gpkg
-check "-z_unit m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
+expect_failure "-z_to m, unknown unit" 1 out simplify -z_to m in/fault.tif out/x.gpkg
+check "-z_to m, unknown unit: says -z_unit and -z_factor" \
+  grep -q -- "-z_unit ft|us-ft|m.*-z_factor" err.txt
+run simplify -q -z_to m -z_factor 0.5 in/fault.tif out/zf.gpkg
+check "-z_to m with -z_factor: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
 rm -f out/*
 expect_failure "-max_points 0" 2 out simplify -max_points 0 in/fault.tif out/x.gpkg
 expect_failure "-max_triangles 0" 2 out simplify -max_triangles 0 in/fault.tif out/x.gpkg
@@ -608,6 +619,7 @@ expect_failure "-max_points absurd" 2 out simplify -max_points 99999999999999999
 gdal_translate -q -of VRT -outsize 100000 100000 in/fault.tif in/huge.vrt
 expect_failure "100k x 100k raster" 1 out simplify in/huge.vrt out/x.gpkg
 check "100k x 100k: says how much memory (37.3 GiB)" grep -q "need 37.3 GiB" err.txt
+check "100k x 100k: names -tile_size" grep -q -- "-tile_size 1024 runs it in tiles" err.txt
 # GCPs only, no geotransform
 gdal_translate -q -of VRT -gcp 0 0 10 10 -gcp 100 0 20 10 -gcp 0 100 10 0 \
   in/fault.tif in/gcp.vrt

@@ -523,13 +523,13 @@ static void test_eval(void)
   CHECK_USAGE("does not apply", "eval", "a", "b", "-overwrite");
   CHECK_USAGE("without -error_raster", "eval", "a", "b", "-co", "A=B");
   CHECK_USAGE("does not apply", "eval", "a", "b", "-of", "GTiff");
-  CHECK_USAGE("missing DEM and OUTPUT", "rasterize", "tin.gpkg");
-  CHECK_USAGE("missing OUTPUT", "rasterize", "tin.gpkg", "dem.tif");
+  CHECK_USAGE("missing TIN and OUTPUT", "rasterize", "dem.tif");
+  CHECK_USAGE("missing OUTPUT", "rasterize", "dem.tif", "tin.gpkg");
   CHECK_USAGE("-co expects NAME=VALUE", "rasterize", "a", "b", "c", "-co",
               "X");
   CHECK_USAGE("does not apply", "rasterize", "a", "b", "c", "-lco", "A=B");
   CHECK_USAGE("unexpected argument", "rasterize", "a", "b", "c", "d");
-  PARSE_OK(o, "rasterize", "t.gpkg", "d.tif", "o.tif", "-co", "A=1", "-co",
+  PARSE_OK(o, "rasterize", "d.tif", "t.gpkg", "o.tif", "-co", "A=1", "-co",
            "B=2", "-of", "AAIGrid", "-layer", "tri");
   s = tt_app_options_settings(o);
   CHECK(s && s->command == TT_APP_RASTERIZE && strcmp(s->tin, "t.gpkg") == 0 &&

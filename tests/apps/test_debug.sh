@@ -66,7 +66,7 @@ debug "shapefile" 0 --debug on simplify dem.tif shp/t.shp -max_error 5 -q
 debug "shapefile exists" 1 --debug on simplify dem.tif shp/t.shp -max_error 5 -q
 check "shapefile exists: named" grep -q 't_triangles\|exists' err.txt
 debug "eval" 0 --debug on eval dem.tif a.gpkg
-debug "rasterize" 0 --debug on rasterize a.gpkg dem.tif r.tif -q
+debug "rasterize" 0 --debug on rasterize dem.tif a.gpkg r.tif -q
 debug "optimize" 0 --debug on optimize dem.tif a.gpkg o.gpkg -q
 debug "generate" 0 --debug on generate bump b.tif -q
 debug "missing DEM" 1 --debug on simplify nosuch.tif n.gpkg -q

@@ -61,8 +61,9 @@ static void check_settings(const tt_app_settings *s)
 {
   REQUIRE(s != NULL);
   const tt__app_command_def *cmd = tt__app_command_def_of(s->command);
-  REQUIRE(cmd || s->command == TT_APP_HELP || s->command == TT_APP_VERSION);
-  REQUIRE(s->help_topic == TT_APP_NONE ||
+  REQUIRE(cmd || s->command == TT_APP_HELP || s->command == TT_APP_VERSION ||
+          s->command == TT_APP_HELP_GENERAL || s->command == TT_APP_FORMATS);
+  REQUIRE(s->help_topic == TT_APP_NONE || s->help_topic == TT_APP_TILES ||
           tt__app_command_def_of(s->help_topic) != NULL);
   for (size_t k = 0; cmd && k < cmd->npos; k++)
     if (cmd->pos[k] != TT_APP_POS_NONE)
@@ -138,7 +139,9 @@ static void run_one(const uint8_t *data, size_t size)
     const tt_app_settings *s = tt_app_options_settings(o);
     if (s->command < 64)
       commands_seen |= UINT64_C(1) << s->command;
-    if (s->command == TT_APP_HELP || s->command == TT_APP_VERSION) {
+    /* (--formats registers every GDAL driver: not run per input) */
+    if (s->command == TT_APP_HELP || s->command == TT_APP_VERSION ||
+        s->command == TT_APP_HELP_GENERAL) {
       FILE *null = fopen("/dev/null", "w");
       if (null) {
         tt_app_result rr;

@@ -177,7 +177,7 @@ check "-a_nodata: the TIN of -srcnodata" same_tin src_nd.gpkg a_nd.gpkg
 check "eval -srcwin: the window's TIN within its bound" [ $? -eq 0 ]
 check "eval -srcwin: every valid sample covered" \
   [ "$(field eval.json uncovered 2>/dev/null || echo x)" = 0 ]
-"$T" rasterize -q srcwin.gpkg "$SRC" -srcwin 50 40 120 100 tin.tif
+"$T" rasterize -q "$SRC" srcwin.gpkg -srcwin 50 40 120 100 tin.tif
 check "rasterize -srcwin: the window's grid" \
   [ "$(gdalinfo tin.tif | grep -E '^(Size is|Origin)')" = \
     "$(gdalinfo win.tif | grep -E '^(Size is|Origin)')" ]

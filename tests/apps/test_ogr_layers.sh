@@ -70,7 +70,9 @@ mkdir one
 # single DRIVER EXT LAYER OGRLAYER EXPECTED
 single() {
   local drv=$1 ext=$2 layer=$3 olayer=$4 want=$5
-  local f=one/$layer.$ext
+  # a folder per format: the styles beside them (t.qml) would share a name
+  local f=one/$ext/$layer.$ext
+  mkdir -p "one/$ext"
   run simplify -q -max_error 1 -of "$drv" -layers "$layer" dem.tif "$f"
   check "$drv -layers $layer: exit 0 ($(head -c 300 err.txt))" [ "$rc" -eq 0 ]
   [ -n "$olayer" ] || olayer=$(ogrinfo -ro -q "$f" 2>/dev/null |
@@ -88,10 +90,10 @@ single KML kml triangles triangles "$NT"
 single GPX gpx vertices waypoints "$NV"
 # the attributes came along where the format keeps them
 check "GeoJSON: the triangles keep max_err" \
-  grep -q '"max_err"' one/triangles.geojson
+  grep -q '"max_err"' one/geojson/triangles.geojson
 check "GPX: the vertices keep ins_err in <extensions>" \
-  grep -q 'ins_err' one/vertices.gpx
-python3 - one/triangles.geojson "$NT" <<'EOF' || fail "GeoJSON: 3-D closed rings"
+  grep -q 'ins_err' one/gpx/vertices.gpx
+python3 - one/geojson/triangles.geojson "$NT" <<'EOF' || fail "GeoJSON: 3-D closed rings"
 import json, sys
 d = json.load(open(sys.argv[1]))
 f = d["features"]
@@ -178,7 +180,7 @@ refused_early "a -lco the driver refuses" "-lco" \
 # a failure that is not the driver's is said as the write would say it
 run generate bump nocrs.tif -size 30 -q
 run simplify -q -t_srs EPSG:4326 -layers triangles nocrs.tif ref/n.geojson
-check "no CRS to transform from: exit 1, not a driver refusal ($rc)" [ "$rc" -eq 1 ]
+check "no CRS to transform from: exit 2 (refused up front), not a driver refusal ($rc)" [ "$rc" -eq 2 ]
 check "no CRS to transform from: says so" grep -q "no CRS" err.txt
 check "no CRS to transform from: nothing left" [ -z "$(ls -A ref)" ]
 # a DEM without a CRS is in pixel or map units: "Undefined Cartesian SRS"

@@ -252,8 +252,8 @@ check "MapInfo folder: says it drops the heights" \
 check "MapInfo folder: nothing left" [ ! -e fold/mi ]
 run simplify -q -of FlatGeobuf in/north.tif fold/fg
 check "FlatGeobuf folder: exit 0 ($(cat err.txt))" [ "$rc" -eq 0 ]
-check "FlatGeobuf folder: three .fgb in fold/fg" \
-  [ "$(ls fold/fg | tr '\n' ' ')" = "run_parameters.fgb triangles.fgb vertices.fgb " ]
+check "FlatGeobuf folder: three .fgb and the two layers' styles in fold/fg" \
+  [ "$(ls fold/fg | tr '\n' ' ')" = "run_parameters.fgb triangles.fgb triangles.qml vertices.fgb vertices.qml " ]
 run simplify -q -overwrite -max_error 1 -of FlatGeobuf in/north.tif fold/fg
 check "FlatGeobuf folder: -overwrite replaces it ($(cat err.txt))" [ "$rc" -eq 0 ]
 check "FlatGeobuf folder: only fg remains" [ "$(ls -A fold)" = "fg" ]

@@ -155,7 +155,7 @@ for f in "password=s3cretpw.tif|password=***|s3cr,cretpw" \
   run eval "$name" "o$i.gpkg" -json
   check "eval -json $name: exit 0" test "$rc" = 0
   hidden "eval -json $name" "${pieces[@]}"
-  run rasterize "o$i.gpkg" "$name" "r$i.tif"
+  run rasterize "$name" "o$i.gpkg" "r$i.tif"
   check "rasterize $name: exit 0" test "$rc" = 0
   hidden "rasterize $name" "${pieces[@]}"
 done

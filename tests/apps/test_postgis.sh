@@ -9,6 +9,12 @@
 #  - -of PostgreSQL "PG:..." and the same guessed from the "PG:" prefix:
 #    counts equal the run's, every triangle ST_IsValid, the SRID the DEM's,
 #    ST_Area equal to our area_2d;
+#  - QGIS's layer_styles table with a default style per geometry layer
+#    (catalog, schema, table, geometry column; the triangles' QML on
+#    max_err with see-through fills), one per table after -overwrite, in
+#    the -lco SCHEMA's name; every column's description as its comment;
+#    QGIS opens the table with the style and the comments (when
+#    python3-qgis is installed);
 #  - existing tables refused without -overwrite (before the work, the old
 #    tables untouched), replaced with it; -lco SCHEMA=...;
 #  - a write that fails half way (-lco FID=v0 clashing with a field) leaves
@@ -133,6 +139,59 @@ check "vertex ids 0..$((NV - 1))" [ "$(q "SELECT min(vertex_id) || ',' ||
   "0,$((NV - 1)),$NV" ]
 check "the run's vertices recorded" \
   [ "$(q 'SELECT vertices FROM run_parameters')" = "$NV" ]
+styles() { # the default styles of schema $1: table:geometry column
+  q "SELECT string_agg(f_table_name || ':' || f_geometry_column, ' ' ORDER
+     BY f_table_name) FROM layer_styles WHERE useAsDefault AND type IS NULL
+     AND f_table_catalog = 'postgres' AND f_table_schema = '$1'"
+}
+check "layer_styles: a default style per geometry layer ($(styles public))" \
+  [ "$(styles public)" = "triangles:wkb_geometry vertices:wkb_geometry" ]
+check "layer_styles: the triangles' QML on max_err, see-through" \
+  [ "$(q "SELECT count(*) FROM layer_styles WHERE f_table_name = 'triangles'
+          AND xpath_exists('/qgis/renderer-v2[@attr=\"max_err\"]', styleQML)
+          AND xpath_exists('//symbol[@type=\"fill\" and @alpha < 1]',
+                           styleQML)")" = 1 ]
+
+uncommented() { # the columns of table $1 (schema public) without a comment
+  q "SELECT count(*) FROM pg_attribute WHERE attrelid = 'public.$1'::regclass
+     AND attnum > 0 AND NOT attisdropped AND attname NOT IN ('ogc_fid',
+     'wkb_geometry') AND col_description(attrelid, attnum) IS NULL"
+}
+for t in triangles vertices run_parameters; do
+  check "every column of $t described (COMMENT ON COLUMN)" \
+    [ "$(uncommented $t)" = 0 ]
+done
+check "max_err's comment and unit" \
+  [ "$(q "SELECT col_description('public.triangles'::regclass, attnum) FROM
+          pg_attribute WHERE attrelid = 'public.triangles'::regclass AND
+          attname = 'max_err'")" = \
+    "largest |TIN - DEM| of the samples in this triangle (z units)" ]
+
+# QGIS (when python3-qgis is installed) opens the table with that style
+if /usr/bin/python3 -c 'import qgis.core' >/dev/null 2>&1; then
+  mkdir -m 700 "$W/xdg"
+  QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR="$W/xdg" /usr/bin/python3 - "$S" \
+    >qgis.txt 2>qgis_err.txt <<'EOF'
+import sys
+from qgis.core import QgsApplication, QgsVectorLayer
+app = QgsApplication([], False)
+app.initQgis()
+def main():
+    uri = ("host=%s dbname=postgres user=tt key='ogc_fid' "
+           "table=\"public\".\"triangles\" (wkb_geometry)" % sys.argv[1])
+    layer = QgsVectorLayer(uri, "triangles", "postgres")
+    r = layer.renderer() if layer.isValid() else None
+    print(layer.isValid(), r.type() if r else None,
+          r.classAttribute() if r and r.type() == "graduatedSymbol" else None,
+          layer.fields().field("max_err").comment().startswith("largest"))
+main()
+app.exitQgis()
+EOF
+  check "QGIS opens the triangles styled ($(cat qgis.txt))" \
+    [ "$(cat qgis.txt)" = "True graduatedSymbol max_err True" ]
+else
+  echo "SKIP: python3-qgis is not installed: QGIS reading layer_styles skipped"
+fi
 
 # --- existing tables ------------------------------------------------------------
 "$T" simplify -max_error 1 dem.tif "$PG" >out.txt 2>err.txt
@@ -150,6 +209,8 @@ check "-overwrite: the new triangles ($NT2, fewer than $NT)" \
   [ "$(q 'SELECT count(*) FROM triangles')" = "$NT2" -a "$NT2" -lt "$NT" ]
 check "-overwrite: one run_parameters row" \
   [ "$(q 'SELECT count(*) FROM run_parameters')" = 1 ]
+check "-overwrite: still one style per layer" \
+  [ "$(q 'SELECT count(*) FROM layer_styles')" = 2 ]
 
 # --- -lco SCHEMA -------------------------------------------------------------
 q 'CREATE SCHEMA tin' >/dev/null
@@ -160,6 +221,8 @@ check "-lco SCHEMA=tin: the tables there" \
 check "-lco SCHEMA=tin: $NT triangles" [ "$(q 'SELECT count(*) FROM tin.triangles')" = "$NT" ]
 check "-lco SCHEMA=tin: public left alone" \
   [ "$(q 'SELECT count(*) FROM public.triangles')" = "$NT2" ]
+check "-lco SCHEMA=tin: its styles name the schema ($(styles tin))" \
+  [ "$(styles tin)" = "triangles:wkb_geometry vertices:wkb_geometry" ]
 run simplify -q -max_error 1 -lco SCHEMA=tin dem.tif "$PG"
 check "-lco SCHEMA=tin again: refused" [ "$rc" -eq 1 ]
 check "-lco SCHEMA=tin again: names tin.triangles" grep -q 'tin\.triangles' err.txt

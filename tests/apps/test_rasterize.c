@@ -1,5 +1,5 @@
 /*
- * test_rasterize.c -- `terratin rasterize TIN DEM OUT` and `terratin eval
+ * test_rasterize.c -- `terratin rasterize DEM TIN OUT` and `terratin eval
  * DEM TIN -error_raster OUT` through the command's library (issue 17), with
  * the rasters read back by GDAL:
  *  - a tilted plane with a lake and a cut corner of nodata: the rasterized
@@ -206,7 +206,7 @@ static void test_plane(void)
   char *s[] = {"simplify", "-q", "-max_error", "0.001", (char *)dem,
                (char *)tin, NULL};
   CHECK_INT_EQ(run(s, NULL, 0), 0);
-  char *a[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)out,
+  char *a[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)out,
                NULL};
   CHECK_INT_EQ(run(a, NULL, 0), 0);
   GDALDataType type;
@@ -277,7 +277,7 @@ static void test_error_raster(int kind)
   char *e[] = {"eval", "-q", (char *)dem, (char *)tin, "-error_raster",
                (char *)err, NULL};
   CHECK_INT_EQ(run(e, NULL, 0), 0);
-  char *a[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)ras,
+  char *a[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)ras,
                NULL};
   CHECK_INT_EQ(run(a, NULL, 0), 0);
   tt_eval_result ref = reference_eval(dem, tin);
@@ -375,21 +375,21 @@ static void test_refusals(void)
     fputs("not a GeoPackage\n", f);
     fclose(f);
   }
-  char *a1[] = {"rasterize", (char *)junk, (char *)dem, (char *)out, NULL};
+  char *a1[] = {"rasterize", (char *)dem, (char *)junk, (char *)out, NULL};
   CHECK_INT_EQ(run(a1, msg, sizeof msg), 1);
   CHECK(strstr(msg, "junk.gpkg") != NULL);
-  char *a2[] = {"rasterize", (char *)tin, (char *)tmp_path("none.tif"),
+  char *a2[] = {"rasterize", (char *)tmp_path("none.tif"), (char *)tin,
                 (char *)out, NULL};
   CHECK_INT_EQ(run(a2, msg, sizeof msg), 1);
   CHECK(strstr(msg, "none.tif") != NULL);
-  char *a3[] = {"rasterize", (char *)tin, (char *)dem, (char *)out, "-of",
+  char *a3[] = {"rasterize", (char *)dem, (char *)tin, (char *)out, "-of",
                 "PNG", NULL};
   CHECK_INT_EQ(run(a3, msg, sizeof msg), 2);
   CHECK(strstr(msg, "Float32") != NULL);
-  char *a4[] = {"rasterize", (char *)tin, (char *)dem, (char *)out, "-of",
+  char *a4[] = {"rasterize", (char *)dem, (char *)tin, (char *)out, "-of",
                 "NoSuchDriver", NULL};
   CHECK_INT_EQ(run(a4, msg, sizeof msg), 2);
-  char *a5[] = {"rasterize", (char *)tin, (char *)dem, (char *)dem,
+  char *a5[] = {"rasterize", (char *)dem, (char *)tin, (char *)dem,
                 "-overwrite", NULL};
   CHECK_INT_EQ(run(a5, msg, sizeof msg), 1);
   CHECK(strstr(msg, "input") != NULL);
@@ -399,7 +399,7 @@ static void test_refusals(void)
   CHECK(strstr(msg, "Point") && !strstr(msg, "polygons rejected"));
   CHECK(!exists(out));
   /* a driver's failure names the output, not its temporary file */
-  char *a12[] = {"rasterize", (char *)tin, (char *)dem, (char *)out, "-co",
+  char *a12[] = {"rasterize", (char *)dem, (char *)tin, (char *)out, "-co",
                  "TILED=YES", "-co", "BLOCKXSIZE=7", NULL};
   CHECK_INT_EQ(run(a12, msg, sizeof msg), 1);
   CHECK(strstr(msg, "refused.tif") && !strstr(msg, "/.tt"));
@@ -408,7 +408,7 @@ static void test_refusals(void)
   /* an interrupt during the write */
   tt_app_options *opts = NULL;
   tt_app_result res;
-  char *a7[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)out,
+  char *a7[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)out,
                 NULL};
   CHECK_INT_EQ(tt_app_options_new(a7, &opts, &res), TT_OK);
   if (opts) {
@@ -423,7 +423,7 @@ static void test_refusals(void)
 
   /* a driver that only copies, and -co */
   const char *asc = tmp_path("plane_tin.asc");
-  char *a8[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)asc,
+  char *a8[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)asc,
                 "-of", "AAIGrid", "-co", "DECIMAL_PRECISION=9", NULL};
   CHECK_INT_EQ(run(a8, NULL, 0), 0);
   GDALDataType t;
@@ -445,7 +445,7 @@ static void test_refusals(void)
    * one no driver claims: GTiff) */
   const char *asc2 = tmp_path("guessed.asc"), *png = tmp_path("x.png");
   const char *foo = tmp_path("x.foo");
-  char *a9[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)asc2,
+  char *a9[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)asc2,
                 NULL};
   CHECK_INT_EQ(run(a9, NULL, 0), 0);
   GDALDatasetH ds = GDALOpen(asc2, GA_ReadOnly);
@@ -453,12 +453,12 @@ static void test_refusals(void)
                      "AAIGrid") == 0);
   if (ds)
     GDALClose(ds);
-  char *a10[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)png,
+  char *a10[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)png,
                  NULL};
   CHECK_INT_EQ(run(a10, msg, sizeof msg), 2);
   CHECK(strstr(msg, "x.png (by its extension: PNG)") != NULL);
   CHECK(!exists(png));
-  char *a11[] = {"rasterize", "-q", (char *)tin, (char *)dem, (char *)foo,
+  char *a11[] = {"rasterize", "-q", (char *)dem, (char *)tin, (char *)foo,
                  NULL};
   CHECK_INT_EQ(run(a11, NULL, 0), 0);
   ds = GDALOpen(foo, GA_ReadOnly);
@@ -484,7 +484,7 @@ static void test_real_dem(const char *shared)
   char *e[] = {"eval", "-q", dem, (char *)tin, "-error_raster", (char *)err,
                NULL};
   CHECK_INT_EQ(run(e, NULL, 0), 0);
-  char *a[] = {"rasterize", "-q", (char *)tin, dem, (char *)ras, NULL};
+  char *a[] = {"rasterize", "-q", dem, (char *)tin, (char *)ras, NULL};
   CHECK_INT_EQ(run(a, NULL, 0), 0);
   tt_eval_result ref = reference_eval(dem, tin);
   GDALDataType t;

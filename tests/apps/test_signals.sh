@@ -29,8 +29,10 @@ check "--help: 143 for SIGTERM" grep -q '143 SIGTERM' help.txt
 check "--help: 129 for SIGHUP" grep -q '129 SIGHUP' help.txt
 check "--help: an interruption is not exit 1" \
   bash -c '! sed -n "/^Exit codes/,/^$/p" help.txt | grep -q interrupt'
-for c in simplify generate eval optimize study rasterize; do
-  "$T" "$c" --help >help.txt 2>&1
+for c in simplify generate eval optimize study rasterize tiles "tiles plan" \
+         "tiles run" "tiles merge"; do
+  # shellcheck disable=SC2086
+  "$T" $c --help >help.txt 2>&1
   check "$c --help: 128+N, 130 for Ctrl-C" \
     bash -c 'grep -q "128+N" help.txt && grep -q "130 Ctrl-C" help.txt'
 done

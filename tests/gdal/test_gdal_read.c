@@ -936,6 +936,80 @@ static void test_cache_and_progress(tt_context *ctx)
   GDALClose(ds);
 }
 
+/* Progress through a geographic read: the ground points' projection
+ * reports as it goes (issue 27: a 12000^2 VRT sat at 0 for 30 s), on
+ * 0 - 0.8, then the scan on 0.8 - 1; never backwards; a 0 during the
+ * projection stops the read. */
+typedef struct progress_log {
+  double at[4096];
+  int projecting[4096];
+  int n, stop_at;
+} progress_log;
+
+static int log_progress(double complete, const char *msg, void *arg)
+{
+  progress_log *l = arg;
+  if (l->n < 4096) {
+    l->at[l->n] = complete;
+    l->projecting[l->n] = msg && strcmp(msg, "projecting") == 0;
+    l->n++;
+  }
+  return l->stop_at == 0 || l->n < l->stop_at;
+}
+
+static void test_ground_points_progress(tt_context *ctx)
+{
+  const int nx = 300, ny = 256;
+  double *v = terrain_values(nx, ny);
+  const double d = 0.0005;
+  double gt[6] = {10 - nx / 2 * d, d, 0, 45 + ny / 2 * d, 0, -d};
+  raster_spec sp = {GDT_Int16, nx, ny, NULL, 0, 0, 0, 1, 0, 4326, gt, v,
+                    NULL, NULL};
+  make_raster(tmp_path("geo_progress.tif"), &sp);
+  free(v);
+  GDALDatasetH ds = GDALOpen(tmp_path("geo_progress.tif"), GA_ReadOnly);
+  static progress_log l;
+  memset(&l, 0, sizeof l);
+  tt_grid *g = NULL;
+  CHECK_OK(ctx, tt_gdal_read_grid(ctx, GDALGetRasterBand(ds, 1), NULL,
+                                  log_progress, &l, &g, NULL));
+  CHECK(g && tt_grid_ground_xy(g) != NULL);
+  int proj = 0, mid = 0, scan = 0, backwards = 0, scan_first = -1;
+  for (int i = 0; i < l.n; i++) {
+    if (i && l.at[i] < l.at[i - 1])
+      backwards++;
+    if (l.projecting[i]) {
+      proj++;
+      mid += l.at[i] > 0.0 && l.at[i] < 0.8;
+      CHECK(l.at[i] <= 0.8);
+      CHECK(scan_first < 0); /* every projection step before the scan */
+    } else {
+      scan++;
+      if (scan_first < 0)
+        scan_first = i;
+      CHECK(l.at[i] >= 0.8);
+    }
+  }
+  CHECK_INT_EQ(backwards, 0);
+  CHECK_INT_EQ(proj, ny / 16);   /* one every 16 rows */
+  CHECK(mid >= ny / 16 - 1);     /* values between, not just the ends */
+  CHECK(scan >= 2);
+  CHECK_DBL_NEAR(l.at[l.n - 1], 1.0, 0);
+  tt_grid_destroy(g);
+
+  /* a 0 while projecting stops the read */
+  memset(&l, 0, sizeof l);
+  l.stop_at = 3;
+  g = NULL;
+  CHECK_INT_EQ(tt_gdal_read_grid(ctx, GDALGetRasterBand(ds, 1), NULL,
+                                 log_progress, &l, &g, NULL),
+               TT_ERR_INTERRUPTED);
+  CHECK(g == NULL);
+  CHECK_INT_EQ(l.n, 3);
+  CHECK(l.projecting[2]);
+  GDALClose(ds);
+}
+
 /* tt_gdal_write_grid: Float32, tiled, DEFLATE, NaN nodata only when
  * needed, CRS, temporary name, refusal without overwrite; read back. */
 static void test_write_grid(tt_context *ctx)
@@ -1118,6 +1192,7 @@ int main(void)
   TT_RUN(test_refusals(ctx));
   TT_RUN(test_band_types(ctx));
   TT_RUN(test_cache_and_progress(ctx));
+  TT_RUN(test_ground_points_progress(ctx));
   TT_RUN(test_write_grid(ctx));
   int shared = test_shared_data(ctx);
   tt_context_destroy(ctx);

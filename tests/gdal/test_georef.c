@@ -563,7 +563,7 @@ static void test_feet(const char *path)
   }
 
   /* The command: the summary names m, the CRS, the frame, valid samples. */
-  char *argv[] = {"simplify", "-verbose", "-z_unit", "m", "-max_error", "1",
+  char *argv[] = {"simplify", "-verbose", "-z_to", "m", "-max_error", "1",
                   (char *)path, (char *)tmp_path("sf.gpkg"), "-overwrite",
                   NULL};
   tt_app_options *opts = NULL;
@@ -582,9 +582,10 @@ static void test_feet(const char *path)
                                                         "bound 1 m; RMS "));
     CHECK(strstr(text, "valid;") != NULL);
     CHECK(strstr(text, "; unnamed (like EPSG:26710); heights in ft, "
-                       "converted to m\n") != NULL);
+                       "converted to m (asked by -z_to m)\n") != NULL);
     CHECK(strstr(text, "\nframe:  geotransform") != NULL);
-    CHECK(strstr(text, "(the band unit's ft times 0.3048)") != NULL);
+    CHECK(strstr(text, "(the band unit's ft times 0.3048: asked by -z_to "
+                       "m)") != NULL);
   }
   if (out)
     fclose(out);

@@ -332,6 +332,37 @@ static int any_dat(const char *stem)
   return n;
 }
 
+/* 2DM's CRS beside stem.2dm: stem.prj in ESRI's WKT1 (PROJCS, ESRI's
+ * names), the same CRS as want; want NULL: no .prj at all. */
+static void check_prj(const char *stem, OGRSpatialReferenceH want)
+{
+  char p[600], wkt[4096];
+  snprintf(p, sizeof p, "%s.prj", stem);
+  FILE *f = fopen(p, "rb");
+  if (!want) {
+    CHECK(f == NULL);
+    if (f)
+      fclose(f);
+    return;
+  }
+  CHECK(f != NULL);
+  if (!f)
+    return;
+  size_t n = fread(wkt, 1, sizeof wkt - 1, f);
+  fclose(f);
+  wkt[n] = '\0';
+  /* ESRI's dialect: one line, the projection named as ESRI names it */
+  static const char head[] = "PROJCS[\"WGS_1984_UTM_Zone_33N\",";
+  CHECK(strncmp(wkt, head, sizeof head - 1) == 0);
+  CHECK(strchr(wkt, '\n') == NULL);
+  OGRSpatialReferenceH got = OSRNewSpatialReference(NULL);
+  char *w = wkt;
+  CHECK(OSRImportFromESRI(got, (char **)(char *[]){w, NULL}) ==
+        OGRERR_NONE);
+  CHECK(OSRIsSame(got, want));
+  OSRDestroySpatialReference(got);
+}
+
 /* A text attribute of a netCDF variable, or "" (static buffer). */
 static const char *nc_text(int nc, int var, const char *att)
 {
@@ -559,7 +590,8 @@ int main(void)
   CHECK(tt_mesh_format_from_path("x.nc") == TT_MESH_NONE); /* OGR's */
   CHECK_STR_EQ(tt_mesh_format_sidecars(TT_MESH_2DM)[5],
                "_n_samples_els.dat");
-  CHECK(tt_mesh_format_sidecars(TT_MESH_2DM)[6] == NULL);
+  CHECK_STR_EQ(tt_mesh_format_sidecars(TT_MESH_2DM)[6], ".prj");
+  CHECK(tt_mesh_format_sidecars(TT_MESH_2DM)[7] == NULL);
   CHECK(tt_mesh_format_sidecars(TT_MESH_PLY)[0] == NULL);
 
   tt_context *ctx = tt_context_create();
@@ -577,6 +609,12 @@ int main(void)
     read_2dm(p, &e);
     snprintf(p, sizeof p, "%s/t", tmpdir);
     read_dat(p, &e);
+    check_prj(p, srs);
+    /* no CRS: no .prj */
+    snprintf(p, sizeof p, "%s/nocrs.2dm", tmpdir);
+    write_file(ctx, tin, p, TT_MESH_2DM, NULL, NULL, 0);
+    snprintf(p, sizeof p, "%s/nocrs", tmpdir);
+    check_prj(p, NULL);
     snprintf(p, sizeof p, "%s/t.nc", tmpdir);
     write_file(ctx, tin, p, TT_MESH_UGRID, srs, NULL, 0);
     read_ugrid(p, &e, 32633);
@@ -619,6 +657,7 @@ int main(void)
     }
     snprintf(p, sizeof p, "%s/stopped", tmpdir);
     CHECK_INT_EQ(any_dat(p), 0);
+    check_prj(p, NULL);
     /* A folder that does not exist: TT_ERR_IO, nothing made. */
     snprintf(p, sizeof p, "%s/no/such.2dm", tmpdir);
     CHECK(tt_mesh_write(ctx, p, TT_MESH_2DM, NULL, tin, srs, NULL, 0, NULL,

@@ -3,7 +3,7 @@
 # metres, made by gdalwarp from the bundled Jacksboro DEM (real heights):
 # Web Mercator (EPSG:3857, scale 1.24 there and growing as sec(lat)) and
 # the Tennessee state plane in US survey feet (EPSG:2274), with metre
-# heights and with the heights in feet (band unit ft, -z_unit m). Every
+# heights and with the heights in feet (band unit ft, -z_to m). Every
 # triangle's area_2d and slope in the output are checked against the same
 # triangle measured independently: its vertices reprojected by ogr2ogr into
 # a Lambert azimuthal equal-area projection centred on the DEM (areas
@@ -91,8 +91,9 @@ grep -q 'm per US survey foot' ft.json && pass || fail "feet: frame $(grep -o '"
 # feet taken for metres would be 10.8 times off in area, 3.3 in slope
 check ft ft.gpkg 5e-4 5e-4
 
-# heights in feet: converted by -z_unit m, the vertices' z in metres
-"$T" simplify -q -json -max_error 5 -z_unit m ftz.vrt ftz.gpkg >ftz.json \
+# heights in feet on a map in feet: kept so by default (-z_to auto), and
+# converted by -z_to m, the vertices' z in metres
+"$T" simplify -q -json -max_error 5 -z_to m ftz.vrt ftz.gpkg >ftz.json \
   2>ftz.err || fail "feet heights: simplify failed: $(cat ftz.err)"
 check ftz ftz.gpkg 5e-4 5e-4
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Post-install test: installs the build tree into a scratch prefix, then
+# Post-install test: installs the build tree into a scratch prefix, checks
+# the manual page terratin(1) is there and says what --help says, then
 # builds and runs a small program against the installed package twice:
 # through the CMake package config, and through pkg-config.
 set -u
@@ -14,6 +15,24 @@ check test -f "$work/prefix/include/terratin/terratin.h"
 check test -f "$work/prefix/include/terratin/terratin_gdal.h"
 check test -x "$work/prefix/bin/terratin"
 check "$work/prefix/bin/terratin" --version
+
+# The manual page: installed, generated from the same help texts as
+# --help (each page's usage line is in it, roff-escaped), and readable by
+# man when man is installed.
+page="$work/prefix/share/man/man1/terratin.1"
+check test -f "$page"
+for c in simplify generate eval optimize study rasterize "tiles plan" \
+         "tiles run" "tiles merge"; do
+  # shellcheck disable=SC2086
+  usage=$("$work/prefix/bin/terratin" $c --help | head -1 | sed 's/-/\\-/g')
+  check grep -qF -- "$usage" "$page"
+done
+check grep -qF -- '\-\-help\-general' "$page"
+if command -v man >/dev/null; then
+  check bash -c "MANWIDTH=80 man -l '$page' 2>&1 | grep -q 'terratin rasterize DEM TIN OUTPUT'"
+else
+  echo "note: man is not installed; the page is not rendered"
+fi
 
 # CMake package
 check cmake -S "$src/tests/install" -B "$work/cmake-build" \

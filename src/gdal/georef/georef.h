@@ -61,8 +61,10 @@ TT_HIDDEN int tt__georef_is_web_mercator(OGRSpatialReferenceH srs);
  * everything measured depend on the raster only: a window's ground points
  * are the whole raster's, bit for bit. out_name describes the frame;
  * out_scale_error gets the largest |k - 1| over the raster's outline and
- * centre. TT_ERR_ARG for an unusable work_srs; other failures leave the
- * grid as it was and return the status. */
+ * centre. progress (may be NULL) is told the share of rows projected;
+ * its 0 stops with TT_ERR_INTERRUPTED. TT_ERR_ARG for an unusable
+ * work_srs; other failures leave the grid as it was and return the
+ * status. */
 TT_HIDDEN tt_status tt__georef_ground_points(tt_context *ctx,
                                              OGRSpatialReferenceH srs,
                                              const char *work_srs,
@@ -70,6 +72,8 @@ TT_HIDDEN tt_status tt__georef_ground_points(tt_context *ctx,
                                              size_t raster_nx,
                                              size_t raster_ny, size_t col0,
                                              size_t row0, tt_grid *grid,
+                                             tt_progress_fn progress,
+                                             void *progress_arg,
                                              char *out_name,
                                              size_t name_size,
                                              double *out_scale_error);

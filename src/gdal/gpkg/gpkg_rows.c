@@ -549,10 +549,12 @@ static tt_status parse_rows_options(tt_context *ctx, char **options,
       o->pages = CPLTestBool(value);
     else if (strcasecmp(key, "ROWS") != 0 && strcasecmp(key, "RTREE") != 0 &&
              strcasecmp(key, "STYLE") != 0 &&
+             strcasecmp(key, "Z_UNIT") != 0 &&
              strcasecmp(key, "OVERWRITE") != 0)
       s = tt__error(ctx, TT_ERR_ARG, "unknown write option \"%s\" (known: "
                     "JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, PAGES, "
-                    "ROWS, RTREE, RTREE_CHECK, STYLE, T_SRS, THREADS)", key);
+                    "ROWS, RTREE, RTREE_CHECK, STYLE, T_SRS, THREADS, Z_UNIT)",
+                    key);
     CPLFree(key);
     if (s != TT_OK)
       return s;

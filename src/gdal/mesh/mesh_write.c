@@ -31,6 +31,8 @@
  * them with "Add extra dataset" or QgsMeshDataProvider::addDataset(), not
  * by itself). The same attributes are PLY's properties. NaN (ins_err of
  * the starting vertices) is written "nan", which MDAL reads back as NaN.
+ * 2DM carries no CRS either (MDAL gives the mesh none): a TIN with one
+ * gets OUT.prj beside it (ESRI's WKT1), to set the layer's CRS by hand.
  */
 #include "gdal/mesh/mesh_ugrid.h"
 #include "gdal/ogr/tin_records.h"
@@ -73,10 +75,17 @@ static const char *const dat_suffixes[N_DATASETS + 1] = {
     "_ins_err.dat",     "_star_max.dat", "_star_rmse.dat",
     "_max_err_els.dat", "_rmse_els.dat", "_n_samples_els.dat", NULL};
 static const char *const no_suffixes[1] = {NULL};
+/* 2DM's sidecars: its datasets and the CRS (.prj, WKT1 as ESRI writes it;
+ * only when the TIN has a CRS). */
+#define PRJ_SUFFIX ".prj"
+static const char *const twodm_sidecars[N_DATASETS + 2] = {
+    "_ins_err.dat",     "_star_max.dat", "_star_rmse.dat",
+    "_max_err_els.dat", "_rmse_els.dat", "_n_samples_els.dat", PRJ_SUFFIX,
+    NULL};
 
 const char *const *tt_mesh_format_sidecars(tt_mesh_format fmt)
 {
-  return fmt == TT_MESH_2DM ? dat_suffixes : no_suffixes;
+  return fmt == TT_MESH_2DM ? twodm_sidecars : no_suffixes;
 }
 
 tt_mesh_format tt_mesh_format_from_name(const char *name)
@@ -376,7 +385,8 @@ static void write_vertex(FILE *f, tt_mesh_format fmt, size_t i,
 /* LandXML's Surface/SourceData/Breaklines: the TIN's edges on breaklines
  * joined into polylines (a chain goes on through every vertex with two
  * such edges), one Breakline each, its points northing, easting,
- * elevation as the Pnts are. Nothing without breaklines. */
+ * elevation as the Pnts are (nothing without breaklines); then the
+ * Definition's start. */
 static tt_status write_source_data(FILE *f, const tt__records *rec,
                                    tt_context *ctx)
 {
@@ -384,8 +394,10 @@ static tt_status write_source_data(FILE *f, const tt__records *rec,
   size_t n = 0;
   if (!tt__records_breakline_edges(rec->tin, &pairs, &n))
     return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
-  if (n == 0)
+  if (n == 0) {
+    fputs("      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
     return TT_OK;
+  }
   tt_status st = TT_OK;
   size_t nv = tt_tin_vertex_count(rec->tin);
   /* the edges by vertex: first[v] .. first[v + 1] in inc (edge numbers) */
@@ -447,6 +459,7 @@ static tt_status write_source_data(FILE *f, const tt__records *rec,
       }
     }
   fputs("        </Breaklines>\n      </SourceData>\n", f);
+  fputs("      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
 done:
   free(pairs);
   free(first);
@@ -544,6 +557,49 @@ static char *sidecar_path(const char *path, const char *suffix)
   return p;
 }
 
+/* 2DM has no CRS and MDAL reads none: the CRS goes beside path as a
+ * .prj (WKT1 in ESRI's dialect, as a shapefile's), for whoever loads the
+ * mesh by hand and sets its CRS. *out_path: the file written (malloc'd),
+ * NULL on failure. */
+static tt_status write_prj(tt_context *ctx, const char *path,
+                           OGRSpatialReferenceH srs, char **out_path)
+{
+  const char *const opts[] = {"FORMAT=WKT1_ESRI", NULL};
+  char *wkt = NULL;
+  char *prj_path = sidecar_path(path, PRJ_SUFFIX);
+  *out_path = NULL;
+  if (!prj_path)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  if (OSRExportToWktEx(srs, &wkt, opts) != OGRERR_NONE || !wkt) {
+    CPLFree(wkt);
+    tt_status st = tt__error(ctx, TT_ERR_FORMAT, "%s: the CRS has no ESRI "
+                             "WKT form", prj_path);
+    free(prj_path);
+    return st;
+  }
+  FILE *f = fopen(prj_path, "wb");
+  tt_status st = TT_OK;
+  if (!f) {
+    st = tt__error(ctx, TT_ERR_IO, "%s: cannot create: %s", prj_path,
+                   strerror(errno));
+  } else {
+    int bad = fputs(wkt, f) < 0;
+    if (fclose(f) != 0)
+      bad = 1;
+    if (bad) {
+      st = tt__error(ctx, TT_ERR_IO, "%s: write failed: %s", prj_path,
+                     strerror(errno));
+      remove(prj_path);
+    }
+  }
+  CPLFree(wkt);
+  if (st == TT_OK)
+    *out_path = prj_path;
+  else
+    free(prj_path);
+  return st;
+}
+
 /* The value of dataset k for a vertex or a triangle. */
 static double vertex_value(int k, const tt_vertex_info *v)
 {
@@ -570,6 +626,7 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   FILE *f = NULL;
   FILE *dat[N_DATASETS] = {NULL};
   char *dat_path[N_DATASETS] = {NULL};
+  char *prj_path = NULL; /* written: removed on a later failure */
   int made = 0;
   const int ndat = fmt == TT_MESH_2DM ? N_DATASETS : 0;
   memset(&rec, 0, sizeof rec);
@@ -621,12 +678,8 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   }
   const int swap = host_big_endian();
   write_header(f, fmt, name, &rec, nv, nt, origin, local);
-  if (fmt == TT_MESH_LANDXML) {
-    st = write_source_data(f, &rec, ctx);
-    if (st != TT_OK)
-      goto done;
-    fputs("      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
-  }
+  if (fmt == TT_MESH_LANDXML && (st = write_source_data(f, &rec, ctx)))
+    goto done;
   for (size_t i = 0; i < nv && st == TT_OK; i++) {
     tt_vertex_info v;
     double x, y;
@@ -686,6 +739,9 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   }
   if (st != TT_OK)
     goto done;
+  if (fmt == TT_MESH_2DM && rec.out_srs &&
+      (st = write_prj(ctx, path, rec.out_srs, &prj_path)) != TT_OK)
+    goto done;
   if (progress && !progress(1.0, NULL, progress_arg))
     st = tt__error(ctx, TT_ERR_INTERRUPTED, "interrupted");
 
@@ -701,6 +757,9 @@ done:
   }
   if (st != TT_OK && made)
     remove(path);
+  if (st != TT_OK && prj_path)
+    remove(prj_path);
+  free(prj_path);
   tt__records_free(&rec);
   return st;
 }

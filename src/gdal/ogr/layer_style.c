@@ -3,17 +3,22 @@
  * triangles read from one, the features' records, QGIS's default style,
  * safe output paths and the protection of the input's files.
  *
- * layer_style.c -- the default QGIS style saved with a GeoPackage, so that
- * its layers open styled: the `layer_styles` table of QGIS's convention
+ * layer_style.c -- the default QGIS style saved with the layers, so that
+ * they open styled: in a GeoPackage the `layer_styles` table of QGIS's convention
  * (the schema QGIS's OGR provider creates when a user saves a style into a
  * GeoPackage: f_table_catalog, f_table_schema, f_table_name,
  * f_geometry_column, styleName, styleQML, styleSLD, useAsDefault,
  * description, owner, ui, update_time, FID id; QGIS takes the row with
  * useAsDefault = 1, f_table_schema = '' and the layer's table and
- * geometry column), one row for each geometry layer written.
+ * geometry column), one row for each geometry layer written; in
+ * PostgreSQL the same table as QGIS's PostgreSQL provider makes it (xml
+ * columns, a type column), through SQL in the write's transaction; beside
+ * a Shapefile's, FlatGeobuf's or GeoJSON's layer file a NAME.qml, which
+ * QGIS loads with NAME.shp by itself.
  *
  * The QML holds a graduated renderer, five classes from the TIN's own
- * values coloured yellow to red (ColorBrewer YlOrRd): max_err for the
+ * values coloured yellow to red (ColorBrewer YlOrRd), the triangles' fills
+ * at 45 % opacity so that a hillshade under them shows through: max_err for the
  * triangles in equal intervals from the smallest to the largest (the
  * errors lie under the bound, and an integer DEM gives most triangles an
  * error of 0, which would merge quantile classes into one); ins_err for
@@ -23,11 +28,14 @@
  * repeated values leave fewer than three. ins_err is NULL for the starting
  * corners, the forced outline vertices and every vertex of a decimated
  * TIN: coalesce() maps it to -1, drawn grey in a class of its own, so no
- * vertex disappears.
+ * vertex disappears. The QML also names every field's title
+ * (field_docs.c) as QGIS's alias, which GDAL 3.6 would not pass on from
+ * gpkg_data_columns.
  *
  * Workload: one sort of the triangles' and vertices' errors (8 bytes
  * each), a QML of a few kilobytes per layer.
  */
+#include "gdal/ogr/field_docs.h"
 #include "gdal/ogr/layer_style.h"
 #include "gdal/ogr/tin_records.h"
 #include "tin/tin.h"
@@ -35,6 +43,7 @@
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
+#include <cpl_vsi.h>
 
 #include <math.h>
 #include <stdarg.h>
@@ -49,6 +58,11 @@ static const char *const ramp[N_CLASSES] = {"255,255,178,255", "254,204,92,255",
                                             "253,141,60,255", "240,59,32,255",
                                             "189,0,38,255"};
 static const char *const null_colour = "160,160,160,255";
+
+/* The triangles' fills are see-through, so that a hillshade or an image
+ * under the TIN stays visible (the terrain shows through, the classes
+ * tint it); their dark outlines stay opaque and draw the mesh. */
+#define FILL_OPACITY "0.45"
 
 /* A growing string; on failure of an allocation it stays failed. */
 typedef struct text {
@@ -102,6 +116,22 @@ static void add_escaped(text *t, const char *s)
     default: add(t, "%c", *s);
     }
   }
+}
+
+/* The fields' titles as QGIS's aliases (the names its attribute table and
+ * forms show): every field of the layer (a vertex field the TIN lacks,
+ * importance, is ignored by QGIS). */
+static void add_aliases(text *t, int point)
+{
+  const tt__field_doc *docs = point ? tt__vertex_docs : tt__triangle_docs;
+  int n = point ? TT__VF_COUNT : TT__TF_COUNT;
+  add(t, "  <aliases>\n");
+  for (int i = 0; i < n; i++) {
+    add(t, "    <alias field=\"%s\" index=\"%d\" name=\"", docs[i].name, i);
+    add_escaped(t, docs[i].title);
+    add(t, "\"/>\n");
+  }
+  add(t, "  </aliases>\n");
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -171,7 +201,7 @@ static void add_symbol(text *t, int name, const char *colour, int point)
         name, colour);
   else
     add(t,
-        "      <symbol type=\"fill\" name=\"%d\" alpha=\"1\" "
+        "      <symbol type=\"fill\" name=\"%d\" alpha=\"" FILL_OPACITY "\" "
         "clip_to_extent=\"1\" force_rhr=\"0\">\n"
         "        <layer class=\"SimpleFill\" pass=\"0\" locked=\"0\" "
         "enabled=\"1\">\n"
@@ -248,7 +278,7 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
   text t;
   memset(&t, 0, sizeof t);
   add(&t, "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
-          "<qgis version=\"3.22.0\" styleCategories=\"Symbology\">\n"
+          "<qgis version=\"3.22.0\" styleCategories=\"Symbology|Fields\">\n"
           "  <renderer-v2 type=\"graduatedSymbol\" attr=\"");
   add_escaped(&t, attr);
   add(&t, "\" graduatedMethod=\"GraduatedColor\" symbollevels=\"0\" "
@@ -280,10 +310,12 @@ char *tt__style_graduated_qml(const char *attr, const double *values,
           "      <labelFormat format=\"%%1 - %%2\" labelprecision=\"4\" "
           "trimtrailingzeroes=\"1\"/>\n"
           "    </classificationMethod>\n"
-          "  </renderer-v2>\n"
-          "  <layerGeometryType>%d</layerGeometryType>\n"
+          "  </renderer-v2>\n",
+      quantiles ? "Quantile" : "EqualInterval");
+  add_aliases(&t, point);
+  add(&t, "  <layerGeometryType>%d</layerGeometryType>\n"
           "</qgis>\n",
-      quantiles ? "Quantile" : "EqualInterval", point ? 0 : 2);
+      point ? 0 : 2);
   if (t.failed) {
     free(t.s);
     return NULL;
@@ -356,6 +388,29 @@ static tt_status insert_row(tt_context *ctx, OGRLayerH layer,
   return TT_OK;
 }
 
+/* The default style of the triangles (tri set) or the vertices of tin:
+ * classes from its own values. NULL when out of memory (said). */
+static char *layer_qml(tt_context *ctx, const tt_tin *tin, int tri)
+{
+  size_t n = tri ? tt_tin_triangle_count(tin) : tt_tin_vertex_count(tin);
+  double *values = malloc((n ? n : 1) * sizeof *values);
+  if (!values) {
+    tt__error(ctx, TT_ERR_NOMEM, "out of memory for the style's classes "
+              "of %zu features", n);
+    return NULL;
+  }
+  /* the TIN's own arrays (tt_tin_triangle() would work out every field
+   * of the triangle for its max_error) */
+  memcpy(values, tri ? tin->t_max : tin->v_ins_err, n * sizeof *values);
+  char *qml = tt__style_graduated_qml(
+      tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri,
+      !tri);
+  free(values);
+  if (!qml)
+    tt__error(ctx, TT_ERR_NOMEM, "out of memory for a style");
+  return qml;
+}
+
 tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                            const tt_tin *tin, const char *prefix,
                            unsigned layers, const char *tri_geom,
@@ -366,20 +421,9 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
     const int tri = k == 0;
     if (!(layers & (tri ? TT__LAYER_TRIANGLES : TT__LAYER_VERTICES)))
       continue;
-    size_t n = tri ? tt_tin_triangle_count(tin) : tt_tin_vertex_count(tin);
-    double *values = malloc((n ? n : 1) * sizeof *values);
-    if (!values)
-      return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the style's "
-                       "classes of %zu features", n);
-    /* the TIN's own arrays (tt_tin_triangle() would work out every field
-     * of the triangle for its max_error) */
-    memcpy(values, tri ? tin->t_max : tin->v_ins_err, n * sizeof *values);
-    char *qml = tt__style_graduated_qml(
-        tri ? "max_err" : "coalesce(\"ins_err\", -1)", values, n, !tri, !tri,
-        !tri);
-    free(values);
+    char *qml = layer_qml(ctx, tin, tri);
     if (!qml)
-      return tt__error(ctx, TT_ERR_NOMEM, "out of memory for a style");
+      return TT_ERR_NOMEM;
     char *table = CPLStrdup(CPLSPrintf("%s%s", prefix,
                                        tri ? "triangles" : "vertices"));
     s = insert_row(ctx, layer, table, tri ? tri_geom : vtx_geom, qml,
@@ -388,6 +432,167 @@ tt_status tt__style_insert(tt_context *ctx, OGRLayerH layer,
                        : "terratin: vertices by their insertion error "
                          "(ins_err), quantile classes; grey: none");
     CPLFree(table);
+    CPLFree(qml);
+  }
+  return s;
+}
+
+/* The .qml beside the layer's file: in a folder dataset (a shapefile's
+ * temporary folder, FlatGeobuf's folder of layers) <dir>/<layer>.qml,
+ * else the dataset's file with the extension .qml. */
+static char *qml_path(GDALDatasetH dst, OGRLayerH layer)
+{
+  const char *desc = GDALGetDescription(dst);
+  char **entries = VSIReadDir(desc); /* NULL for a file */
+  int folder = entries != NULL;
+  CSLDestroy(entries);
+  if (folder)
+    return CPLStrdup(CPLFormFilename(desc, OGR_L_GetName(layer), "qml"));
+  return CPLStrdup(CPLResetExtension(desc, "qml"));
+}
+
+static tt_status write_file(tt_context *ctx, const char *path,
+                            const char *qml)
+{
+  VSILFILE *f = VSIFOpenL(path, "wb");
+  if (!f)
+    return tt__error(ctx, TT_ERR_IO, "%s: cannot create the style file",
+                     path);
+  size_t n = strlen(qml);
+  int ok = VSIFWriteL(qml, 1, n, f) == n;
+  if (VSIFCloseL(f) != 0)
+    ok = 0;
+  if (!ok) {
+    VSIUnlink(path);
+    return tt__error(ctx, TT_ERR_IO, "%s: cannot write the style file",
+                     path);
+  }
+  return TT_OK;
+}
+
+tt_status tt__style_write_files(tt_context *ctx, GDALDatasetH dst,
+                                const tt_tin *tin, OGRLayerH tri_layer,
+                                OGRLayerH vtx_layer)
+{
+  tt_status s = TT_OK;
+  for (int k = 0; k < 2 && s == TT_OK; k++) {
+    OGRLayerH layer = k == 0 ? tri_layer : vtx_layer;
+    if (!layer)
+      continue;
+    char *qml = layer_qml(ctx, tin, k == 0);
+    if (!qml)
+      return TT_ERR_NOMEM;
+    char *path = qml_path(dst, layer);
+    s = write_file(ctx, path, qml);
+    CPLFree(path);
+    CPLFree(qml);
+  }
+  return s;
+}
+
+/* An SQL string literal of s (quotes doubled: PostgreSQL's standard
+ * strings), CPLFree(). */
+static char *sql_literal(const char *s)
+{
+  size_t n = 3;
+  for (const char *p = s; *p; p++)
+    n += *p == '\'' ? 2 : 1;
+  char *q = CPLMalloc(n), *o = q;
+  *o++ = '\'';
+  for (const char *p = s; *p; p++) {
+    *o++ = *p;
+    if (*p == '\'')
+      *o++ = '\'';
+  }
+  *o++ = '\'';
+  *o = '\0';
+  return q;
+}
+
+static tt_status pg_exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
+{
+  CPLErrorReset();
+  OGRLayerH rs = GDALDatasetExecuteSQL(dst, sql, NULL, NULL);
+  if (rs)
+    GDALDatasetReleaseResultSet(dst, rs);
+  if (CPLGetLastErrorType() >= CE_Failure) {
+    const char *m = CPLGetLastErrorMsg();
+    return tt__error(ctx, TT_ERR_IO, "cannot write the layers' style "
+                     "(layer_styles): %s", m && *m ? m : "no details from "
+                     "GDAL");
+  }
+  return TT_OK;
+}
+
+/* QGIS's layer_styles as its PostgreSQL provider creates it. */
+#define PG_STYLE_TABLE                                                         \
+  "CREATE TABLE IF NOT EXISTS layer_styles (id SERIAL PRIMARY KEY, "          \
+  "f_table_catalog varchar, f_table_schema varchar, f_table_name varchar, "   \
+  "f_geometry_column varchar, styleName text, styleQML xml, styleSLD xml, "   \
+  "useAsDefault boolean, description text, owner varchar(63) DEFAULT "        \
+  "CURRENT_USER, ui xml, update_time timestamp DEFAULT CURRENT_TIMESTAMP, "   \
+  "type varchar)"
+
+/* One layer's row: terratin's earlier row for the same table replaced.
+ * type NULL: QGIS matches its geometry type with the layer URI's (absent
+ * from a URI written by hand: "Unknown geometry") or takes NULL as any. */
+static tt_status pg_insert_row(tt_context *ctx, GDALDatasetH dst,
+                               const char *schema, OGRLayerH layer,
+                               const char *qml, int tri)
+{
+  /* OGR names a layer of another schema "schema.table" */
+  const char *name = OGR_L_GetName(layer);
+  const char *dot = schema ? strchr(name, '.') : NULL;
+  char *sch = schema ? sql_literal(schema) : CPLStrdup("current_schema()");
+  char *table = sql_literal(dot ? dot + 1 : name);
+  char *geom = sql_literal(OGR_L_GetGeometryColumn(layer));
+  char *doc = sql_literal(qml);
+  const char *description =
+      tri ? "'terratin: triangles by their max error (max_err), equal "
+            "intervals'"
+          : "'terratin: vertices by their insertion error (ins_err), "
+            "quantile classes; grey: none'";
+  char *where = CPLStrdup(CPLSPrintf(
+      "f_table_catalog = current_database() AND f_table_schema = %s AND "
+      "f_table_name = %s AND f_geometry_column = %s", sch, table, geom));
+  char *del = CPLStrdup(CPLSPrintf("DELETE FROM layer_styles WHERE %s AND "
+                                   "description LIKE 'terratin:%%'", where));
+  char *ins = CPLStrdup(CPLSPrintf(
+      "INSERT INTO layer_styles (f_table_catalog, f_table_schema, "
+      "f_table_name, f_geometry_column, styleName, styleQML, useAsDefault, "
+      "description, type) VALUES (current_database(), %s, %s, %s, %s, "
+      "XMLPARSE(DOCUMENT %s), true, %s, NULL)",
+      sch, table, geom, table, doc, description));
+  tt_status s = pg_exec(ctx, dst, del);
+  if (s == TT_OK)
+    s = pg_exec(ctx, dst, ins);
+  CPLFree(ins);
+  CPLFree(del);
+  CPLFree(where);
+  CPLFree(doc);
+  CPLFree(geom);
+  CPLFree(table);
+  CPLFree(sch);
+  return s;
+}
+
+tt_status tt__style_insert_pg(tt_context *ctx, GDALDatasetH dst,
+                              const tt_tin *tin, const char *schema,
+                              OGRLayerH tri_layer, OGRLayerH vtx_layer)
+{
+  tt_status s = pg_exec(ctx, dst, PG_STYLE_TABLE);
+  /* a table of QGIS before 3.14 has no type column; QGIS adds it too */
+  if (s == TT_OK)
+    s = pg_exec(ctx, dst, "ALTER TABLE layer_styles ADD COLUMN IF NOT "
+                          "EXISTS type varchar");
+  for (int k = 0; k < 2 && s == TT_OK; k++) {
+    OGRLayerH layer = k == 0 ? tri_layer : vtx_layer;
+    if (!layer)
+      continue;
+    char *qml = layer_qml(ctx, tin, k == 0);
+    if (!qml)
+      return TT_ERR_NOMEM;
+    s = pg_insert_row(ctx, dst, schema, layer, qml, k == 0);
     CPLFree(qml);
   }
   return s;

@@ -41,8 +41,10 @@
  * Fields: Integer64 becomes Integer where the driver has no Integer64
  * (MapInfo); a layer that creates no fields (DXF's fixed set) gets the
  * features without attributes, warned once. STYLE=YES writes QGIS's
- * layer_styles table of a GeoPackage (layer_style.c) in the same
- * transaction.
+ * layer_styles table of a GeoPackage or a PostgreSQL database
+ * (layer_style.c) in the same transaction, or a .qml beside each layer's
+ * file (Shapefile, FlatGeobuf, GeoJSON) once the layers are written. A GeoPackage gets every field's title and description in
+ * gpkg_data_columns (field_docs.c), with the height unit Z_UNIT.
  *
  * Spatial index: GPKG layers are created with SPATIAL_INDEX=NO (its R-tree
  * triggers would update the index per insert) and the R-tree is built once,
@@ -69,6 +71,7 @@
  * Workload: O(vertices + triangles) feature inserts (about 16 us each into
  * GPKG, R-tree included); memory O(1) beyond what the driver buffers.
  */
+#include "gdal/ogr/field_docs.h"
 #include "gdal/ogr/layer_style.h"
 #include "gdal/ogr/tin_records.h"
 
@@ -96,7 +99,12 @@ typedef struct write_state {
   int gpkg;
   unsigned layers;         /* LAYERS: the TT__LAYER_* bits to write */
   int overwrite;           /* OVERWRITE=YES: drop layers of those names */
-  int style;               /* STYLE=YES: QGIS's layer_styles (GPKG) */
+  int style;               /* STYLE=YES: QGIS's layer_styles (GPKG,
+                              PostgreSQL), .qml files (style_files) */
+  int style_files;         /* a QML file beside each layer's file:
+                              Shapefile, FlatGeobuf, GeoJSON */
+  char *z_unit;            /* Z_UNIT: the heights' unit, for the fields'
+                              descriptions; NULL: unknown */
   int no_int64;            /* the driver has no Integer64 fields */
   int warned_fields;       /* a field the driver dropped, said once */
   int build_rtree;         /* GPKG: bulk-build the R-trees before commit */
@@ -196,6 +204,9 @@ static tt_status parse_options(write_state *w, char **options)
       w->overwrite = CPLTestBool(value);
     } else if (strcasecmp(key, "STYLE") == 0) {
       w->style = CPLTestBool(value);
+    } else if (strcasecmp(key, "Z_UNIT") == 0) {
+      CPLFree(w->z_unit);
+      w->z_unit = *value ? CPLStrdup(value) : NULL;
     } else if (strcasecmp(key, "ROWS") == 0) {
       if (strcasecmp(value, "DEFERRED") == 0)
         w->rows_deferred = 1;
@@ -218,7 +229,7 @@ static tt_status parse_options(write_state *w, char **options)
       /* THREADS, JOURNAL and PAGES are tt_gpkg_write_rows()'s */
       s = tt__error(w->ctx, TT_ERR_ARG, "unknown write option \"%s\" "
                     "(known: JOURNAL, NLN_PREFIX, LAYERS, LCO, OVERWRITE, "
-                    "PAGES, ROWS, RTREE, STYLE, T_SRS, THREADS)", key);
+                    "PAGES, ROWS, RTREE, STYLE, T_SRS, THREADS, Z_UNIT)", key);
     }
     CPLFree(key);
     if (s != TT_OK)
@@ -789,6 +800,9 @@ static void begin_write(write_state *w, tt_context *ctx, GDALDatasetH dst,
   w->drv_name = drv ? GDALGetDriverShortName(drv) : "";
   w->shapefile = strcasecmp(w->drv_name, "ESRI Shapefile") == 0;
   w->gpkg = strcasecmp(w->drv_name, "GPKG") == 0;
+  w->style_files = w->shapefile ||
+                   strcasecmp(w->drv_name, "FlatGeobuf") == 0 ||
+                   strcasecmp(w->drv_name, "GeoJSON") == 0;
   const char *types =
       drv ? GDALGetMetadataItem(drv, GDAL_DMD_CREATIONFIELDDATATYPES, NULL)
           : NULL;
@@ -898,6 +912,22 @@ static tt_status fill_and_commit(write_state *w, const tt_tin *tin,
                                       : NULL,
                          w->vtx_layer ? OGR_L_GetGeometryColumn(w->vtx_layer)
                                       : NULL);
+  if (s == TT_OK && w->style && w->database &&
+      strcasecmp(w->drv_name, "PostgreSQL") == 0)
+    s = tt__style_insert_pg(w->ctx, w->dst, tin,
+                            CSLFetchNameValue(w->lco, "SCHEMA"),
+                            w->tri_layer, w->vtx_layer);
+  if (s == TT_OK && w->database &&
+      strcasecmp(w->drv_name, "PostgreSQL") == 0)
+    s = tt__field_docs_comment_pg(w->ctx, w->dst,
+                                  CSLFetchNameValue(w->lco, "SCHEMA"),
+                                  w->prefix, w->layers,
+                                  tt__records_vertex_fields(tin), fields,
+                                  nfields, w->z_unit);
+  if (s == TT_OK && w->gpkg)
+    s = tt__field_docs_write_gpkg(w->ctx, w->dst, w->prefix, w->layers,
+                                  tt__records_vertex_fields(tin), fields,
+                                  nfields, w->z_unit);
   if (s == TT_OK && w->build_rtree && w->tri_layer)
     s = build_rtree(w, w->tri_layer);
   if (s == TT_OK && w->build_rtree && w->progress &&
@@ -950,6 +980,7 @@ static void end_write(write_state *w, tt_status s)
   free(w->run_idx);
   tt__records_free(&w->rec);
   CPLFree(w->t_srs);
+  CPLFree(w->z_unit);
   CPLFree(w->prefix);
   CSLDestroy(w->lco);
 }
@@ -995,6 +1026,8 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
     if (s == TT_OK)
       s = fill_and_commit(&w, tin, fields, nfields);
   }
+  if (s == TT_OK && w.style && w.style_files)
+    s = tt__style_write_files(ctx, dst, tin, w.tri_layer, w.vtx_layer);
   if (s == TT_OK)
     s = flush_output(&w);
 

@@ -76,10 +76,11 @@
 
 /* The layers the TIN writer makes, and the files a shapefile layer may
  * have (.qix with SPATIAL_INDEX=YES; .sbn/.sbx are ESRI's index files,
- * which would be stale next to new data). */
+ * which would be stale next to new data; .qml is QGIS's style, which
+ * tt_ogr_write_tin's STYLE=YES writes). */
 static const char *const shp_geom_layers[] = {"triangles", "vertices"};
-static const char *const shp_geom_exts[] = {"shp", "shx", "dbf", "prj",
-                                            "cpg", "qix", "sbn", "sbx"};
+static const char *const shp_geom_exts[] = {"shp", "shx", "dbf", "prj", "cpg",
+                                            "qix", "sbn", "sbx", "qml"};
 static const char *const shp_table_layers[] = {"run_parameters"};
 static const char *const shp_table_exts[] = {"dbf", "cpg"};
 

@@ -118,6 +118,8 @@ static tt_status parse_options(tt_context *ctx, char **options,
   opt->z_factor = 1.0;
   opt->has_z_factor = 0;
   opt->z_unit_m = 0;
+  opt->z_unit_auto = 0;
+  opt->src_z_unit = NULL;
   opt->work_srs = NULL;
   opt->has_srcnodata = 0;
   opt->srcnodata_is_nan = 0;
@@ -150,11 +152,25 @@ static tt_status parse_options(tt_context *ctx, char **options,
         opt->has_z_factor = 1;
       }
     } else if (strcasecmp(key, "Z_UNIT") == 0) {
-      if (strcasecmp(value, "m") != 0)
-        s = tt__error(ctx, TT_ERR_ARG, "Z_UNIT must be m (heights in ft or "
-                      "us-ft converted to metres), got \"%s\"", value);
-      else
+      if (strcasecmp(value, "m") == 0)
         opt->z_unit_m = 1;
+      else if (strcasecmp(value, "auto") == 0)
+        opt->z_unit_auto = 1;
+      else
+        s = tt__error(ctx, TT_ERR_ARG, "Z_UNIT must be m (heights in ft or "
+                      "us-ft converted to metres) or auto (the same when "
+                      "the CRS is in metres or geographic), got \"%s\"",
+                      value);
+    } else if (strcasecmp(key, "SRC_Z_UNIT") == 0) {
+      static const char *const units[] = {"m", "ft", "us-ft"};
+      opt->src_z_unit = NULL;
+      for (int k = 0; k < 3; k++)
+        if (strcasecmp(value, units[k]) == 0 ||
+            (k == 2 && strcasecmp(value, "us_ft") == 0))
+          opt->src_z_unit = units[k];
+      if (!opt->src_z_unit)
+        s = tt__error(ctx, TT_ERR_ARG, "SRC_Z_UNIT must be m, ft or us-ft "
+                      "(the unit the heights are in), got \"%s\"", value);
     } else if (strcasecmp(key, "WORK_SRS") == 0) {
       if (!*value)
         s = tt__error(ctx, TT_ERR_ARG, "WORK_SRS needs a CRS");
@@ -355,6 +371,7 @@ static tt_status fill_info(raster_read *r)
   info->z_unit_declared = tt__raster_dup_str(r->unit_declared);
   info->z_unit_source = tt__raster_dup_str(r->unit_source);
   info->z_unit_factor = r->unit_factor;
+  info->z_unit_why = r->unit_why ? r->unit_why : "";
   info->scale = r->scale;
   info->offset = r->offset;
   info->z_factor = r->opt.z_factor;
@@ -390,6 +407,8 @@ tt_status tt_gdal_read_grid(tt_context *ctx, GDALRasterBandH band,
   r.band = band;
   r.progress = progress;
   r.progress_arg = progress_arg;
+  r.prog_lo = 0.0;
+  r.prog_hi = 1.0;
   r.ds = GDALGetBandDataset(band);
   r.path = r.ds ? GDALGetDescription(r.ds) : "";
   if (!r.path || !*r.path)

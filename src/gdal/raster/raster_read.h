@@ -29,6 +29,9 @@ typedef struct read_options {
   double z_factor;
   int has_z_factor;      /* Z_FACTOR was given */
   int z_unit_m;          /* Z_UNIT=m: convert ft and us-ft to metres */
+  int z_unit_auto;       /* Z_UNIT=auto: the same when the CRS is in
+                            metres or geographic */
+  const char *src_z_unit; /* SRC_Z_UNIT: "m", "ft" or "us-ft", NULL */
   const char *work_srs;  /* WORK_SRS, NULL: chosen here (points into the
                             options list) */
   int has_srcnodata;
@@ -69,6 +72,9 @@ typedef struct raster_read {
   const char *path;         /* its name, for messages */
   tt_progress_fn progress;
   void *progress_arg;
+  double prog_lo, prog_hi;  /* the stage's share of the read's progress:
+                               the ground points' (0 - 0.8, when made),
+                               then the scan's */
   read_options opt;         /* as given */
   /* the band (raster_read.c) */
   GDALDataType dtype;
@@ -86,6 +92,7 @@ typedef struct raster_read {
   const char *unit_source;  /* where it was declared ("band unit", ...) */
   const char *unit_out;     /* the unit of the grid's heights */
   double unit_factor;       /* Z_UNIT=m's factor, else 1 */
+  const char *unit_why;     /* why the heights were converted, "" */
   read_options conv;        /* what the scan multiplies by: Z_FACTOR times
                                unit_factor */
   char frame_name[512];
@@ -126,6 +133,16 @@ static inline tt_status tt__raster_with_path(tt_context *ctx, tt_status s,
   char msg[TT_ERRMSG_MAX];
   snprintf(msg, sizeof msg, "%s", ctx->errmsg);
   return tt__error(ctx, s, "%s: %s", path, msg);
+}
+
+/* The read's progress at fraction f of the current stage (prog_lo ..
+ * prog_hi); 0 when the run is to stop. */
+static inline int tt__raster_progress(raster_read *r, double f,
+                                      const char *what)
+{
+  return !r->progress ||
+         r->progress(r->prog_lo + (r->prog_hi - r->prog_lo) * f, what,
+                     r->progress_arg);
 }
 
 /* --- the georeferencing (raster_georef.c) --------------------------------

@@ -339,7 +339,7 @@ tt_status tt__raster_scan(raster_read *rd)
   hold_cache(rd);
 
   rd->valid = 0;
-  if (rd->progress && !rd->progress(0.0, "reading", rd->progress_arg))
+  if (!tt__raster_progress(rd, 0.0, "reading"))
     return tt__error(ctx, TT_ERR_INTERRUPTED, "%s: read interrupted",
                      rd->path);
   for (size_t r0 = 0; r0 < ny; r0 += rd->step) {
@@ -355,9 +355,8 @@ tt_status tt__raster_scan(raster_read *rd)
                       &rd->conv, rd->scale, rd->offset, &rd->valid);
     if (s != TT_OK)
       return s;
-    if (rd->progress &&
-        !rd->progress((double)(r0 + nrows) / (double)ny, "reading",
-                      rd->progress_arg))
+    if (!tt__raster_progress(rd, (double)(r0 + nrows) / (double)ny,
+                             "reading"))
       return tt__error(ctx, TT_ERR_INTERRUPTED, "%s: read interrupted at "
                        "row %zu of %zu", rd->path, r0 + nrows, ny);
   }
