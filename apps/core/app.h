@@ -374,6 +374,9 @@ typedef struct app_simplify_report {
    * only (GPX: EPSG:4326, chosen by the dry run); NULL: the DEM's */
   const char *t_srs;
   int t_srs_auto;     /* t_srs was chosen for the format, not given */
+  /* -breaklines (apps/simplify/breaklines.c): the features read, the
+   * constrained segments they made */
+  size_t breaklines, breakline_segments;
   /* what was written, as the user names it (tt__app_output_names): the
    * files, and the layers of a dataset of several (else NULL) */
   char **files, **layers;

@@ -249,6 +249,11 @@ static const tt__app_opt_def opt_defs[] = {
     {"-work_srs", O_WORK_SRS, FOR_S, OPT_TEXT, AT(s.work_srs),
      .need = CRS_NEEDED},
     {"-t_srs", O_T_SRS, FOR_S, OPT_TEXT, AT(s.t_srs), .need = CRS_NEEDED},
+    {"-breaklines", O_BREAKLINES, FOR_S, OPT_TEXT, AT(s.breaklines)},
+    {"-breaklines_layer", O_BREAKLINES_LAYER, FOR_S, OPT_TEXT,
+     AT(s.breaklines_layer)},
+    {"-breaklines_where", O_BREAKLINES_WHERE, FOR_S, OPT_TEXT,
+     AT(s.breaklines_where)},
     {"-anneal_t0", O_ANNEAL_T0, FOR_S | FOR_O | FOR_T, OPT_REAL,
      AT(s.anneal.t0), .lo = 0, .hi = HUGE_VAL, .flags = OPT_GT,
      .bad = "must be a finite number > 0 (the start temperature, in swap "

@@ -327,6 +327,12 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   else
     tt__json_null(&j, "memory_limit");
   tt__json_str(&j, "memory_limit_source", p->mem_source);
+  if (p->breaklines) {
+    tt__json_open(&j, "breaklines");
+    tt__json_size(&j, "lines", p->breaklines);
+    tt__json_size(&j, "segments", p->breakline_segments);
+    tt__json_close(&j);
+  }
   if (p->tiles) {
     tt__json_open(&j, "tiling");
     tt__json_size(&j, "tiles", p->tiles);
@@ -550,6 +556,11 @@ void tt__app_print_simplify_summary(app_run *r, const app_simplify_report *p)
   say_input(r, p);
   say_output(r, p);
   say_error(r, p);
+  if (p->breaklines)
+    fprintf(r->out, "lines:  %zu breakline%s read, %zu constrained "
+            "segment%s after simplification along them\n", p->breaklines,
+            p->breaklines == 1 ? "" : "s", p->breakline_segments,
+            p->breakline_segments == 1 ? "" : "s");
   if (r->s->verbose)
     say_details(r, p);
 }

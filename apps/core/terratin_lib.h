@@ -121,6 +121,10 @@ typedef struct tt_app_settings {
                                 from the DEM's CRS (simplify) */
   const char *t_srs;         /* -t_srs: the output layers' CRS; NULL: the
                                 DEM's (simplify) */
+  const char *breaklines;    /* -breaklines: an OGR source of lines the
+                                TIN follows; NULL: none (simplify) */
+  const char *breaklines_layer; /* -breaklines_layer; NULL: the first */
+  const char *breaklines_where; /* -breaklines_where: an attribute filter */
   /* the DEM as GDAL's input options present it (dem_view.c): read
    * through an in-memory VRT of the window, map coordinates unchanged */
   tt_app_box srcwin;         /* -srcwin xoff yoff xsize ysize (samples) */

@@ -195,6 +195,7 @@ void tt__app_job_free(app_simplify_job *job)
   CPLFree(job->t_srs_auto);
   CSLDestroy(job->dsco);
   tt_tin_destroy(job->tin);
+  free(job->bl_ends);
   tt_grid_destroy(job->grid);
   tt_raster_info_destroy(job->info);
 }

@@ -206,15 +206,19 @@ void tt__app_output_choose_stream(app_simplify_job *job)
   job->rep.streamed = 1;
 }
 
-/* The layers the output holds, under their written names (-nln first). */
+/* The layers the output holds, under their written names (-nln first):
+ * the breaklines' beside the triangles when the run had some. */
 static char **layer_names(const app_simplify_job *job, const char *prefix,
-                          const char *const suffix[3])
+                          const char *const suffix[4])
 {
   static const char *const names[] = {"triangles", "vertices",
-                                      "run_parameters"};
+                                      "run_parameters", "breaklines"};
+  unsigned want = job->s->layers;
+  if (job->rep.breakline_segments && (want & 1u))
+    want |= 8u;
   char **out = NULL;
-  for (unsigned i = 0; i < 3; i++)
-    if (job->s->layers & (1u << i))
+  for (unsigned i = 0; i < 4; i++)
+    if (want & (1u << i))
       out = CSLAddString(out, CPLSPrintf("%s%s%s%s", prefix, job->s->nln,
                                          names[i], suffix ? suffix[i] : ""));
   return out;
@@ -253,7 +257,7 @@ void tt__app_output_names(const app_simplify_job *job, char ***out_files,
     CPLFree(stem);
   } else if (tt__app_str_ieq(job->drvname, "ESRI Shapefile")) {
     /* files of their own beside OUTPUT: <name>_triangles.shp, ... */
-    static const char *const ext[3] = {".shp", ".shp", ".dbf"};
+    static const char *const ext[4] = {".shp", ".shp", ".dbf", ".shp"};
     const char *slash = strrchr(s->output, '/');
     char *dir = CPLStrdup(s->output);
     dir[slash ? (size_t)(slash - s->output) + 1 : 0] = '\0';

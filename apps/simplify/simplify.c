@@ -240,6 +240,8 @@ static tt_status run_whole(app_simplify_job *job)
     tt__app_step_of_grid(&step, job->grid);
     tt__app_job_default_bound(job, &step);
   }
+  if (s->breaklines && (st = tt__app_breaklines(job)) != TT_OK)
+    return st;
   tt__app_phase_set(&r->prog, read_share(job), 0.85);
   rep->ropt = &job->ro;
   if (job->decimate)
@@ -310,6 +312,11 @@ tt_status tt__app_simplify(app_run *r)
                       "a tiled run (-tile_size, or tiles chosen by the "
                       "memory limit) cannot count patches across its "
                       "tiles: run untiled");
+  if (st == TT_OK && r->s->breaklines && job.tile_size)
+    st = tt__app_fail(r, TT_APP_EXIT_USAGE, TT_ERR_ARG, NULL,
+                      "simplify: -breaklines: not yet with a tiled run "
+                      "(-tile_size, or a DEM tiled automatically for "
+                      "memory)");
   if (st == TT_OK)
     st = job.tile_size ? run_tiled(&job) : run_whole(&job);
   /* nothing to write: one tile of `tiles run`, handed to its hook */

@@ -16,6 +16,8 @@
  *                   the creation options, a database output)
  *   write.c         the write of the TIN into the output, and its commit
  *   run_fields.c    the run_parameters layer's fields of a run
+ *   breaklines.c    -breaklines: lines made chains of samples, simplified,
+ *                   the engine's constrained segments
  *   tiled.c         the tiled path: the passes over the tiles, merged
  *   tiled_workers.c the tiles read and run on worker threads (tiled.h)
  *   tiled_budget.c  a budget in tiles: the curves and the bound
@@ -108,6 +110,7 @@ struct app_simplify_job {
   tt_grid *grid;              /* a whole run's DEM, until simplified */
   tt_raster_info *info;
   tt_tin *tin;                /* NULL when streamed */
+  int64_t *bl_ends;           /* -breaklines: ro.breaklines's ends (free) */
   app_simplify_report rep;
 };
 
@@ -155,6 +158,11 @@ int tt__app_job_default_wanted(const app_simplify_job *job);
 void tt__app_job_default_bound(app_simplify_job *job, const app_step *step);
 /* Closes and frees what the job holds; an unfinished output is removed. */
 void tt__app_job_free(app_simplify_job *job);
+
+/* breaklines.c: -breaklines read and traced on the whole run's grid into
+ * job->ro.breaklines (the ends kept in job->bl_ends), the lines clipped
+ * warned about. The failure is recorded. */
+tt_status tt__app_breaklines(app_simplify_job *job);
 
 /* output.c: the kind of output and its driver (-of, else OUTPUT's form),
  * the mesh formats' refusals of the OGR options. */

@@ -350,6 +350,22 @@ tt_optimize tt_optimize_resolve(tt_optimize optimize, tt_criterion criterion,
 typedef struct tt_step_info tt_step_info;
 typedef int (*tt_step_fn)(const tt_step_info *step, void *arg);
 
+/* Breaklines: segments between grid samples that the TIN must have as
+ * edges. Sample s is the one at column s % width, row s / width of the
+ * grid. The edges are constrained: no flip of the criterion and no
+ * optimiser removes them, and a vertex inserted on one splits it into two
+ * constrained edges. Every end must be a valid sample in the valid domain
+ * (not across nodata), and two segments may meet only at their ends or
+ * overlap along a line; a run that cannot make them edges fails with
+ * TT_ERR_DATA naming the segment. The ends count as forced vertices of the
+ * start, like the nodata outline's. The caller keeps ends alive during the
+ * run; { NULL, 0 } (the default): none. */
+typedef struct tt_breaklines {
+  const int64_t *ends;  /* 2 n sample indices: segment i from ends[2 i]
+                           to ends[2 i + 1] */
+  size_t n;
+} tt_breaklines;
+
 typedef struct tt_refine_options {
   /* Stop when the worst remaining sample error is <= max_error (z units).
    * Negative: no error limit. */
@@ -400,6 +416,8 @@ typedef struct tt_refine_options {
   size_t step_until;
   const size_t *step_at;
   size_t nstep_at;
+  /* Edges the TIN must have (tt_breaklines above). */
+  tt_breaklines breaklines;
 } tt_refine_options;
 
 /* Default: max_error 1 z unit, no other limit, Delaunay, no progress. */
@@ -576,6 +594,9 @@ typedef struct tt_triangle_info {
                              (+y), [0,360); NaN when flat */
   double min_angle_deg;   /* in the ground frame */
   double max_angle_deg;
+  /* Bit k (1, 2, 4) set when edge v[k] -> v[(k + 1) % 3] lies on one of
+   * the run's breaklines (tt_breaklines); 0 without breaklines. */
+  unsigned constrained;
 } tt_triangle_info;
 
 /* index < count, else TT_ERR_ARG (the context may be NULL here). */
@@ -668,6 +689,9 @@ typedef struct tt_decimate_options {
    * every sample (decimation keeps no running sums). NULL: none. */
   tt_step_fn step;
   void *step_arg;
+  /* Edges the TIN must have (tt_breaklines): made constrained edges of
+   * the start (every start); their vertices are never removed. */
+  tt_breaklines breaklines;
 } tt_decimate_options;
 
 /* Default: no limit at all (set one), Delaunay, start all, importance

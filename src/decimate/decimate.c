@@ -42,6 +42,7 @@
  * Part of src/decimate/, the vertex decimation method (tt_decimate_run).
  */
 #include "decimate/decimate.h"
+#include "mesh/breaklines.h"
 
 #include "base/heap.h"
 #include "base/parallel.h"
@@ -623,7 +624,8 @@ static tt_status trim_borders(run *r)
 }
 
 /* Vertices that may never go: those with several fans (the outline
- * pinches there) and the ends of constrained inner edges. */
+ * pinches there), the ends of constrained inner edges and of every edge
+ * on a breakline. */
 static void pin(tt__dec *d)
 {
   tt__mesh *m = &d->m;
@@ -632,6 +634,10 @@ static void pin(tt__dec *d)
     if (!tt__mesh_live(m, (int32_t)(e / 3)))
       continue;
     int32_t a = m->hv[e];
+    if (m->eflag[e] & TT__EDGE_BREAKLINE) /* both ends, on the boundary
+                                            too: a line keeps its edges */
+      d->vflag[a] |= TT__DV_PINNED,
+          d->vflag[m->hv[tt__next((int32_t)e)]] |= TT__DV_PINNED;
     if (m->twin[e] < 0) {
       if (out && out[a] < 2)
         out[a]++;
@@ -699,6 +705,11 @@ static tt_status build_tin(run *r, tt_tin **out_tin)
     status = oom(r);
     goto done;
   }
+  /* the breaklines' edges, flagged in the copy as in the mesh */
+  for (size_t e = 0; e < 3 * m->nslots; e++)
+    if ((m->eflag[e] & TT__EDGE_BREAKLINE) && tt__mesh_live(m, (int32_t)(e / 3)))
+      (void)tt__breaklines_flag(&c, map[m->hv[e]],
+                                map[m->hv[tt__next((int32_t)e)]]);
   if (d->borders) /* the piece's scans follow the neighbour's edges */
     tt__tile_flag_edges(&c, d->g->nx, d->g->ny, d->borders);
   for (size_t v = 0; v < m->nv; v++)

@@ -137,6 +137,9 @@ tt_status tt__decimate_check_options(tt_context *ctx,
       o->percent == 0)
     return tt__error(ctx, TT_ERR_ARG, "no stop condition: set a max error, "
                      "a point or triangle budget, or a percentage");
+  if (o->breaklines.n && !o->breaklines.ends)
+    return tt__error(ctx, TT_ERR_ARG, "breaklines.ends is NULL with n %zu",
+                     o->breaklines.n);
   if (!tt__criterion_get(o->criterion))
     return tt__error(ctx, TT_ERR_ARG, "unknown criterion %d",
                      (int)o->criterion);

@@ -27,6 +27,7 @@
  */
 #include "decimate/decimate.h"
 
+#include "mesh/breaklines.h"
 #include "tin/tin.h"
 
 #include <math.h>
@@ -150,6 +151,7 @@ static tt_status start_greedy(tt__dec *d, size_t points)
   ro.max_points = points;
   ro.threads = o->threads;
   ro.optimize = TT_OPTIMIZE_NONE;
+  ro.breaklines = o->breaklines;
   tt_tin *tin = NULL;
   /* a tile starts from its border vertices, as refinement does, and N
    * counts the insertions after them (tile.h) */
@@ -173,11 +175,45 @@ static tt_status start_greedy(tt__dec *d, size_t points)
       status = oom(d);
       goto done;
     }
-  if (!tt__mesh_link_all(m))
+  if (!tt__mesh_link_all(m)) {
     status = oom(d);
+    goto done;
+  }
+  /* the breaklines' edges, as the greedy TIN has them */
+  for (size_t t = 0; tin->t_brk && t < tin->nt; t++)
+    for (int k = 0; k < 3; k++)
+      if (((tin->t_brk[t] >> k) & 1u) &&
+          !tt__breaklines_flag(m, tin->tv[3 * t + (size_t)k],
+                               tin->tv[3 * t + (size_t)(k + 1) % 3])) {
+        status = tt__error(d->ctx, TT_ERR_INTERNAL, "a breakline edge of "
+                           "the greedy start is not in the mesh");
+        goto done;
+      }
 done:
   tt_tin_destroy(tin);
   return status;
+}
+
+/* A vertex for a breakline's end (start_all has every usable sample
+ * already: a safety net). */
+static bool add_end(void *arg, int32_t col, int32_t row, int32_t *out_v)
+{
+  tt__dec *d = arg;
+  size_t at = (size_t)row * d->g->nx + (size_t)col;
+  *out_v = tt__mesh_add_vertex(&d->m, col, row, tt__grid_z(d->g, at));
+  return *out_v >= 0;
+}
+
+/* Every sample, then the breaklines recovered in it as constrained
+ * edges (their vertices are pinned by decimate.c). */
+static tt_status start_all_lines(tt__dec *d)
+{
+  tt_status s = start_all(d);
+  if (s == TT_OK && d->opt->breaklines.n)
+    s = tt__breaklines_insert(d->ctx, &d->m, d->g, &d->opt->breaklines,
+                              &tt__criterion_delaunay, &d->env, &d->stack,
+                              add_end, d);
+  return s;
 }
 
 tt_status tt__dec_start(tt__dec *d, size_t valid)
@@ -185,7 +221,7 @@ tt_status tt__dec_start(tt__dec *d, size_t valid)
   (void)valid;
   switch (d->opt->start) {
   case TT_DSTART_ALL:
-    return start_all(d);
+    return start_all_lines(d);
   case TT_DSTART_GREEDY:
     return start_greedy(d, 0);
   default:

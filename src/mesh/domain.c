@@ -313,6 +313,16 @@ static bool recover(tt__mesh *m, int32_t a, int32_t b, queue *q, int depth,
   return true;
 }
 
+bool tt__domain_recover_segment(tt__mesh *m, int32_t a, int32_t b,
+                                bool *out_ok)
+{
+  queue q = {NULL, 0, 0, 0};
+  *out_ok = true;
+  bool done = recover(m, a, b, &q, 0, out_ok);
+  free(q.q);
+  return done;
+}
+
 /* Whether triangle t lies in the domain. No triangle crosses the outline
  * once it is recovered, so one interior point decides: the centroid, exact
  * in thrice-scaled integer coordinates. The cell holding it decides in

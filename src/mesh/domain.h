@@ -30,4 +30,11 @@ TT_HIDDEN tt_status tt__domain_build(tt_context *ctx, tt__mesh *m,
                                      tt__domain_add_vertex add_vertex,
                                      void *add_arg);
 
+/* Recovers the segment between vertices a and b of m as constrained
+ * edges by flips (split at the vertices that lie on it, as the outline's
+ * runs are). False when out of memory; *out_ok is set false when the mesh
+ * defeats the recovery (a constrained edge crosses the segment). */
+TT_HIDDEN bool tt__domain_recover_segment(tt__mesh *m, int32_t a, int32_t b,
+                                          bool *out_ok);
+
 #endif /* TT_DOMAIN_H */

@@ -397,8 +397,8 @@ bool tt__mesh_split_edge(tt__mesh *m, int32_t e, int32_t p,
     out_opposite[2] = 3 * u;
     out_opposite[3] = 3 * u1 + 2;
   } else {
-    link(m, 3 * t + 1, -1, 0);
-    link(m, 3 * t1 + 1, -1, 0);
+    link(m, 3 * t + 1, -1, f_ab); /* the halves keep its flags */
+    link(m, 3 * t1 + 1, -1, f_ab);
     out_opposite[2] = out_opposite[3] = -1;
   }
   return true;
@@ -844,7 +844,7 @@ bool tt__mesh_replace_region(tt__mesh *m, const int32_t *old_slots, int nold,
     for (int h = 0; h < nhalf; h++) {
       int32_t x = tris[h / 3][h % 3], y = tris[h / 3][(h % 3 + 1) % 3];
       if ((x == a && y == b) || (x == b && y == a)) {
-        iflag[h] = TT__EDGE_CONSTRAINED;
+        iflag[h] = m->eflag[icons[i]]; /* breakline bit included */
         kept = true;
       }
     }

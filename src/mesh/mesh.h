@@ -37,6 +37,10 @@
  * (raster_scan.h), as if the edge were an inner one. */
 #define TT__EDGE_BORDER 2u
 #define TT__EDGE_BORDER_SHARED 4u
+/* A constrained edge on one of the caller's breaklines (breaklines.c),
+ * kept by splits and region replacements with TT__EDGE_CONSTRAINED, so
+ * that the TIN can say which of its edges follow a line. */
+#define TT__EDGE_BREAKLINE 8u
 
 /* A vertex: one 16-byte record, so a triangle's corners cost three cache
  * lines, not twelve. Its height is read through tt__mesh_z(): the record's

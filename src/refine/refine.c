@@ -46,6 +46,7 @@
 #include "refine/refine.h"
 
 #include "criteria/criterion.h"
+#include "mesh/breaklines.h"
 #include "mesh/domain.h"
 #include "base/heap.h"
 #include "mesh/mesh.h"
@@ -585,6 +586,14 @@ static tt_status start(refine *r, size_t valid)
       return s;
     r->forced = r->m.nv - before;
   }
+  if (r->opt->breaklines.n) {
+    size_t before = r->m.nv;
+    s = tt__breaklines_insert(r->ctx, &r->m, g, &r->opt->breaklines, r->crit,
+                              &r->env, &r->stack, domain_vertex, r);
+    if (s != TT_OK)
+      return s;
+    r->forced += r->m.nv - before;
+  }
   if (r->borders && (s = start_borders(r)) != TT_OK)
     return s;
   /* every slot written so far is logged: scan them all */
@@ -774,6 +783,9 @@ static tt_status check_options(tt_context *ctx, const tt_refine_options *o)
     return st;
   if (!tt_repair_name(o->repair))
     return tt__error(ctx, TT_ERR_ARG, "unknown repair %d", (int)o->repair);
+  if (o->breaklines.n && !o->breaklines.ends)
+    return tt__error(ctx, TT_ERR_ARG, "breaklines.ends is NULL with n %zu",
+                     o->breaklines.n);
   if (o->nstep_at && !o->step_at)
     return tt__error(ctx, TT_ERR_ARG, "step_at is NULL with nstep_at %zu",
                      o->nstep_at);
@@ -876,10 +888,11 @@ static tt_status run(tt_context *ctx, const tt_grid *grid,
    * corners, or the hull and the nodata outline's forced vertices, which
    * the run cannot drop) is refused before any insertion, with the count
    * to ask for instead. */
-  char why[96];
+  char why[128];
   if (r.forced)
-    snprintf(why, sizeof why, "%zu of its %zu vertices forced by the nodata "
-             "outline", r.forced, r.linked);
+    snprintf(why, sizeof why, "%zu of its %zu vertices forced by the %s",
+             r.forced, r.linked, opt->breaklines.n ? "nodata outline and "
+             "the breaklines" : "nodata outline");
   else
     snprintf(why, sizeof why, "%s", valid == grid->nx * grid->ny
                                         ? "the grid's four corners"

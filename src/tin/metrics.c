@@ -140,6 +140,27 @@ static size_t top_row(const tt__mesh *m, int32_t t)
   return (size_t)(r < r2 ? r : r2);
 }
 
+/* tin->t_brk from the mesh's breakline flags (order: triangle i's slot),
+ * left NULL when no edge has one. */
+static tt_status breakline_bits(tt_context *ctx, const tt__mesh *m,
+                                const int32_t *order, tt_tin *tin)
+{
+  bool any = false;
+  for (size_t e = 0; e < 3 * m->nslots && !any; e++)
+    any = (m->eflag[e] & TT__EDGE_BREAKLINE) && m->hv[e - e % 3] >= 0;
+  if (!any)
+    return TT_OK;
+  tin->t_brk = calloc(m->nlive ? m->nlive : 1, 1);
+  if (!tin->t_brk)
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory for the breakline "
+                     "flags of %zu triangles", m->nlive);
+  for (size_t i = 0; i < m->nlive; i++)
+    for (int k = 0; k < 3; k++)
+      if (m->eflag[3 * (size_t)order[i] + (size_t)k] & TT__EDGE_BREAKLINE)
+        tin->t_brk[i] |= (uint8_t)(1u << k);
+  return TT_OK;
+}
+
 static tt_status build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
                        double *ins_err, tt__pool *pool, bool homes,
                        tt_tin **out_tin)
@@ -280,6 +301,9 @@ static tt_status build(tt_context *ctx, const tt__mesh *m, const tt_grid *g,
     for (int k = 0; k < 3; k++)
       tin->tv[3 * i + k] = vmap[m->hv[3 * (size_t)s + k]];
   }
+  status = breakline_bits(ctx, m, order, tin);
+  if (status != TT_OK)
+    goto done;
   /* the scans, in fixed chunks reduced in chunk order: the sums do not
    * depend on the number of threads */
   size_t nchunks = (nt + CHUNK - 1) / CHUNK;

@@ -32,6 +32,7 @@ void tt_tin_destroy(tt_tin *tin)
   free(tin->t_max);
   free(tin->t_rmse);
   free(tin->t_n);
+  free(tin->t_brk);
   free(tin->vgxy);
   free(tin->vgk);
   free(tin->vgconv);
@@ -139,6 +140,7 @@ tt_status tt_tin_triangle(const tt_tin *tin, size_t index,
   o->max_error = tin->t_max[index];
   o->rmse = tin->t_rmse[index];
   o->samples = (size_t)tin->t_n[index];
+  o->constrained = tin->t_brk ? tin->t_brk[index] : 0u;
   double ux = p[1][0] - p[0][0], uy = p[1][1] - p[0][1];
   double vx = p[2][0] - p[0][0], vy = p[2][1] - p[0][1];
   double uz = z[1] - z[0], vz = z[2] - z[0];

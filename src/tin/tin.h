@@ -35,6 +35,8 @@ struct tt_tin {
   double *t_rmse;        /* doubles, clamped to t_max: a float's rounding
                             put 1,929 of Mt Hood's rmse above max_err */
   uint64_t *t_n;
+  uint8_t *t_brk;        /* bit k: edge v[k] -> v[k+1] lies on a breakline;
+                            NULL when the TIN has none */
   /* georeference */
   double gt[6];
   double frame[4];

@@ -760,7 +760,8 @@ tt_status tt_gpkg_write_rows(tt_context *ctx, const char *gpkg_path,
   const char *why = NULL;
   if (s == TT_OK && rw.o.pages)
     s = tt__rows_pages_possible(w, &rw.tri, &rw.vtx, rw.do_tri, rw.do_vtx,
-                                rw.o.rtree, tt__records_vertex_fields(tin),
+                                rw.o.rtree, tt__records_triangle_fields(tin),
+                                tt__records_vertex_fields(tin),
                                 rw.job.lay, &why);
   if (s == TT_OK && rw.o.pages && why)
     CPLDebug("terratin", "%s: the rows go through SQLite, not as pages: %s",

@@ -232,7 +232,8 @@ TT_HIDDEN tt_status tt__rows_pages_possible(rows_state *w,
                                             const layer_table *tri,
                                             const layer_table *vtx,
                                             int do_tri, int do_vtx,
-                                            int rtree, int nvfields,
+                                            int rtree, int ntfields,
+                                            int nvfields,
                                             page_layout lay[2],
                                             const char **why);
 /* Steps 1 (from the open transaction of j->w->db, which it ends) to 3 of

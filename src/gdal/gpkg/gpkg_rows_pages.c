@@ -214,7 +214,8 @@ tt_status tt__gpkg_pages_check(tt_context *ctx, const char *path)
  * triangles, lay[1]: vertices, when written); why not in *why. */
 tt_status tt__rows_pages_possible(rows_state *w, const layer_table *tri,
                                 const layer_table *vtx, int do_tri,
-                                int do_vtx, int rtree, int nvfields,
+                                int do_vtx, int rtree, int ntfields,
+                                int nvfields,
                                 page_layout lay[2], const char **why)
 {
   int page, reserve;
@@ -233,7 +234,7 @@ tt_status tt__rows_pages_possible(rows_state *w, const layer_table *tri,
   }
   tt_status s = TT_OK;
   if (do_tri)
-    s = layout_find(w, tri, tt__triangle_fields, TT__TF_COUNT,
+    s = layout_find(w, tri, tt__triangle_fields, ntfields,
                     TRI_BLOB_BYTES, max_payload, &lay[0], why);
   if (s == TT_OK && !*why && do_vtx)
     s = layout_find(w, vtx, tt__vertex_fields, nvfields, PT_BLOB_BYTES,
@@ -638,7 +639,8 @@ tt_status tt__gpkg_pages_open(tt_context *ctx, const char *path,
   const char *why = NULL;
   if (s == TT_OK)
     s = tt__rows_pages_possible(w, &p->layer[0], &p->layer[1], j->todo[0],
-                       j->todo[1], j->rtree, nvfields, j->lay, &why);
+                       j->todo[1], j->rtree, TT__TF_COUNT - 1, nvfields,
+                       j->lay, &why);
   if (s == TT_OK && why)
     s = tt__error(ctx, TT_ERR_FORMAT, "%s: the rows cannot be written as "
                   "pages: %s", path, why);

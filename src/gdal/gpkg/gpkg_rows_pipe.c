@@ -70,6 +70,8 @@ static tt_status fill_triangle(const rows_pipe *p, tt_context *ctx,
   set_real(&f[TT__TF_ASPECT], tr.aspect_deg);
   set_real(&f[TT__TF_MIN_ANGLE], tr.min_angle_deg);
   set_real(&f[TT__TF_MAX_ANGLE], tr.max_angle_deg);
+  if (p->ncols[0] > 1 + TT__TF_CONSTRAINED)
+    set_int(&f[TT__TF_CONSTRAINED], (sqlite3_int64)tr.constrained);
   return TT_OK;
 }
 
@@ -344,7 +346,7 @@ tt_status tt__rows_pipe_begin(rows_pipe *p, rows_state *w,
   p->layer[1] = vtx;
   p->count[0] = nt;
   p->count[1] = nv;
-  p->ncols[0] = 1 + TT__TF_COUNT;
+  p->ncols[0] = 1 + tt__records_triangle_fields(rec->tin);
   p->ncols[1] = 1 + tt__records_vertex_fields(rec->tin);
   p->decimated = tt__records_decimated(rec->tin);
   p->ring = calloc(NCHUNKS, sizeof *p->ring);

@@ -324,7 +324,7 @@ static void write_header(FILE *f, tt_mesh_format fmt, const char *name,
     fputs("  <Application name=\"terratin\"/>\n"
           "  <Surfaces>\n    <Surface name=\"", f);
     put_xml_text(f, name);
-    fputs("\">\n      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
+    fputs("\">\n", f); /* SourceData and Definition follow */
     break;
   }
   case TT_MESH_DXF:
@@ -380,6 +380,92 @@ static void write_vertex(FILE *f, tt_mesh_format fmt, size_t i,
   default:
     break;
   }
+}
+
+/* LandXML's Surface/SourceData/Breaklines: the TIN's edges on breaklines
+ * joined into polylines (a chain goes on through every vertex with two
+ * such edges), one Breakline each, its points northing, easting,
+ * elevation as the Pnts are (nothing without breaklines); then the
+ * Definition's start. */
+static tt_status write_source_data(FILE *f, const tt__records *rec,
+                                   tt_context *ctx)
+{
+  int32_t *pairs = NULL;
+  size_t n = 0;
+  if (!tt__records_breakline_edges(rec->tin, &pairs, &n))
+    return tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+  if (n == 0) {
+    fputs("      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
+    return TT_OK;
+  }
+  tt_status st = TT_OK;
+  size_t nv = tt_tin_vertex_count(rec->tin);
+  /* the edges by vertex: first[v] .. first[v + 1] in inc (edge numbers) */
+  size_t *first = calloc(nv + 1, sizeof *first);
+  size_t *inc = malloc(2 * n * sizeof *inc);
+  unsigned char *used = calloc(n, 1);
+  if (!first || !inc || !used) {
+    st = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+    goto done;
+  }
+  for (size_t i = 0; i < 2 * n; i++)
+    first[pairs[i] + 1]++;
+  for (size_t v = 0; v < nv; v++)
+    first[v + 1] += first[v];
+  {
+    size_t *fill = malloc((nv + 1) * sizeof *fill);
+    if (!fill) {
+      st = tt__error(ctx, TT_ERR_NOMEM, "out of memory");
+      goto done;
+    }
+    memcpy(fill, first, (nv + 1) * sizeof *fill);
+    for (size_t i = 0; i < 2 * n; i++)
+      inc[fill[pairs[i]]++] = i / 2;
+    free(fill);
+  }
+  fputs("      <SourceData>\n        <Breaklines>\n", f);
+  /* chains from the ends (degree != 2) first, then the closed loops */
+  for (int pass = 0; pass < 2 && st == TT_OK; pass++)
+    for (size_t s = 0; s < nv && st == TT_OK; s++) {
+      size_t deg = first[s + 1] - first[s];
+      if (deg == 0 || (pass == 0 && deg == 2))
+        continue;
+      for (size_t k = first[s]; k < first[s + 1] && st == TT_OK; k++) {
+        if (used[inc[k]])
+          continue;
+        fputs("          <Breakline brkType=\"standard\"><PntList3D>", f);
+        size_t v = s, e = inc[k];
+        for (int firstpt = 1;; firstpt = 0) {
+          tt_vertex_info vi;
+          double x, y;
+          st = tt__records_vertex(rec, ctx, v, &vi, &x, &y);
+          if (st != TT_OK)
+            break;
+          if (!firstpt)
+            fputc(' ', f);
+          put_nums(f, (const double[3]){y, x, vi.z}, 3, "");
+          if (e == (size_t)-1)
+            break;
+          used[e] = 1;
+          v = (size_t)(pairs[2 * e] == (int32_t)v ? pairs[2 * e + 1]
+                                                   : pairs[2 * e]);
+          e = (size_t)-1;
+          if (first[v + 1] - first[v] == 2) /* the chain goes on */
+            for (size_t j = first[v]; j < first[v + 1]; j++)
+              if (!used[inc[j]])
+                e = inc[j];
+        }
+        fputs("</PntList3D></Breakline>\n", f);
+      }
+    }
+  fputs("        </Breaklines>\n      </SourceData>\n", f);
+  fputs("      <Definition surfType=\"TIN\">\n        <Pnts>\n", f);
+done:
+  free(pairs);
+  free(first);
+  free(inc);
+  free(used);
+  return st;
 }
 
 /* Between the vertices and the faces. */
@@ -592,6 +678,8 @@ tt_status tt_mesh_write(tt_context *ctx, const char *path,
   }
   const int swap = host_big_endian();
   write_header(f, fmt, name, &rec, nv, nt, origin, local);
+  if (fmt == TT_MESH_LANDXML && (st = write_source_data(f, &rec, ctx)))
+    goto done;
   for (size_t i = 0; i < nv && st == TT_OK; i++) {
     tt_vertex_info v;
     double x, y;

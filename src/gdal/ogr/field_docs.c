@@ -52,7 +52,17 @@ const tt__field_doc tt__triangle_docs[TT__TF_COUNT] = {
     {"min_angle", "smallest angle", "smallest interior angle of the "
      "triangle (degrees)"},
     {"max_angle", "largest angle", "largest interior angle of the triangle "
-     "(degrees)"}};
+     "(degrees)"},
+    {"constrained", "breakline edges", "edges of the triangle on a "
+     "breakline: 1 for v0-v1, 2 for v1-v2, 4 for v2-v0, summed (only in "
+     "a TIN made with -breaklines)"}};
+
+/* The triangles layer's fields: constrained only beside a breaklines
+ * layer (a TIN made with breaklines, tin_records.h). */
+static int tri_fields(unsigned layers)
+{
+  return (layers & TT__LAYER_BREAKLINES) ? TT__TF_COUNT : TT__TF_COUNT - 1;
+}
 
 const tt__field_doc tt__vertex_docs[TT__VF_COUNT] = {
     {"vertex_id", "vertex id", "the vertex's number, as the triangles' v0, "
@@ -291,7 +301,7 @@ tt_status tt__field_docs_write_gpkg(tt_context *ctx, GDALDatasetH dst,
 {
   tt_status s = create_schema_tables(ctx, dst);
   char *table = CPLStrdup(CPLSPrintf("%striangles", prefix));
-  for (int i = 0; i < TT__TF_COUNT && s == TT_OK &&
+  for (int i = 0; i < tri_fields(layers) && s == TT_OK &&
                   (layers & TT__LAYER_TRIANGLES); i++)
     s = insert_row(ctx, dst, table, tt__triangle_docs[i].name,
                    tt__triangle_docs[i].title,
@@ -369,7 +379,8 @@ tt_status tt__field_docs_comment_pg(tt_context *ctx, GDALDatasetH dst,
     char *t = identifier(CPLSPrintf("%s%s", prefix, suffix[k]));
     char *sch = schema && *schema ? identifier(schema) : NULL;
     char *qualified = CPLStrdup(sch ? CPLSPrintf("%s.%s", sch, t) : t);
-    size_t n = k == 0 ? TT__TF_COUNT : k == 1 ? (size_t)n_vertex_fields
+    size_t n = k == 0 ? (size_t)tri_fields(layers)
+             : k == 1 ? (size_t)n_vertex_fields
                                               : nfields;
     for (size_t i = 0; i < n && s == TT_OK; i++) {
       const tt__field_doc *d = k == 0   ? &tt__triangle_docs[i]

@@ -38,7 +38,8 @@ TT_HIDDEN char *tt__field_doc_text(const char *description,
  * gpkg_data_columns and gpkg_data_column_constraints when missing, their
  * registration in gpkg_extensions (extension gpkg_schema), and one row per
  * field of the layers in layers (TT__LAYER_* bits) named prefix +
- * "triangles", "vertices", "run_parameters": n_vertex_fields of the vertex
+ * "triangles", "vertices", "run_parameters" (the triangles' constrained
+ * field only with TT__LAYER_BREAKLINES in layers): n_vertex_fields of the vertex
  * fields, and fields[0..nfields) of run_parameters, described by
  * tt__field_doc_run() (a field it does not know: its name as title, no
  * description). Rows of

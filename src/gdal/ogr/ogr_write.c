@@ -94,7 +94,7 @@ typedef struct write_state {
   int shapefile;
   char *prefix;
   char **lco;              /* layer creation options */
-  char *created[4];        /* names of the layers made, for cleanup */
+  char *created[5];        /* names of the layers made, for cleanup */
   int ncreated;
   int gpkg;
   unsigned layers;         /* LAYERS: the TT__LAYER_* bits to write */
@@ -111,9 +111,12 @@ typedef struct write_state {
   int rtree_deferred;      /* RTREE=DEFERRED: the caller builds them */
   int rows_deferred;       /* ROWS=DEFERRED: tt_gpkg_write_rows() writes
                               the triangles and vertices */
-  OGRLayerH tri_layer, vtx_layer, run_layer, style_layer;
+  OGRLayerH tri_layer, vtx_layer, run_layer, style_layer, brk_layer;
   int tri_idx[TT__TF_COUNT], vtx_idx[TT__VF_COUNT];
   int ele_idx;             /* GPX: the waypoints' "ele" field, else -1 */
+  int brk_fields;          /* the TIN has breaklines: the triangles'
+                              constrained field, the breaklines layer */
+  int brk_idx[2];          /* the breaklines layer's v0, v1 */
   int *run_idx;
   tt_progress_fn progress;
   void *progress_arg;
@@ -479,6 +482,8 @@ static tt_status write_triangles(write_state *w, const tt_tin *tin)
     set_real(f, idx[TT__TF_ASPECT], t.aspect_deg);
     set_real(f, idx[TT__TF_MIN_ANGLE], t.min_angle_deg);
     set_real(f, idx[TT__TF_MAX_ANGLE], t.max_angle_deg);
+    if (w->brk_fields)
+      set_int(f, idx[TT__TF_CONSTRAINED], (int)t.constrained);
     s = insert(w, layer, f, i);
   }
   OGR_G_DestroyGeometry(poly);
@@ -523,6 +528,44 @@ static tt_status write_vertices(write_state *w, const tt_tin *tin)
   }
   OGR_G_DestroyGeometry(pt);
   OGR_F_Destroy(f);
+  return s;
+}
+
+/* The breaklines layer's rows: a 3-D line per TIN edge on a breakline,
+ * with its two vertex indices. */
+static tt_status write_breaklines(write_state *w, const tt_tin *tin)
+{
+  int32_t *pairs = NULL;
+  size_t n = 0;
+  if (!tt__records_breakline_edges(tin, &pairs, &n))
+    return tt__error(w->ctx, TT_ERR_NOMEM, "out of memory for the "
+                     "breaklines layer");
+  tt_status s = TT_OK;
+  OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(w->brk_layer));
+  OGRGeometryH line = OGR_G_CreateGeometry(wkbLineString25D);
+  OGR_G_Set3D(line, TRUE);
+  for (size_t i = 0; i < n && s == TT_OK; i++) {
+    for (int k = 0; k < 2 && s == TT_OK; k++) {
+      tt_vertex_info v;
+      double x, y;
+      s = tt__records_vertex(&w->rec, w->ctx, (size_t)pairs[2 * i + k], &v,
+                             &x, &y);
+      OGR_G_SetPoint(line, k, x, y, v.z);
+    }
+    if (s != TT_OK)
+      break;
+    OGR_F_SetGeometry(f, line);
+    set_int(f, w->brk_idx[0], pairs[2 * i]);
+    set_int(f, w->brk_idx[1], pairs[2 * i + 1]);
+    OGR_F_SetFID(f, OGRNullFID);
+    CPLErrorReset();
+    if (OGR_L_CreateFeature(w->brk_layer, f) != OGRERR_NONE)
+      s = tt__error(w->ctx, TT_ERR_IO, "cannot write feature %zu of layer "
+                    "%s: %s", i, OGR_L_GetName(w->brk_layer), ogr_msg());
+  }
+  OGR_G_DestroyGeometry(line);
+  OGR_F_Destroy(f);
+  free(pairs);
   return s;
 }
 
@@ -686,8 +729,8 @@ static tt_status make_layer(write_state *w, const tt_tin *tin,
     s = create_layer(w, "triangles", w->rec.out_srs, wkbPolygon25D,
                      &w->tri_layer);
     if (s == TT_OK)
-      s = create_fields(w, w->tri_layer, tt__triangle_fields, TT__TF_COUNT,
-                        w->tri_idx);
+      s = create_fields(w, w->tri_layer, tt__triangle_fields,
+                        tt__records_triangle_fields(tin), w->tri_idx);
   } else if (which == TT__LAYER_VERTICES) {
     s = create_layer(w, "vertices", w->rec.out_srs, wkbPoint25D,
                      &w->vtx_layer);
@@ -700,6 +743,13 @@ static tt_status make_layer(write_state *w, const tt_tin *tin,
     if (s == TT_OK && strcasecmp(w->drv_name, "GPX") == 0)
       w->ele_idx = OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(w->vtx_layer),
                                         "ele");
+  } else if (which == TT__LAYER_BREAKLINES) {
+    static const tt__field_spec brk_fields[2] = {{"v0", OFTInteger},
+                                                 {"v1", OFTInteger}};
+    s = create_layer(w, "breaklines", w->rec.out_srs, wkbLineString25D,
+                     &w->brk_layer);
+    if (s == TT_OK)
+      s = create_fields(w, w->brk_layer, brk_fields, 2, w->brk_idx);
   } else {
     s = create_layer(w, "run_parameters", NULL, wkbNone, &w->run_layer);
     if (s == TT_OK)
@@ -715,6 +765,8 @@ static tt_status fill_layer(write_state *w, const tt_tin *tin,
 {
   if (which == TT__LAYER_RUN_PARAMETERS)
     return write_run_parameters(w, fields, nfields);
+  if (which == TT__LAYER_BREAKLINES) /* a few rows: never deferred */
+    return write_breaklines(w, tin);
   if (w->rows_deferred)
     return TT_OK;
   return which == TT__LAYER_TRIANGLES ? write_triangles(w, tin)
@@ -731,9 +783,10 @@ static tt_status start_transaction(write_state *w)
 }
 
 /* The order the layers are made and filled in. */
-static const unsigned layer_order[3] = {TT__LAYER_TRIANGLES,
-                                        TT__LAYER_VERTICES,
-                                        TT__LAYER_RUN_PARAMETERS};
+#define NLAYERS 4
+static const unsigned layer_order[NLAYERS] = {
+    TT__LAYER_TRIANGLES, TT__LAYER_VERTICES, TT__LAYER_BREAKLINES,
+    TT__LAYER_RUN_PARAMETERS};
 
 /* The state of a write into dst: the driver's name and what it takes. */
 static void begin_write(write_state *w, tt_context *ctx, GDALDatasetH dst,
@@ -793,7 +846,7 @@ static tt_status write_layer_by_layer(write_state *w, const tt_tin *tin,
                                       size_t nfields)
 {
   tt_status s = TT_OK;
-  for (int k = 0; k < 3 && s == TT_OK; k++)
+  for (int k = 0; k < NLAYERS && s == TT_OK; k++)
     if (w->layers & layer_order[k]) {
       s = make_layer(w, tin, layer_order[k], fields, nfields);
       if (s == TT_OK)
@@ -815,7 +868,7 @@ static tt_status make_layers(write_state *w, const tt_tin *tin,
       return s;
     w->in_transaction = 1;
   }
-  for (int k = 0; k < 3 && s == TT_OK; k++)
+  for (int k = 0; k < NLAYERS && s == TT_OK; k++)
     if (w->layers & layer_order[k])
       s = make_layer(w, tin, layer_order[k], fields, nfields);
   if (s == TT_OK && w->style && w->gpkg &&
@@ -850,7 +903,7 @@ static tt_status fill_and_commit(write_state *w, const tt_tin *tin,
                                  const tt_run_field *fields, size_t nfields)
 {
   tt_status s = TT_OK;
-  for (int k = 0; k < 3 && s == TT_OK; k++)
+  for (int k = 0; k < NLAYERS && s == TT_OK; k++)
     if (w->layers & layer_order[k])
       s = fill_layer(w, tin, layer_order[k], fields, nfields);
   if (s == TT_OK && w->style_layer)
@@ -948,6 +1001,10 @@ tt_status tt_ogr_write_tin(tt_context *ctx, GDALDatasetH dst,
   tt_status s = parse_options(&w, options);
   if (s == TT_OK)
     s = check_run_fields(&w, fields, nfields);
+  /* a TIN with breaklines: their layer beside the triangles */
+  w.brk_fields = tt__records_triangle_fields(tin) == TT__TF_COUNT;
+  if (w.brk_fields && (w.layers & TT__LAYER_TRIANGLES))
+    w.layers |= TT__LAYER_BREAKLINES;
   if (s == TT_OK)
     s = prepare_rows(&w, tin, srs);
   if (s != TT_OK)

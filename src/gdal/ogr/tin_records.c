@@ -49,7 +49,8 @@ const tt__field_spec tt__triangle_fields[TT__TF_COUNT] = {
     {"rmse", OFTReal},          {"n_samples", OFTInteger64},
     {"area_2d", OFTReal},       {"area_3d", OFTReal},
     {"slope", OFTReal},         {"aspect", OFTReal},
-    {"min_angle", OFTReal},     {"max_angle", OFTReal}};
+    {"min_angle", OFTReal},     {"max_angle", OFTReal},
+    {"constrained", OFTInteger}};
 
 const tt__field_spec tt__vertex_fields[TT__VF_COUNT] = {
     {"vertex_id", OFTInteger},  {"col", OFTInteger},
@@ -58,11 +59,68 @@ const tt__field_spec tt__vertex_fields[TT__VF_COUNT] = {
     {"star_rmse", OFTReal},     {"star_n", OFTInteger64},
     {"importance", OFTReal}};
 
+/* The edge bits of tt_triangle_info.constrained once v[1] and v[2] are
+ * swapped: edge 0 (v0 v1) becomes edge 2, edge 2 becomes edge 0. */
+static unsigned swap_edge_bits(unsigned b)
+{
+  return (b & 2u) | ((b & 1u) << 2) | ((b & 4u) >> 2);
+}
+
 int tt__records_decimated(const tt_tin *tin)
 {
   tt_tin_summary s;
   tt_tin_get_summary(tin, &s);
   return s.start_vertices > 0;
+}
+
+int tt__records_triangle_fields(const tt_tin *tin)
+{
+  return tin->t_brk ? TT__TF_COUNT : TT__TF_COUNT - 1;
+}
+
+static int cmp_pair(const void *a, const void *b)
+{
+  const int32_t *x = a, *y = b;
+  return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0])
+                      : (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+bool tt__records_breakline_edges(const tt_tin *tin, int32_t **out_pairs,
+                                 size_t *out_n)
+{
+  *out_pairs = NULL;
+  *out_n = 0;
+  if (!tin->t_brk)
+    return true;
+  size_t n = 0;
+  for (size_t t = 0; t < tin->nt; t++)
+    for (int k = 0; k < 3; k++)
+      n += (tin->t_brk[t] >> k) & 1u;
+  int32_t *p = malloc((2 * n + 2) * sizeof *p);
+  if (!p)
+    return false;
+  size_t m = 0;
+  for (size_t t = 0; t < tin->nt; t++)
+    for (int k = 0; k < 3; k++)
+      if ((tin->t_brk[t] >> k) & 1u) {
+        int32_t a = tin->tv[3 * t + (size_t)k];
+        int32_t b = tin->tv[3 * t + (size_t)(k + 1) % 3];
+        p[2 * m] = a < b ? a : b;
+        p[2 * m + 1] = a < b ? b : a;
+        m++;
+      }
+  qsort(p, m, 2 * sizeof *p, cmp_pair);
+  size_t u = 0; /* an inner edge is in two triangles: once */
+  for (size_t i = 0; i < m; i++)
+    if (u == 0 || p[2 * i] != p[2 * (u - 1)] ||
+        p[2 * i + 1] != p[2 * (u - 1) + 1]) {
+      p[2 * u] = p[2 * i];
+      p[2 * u + 1] = p[2 * i + 1];
+      u++;
+    }
+  *out_pairs = p;
+  *out_n = u;
+  return true;
 }
 
 int tt__records_vertex_fields(const tt_tin *tin)
@@ -257,6 +315,7 @@ tt_status tt__records_triangle(const tt__records *r, tt_context *ctx,
     out_x[2] = sx, out_y[2] = sy, out_z[2] = sz;
     int32_t si = t->v[1];
     t->v[1] = t->v[2], t->v[2] = si;
+    t->constrained = swap_edge_bits(t->constrained);
   }
   if (r->geodesic) {
     double lats[3], lons[3], area = 0, perimeter = 0;
@@ -288,9 +347,11 @@ tt_status tt__records_face(const tt__records *r, tt_context *ctx, size_t i,
     output_xy(r, (size_t)out_t->v[k], &x[k], &y[k]);
   }
   /* the test and the swap of tt__records_triangle() */
+  out_t->constrained = tin->t_brk ? tin->t_brk[i] : 0u;
   if ((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]) < 0) {
     int32_t si = out_t->v[1];
     out_t->v[1] = out_t->v[2], out_t->v[2] = si;
+    out_t->constrained = swap_edge_bits(out_t->constrained);
   }
   out_t->max_error = tin->t_max[i];
   out_t->rmse = tin->t_rmse[i];

@@ -31,7 +31,12 @@ typedef struct tt__field_spec {
  * below by these values. Names have at most 10 characters (DBF). */
 enum { TT__TF_V0, TT__TF_V1, TT__TF_V2, TT__TF_MAX_ERR, TT__TF_RMSE,
        TT__TF_N_SAMPLES, TT__TF_AREA_2D, TT__TF_AREA_3D, TT__TF_SLOPE,
-       TT__TF_ASPECT, TT__TF_MIN_ANGLE, TT__TF_MAX_ANGLE, TT__TF_COUNT };
+       TT__TF_ASPECT, TT__TF_MIN_ANGLE, TT__TF_MAX_ANGLE, TT__TF_CONSTRAINED,
+       TT__TF_COUNT };
+/* The last triangle field, constrained (tt_triangle_info.constrained: bit
+ * k for edge k on a breakline), exists for TINs made with breaklines
+ * only: tt__records_triangle_fields() says how many fields a TIN's
+ * triangles layer has. */
 /* The last vertex field, importance, exists for decimated TINs only
  * (they also leave ins_err and ins_rank NULL: there was no insertion):
  * tt__records_vertex_fields() says how many fields a TIN's layer has. */
@@ -46,11 +51,22 @@ TT_HIDDEN extern const tt__field_spec tt__vertex_fields[TT__VF_COUNT];
  * fields of its vertices layer: TT__VF_COUNT then, one fewer otherwise. */
 TT_HIDDEN int tt__records_decimated(const tt_tin *tin);
 TT_HIDDEN int tt__records_vertex_fields(const tt_tin *tin);
+TT_HIDDEN int tt__records_triangle_fields(const tt_tin *tin);
+/* The TIN's edges on breaklines, each once: *out_n pairs of vertex
+ * indices (the smaller first, sorted) into *out_pairs, which the caller
+ * frees with free(); NULL and 0 without breaklines. False when out of
+ * memory. */
+TT_HIDDEN bool tt__records_breakline_edges(const tt_tin *tin,
+                                           int32_t **out_pairs,
+                                           size_t *out_n);
 
 /* The layers a writer makes (option LAYERS=triangles,vertices,
  * run_parameters, any subset in any order; default all three). */
 enum { TT__LAYER_TRIANGLES = 1, TT__LAYER_VERTICES = 2,
-       TT__LAYER_RUN_PARAMETERS = 4, TT__LAYERS_ALL = 7 };
+       TT__LAYER_RUN_PARAMETERS = 4, TT__LAYERS_ALL = 7,
+       /* made beside the triangles when the TIN has breaklines: a line
+        * feature per edge on a breakline */
+       TT__LAYER_BREAKLINES = 8 };
 /* The bits of a LAYERS value; TT_ERR_ARG naming the word at fault. */
 TT_HIDDEN tt_status tt__records_parse_layers(tt_context *ctx,
                                              const char *value,
