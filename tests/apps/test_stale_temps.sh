@@ -74,8 +74,15 @@ killed() {
   sleep "$delay"
   kill -9 "$pid" 2>/dev/null
   wait "$pid" 2>/dev/null
+  local ended=$? # 0: it ended by itself (a killed run: 137)
   local left
   left=$(hidden k | tr '\n' ' ')
+  # a run that finished and committed before the kill (a fast, idle
+  # machine) left nothing by design: the case was not reached, said so
+  if [ "$ended" = 0 ] && [ -z "$left" ] && [ -s "k/$out" ]; then
+    echo "note: $what: the run committed before the kill; case not reached"
+    return
+  fi
   if [ -z "$left" ]; then
     fail "$what: the kill left nothing to test with ($(ls -A k | tr '\n' ' '))"
     return
