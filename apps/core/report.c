@@ -200,10 +200,79 @@ void tt__json_strs(app_json *j, const char *key, char *const *v)
   fputc(']', j->fp);
 }
 
+/* simplify -json: the limits the run had (the default bound and its step). */
+static void json_limits(app_json *j, const app_simplify_report *p)
+{
+  const tt_refine_options *ro = p->ropt;
+  tt__json_open(j, "limits");
+  if (ro->max_error >= 0) tt__json_num(j, "max_error", ro->max_error);
+  else tt__json_null(j, "max_error");
+  tt__json_bool(j, "max_error_default", p->default_error);
+  if (p->default_error)
+    tt__json_num(j, "mean_step", p->step);
+  if (ro->max_points) tt__json_size(j, "max_points", ro->max_points);
+  else tt__json_null(j, "max_points");
+  if (ro->max_triangles) tt__json_size(j, "max_triangles", ro->max_triangles);
+  else tt__json_null(j, "max_triangles");
+  if (ro->percent > 0) tt__json_num(j, "percent", ro->percent);
+  else tt__json_null(j, "percent");
+  tt__json_close(j);
+}
+
+/* simplify -json: decimation's options as resolved, and its counts. */
+static void json_decimation(app_json *j, const app_simplify_report *p)
+{
+  const tt_decimate_options *d = p->dopt;
+  tt__json_open(j, "decimation");
+  if (d->start == TT_DSTART_GREEDY_N) {
+    char sn[48];
+    snprintf(sn, sizeof sn, "greedy:%zu", d->start_points);
+    tt__json_str(j, "start", sn);
+  } else {
+    tt__json_str(j, "start", tt_decimate_start_name(d->start));
+  }
+  tt_importance imp = d->importance != TT_IMPORTANCE_AUTO ? d->importance
+                      : d->max_error >= 0 ? TT_IMPORTANCE_ERROR
+                                          : TT_IMPORTANCE_HDH;
+  tt__json_str(j, "importance", tt_importance_name(imp));
+  tt__json_str(j, "selection", tt_selection_name(d->selection));
+  tt__json_bool(j, "onepass", d->onepass);
+  tt_hole hole = d->hole != TT_HOLE_AUTO ? d->hole
+                 : d->criterion == TT_CRITERION_DELAUNAY
+                     ? TT_HOLE_CIRCUMRADIUS
+                     : TT_HOLE_MINANGLE;
+  tt__json_str(j, "hole", tt_hole_name(hole));
+  tt__json_size(j, "start_vertices", p->sum.start_vertices);
+  tt__json_size(j, "removed_vertices", p->sum.removed_vertices);
+  tt__json_size(j, "rounds", p->sum.rounds);
+  tt__json_size(j, "refused_for_bound", p->sum.refused_bound);
+  tt__json_close(j);
+}
+
+/* simplify -json: the heights' unit and conversion, the CRSs, the frame. */
+static void json_units_crs(app_json *j, const app_simplify_report *p)
+{
+  tt__json_str(j, "z_unit", tt__app_nonempty_or_null(p->info->z_unit));
+  tt__json_str(j, "z_unit_declared",
+               tt__app_nonempty_or_null(p->info->z_unit_declared));
+  tt__json_str(j, "z_unit_source",
+               tt__app_nonempty_or_null(tt__app_z_unit_source(p->info)));
+  tt__json_str(j, "z_unit_conversion",
+               tt__app_nonempty_or_null(tt__app_z_unit_why(p->info)));
+  tt__json_num(j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
+  tt__json_str(j, "pixel_is",
+               tt__app_nonempty_or_null(p->info->area_or_point));
+  tt__json_str(j, "crs", tt__app_nonempty_or_null(p->info->crs_name));
+  tt__json_str(j, "output_crs",
+               p->t_srs ? p->t_srs
+                           : tt__app_nonempty_or_null(p->info->crs_name));
+  tt__json_bool(j, "output_crs_automatic", p->t_srs_auto);
+  tt__json_str(j, "frame", p->info->frame_name);
+}
+
 void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
 {
   app_json j;
-  const tt_refine_options *ro = p->ropt;
   const tt_error_stats *e = &p->sum.errors;
   tt__json_begin(&j, r->out);
   tt__json_str(&j, "input", tt__app_shown(r, r->s->input));
@@ -234,46 +303,9 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   }
   tt__json_num(&j, "z_min", p->zmin);
   tt__json_num(&j, "z_max", p->zmax);
-  tt__json_open(&j, "limits");
-  if (ro->max_error >= 0) tt__json_num(&j, "max_error", ro->max_error);
-  else tt__json_null(&j, "max_error");
-  tt__json_bool(&j, "max_error_default", p->default_error);
-  if (p->default_error)
-    tt__json_num(&j, "mean_step", p->step);
-  if (ro->max_points) tt__json_size(&j, "max_points", ro->max_points);
-  else tt__json_null(&j, "max_points");
-  if (ro->max_triangles) tt__json_size(&j, "max_triangles", ro->max_triangles);
-  else tt__json_null(&j, "max_triangles");
-  if (ro->percent > 0) tt__json_num(&j, "percent", ro->percent);
-  else tt__json_null(&j, "percent");
-  tt__json_close(&j);
-  if (p->dopt) {
-    const tt_decimate_options *d = p->dopt;
-    tt__json_open(&j, "decimation");
-    if (d->start == TT_DSTART_GREEDY_N) {
-      char sn[48];
-      snprintf(sn, sizeof sn, "greedy:%zu", d->start_points);
-      tt__json_str(&j, "start", sn);
-    } else {
-      tt__json_str(&j, "start", tt_decimate_start_name(d->start));
-    }
-    tt_importance imp = d->importance != TT_IMPORTANCE_AUTO ? d->importance
-                        : d->max_error >= 0 ? TT_IMPORTANCE_ERROR
-                                            : TT_IMPORTANCE_HDH;
-    tt__json_str(&j, "importance", tt_importance_name(imp));
-    tt__json_str(&j, "selection", tt_selection_name(d->selection));
-    tt__json_bool(&j, "onepass", d->onepass);
-    tt_hole hole = d->hole != TT_HOLE_AUTO ? d->hole
-                   : d->criterion == TT_CRITERION_DELAUNAY
-                       ? TT_HOLE_CIRCUMRADIUS
-                       : TT_HOLE_MINANGLE;
-    tt__json_str(&j, "hole", tt_hole_name(hole));
-    tt__json_size(&j, "start_vertices", p->sum.start_vertices);
-    tt__json_size(&j, "removed_vertices", p->sum.removed_vertices);
-    tt__json_size(&j, "rounds", p->sum.rounds);
-    tt__json_size(&j, "refused_for_bound", p->sum.refused_bound);
-    tt__json_close(&j);
-  }
+  json_limits(&j, p);
+  if (p->dopt)
+    json_decimation(&j, p);
   tt__json_str(&j, "stop_reason", tt_stop_reason_name(p->sum.stop_reason));
   tt__json_size(&j, "vertices", p->sum.vertices);
   tt__json_size(&j, "triangles", p->sum.triangles);
@@ -305,22 +337,7 @@ void tt__app_print_simplify_json(app_run *r, const app_simplify_report *p)
   } else {
     tt__json_null(&j, "max_error_at");
   }
-  tt__json_str(&j, "z_unit", tt__app_nonempty_or_null(p->info->z_unit));
-  tt__json_str(&j, "z_unit_declared",
-               tt__app_nonempty_or_null(p->info->z_unit_declared));
-  tt__json_str(&j, "z_unit_source",
-               tt__app_nonempty_or_null(tt__app_z_unit_source(p->info)));
-  tt__json_str(&j, "z_unit_conversion",
-               tt__app_nonempty_or_null(tt__app_z_unit_why(p->info)));
-  tt__json_num(&j, "z_multiplier", p->info->z_unit_factor * p->info->z_factor);
-  tt__json_str(&j, "pixel_is",
-               tt__app_nonempty_or_null(p->info->area_or_point));
-  tt__json_str(&j, "crs", tt__app_nonempty_or_null(p->info->crs_name));
-  tt__json_str(&j, "output_crs",
-               p->t_srs ? p->t_srs
-                           : tt__app_nonempty_or_null(p->info->crs_name));
-  tt__json_bool(&j, "output_crs_automatic", p->t_srs_auto);
-  tt__json_str(&j, "frame", p->info->frame_name);
+  json_units_crs(&j, p);
   tt__json_size(&j, "warnings", r->msg.warnings);
   if (p->mem_limit && p->mem_limit != SIZE_MAX)
     tt__json_size(&j, "memory_limit", p->mem_limit);
