@@ -207,7 +207,7 @@ char *tt__field_doc_text(const char *description, const char *z_unit)
 }
 
 /* An SQL string literal of s (quotes doubled), NULL for none; CPLFree. */
-static char *literal(const char *s)
+char *tt__sql_literal(const char *s)
 {
   if (!s)
     return CPLStrdup("NULL");
@@ -227,7 +227,8 @@ static char *literal(const char *s)
 }
 
 /* Runs one statement that returns no rows. */
-static tt_status exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
+tt_status tt__sql_exec(tt_context *ctx, GDALDatasetH dst, const char *sql,
+                       const char *what)
 {
   CPLErrorReset();
   OGRLayerH rs = GDALDatasetExecuteSQL(dst, sql, NULL, NULL);
@@ -235,7 +236,7 @@ static tt_status exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
     GDALDatasetReleaseResultSet(dst, rs);
   if (CPLGetLastErrorType() >= CE_Failure) {
     const char *m = CPLGetLastErrorMsg();
-    return tt__error(ctx, TT_ERR_IO, "cannot describe the fields: %s",
+    return tt__error(ctx, TT_ERR_IO, "cannot %s: %s", what,
                      m && *m ? m : "no details from GDAL");
   }
   return TT_OK;
@@ -267,7 +268,7 @@ static tt_status create_schema_tables(tt_context *ctx, GDALDatasetH dst)
       "'http://www.geopackage.org/spec121/#extension_schema', 'read-write')"};
   tt_status s = TT_OK;
   for (size_t i = 0; i < sizeof sql / sizeof sql[0] && s == TT_OK; i++)
-    s = exec(ctx, dst, sql[i]);
+    s = tt__sql_exec(ctx, dst, sql[i], "describe the fields");
   return s;
 }
 
@@ -277,13 +278,13 @@ static tt_status insert_row(tt_context *ctx, GDALDatasetH dst,
                             const char *z_unit)
 {
   char *text = description ? tt__field_doc_text(description, z_unit) : NULL;
-  char *t = literal(table), *c = literal(column), *ti = literal(title),
-       *d = literal(text);
+  char *t = tt__sql_literal(table), *c = tt__sql_literal(column), *ti = tt__sql_literal(title),
+       *d = tt__sql_literal(text);
   char *sql = CPLStrdup(CPLSPrintf(
       "INSERT OR REPLACE INTO gpkg_data_columns (table_name, column_name, "
       "name, title, description) VALUES (%s, %s, %s, %s, %s)",
       t, c, ti, ti, d));
-  tt_status s = exec(ctx, dst, sql);
+  tt_status s = tt__sql_exec(ctx, dst, sql, "describe the fields");
   CPLFree(sql);
   CPLFree(t);
   CPLFree(c);
@@ -351,10 +352,10 @@ static tt_status comment_column(tt_context *ctx, GDALDatasetH dst,
   if (!description)
     return TT_OK;
   char *text = tt__field_doc_text(description, z_unit);
-  char *c = identifier(column), *d = literal(text);
+  char *c = identifier(column), *d = tt__sql_literal(text);
   char *sql = CPLStrdup(CPLSPrintf("COMMENT ON COLUMN %s.%s IS %s",
                                    qualified, c, d));
-  tt_status s = exec(ctx, dst, sql);
+  tt_status s = tt__sql_exec(ctx, dst, sql, "describe the fields");
   CPLFree(sql);
   CPLFree(d);
   CPLFree(c);

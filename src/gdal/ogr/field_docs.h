@@ -66,4 +66,12 @@ TT_HIDDEN tt_status tt__field_docs_comment_pg(tt_context *ctx,
                                               size_t nfields,
                                               const char *z_unit);
 
+/* The SQL the descriptions and styles are written with (field_docs.c,
+ * layer_style.c): s as a string literal, quotes doubled ("NULL" for NULL;
+ * CPLFree), and one statement run on dst, a failure recorded as "cannot
+ * WHAT: GDAL's message". */
+TT_HIDDEN char *tt__sql_literal(const char *s);
+TT_HIDDEN tt_status tt__sql_exec(tt_context *ctx, GDALDatasetH dst,
+                                 const char *sql, const char *what);
+
 #endif /* TERRATIN_FIELD_DOCS_H */

@@ -490,39 +490,8 @@ tt_status tt__style_write_files(tt_context *ctx, GDALDatasetH dst,
   return s;
 }
 
-/* An SQL string literal of s (quotes doubled: PostgreSQL's standard
- * strings), CPLFree(). */
-static char *sql_literal(const char *s)
-{
-  size_t n = 3;
-  for (const char *p = s; *p; p++)
-    n += *p == '\'' ? 2 : 1;
-  char *q = CPLMalloc(n), *o = q;
-  *o++ = '\'';
-  for (const char *p = s; *p; p++) {
-    *o++ = *p;
-    if (*p == '\'')
-      *o++ = '\'';
-  }
-  *o++ = '\'';
-  *o = '\0';
-  return q;
-}
-
-static tt_status pg_exec(tt_context *ctx, GDALDatasetH dst, const char *sql)
-{
-  CPLErrorReset();
-  OGRLayerH rs = GDALDatasetExecuteSQL(dst, sql, NULL, NULL);
-  if (rs)
-    GDALDatasetReleaseResultSet(dst, rs);
-  if (CPLGetLastErrorType() >= CE_Failure) {
-    const char *m = CPLGetLastErrorMsg();
-    return tt__error(ctx, TT_ERR_IO, "cannot write the layers' style "
-                     "(layer_styles): %s", m && *m ? m : "no details from "
-                     "GDAL");
-  }
-  return TT_OK;
-}
+/* What a failed statement of the PostgreSQL style could not do. */
+#define PG_STYLE_WHAT "write the layers' style (layer_styles)"
 
 /* QGIS's layer_styles as its PostgreSQL provider creates it. */
 #define PG_STYLE_TABLE                                                         \
@@ -543,10 +512,11 @@ static tt_status pg_insert_row(tt_context *ctx, GDALDatasetH dst,
   /* OGR names a layer of another schema "schema.table" */
   const char *name = OGR_L_GetName(layer);
   const char *dot = schema ? strchr(name, '.') : NULL;
-  char *sch = schema ? sql_literal(schema) : CPLStrdup("current_schema()");
-  char *table = sql_literal(dot ? dot + 1 : name);
-  char *geom = sql_literal(OGR_L_GetGeometryColumn(layer));
-  char *doc = sql_literal(qml);
+  char *sch = schema ? tt__sql_literal(schema)
+                     : CPLStrdup("current_schema()");
+  char *table = tt__sql_literal(dot ? dot + 1 : name);
+  char *geom = tt__sql_literal(OGR_L_GetGeometryColumn(layer));
+  char *doc = tt__sql_literal(qml);
   const char *description =
       tri ? "'terratin: triangles by their max error (max_err), equal "
             "intervals'"
@@ -563,9 +533,9 @@ static tt_status pg_insert_row(tt_context *ctx, GDALDatasetH dst,
       "description, type) VALUES (current_database(), %s, %s, %s, %s, "
       "XMLPARSE(DOCUMENT %s), true, %s, NULL)",
       sch, table, geom, table, doc, description));
-  tt_status s = pg_exec(ctx, dst, del);
+  tt_status s = tt__sql_exec(ctx, dst, del, PG_STYLE_WHAT);
   if (s == TT_OK)
-    s = pg_exec(ctx, dst, ins);
+    s = tt__sql_exec(ctx, dst, ins, PG_STYLE_WHAT);
   CPLFree(ins);
   CPLFree(del);
   CPLFree(where);
@@ -580,11 +550,11 @@ tt_status tt__style_insert_pg(tt_context *ctx, GDALDatasetH dst,
                               const tt_tin *tin, const char *schema,
                               OGRLayerH tri_layer, OGRLayerH vtx_layer)
 {
-  tt_status s = pg_exec(ctx, dst, PG_STYLE_TABLE);
+  tt_status s = tt__sql_exec(ctx, dst, PG_STYLE_TABLE, PG_STYLE_WHAT);
   /* a table of QGIS before 3.14 has no type column; QGIS adds it too */
   if (s == TT_OK)
-    s = pg_exec(ctx, dst, "ALTER TABLE layer_styles ADD COLUMN IF NOT "
-                          "EXISTS type varchar");
+    s = tt__sql_exec(ctx, dst, "ALTER TABLE layer_styles ADD COLUMN IF NOT "
+                     "EXISTS type varchar", PG_STYLE_WHAT);
   for (int k = 0; k < 2 && s == TT_OK; k++) {
     OGRLayerH layer = k == 0 ? tri_layer : vtx_layer;
     if (!layer)
