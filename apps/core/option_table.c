@@ -358,23 +358,7 @@ static const tt__app_opt_def opt_defs[] = {
  * is the option's, not a letter of its name. */
 static int name_matches(const char *w, const char *name)
 {
-  if (*w != '-' || *name != '-')
-    return 0;
-  for (w++, name++;; w++, name++) {
-    char a = *w, b = *name;
-    if (a >= 'A' && a <= 'Z')
-      a = (char)(a - 'A' + 'a');
-    if (b >= 'A' && b <= 'Z')
-      b = (char)(b - 'A' + 'a');
-    if (a == '-')
-      a = '_';
-    if (b == '-')
-      b = '_';
-    if (a != b)
-      return 0;
-    if (!a)
-      return 1;
-  }
+  return *w == '-' && *name == '-' && name_matches_word(w + 1, name + 1);
 }
 
 const tt__app_opt_def *tt__app_find_opt(const char *w)
